@@ -1,0 +1,308 @@
+// spacar._core: thin pybind11 bindings of the C++ core. No logic here: the Python package
+// (python/spacar) builds the user-facing API on top.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "spacar/catalogue.hpp"
+#include "spacar/errors.hpp"
+#include "spacar/integrator.hpp"
+#include "spacar/model.hpp"
+#include "spacar/simulate.hpp"
+
+namespace py = pybind11;
+using namespace spacar;
+
+void bind_kernels(py::module_& m);
+void bind_integrator(py::module_& m);
+
+namespace {
+
+// The Python exception types, created once; the C++ exception of the same name maps to each.
+struct PyErrors {
+  py::handle base, input, kinematics, mass, integration, not_implemented;
+};
+
+PyErrors& py_errors() {
+  static PyErrors e;
+  return e;
+}
+
+void bind_errors(py::module_& m) {
+  PyErrors& e = py_errors();
+  e.base = py::exception<Error>(m, "SpacarError").release();
+  e.input = py::exception<InputError>(m, "InputError", e.base).release();
+  e.kinematics = py::exception<KinematicsError>(m, "KinematicsError", e.base).release();
+  e.mass = py::exception<SingularMassError>(m, "SingularMassError", e.base).release();
+  e.integration = py::exception<IntegrationError>(m, "IntegrationError", e.base).release();
+  e.not_implemented = py::exception<NotImplementedError>(m, "NotImplementedError", e.base).release();
+  py::register_exception_translator([](std::exception_ptr p) {
+    const PyErrors& e = py_errors();
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& x) {
+      py::set_error(e.input, x.what());
+    } catch (const KinematicsError& x) {
+      py::set_error(e.kinematics, x.what());
+    } catch (const SingularMassError& x) {
+      py::set_error(e.mass, x.what());
+    } catch (const NotImplementedError& x) {
+      py::set_error(e.not_implemented, x.what());
+    } catch (const IntegrationError& x) {
+      py::set_error(e.integration, x.what());
+    } catch (const StepRejected& x) {
+      py::set_error(e.integration, x.what());
+    } catch (const Error& x) {
+      py::set_error(e.base, x.what());
+    }
+  });
+}
+
+void bind_catalogue(py::module_& m) {
+  py::enum_<NodeKind>(m, "NodeKind")
+      .value("X", NodeKind::Any)
+      .value("XY", NodeKind::XY)
+      .value("BETA", NodeKind::Beta)
+      .value("XYZ", NodeKind::XYZ)
+      .value("LAMBDA", NodeKind::Lambda);
+  m.def("node_size", &node_size);
+  py::class_<ElementType>(m, "ElementType")
+      .def_readonly("name", &ElementType::name)
+      .def_readonly("nodes", &ElementType::nodes)
+      .def_readonly("node_roles", &ElementType::node_roles)
+      .def_readonly("deformations", &ElementType::deformations)
+      .def_readonly("n_params_min", &ElementType::n_params_min)
+      .def_readonly("n_params_max", &ElementType::n_params_max)
+      .def_readonly("params", &ElementType::params)
+      .def_readonly("estiff", &ElementType::estiff)
+      .def_readonly("edampp", &ElementType::edampp)
+      .def_readonly("emass", &ElementType::emass)
+      .def_readonly("n_estiff", &ElementType::n_estiff)
+      .def_readonly("n_emass", &ElementType::n_emass)
+      .def_readonly("has_length", &ElementType::has_length)
+      .def_readonly("n_lgeomy", &ElementType::n_lgeomy)
+      .def_readonly("has_direction", &ElementType::has_direction)
+      .def_readonly("extension", &ElementType::extension)
+      .def_readonly("description", &ElementType::description)
+      .def_property_readonly("implemented", [](const ElementType& t) { return t.make != nullptr; })
+      .def_property_readonly("n_deformations", &ElementType::n_deformations);
+  m.def("element_catalogue", &element_catalogue, py::return_value_policy::reference);
+}
+
+void bind_model(py::module_& m) {
+  py::enum_<CoordClass>(m, "CoordClass")
+      .value("calculable", CoordClass::Calculable)
+      .value("fixed", CoordClass::Fixed)
+      .value("input", CoordClass::Input)
+      .value("dynamic", CoordClass::Dynamic);
+  py::enum_<DefClass>(m, "DefClass")
+      .value("fixed", DefClass::Fixed)
+      .value("released", DefClass::Released)
+      .value("input", DefClass::Input)
+      .value("dynamic", DefClass::Dynamic)
+      .value("linearization", DefClass::Linearization)
+      .value("nonholonomic", DefClass::Nonholonomic)
+      .value("kinematic", DefClass::Kinematic);
+
+  py::class_<Node>(m, "Node")
+      .def_readonly("id", &Node::id)
+      .def_readonly("kind", &Node::kind)
+      .def_readonly("x", &Node::x)
+      .def_readonly("cls", &Node::cls)
+      .def_readonly("xd", &Node::xd)
+      .def_readonly("xdd", &Node::xdd)
+      .def_readonly("force", &Node::force)
+      .def_readonly("mass", &Node::mass)
+      .def_readonly("torquel", &Node::torquel)
+      .def_readonly("used", &Node::used);
+  py::class_<Element>(m, "Element")
+      .def_readonly("id", &Element::id)
+      .def_readonly("type", &Element::type)
+      .def_property_readonly("type_name", [](const Element& e) { return element_catalogue()[e.type].name; })
+      .def_readonly("nodes", &Element::nodes)
+      .def_readonly("params", &Element::params)
+      .def_readonly("l0", &Element::l0)
+      .def_readonly("lgeomy", &Element::lgeomy)
+      .def_readonly("estiff", &Element::estiff)
+      .def_readonly("edampp", &Element::edampp)
+      .def_readonly("emass", &Element::emass)
+      .def_readonly("cls", &Element::cls)
+      .def_readonly("e", &Element::e)
+      .def_readonly("ed", &Element::ed)
+      .def_readonly("edd", &Element::edd)
+      .def_readonly("e_given", &Element::e_given)
+      .def_readonly("kinematic_of", &Element::kinematic_of)
+      .def_readonly("automatic", &Element::automatic);
+  py::class_<Settings>(m, "Settings")
+      .def_readonly("timestep_n", &Settings::timestep_n)
+      .def_readonly("timestep_tp", &Settings::timestep_tp)
+      .def_readonly("hmax", &Settings::hmax)
+      .def_readonly("maxiterat", &Settings::maxiterat)
+      .def_readonly("epskin", &Settings::epskin)
+      .def_readonly("epsint", &Settings::epsint)
+      .def_readonly("epsind", &Settings::epsind)
+      .def_readonly("forcemode", &Settings::forcemode)
+      .def_readonly("animate", &Settings::animate)
+      .def_readonly("matasc", &Settings::matasc)
+      .def_readonly("jobid", &Settings::jobid)
+      .def_readonly("restart", &Settings::restart)
+      .def_readonly("linear", &Settings::linear);
+
+  py::class_<Model>(m, "Model")
+      .def(py::init<>())
+      .def("copy", [](const Model& self) { return Model(self); })
+      .def("add_element", &Model::add_element)
+      .def("set_coordinates", &Model::set_coordinates)
+      .def("set_coordinate_class", &Model::set_coordinate_class)
+      .def("set_deformation_class", &Model::set_deformation_class)
+      .def("set_nonholonomic", &Model::set_nonholonomic)
+      .def("set_xd", &Model::set_xd)
+      .def("set_xdd", &Model::set_xdd)
+      .def("set_e", &Model::set_e)
+      .def("set_ed", &Model::set_ed)
+      .def("set_edd", &Model::set_edd)
+      .def("set_time", &Model::set_time)
+      .def("set_direction", &Model::set_direction)
+      .def("set_lgeomy", &Model::set_lgeomy)
+      .def("set_lengtho", &Model::set_lengtho)
+      .def("set_mass", &Model::set_mass)
+      .def("set_emass", &Model::set_emass)
+      .def("set_estiff", &Model::set_estiff)
+      .def("set_edampp", &Model::set_edampp)
+      .def("set_force", &Model::set_force)
+      .def("set_torquel", &Model::set_torquel)
+      .def("set_gravity", &Model::set_gravity)
+      .def("set_timestep", &Model::set_timestep)
+      .def("set_hmax", &Model::set_hmax)
+      .def("set_maxiterat", &Model::set_maxiterat)
+      .def("set_epskin", &Model::set_epskin)
+      .def("set_epsint", &Model::set_epsint)
+      .def("set_epsind", &Model::set_epsind)
+      .def("set_forcemode", &Model::set_forcemode)
+      .def("set_animate", &Model::set_animate)
+      .def("set_matasc", &Model::set_matasc)
+      .def("set_jobid", &Model::set_jobid)
+      .def("set_restart", &Model::set_restart)
+      .def("set_linear", &Model::set_linear)
+      .def("prepare", &Model::prepare)
+      .def_property_readonly("frozen", &Model::frozen)
+      .def_readonly("nodes", &Model::nodes)
+      .def_readonly("elements", &Model::elements)
+      .def_readonly("settings", &Model::settings)
+      .def_readonly("time", &Model::time)
+      .def_readonly("gravity", &Model::gravity)
+      .def_readonly("gravity_given", &Model::gravity_given);
+}
+
+py::dict block_results_to_dict(BlockResults&& r) {
+  py::dict d;
+  d["t"] = std::move(r.t);
+  d["x"] = std::move(r.x);
+  d["xd"] = std::move(r.xd);
+  d["xdd"] = std::move(r.xdd);
+  d["e"] = std::move(r.e);
+  d["ed"] = std::move(r.ed);
+  d["edd"] = std::move(r.edd);
+  d["sigma"] = std::move(r.sigma);
+  d["rhs_evaluations"] = r.rhs_evaluations;
+  d["steps"] = r.steps;
+  d["accepted"] = r.accepted;
+  d["rejected"] = r.rejected;
+  d["newton_iterations"] = r.newton_iterations;
+  d["last_step"] = r.last_step;
+  d["wall_time"] = r.wall_time;
+  d["warnings"] = r.warnings;
+  return d;
+}
+
+void bind_simulation(py::module_& m) {
+  py::class_<System>(m, "System")
+      .def_readonly("nx", &System::nx)
+      .def_readonly("ne", &System::ne)
+      .def_readonly("coord_label", &System::coord_label)
+      .def_readonly("def_label", &System::def_label)
+      .def_readonly("coord_class", &System::coord_class)
+      .def_readonly("def_class", &System::def_class)
+      .def_readonly("x_calc", &System::x_calc)
+      .def_readonly("x_input", &System::x_input)
+      .def_readonly("x_dyn", &System::x_dyn)
+      .def_readonly("x_fixed", &System::x_fixed)
+      .def_readonly("e_input", &System::e_input)
+      .def_readonly("e_dyn", &System::e_dyn)
+      .def_readonly("rows_P", &System::rows_P)
+      .def_readonly("rows_V", &System::rows_V)
+      .def_readonly("dof_cols", &System::dof_cols)
+      .def_readonly("input_cols", &System::input_cols)
+      .def_readonly("q0", &System::q0)
+      .def_readonly("qd0", &System::qd0)
+      .def_readonly("warnings", &System::warnings)
+      .def_property_readonly("n_dof", &System::n_dof)
+      .def_property_readonly("n_qhat", &System::n_qhat);
+
+  py::class_<Data>(m, "Data")
+      .def_readonly("t", &Data::t)
+      .def_readonly("x", &Data::x)
+      .def_readonly("xd", &Data::xd)
+      .def_readonly("xdd", &Data::xdd)
+      .def_readonly("e", &Data::e)
+      .def_readonly("ed", &Data::ed)
+      .def_readonly("edd", &Data::edd)
+      .def_readonly("sigma", &Data::sigma)
+      .def_readonly("qhat", &Data::qhat)
+      .def_readonly("qhat_d", &Data::qhat_d)
+      .def_readonly("qhat_dd", &Data::qhat_dd)
+      .def_readonly("DF", &Data::DF)
+      .def_readonly("DFe", &Data::DFe)
+      .def_readonly("acc0", &Data::acc0)
+      .def_readonly("M", &Data::M)
+      .def_readonly("Mbar", &Data::Mbar)
+      .def_readonly("qdd", &Data::qdd)
+      .def_readonly("newton_iterations", &Data::newton_iterations);
+
+  py::class_<Simulation>(m, "Simulation")
+      .def(py::init<Model&>(), py::keep_alive<1, 2>())
+      .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
+      .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
+      .def("assemble", &Simulation::assemble)
+      .def("evaluate",
+           [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
+               throw InputError("evaluate(): q and qd must have one value per degree of freedom");
+             s.evaluate(t, q.data(), qd.data());
+           })
+      .def(
+          "run",
+          [](Simulation& s, py::object on_output, double initial_step, const std::string& method) {
+            RunOptions opt;
+            opt.initial_step = initial_step;
+            if (method == "dop853") opt.method = Method::DOP853;
+            else if (method == "dopri5") opt.method = Method::DOPRI5;
+            else throw InputError("unknown integration method '" + method + "' (dop853, dopri5)");
+            if (!on_output.is_none()) {
+              opt.on_output = [on_output](int k, double t) {
+                py::gil_scoped_acquire gil;
+                on_output(k, t);
+              };
+            }
+            BlockResults r;
+            {
+              py::gil_scoped_release release;
+              r = s.run(opt);
+            }
+            return block_results_to_dict(std::move(r));
+          },
+          py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "spacar C++ core";
+  bind_errors(m);
+  bind_catalogue(m);
+  bind_model(m);
+  bind_simulation(m);
+  bind_kernels(m);
+  bind_integrator(m);
+}

@@ -1,0 +1,54 @@
+// The element catalogue: ONE table describing every element type of the SPACAR95 manual (§5.1)
+// plus the extensions. The reader, the writer, the Python builder methods and the generated
+// keyword reference in docs/ are all driven by it.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace spacar {
+
+// Node kinds. `Any` is a node only given by the generic keyword X and not yet used by an
+// element; every element slot has a concrete kind.
+enum class NodeKind : int { Any = 0, XY, Beta, XYZ, Lambda };
+
+int node_size(NodeKind kind);             // number of coordinates (Any: 4, the maximum)
+const char* node_keyword(NodeKind kind);  // "X", "XY", "BETA", "XYZ", "LAMBDA"
+bool is_orientation(NodeKind kind);
+
+class ElementKernel;
+struct ElementSetup;
+
+// Reference geometry from the initial positions (orientation nodes at their reference value):
+// fills the reference length l0 (if the type has one) and the LGEOMY values.
+using ReferenceFn = void (*)(const double* x_ref, const std::vector<double>& params, double& l0,
+                             std::vector<double>& lgeomy);
+using MakeFn = std::unique_ptr<ElementKernel> (*)(const ElementSetup& setup);
+
+struct ElementType {
+  std::string name;                       // input keyword, e.g. "PLBEAM"
+  std::vector<NodeKind> nodes;            // node slots in input order
+  std::vector<std::string> node_roles;    // e.g. {"p1", "o1", "p2", "o2"}
+  std::vector<std::string> deformations;  // meaning of e1, e2, ...
+  int n_params_min = 0, n_params_max = 0; // numbers after the node list on the definition line
+  std::string params;                     // their meaning ("" if none)
+  std::string estiff, edampp, emass;      // meaning of ESTIFF / EDAMPP / EMASS values ("" = not used)
+  int n_estiff = 0, n_emass = 0;          // maximum number of ESTIFF/EDAMPP and EMASS values
+  bool has_length = false;                // LENGTHO applies
+  int n_lgeomy = 0;                       // number of LGEOMY values
+  bool has_direction = false;             // DIR replaces the vector of the definition line
+  bool extension = false;                 // not in the SPACAR95 manual
+  std::string description;
+  ReferenceFn reference = nullptr;
+  MakeFn make = nullptr;                  // nullptr: physics not implemented yet
+
+  int n_deformations() const { return static_cast<int>(deformations.size()); }
+  int n_coordinates() const;
+};
+
+const std::vector<ElementType>& element_catalogue();
+// Index of the type in element_catalogue(), or -1.
+int find_element_type(const std::string& name);
+
+}  // namespace spacar

@@ -1,0 +1,26 @@
+// Dynamic analysis (formulation.md §3): mass matrix, convective inertia and applied forces,
+// constitutive stresses and the reduced equations of motion in the degrees of freedom.
+#pragma once
+
+#include "spacar/data.hpp"
+#include "spacar/system.hpp"
+
+namespace spacar {
+
+// σ = S e + D ė for the deformations whose stresses are constitutive (released, dynamic,
+// kinematic); the others are reactions and are set to 0 here.
+void constitutive_stresses(const System& sys, Data& data);
+
+// Global M, h and f at the current x, ẋ (the element work vectors must hold x and v).
+void assemble_inertia_and_loads(const System& sys, Data& data);
+
+// Solve M̄ q̈ = rhs (3.1) and complete ẍ, ë. Requires positions, DF and velocities.
+// Throws SingularMassError naming the degrees of freedom without inertia.
+void solve_dynamics(const System& sys, Data& data);
+
+// Kinetic energy T = ½ ẋᵀ M ẋ (requires assemble_inertia_and_loads) and potential energy of
+// the constitutive springs and of gravity; for tests and energy balances.
+double kinetic_energy(const System& sys, const Data& data);
+double potential_energy(const System& sys, const Data& data);
+
+}  // namespace spacar

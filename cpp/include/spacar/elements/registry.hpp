@@ -1,0 +1,25 @@
+// Factories and reference-geometry functions of the implemented element types; the catalogue
+// (catalogue.cpp) attaches them to its rows. One source file per element type defines them.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "spacar/elements/element.hpp"
+
+namespace spacar {
+
+// Chord length of two position nodes of dimension dim starting at x_ref[0] and x_ref[offset].
+double reference_chord(const double* p, const double* q, int dim);
+
+void reference_pltruss(const double* x_ref, const std::vector<double>& params, double& l0,
+                     std::vector<double>& lgeomy);
+void reference_plbeam(const double* x_ref, const std::vector<double>& params, double& l0,
+                      std::vector<double>& lgeomy);
+
+std::unique_ptr<ElementKernel> make_pltruss(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_plbeam(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_plbeamnl(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_plhinge(const ElementSetup& setup);
+
+}  // namespace spacar

@@ -1,0 +1,34 @@
+// Exceptions of the spacar core. The bindings map each one to the Python exception of the same
+// name in the `spacar` package, so C++ failures reach users as catchable, explained errors.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace spacar {
+
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Invalid model description: the reader adds file, line and keyword to the message.
+struct InputError : Error {
+  using Error::Error;
+};
+
+// The kinematic analysis cannot be solved (constraint block not square or singular, Newton failed).
+struct KinematicsError : Error {
+  using Error::Error;
+};
+
+// The reduced mass matrix is not positive definite (a degree of freedom without inertia).
+struct SingularMassError : Error {
+  using Error::Error;
+};
+
+// A feature that is specified but whose physics has not been implemented yet.
+struct NotImplementedError : Error {
+  using Error::Error;
+};
+
+}  // namespace spacar

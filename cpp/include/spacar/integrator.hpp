@@ -1,0 +1,88 @@
+// Explicit embedded Runge-Kutta integration with step-size control and dense output:
+// DOP853 (Hairer, Norsett & Wanner: order 8, error estimators of order 5 and 3, dense output of
+// order 7) and DOPRI5 (Dormand & Prince: order 5(4), first-same-as-last, dense output of order 4).
+// See E. Hairer, S.P. Norsett, G. Wanner, "Solving Ordinary Differential Equations I",
+// Sec. II.4-II.6.
+#pragma once
+
+#include <Eigen/Dense>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace spacar {
+
+// Thrown by a right-hand side to ask the integrator to reject the current step and retry with half
+// the step (e.g. Newton iteration failed inside the rhs).
+struct StepRejected : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Thrown when the integrator cannot continue (step size underflow, too many steps, non-finite
+// state). Message says time, step size and why.
+struct IntegrationError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+enum class Method { DOP853, DOPRI5 };
+
+struct IntegratorStats {
+  long nfev = 0, nsteps = 0, naccept = 0, nreject = 0;
+};
+
+class Integrator {
+ public:
+  using Rhs = std::function<void(double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy)>;
+  using Output = std::function<void(double t, const Eigen::VectorXd& y)>;
+
+  Integrator(int n, Method method = Method::DOP853);
+
+  // Per component; both >= 0 and not both zero (defaults: rtol = atol = 1e-6).
+  void set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol);
+  void set_max_step(double hmax);   // default +inf
+  // 0 = automatic estimate (Hairer's hinit); used to continue across blocks (RESTART 0).
+  void set_initial_step(double h);
+  // Step proposed after the last accepted step, to continue later with set_initial_step.
+  double last_step() const;
+
+  // Integrate y from t0 to t_end (t_end >= t0). For every t_k in touts (sorted ascending, within
+  // [t0, t_end]) call out(t_k, y(t_k)) using the dense output (t_k == t0: the initial value;
+  // t_k == t_end: exactly the final state). The last step is clipped to end exactly at t_end.
+  // On return y holds y(t_end); if IntegrationError is thrown, y holds the last accepted state.
+  void integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
+                 const std::vector<double>& touts, const Output& out);
+
+  const IntegratorStats& stats() const;   // cumulative over all integrate calls
+
+ private:
+  enum class Attempt { Accepted, ErrorTooLarge, Failed };
+
+  bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
+  bool eval_stages(const Rhs& f, double t, double h, const Eigen::VectorXd& y, int first, int last);
+  double initial_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y);
+  Attempt attempt_step(const Rhs& f, double t, double h, double t_new, const Eigen::VectorXd& y,
+                       bool dense);
+  double error_norm(double h);
+  double step_factor() const;
+  bool build_dense(const Rhs& f, double t, double h, const Eigen::VectorXd& y);
+  void dense_value(double theta, const Eigen::VectorXd& y_old);
+  size_t emit_outputs(const std::vector<double>& touts, size_t next, double t, double h,
+                      double t_new, const Eigen::VectorXd& y, const Output& out);
+
+  int n_;
+  Method method_;
+  Eigen::VectorXd rtol_, atol_;
+  double hmax_;
+  double h_initial_ = 0.0;
+  double h_last_ = 0.0;
+  double err_ = 0.0;                 // error norm of the last attempted step
+  std::string failure_;              // why the last step was rejected, for error messages
+  IntegratorStats stats_;
+  // Work space, allocated once so that the step loop never touches the heap.
+  std::vector<Eigen::VectorXd> k_;       // stages; k_[0] = f(t, y)
+  std::vector<Eigen::VectorXd> dense_;   // coefficients of the dense-output polynomial
+  Eigen::VectorXd y_stage_, y_new_, scale_, err_a_, err_b_, y_out_;
+};
+
+}  // namespace spacar

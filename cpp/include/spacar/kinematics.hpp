@@ -1,0 +1,42 @@
+// Kinematic analysis (formulation.md §2): positions by Newton iteration on the calculable
+// coordinates, first-order transfer functions DF, velocities, and the second-order
+// (convective) terms that give accelerations.
+#pragma once
+
+#include <string>
+
+#include "spacar/data.hpp"
+#include "spacar/system.hpp"
+
+namespace spacar {
+
+// Prescribed inputs at time t: p, ṗ, p̈ into x^p / targets of e^p and the input part of q̂.
+void set_inputs(const System& sys, Data& data, double t);
+// Degrees of freedom q and their rates: x^d into x, e^d into the targets, q̂ parts.
+void set_dofs(const System& sys, Data& data, const double* q, const double* qd);
+
+// e and the element first derivatives at data.x.
+void evaluate_elements(const System& sys, Data& data);
+
+// Newton iteration on x^c until max|D^P(x) − target| ≤ tol, then one polish iteration; leaves e
+// and B evaluated at the solution. assembly: allow max(max_iter, 50) iterations with
+// backtracking (initial assembly of a roughly given geometry). Throws KinematicsError.
+void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly);
+
+// DF (∂x/∂q̂) and DFe (∂e/∂q̂) at the current positions; factorizes the velocity block.
+void solve_transfer(const System& sys, Data& data);
+
+// ẋ = DF q̂̇, ė = DFe q̂̇; convective terms c and acc0 = ẍ at q̂̈ = 0 (the D2F term).
+void solve_velocities(const System& sys, Data& data);
+
+// ẍ = DF q̂̈ + acc0 and ë = B ẍ + c, for the current q̂̈.
+void solve_accelerations(const System& sys, Data& data);
+
+// A readable diagnosis of the constraint block at the current positions: counts, and from an
+// SVD the redundant deformations and the undetermined coordinates.
+std::string diagnose_constraints(const System& sys, Data& data);
+
+// Check that the constraint block is square; throws KinematicsError with the diagnosis.
+void check_constraint_counts(const System& sys, Data& data);
+
+}  // namespace spacar

@@ -1,0 +1,69 @@
+// One analysis block (what SPACAR does at an END): assemble the mechanism, then integrate the
+// reduced equations of motion over the TIMESTEP interval in C++ with error control, or, without
+// degrees of freedom, run the kinematic analysis at every output time. Results are recorded at
+// the output times; the state reached is stored back into the model (for the dump and the
+// next block).
+#pragma once
+
+#include <Eigen/Dense>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "spacar/data.hpp"
+#include "spacar/integrator.hpp"
+#include "spacar/model.hpp"
+#include "spacar/system.hpp"
+
+namespace spacar {
+
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+struct RunOptions {
+  Method method = Method::DOP853;
+  double initial_step = 0.0;  // > 0: continue with this step (RESTART 0 across blocks)
+  // Called after every output time is recorded (index k, time t): progress bars, live files.
+  std::function<void(int, double)> on_output;
+};
+
+struct BlockResults {
+  Eigen::VectorXd t;
+  RowMatrix x, xd, xdd;        // nt x nx
+  RowMatrix e, ed, edd, sigma; // nt x ne
+  long rhs_evaluations = 0, steps = 0, accepted = 0, rejected = 0, newton_iterations = 0;
+  double last_step = 0.0;
+  double wall_time = 0.0;      // seconds spent in the block
+  std::vector<std::string> warnings;
+};
+
+class Simulation {
+ public:
+  // Prepares (first END) and compiles the model; the model must outlive the simulation.
+  explicit Simulation(Model& model);
+
+  const System& system() const { return *sys_; }
+  Data& data() { return data_; }
+
+  // Assemble at the block start: inputs at t0, DOFs at their initial values, Newton on the
+  // calculable coordinates (with the relaxed limits of an initial assembly).
+  void assemble();
+  // Complete state at (t, q, q̇): positions, DF, velocities, q̈, accelerations, stresses.
+  void evaluate(double t, const double* q, const double* qd);
+  // Right-hand side of the first-order system Y = (q, q̇).
+  void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
+
+  BlockResults run(const RunOptions& options = {});
+  // Write the state reached into the model (coordinates, rates, deformation values, time).
+  void store_state();
+
+ private:
+  void record(BlockResults& res, int k);
+  Model& model_;
+  std::unique_ptr<System> sys_;
+  Data data_;
+  Eigen::VectorXd x_base_, qhat_base_, predictor_;
+  bool have_base_ = false;
+};
+
+}  // namespace spacar

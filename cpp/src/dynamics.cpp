@@ -1,0 +1,151 @@
+#include "spacar/dynamics.hpp"
+
+#include <sstream>
+
+#include "spacar/errors.hpp"
+#include "spacar/kinematics.hpp"
+
+namespace spacar {
+
+namespace {
+
+bool constitutive_class(DefClass c) {
+  return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
+}
+
+// G(λ) of the Euler parameters: ω' = 2 G λ̇ (body angular velocity).
+Eigen::Matrix<double, 3, 4> G_matrix(const double* l) {
+  Eigen::Matrix<double, 3, 4> G;
+  G << -l[1], l[0], l[3], -l[2],  //
+      -l[2], -l[3], l[0], l[1],   //
+      -l[3], l[2], -l[1], l[0];
+  return G;
+}
+
+void add_bodies(const System& sys, Data& data) {
+  for (const BodyInertia& b : sys.bodies) {
+    const double* l = data.x.data() + b.coord;
+    const double* ld = data.xd.data() + b.coord;
+    const Eigen::Matrix<double, 3, 4> G = G_matrix(l), Gd = G_matrix(ld);
+    const Eigen::Vector3d omega = 2.0 * G * Eigen::Map<const Eigen::Vector4d>(ld);
+    data.M.block<4, 4>(b.coord, b.coord) += 4.0 * G.transpose() * b.J * G;
+    // Exact Lagrange term d/dt(∂T/∂λ̇) − ∂T/∂λ minus M λ̈ (formulation.md §3.2).
+    data.h.segment<4>(b.coord) += 4.0 * Gd.transpose() * (b.J * omega);
+  }
+  for (const auto& [coord, T] : sys.torquel)
+    data.f.segment<4>(coord) += 2.0 * G_matrix(data.x.data() + coord).transpose() * T;
+}
+
+}  // namespace
+
+void constitutive_stresses(const System& sys, Data& data) {
+  data.sigma.setZero();
+  for (const SystemElement& se : sys.elements) {
+    if (!se.has_constitutive) continue;
+    const auto e = data.e.segment(se.def_offset, se.nd);
+    const auto ed = data.ed.segment(se.def_offset, se.nd);
+    for (int a = 0; a < se.nd; ++a) {
+      if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
+      data.sigma[se.def_offset + a] = se.S.row(a).dot(e) + se.D.row(a).dot(ed);
+    }
+  }
+}
+
+void assemble_inertia_and_loads(const System& sys, Data& data) {
+  data.M.setZero();
+  data.h.setZero();
+  data.f = sys.force;
+  for (int g = 0; g < sys.nx; ++g) data.M(g, g) = sys.point_mass[g];
+  // Gravity on point masses (position coordinates only).
+  if (sys.gravity.squaredNorm() > 0.0) {
+    for (int g = 0; g < sys.nx; ++g) {
+      const NodeKind k = sys.coord_node_kind[g];
+      if ((k == NodeKind::XY || k == NodeKind::XYZ) && sys.point_mass[g] != 0.0)
+        data.f[g] += sys.point_mass[g] * sys.gravity[sys.coord_label[g][1] - 1];
+    }
+  }
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    if (!se.has_mass) continue;
+    ElementWork& w = data.work[i];
+    const int n = static_cast<int>(se.coords.size());
+    se.kernel->mass(w.x.data(), w.v.data(), w.M.data(), w.h.data());
+    for (int a = 0; a < n; ++a) {
+      data.h[se.coords[a]] += w.h[a];
+      for (int b = 0; b < n; ++b) data.M(se.coords[a], se.coords[b]) += w.M(a, b);
+    }
+    if (sys.gravity.squaredNorm() > 0.0) {
+      se.kernel->gravity(w.x.data(), sys.gravity.data(), w.f.data());
+      for (int a = 0; a < n; ++a) data.f[se.coords[a]] += w.f[a];
+    }
+  }
+  add_bodies(sys, data);
+}
+
+void solve_dynamics(const System& sys, Data& data) {
+  const int nd = sys.n_dof();
+  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = 0.0;
+  solve_accelerations(sys, data);  // ẍ with q̈ = 0: inputs' accelerations and convective terms
+  assemble_inertia_and_loads(sys, data);
+  constitutive_stresses(sys, data);
+  data.g.noalias() = data.M * data.xdd;
+  data.g += data.h - data.f;
+  for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
+  data.Mbar.noalias() = data.DFq.transpose() * data.M * data.DFq;
+  data.rhs.noalias() = -data.DFq.transpose() * data.g;
+  for (int j = 0; j < nd; ++j) data.rhs[j] -= data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
+  data.llt.compute(data.Mbar);
+  if (data.llt.info() != Eigen::Success || nd == 0) {
+    if (nd == 0) return;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(data.Mbar);
+    const Eigen::VectorXd v = eig.eigenvectors().col(0);
+    const double vmax = v.cwiseAbs().maxCoeff();
+    std::ostringstream os;
+    os << "the reduced mass matrix is singular at t = " << data.t << " (smallest eigenvalue "
+       << eig.eigenvalues()[0] << "): the degrees of freedom";
+    for (int j = 0; j < nd; ++j) {
+      if (std::abs(v[j]) < 0.1 * vmax) continue;
+      const int col = sys.dof_cols[j];
+      os << " [";
+      for (int g = 0; g < sys.nx; ++g)
+        if (sys.qhat_col_x[g] == col) os << "DYNX " << sys.coord_name(g);
+      for (int k = 0; k < sys.ne; ++k)
+        if (sys.qhat_col_e[k] == col) os << "DYNE " << sys.def_name(k);
+      os << "]";
+    }
+    os << " move no mass; add MASS or EMASS to the nodes or elements they move";
+    throw SingularMassError(os.str());
+  }
+  data.qdd = data.llt.solve(data.rhs);
+  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
+  solve_accelerations(sys, data);
+}
+
+double kinetic_energy(const System&, const Data& data) { return 0.5 * data.xd.dot(data.M * data.xd); }
+
+double potential_energy(const System& sys, const Data& data) {
+  double V = 0.0;
+  for (const SystemElement& se : sys.elements) {
+    if (!se.has_constitutive) continue;
+    for (int a = 0; a < se.nd; ++a) {
+      if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
+      V += 0.5 * data.e[se.def_offset + a] * se.S.row(a).dot(data.e.segment(se.def_offset, se.nd));
+    }
+  }
+  if (sys.gravity.squaredNorm() > 0.0) {
+    // Gravity potential −Σ m g·x of point masses and of the element mass points.
+    for (int g = 0; g < sys.nx; ++g) {
+      const NodeKind k = sys.coord_node_kind[g];
+      if (k == NodeKind::XY || k == NodeKind::XYZ)
+        V -= sys.point_mass[g] * sys.gravity[sys.coord_label[g][1] - 1] * data.x[g];
+    }
+    for (size_t i = 0; i < sys.elements.size(); ++i) {
+      const SystemElement& se = sys.elements[i];
+      if (!se.has_mass) continue;
+      V += se.kernel->gravity_potential(data.work[i].x.data(), sys.gravity.data());
+    }
+  }
+  return V;
+}
+
+}  // namespace spacar

@@ -1,0 +1,298 @@
+#include "spacar/kinematics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "spacar/errors.hpp"
+
+namespace spacar {
+
+void set_inputs(const System& sys, Data& data, double t) {
+  const double tau = t - sys.t0;
+  data.t = t;
+  const int nxp = static_cast<int>(sys.x_input.size());
+  for (int i = 0; i < sys.n_input(); ++i) {
+    const double p = sys.p0[i] + sys.pd0[i] * tau + 0.5 * sys.pdd0[i] * tau * tau;
+    const double pd = sys.pd0[i] + sys.pdd0[i] * tau;
+    const int col = sys.input_cols[i];
+    data.qhat[col] = p;
+    data.qhat_d[col] = pd;
+    data.qhat_dd[col] = sys.pdd0[i];
+    if (i < nxp) data.x[sys.x_input[i]] = p;
+  }
+}
+
+void set_dofs(const System& sys, Data& data, const double* q, const double* qd) {
+  for (int j = 0; j < sys.n_dof(); ++j) {
+    const int col = sys.dof_cols[j];
+    data.qhat[col] = q[j];
+    data.qhat_d[col] = qd[j];
+  }
+  for (size_t j = 0; j < sys.x_dyn.size(); ++j) data.x[sys.x_dyn[j]] = q[j];
+}
+
+namespace {
+
+// Targets of the position rows: fixed/LINE/kinematic from the system, inputs and DOFs from q̂.
+void set_targets(const System& sys, Data& data) {
+  for (size_t r = 0; r < sys.rows_P.size(); ++r) {
+    const int k = sys.rows_P[r];
+    const int col = sys.qhat_col_e[k];
+    data.target[r] = col >= 0 ? data.qhat[col] : sys.e_target[k];
+  }
+}
+
+void compute_residual(const System& sys, Data& data) {
+  for (size_t r = 0; r < sys.rows_P.size(); ++r) data.residual[r] = data.e[sys.rows_P[r]] - data.target[r];
+}
+
+// A(rows, x^c) from the element derivatives, for the rows given by row_of (row_P or row_V).
+void assemble_block(const System& sys, Data& data, const std::vector<int>& row_of, int n_rows) {
+  auto A = data.A.topRows(n_rows);
+  A.setZero();
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const Eigen::MatrixXd& B = data.work[i].B;
+    for (int a = 0; a < se.nd; ++a) {
+      const int r = row_of[se.def_offset + a];
+      if (r < 0) continue;
+      for (size_t j = 0; j < se.coords.size(); ++j) {
+        const int c = sys.calc_pos[se.coords[j]];
+        if (c >= 0) A(r, c) += B(a, j);
+      }
+    }
+  }
+}
+
+std::string worst_rows(const System& sys, const Data& data, int count) {
+  std::vector<int> order(data.residual.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return std::abs(data.residual[a]) > std::abs(data.residual[b]); });
+  std::ostringstream os;
+  for (int i = 0; i < count && i < static_cast<int>(order.size()); ++i)
+    os << (i ? "; " : "") << sys.def_name(sys.rows_P[order[i]]) << " residual " << data.residual[order[i]];
+  return os.str();
+}
+
+double max_abs(const Eigen::VectorXd& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
+
+// Factorize the current block; a (numerically) singular block raises the diagnosis.
+void factorize(const System& sys, Data& data, int n_rows, const char* what) {
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc == 0) return;
+  data.lu.compute(data.A.topRows(n_rows));
+  const double rc = data.lu.rcond();
+  if (!(rc > 1e-13)) {
+    std::ostringstream os;
+    os << "the " << what << " constraint block is singular at t = " << data.t << " (reciprocal condition "
+       << rc << ").\n"
+       << diagnose_constraints(sys, data);
+    throw KinematicsError(os.str());
+  }
+}
+
+}  // namespace
+
+void evaluate_elements(const System& sys, Data& data) {
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    ElementWork& w = data.work[i];
+    for (size_t j = 0; j < se.coords.size(); ++j) w.x[j] = data.x[se.coords[j]];
+    se.kernel->first_derivatives(w.x.data(), data.e.data() + se.def_offset, w.B.data());
+  }
+}
+
+void check_constraint_counts(const System& sys, Data& data) {
+  const size_t nc = sys.x_calc.size();
+  if (sys.rows_P.size() != nc || sys.rows_V.size() != nc) {
+    std::ostringstream os;
+    os << "the kinematic constraints do not determine the calculable coordinates:\n"
+       << diagnose_constraints(sys, data);
+    throw KinematicsError(os.str());
+  }
+}
+
+void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly) {
+  const int nP = static_cast<int>(sys.rows_P.size());
+  const int nc = static_cast<int>(sys.x_calc.size());
+  set_targets(sys, data);
+  evaluate_elements(sys, data);
+  compute_residual(sys, data);
+  const int limit = assembly ? std::max(max_iter, 50) : max_iter;
+  std::ostringstream history;
+  data.newton_iterations = 0;
+  bool converged = false;
+  for (int it = 0; it <= limit && nc > 0; ++it) {
+    const double rmax = max_abs(data.residual);
+    if (!std::isfinite(rmax)) {
+      converged = false;
+      history << (it ? ", " : "") << rmax;
+      break;
+    }
+    if (converged) break;  // the polish iteration after convergence has been done
+    converged = rmax <= tol;
+    if (it == limit && !converged) break;
+    history << (it ? ", " : "") << rmax;
+    assemble_block(sys, data, sys.row_P, nP);
+    factorize(sys, data, nP, "position");
+    data.step.head(nc) = data.lu.solve(data.residual);
+    double lambda = 1.0;
+    const double norm0 = data.residual.norm();
+    for (int back = 0;; ++back) {
+      for (int j = 0; j < nc; ++j) data.x[sys.x_calc[j]] -= lambda * data.step[j];
+      evaluate_elements(sys, data);
+      compute_residual(sys, data);
+      const double norm1 = data.residual.norm();
+      // Backtracking only while assembling: in a time step a poor iterate means a too large step.
+      if (!assembly || converged || (std::isfinite(norm1) && norm1 < norm0) || back >= 10) break;
+      for (int j = 0; j < nc; ++j) data.x[sys.x_calc[j]] += lambda * data.step[j];
+      lambda *= 0.5;
+    }
+    ++data.newton_iterations;
+  }
+  data.total_newton_iterations += data.newton_iterations;
+  if (!converged && nc > 0) {
+    std::ostringstream os;
+    os << "Newton iteration on the positions did not converge in " << limit << " iterations at t = " << data.t
+       << " (EPSKIN " << tol << "); max residual per iteration: " << history.str() << ".\nLargest residuals: "
+       << worst_rows(sys, data, 3);
+    throw KinematicsError(os.str());
+  }
+  // Deformations without calculable coordinates are not in the block: check them directly.
+  for (int k : sys.auto_released) {
+    const double r = data.e[k] - sys.e_target[k];
+    if (std::abs(r) > std::max(tol, 1e-9 * (1.0 + std::abs(sys.e_target[k])))) {
+      std::ostringstream os;
+      os << sys.def_name(k) << " is fixed but none of its coordinates can move, and its value " << data.e[k]
+         << " differs from its target " << sys.e_target[k] << " at t = " << data.t;
+      throw KinematicsError(os.str());
+    }
+  }
+}
+
+void solve_transfer(const System& sys, Data& data) {
+  const int nV = static_cast<int>(sys.rows_V.size());
+  const int nc = static_cast<int>(sys.x_calc.size());
+  const int nq = sys.n_qhat();
+  // Right-hand sides: −∂D^V/∂x̄ for the independent coordinates, unit rates of e^p and e^d.
+  data.rhs_DF.setZero();
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const Eigen::MatrixXd& B = data.work[i].B;
+    for (int a = 0; a < se.nd; ++a) {
+      const int r = sys.row_V[se.def_offset + a];
+      if (r < 0) continue;
+      for (size_t j = 0; j < se.coords.size(); ++j) {
+        const int col = sys.qhat_col_x[se.coords[j]];
+        if (col >= 0) data.rhs_DF(r, col) -= B(a, j);
+      }
+      const int ecol = sys.qhat_col_e[se.def_offset + a];
+      if (ecol >= 0) data.rhs_DF(r, ecol) += 1.0;
+    }
+  }
+  data.DF.setZero();
+  for (int g = 0; g < sys.nx; ++g)
+    if (sys.qhat_col_x[g] >= 0) data.DF(g, sys.qhat_col_x[g]) = 1.0;
+  if (nc > 0) {
+    assemble_block(sys, data, sys.row_V, nV);
+    factorize(sys, data, nV, "velocity");
+    const Eigen::MatrixXd sol = data.lu.solve(data.rhs_DF);
+    for (int j = 0; j < nc; ++j) data.DF.row(sys.x_calc[j]) = sol.row(j);
+  }
+  // DFe = B DF, element by element.
+  data.DFe.setZero();
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const Eigen::MatrixXd& B = data.work[i].B;
+    for (size_t j = 0; j < se.coords.size(); ++j)
+      data.DFe.middleRows(se.def_offset, se.nd).noalias() += B.col(j) * data.DF.row(se.coords[j]);
+  }
+  (void)nq;
+}
+
+void solve_velocities(const System& sys, Data& data) {
+  data.xd.noalias() = data.DF * data.qhat_d;
+  data.ed.noalias() = data.DFe * data.qhat_d;
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    ElementWork& w = data.work[i];
+    for (size_t j = 0; j < se.coords.size(); ++j) w.v[j] = data.xd[se.coords[j]];
+    se.kernel->convective(w.x.data(), w.v.data(), w.c.data());
+    data.conv.segment(se.def_offset, se.nd) = w.c;
+  }
+  // acc0: accelerations at q̂̈ = 0; calculable rows from A_V ẍ^c = −c^V.
+  data.acc0.setZero();
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc > 0) {
+    const int nV = static_cast<int>(sys.rows_V.size());
+    Eigen::VectorXd::SegmentReturnType cv = data.step.head(nV);
+    for (int r = 0; r < nV; ++r) cv[r] = -data.conv[sys.rows_V[r]];
+    const Eigen::VectorXd sol = data.lu.solve(cv);
+    for (int j = 0; j < nc; ++j) data.acc0[sys.x_calc[j]] = sol[j];
+  }
+}
+
+void solve_accelerations(const System& sys, Data& data) {
+  data.xdd = data.acc0;
+  data.xdd.noalias() += data.DF * data.qhat_dd;
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    ElementWork& w = data.work[i];
+    for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.xdd[se.coords[j]];
+    data.edd.segment(se.def_offset, se.nd).noalias() = w.B * w.a + w.c;
+  }
+}
+
+std::string diagnose_constraints(const System& sys, Data& data) {
+  const int nP = static_cast<int>(sys.rows_P.size());
+  const int nc = static_cast<int>(sys.x_calc.size());
+  std::ostringstream os;
+  os << "  " << nP << " constraint equations (fixed, input, dynamic deformations) for " << nc
+     << " calculable coordinates";
+  if (nP > nc) os << ": over-constrained by " << nP - nc;
+  if (nP < nc) os << ": under-constrained by " << nc - nP;
+  os << ".";
+  if (nP == 0 || nc == 0) {
+    if (nc > 0) {
+      os << "\n  undetermined coordinates:";
+      for (int g : sys.x_calc) os << " (" << sys.coord_name(g) << ")";
+    }
+    return os.str();
+  }
+  evaluate_elements(sys, data);
+  assemble_block(sys, data, sys.row_P, nP);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(data.A.topRows(nP), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd& s = svd.singularValues();
+  const double smax = s.size() ? s[0] : 0.0;
+  const double tol = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(smax, 1e-300);
+  int rank = 0;
+  for (int i = 0; i < s.size(); ++i) rank += s[i] > tol;
+  const Eigen::MatrixXd& U = svd.matrixU();
+  const Eigen::MatrixXd& V = svd.matrixV();
+  if (rank < nP) {
+    os << "\n  redundant constraints (candidates for RLSE):";
+    for (int i = rank; i < nP; ++i) {
+      const Eigen::VectorXd u = U.col(i);
+      const double umax = u.cwiseAbs().maxCoeff();
+      os << "\n   -";
+      for (int r = 0; r < nP; ++r)
+        if (std::abs(u[r]) > 0.1 * umax) os << " " << sys.def_name(sys.rows_P[r]) << " (weight " << u[r] / umax << ")";
+    }
+  }
+  if (rank < nc) {
+    os << "\n  undetermined coordinates (candidates for FIX, DYNX or a missing element):";
+    for (int i = rank; i < nc; ++i) {
+      const Eigen::VectorXd v = V.col(i);
+      const double vmax = v.cwiseAbs().maxCoeff();
+      os << "\n   -";
+      for (int j = 0; j < nc; ++j)
+        if (std::abs(v[j]) > 0.1 * vmax) os << " " << sys.coord_name(sys.x_calc[j]) << " (weight " << v[j] / vmax << ")";
+    }
+  }
+  return os.str();
+}
+
+}  // namespace spacar

@@ -1,0 +1,162 @@
+#include "spacar/simulate.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "spacar/dynamics.hpp"
+#include "spacar/errors.hpp"
+#include "spacar/kinematics.hpp"
+
+namespace spacar {
+
+namespace {
+
+std::unique_ptr<System> prepare_and_compile(Model& model) {
+  model.prepare();
+  return compile(model);
+}
+
+}  // namespace
+
+Simulation::Simulation(Model& model)
+    : model_(model), sys_(prepare_and_compile(model)), data_(*sys_) {
+  int g = 0;
+  for (const auto& [id, n] : model_.nodes)
+    for (double v : n.x) data_.x[g++] = v;
+  x_base_ = data_.x;
+  qhat_base_ = data_.qhat;
+  predictor_ = Eigen::VectorXd::Zero(sys_->nx);
+}
+
+void Simulation::assemble() {
+  const System& sys = *sys_;
+  set_inputs(sys, data_, sys.t0);
+  set_dofs(sys, data_, sys.q0.data(), sys.qd0.data());
+  check_constraint_counts(sys, data_);
+  solve_positions(sys, data_, sys.settings.maxiterat, sys.settings.epskin, true);
+  x_base_ = data_.x;
+  qhat_base_ = data_.qhat;
+  have_base_ = false;  // DF not yet available for the predictor
+}
+
+void Simulation::evaluate(double t, const double* q, const double* qd) {
+  const System& sys = *sys_;
+  set_inputs(sys, data_, t);
+  set_dofs(sys, data_, q, qd);
+  // Predictor: the last solved positions advanced with the first-order transfer function.
+  data_.x = x_base_;
+  for (size_t i = 0; i < sys.x_input.size(); ++i) data_.x[sys.x_input[i]] = data_.qhat[sys.qhat_col_x[sys.x_input[i]]];
+  for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_.x[sys.x_dyn[j]] = q[j];
+  if (have_base_) {
+    predictor_.noalias() = data_.DF * (data_.qhat - qhat_base_);
+    for (int c : sys.x_calc) data_.x[c] += predictor_[c];
+  }
+  solve_positions(sys, data_, sys.settings.maxiterat, sys.settings.epskin, false);
+  solve_transfer(sys, data_);
+  solve_velocities(sys, data_);
+  solve_dynamics(sys, data_);
+  x_base_ = data_.x;
+  qhat_base_ = data_.qhat;
+  have_base_ = true;
+}
+
+void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
+  const int nd = sys_->n_dof();
+  try {
+    evaluate(t, Y.data(), Y.data() + nd);
+  } catch (const KinematicsError& err) {
+    throw StepRejected(err.what());
+  }
+  dY.head(nd) = Y.segment(nd, nd);
+  dY.tail(nd) = data_.qdd;
+}
+
+void Simulation::record(BlockResults& res, int k) {
+  res.t[k] = data_.t;
+  res.x.row(k) = data_.x;
+  res.xd.row(k) = data_.xd;
+  res.xdd.row(k) = data_.xdd;
+  res.e.row(k) = data_.e;
+  res.ed.row(k) = data_.ed;
+  res.edd.row(k) = data_.edd;
+  res.sigma.row(k) = data_.sigma;
+}
+
+BlockResults Simulation::run(const RunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const System& sys = *sys_;
+  const Settings& st = sys.settings;
+  const int n_out = st.timestep_n;
+  const double t0 = sys.t0, t_end = t0 + st.timestep_tp;
+  BlockResults res;
+  res.warnings = sys.warnings;
+  const int nt = n_out + 1;
+  res.t.resize(nt);
+  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd}) m->resize(nt, sys.nx);
+  for (RowMatrix* m : {&res.e, &res.ed, &res.edd, &res.sigma}) m->resize(nt, sys.ne);
+  std::vector<double> times(nt);
+  for (int k = 0; k < nt; ++k) times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
+  times.back() = t_end;  // exactly the end of the block, whatever the rounding
+
+  assemble();
+  const int nd = sys.n_dof();
+  int k_out = 0;
+  auto output = [&](double t, const Eigen::VectorXd& Y) {
+    evaluate(t, Y.data(), Y.data() + nd);
+    record(res, k_out);
+    if (options.on_output) options.on_output(k_out, t);
+    ++k_out;
+  };
+  Eigen::VectorXd Y(2 * nd);
+  Y << sys.q0, sys.qd0;
+  if (nd == 0 || n_out == 0 || !(t_end > t0)) {
+    // Kinematic analysis (or a single analysis at the current time).
+    for (double t : times) output(t, Y);
+  } else {
+    Integrator integ(2 * nd, options.method);
+    Eigen::VectorXd rtol(2 * nd), atol(2 * nd);
+    rtol.head(nd).setConstant(st.epsint);
+    rtol.tail(nd).setConstant(st.epsind);
+    atol = 1e-3 * rtol;  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
+    integ.set_tolerances(rtol, atol);
+    integ.set_max_step(st.hmax);
+    if (options.initial_step > 0.0) integ.set_initial_step(options.initial_step);
+    auto f = [this](double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(t, y, dy); };
+    integ.integrate(f, t0, t_end, Y, times, output);
+    const IntegratorStats& s = integ.stats();
+    res.rhs_evaluations = s.nfev;
+    res.steps = s.nsteps;
+    res.accepted = s.naccept;
+    res.rejected = s.nreject;
+    res.last_step = integ.last_step();
+  }
+  res.newton_iterations = data_.total_newton_iterations;
+  res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  store_state();
+  return res;
+}
+
+void Simulation::store_state() {
+  const System& sys = *sys_;
+  int g = 0;
+  for (auto& [id, n] : model_.nodes)
+    for (size_t i = 0; i < n.x.size(); ++i, ++g) {
+      n.x[i] = data_.x[g];
+      n.xd[i] = data_.xd[g];
+      n.xdd[i] = data_.xdd[g];
+    }
+  int k = 0;
+  for (auto& [id, el] : model_.elements)
+    for (size_t i = 0; i < el.e.size(); ++i, ++k) {
+      const DefClass c = sys.def_class[k];
+      const bool target = (c == DefClass::Fixed || c == DefClass::Linearization) && el.e_given[i];
+      if (!target) el.e[i] = data_.e[k];  // a given target stays exact for the next block
+      el.ed[i] = data_.ed[k];
+      el.edd[i] = data_.edd[k];
+      if (c == DefClass::Input || c == DefClass::Dynamic || c == DefClass::Kinematic) el.e_given[i] = true;
+    }
+  model_.time = data_.t;
+}
+
+}  // namespace spacar

@@ -1,0 +1,60 @@
+"""Summary of a model: nodes and elements by type, coordinates and deformations per class,
+degrees of freedom (``spacar check``)."""
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+
+from . import _core
+
+COORD_CLASSES = ("fixed", "input", "dynamic", "calculable")
+DEF_CLASSES = ("fixed", "released", "input", "dynamic", "linearization", "nonholonomic", "kinematic")
+
+
+@dataclass
+class Summary:
+    nodes: Counter
+    elements: Counter
+    coordinates: Counter
+    deformations: Counter
+
+    @property
+    def n_coordinates(self) -> int:
+        return sum(self.coordinates.values())
+
+    @property
+    def n_deformations(self) -> int:
+        return sum(self.deformations.values())
+
+    @property
+    def degrees_of_freedom(self) -> int:
+        return self.coordinates["dynamic"] + self.deformations["dynamic"]
+
+    def lines(self):
+        def fmt(counter, order=None):
+            keys = order or sorted(counter)
+            return ", ".join(f"{counter[k]} {k}" for k in keys if counter[k])
+
+        yield f"nodes: {sum(self.nodes.values())} ({fmt(self.nodes)})"
+        yield f"elements: {sum(self.elements.values())} ({fmt(self.elements)})"
+        yield f"nodal coordinates: {self.n_coordinates} ({fmt(self.coordinates, COORD_CLASSES)})"
+        yield f"deformations: {self.n_deformations} ({fmt(self.deformations, DEF_CLASSES)})"
+        yield f"degrees of freedom: {self.degrees_of_freedom}"
+
+    def __str__(self):
+        return "\n".join(self.lines())
+
+
+def summary(model) -> Summary:
+    """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
+    nodes are included (they are created at the first END)."""
+    core = model._core.copy()
+    core.prepare()
+    nodes = Counter(str(n.kind.name) for n in core.nodes.values())
+    elements = Counter(el.type_name for el in core.elements.values())
+    coords = Counter(c.name for n in core.nodes.values() for c in n.cls)
+    defs = Counter(c.name for el in core.elements.values() for c in el.cls)
+    return Summary(nodes, elements, coords, defs)
+
+
+__all__ = ["Summary", "summary", "_core"]

@@ -1,0 +1,83 @@
+"""The ``spacar`` command line.
+
+``spacar run FILE``    process the blocks of an input file in order: at every END run the
+                       analysis and print the state dump (a restartable input block).
+``spacar check FILE``  summary of the model of the first block: nodes and elements by type,
+                       coordinates and deformations per class, degrees of freedom.
+
+Everything that is not the dump is printed as ``*`` comment lines, so the output is valid input.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from . import __version__
+from .errors import SpacarError
+from .io.reader import apply_block, read
+from .io.writer import dump
+from .simulate import simulate
+
+
+def _comment(text: str, stream=sys.stdout):
+    for line in str(text).splitlines():
+        print(f"* {line}", file=stream)
+
+
+def _run(args) -> int:
+    model = read(args.file)
+    _comment(f"spacar {__version__}: {args.file}")
+    for w in model.warnings:
+        _comment(f"warning: {w}")
+    if not model.blocks:
+        _comment("no input block ended with END: nothing to analyse")
+        return 0
+    for k, block in enumerate(model.blocks):
+        if k > 0:
+            apply_block(model, block)
+        n_warn = len(model.warnings)
+        res = simulate(model, method=args.method)
+        for w in model.warnings[n_warn:]:
+            _comment(f"warning: {w}")
+        s = res.stats
+        _comment(f"block {k + 1}: t = {res.t[0]:g} .. {res.t[-1]:g}, {len(res.t)} output times, "
+                 f"{s['rhs_evaluations']} right-hand sides, {s['accepted']} steps "
+                 f"({s['rejected']} rejected), {s['wall_time'] * 1e3:.1f} ms")
+        sys.stdout.write(dump(model, digits=args.dump_digits))
+        sys.stdout.flush()
+    return 0
+
+
+def _check(args) -> int:
+    model = read(args.file)
+    _comment(f"spacar check: {args.file}")
+    for w in model.warnings:
+        _comment(f"warning: {w}")
+    _comment(model.summary())
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="spacar", description="Kinematic and dynamic analysis of multibody systems (SPACAR95 input format).")
+    parser.add_argument("--version", action="version", version=f"spacar {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run the analysis of every block and print the state dumps")
+    run.add_argument("file")
+    run.add_argument("--dump-digits", type=int, default=4, metavar="N",
+                     help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
+    run.add_argument("--method", choices=["dop853", "dopri5"], default="dop853", help="integration method")
+    run.set_defaults(func=_run)
+    check = sub.add_parser("check", help="summarise the model: nodes, elements, classes, degrees of freedom")
+    check.add_argument("file")
+    check.set_defaults(func=_check)
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except SpacarError as err:
+        sys.stdout.flush()
+        print(f"spacar: {type(err).__name__}: {err}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

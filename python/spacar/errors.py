@@ -1,0 +1,27 @@
+"""Exceptions of spacar. They are created by the C++ core (``spacar._core``), so an error raised
+in C++ arrives in Python as exactly these classes.
+
+- :class:`SpacarError` — base class of every spacar error.
+- :class:`InputError` — invalid input; from the reader it names file, line and keyword.
+- :class:`KinematicsError` — the kinematic analysis cannot be solved.
+- :class:`SingularMassError` — a degree of freedom without inertia.
+- :class:`IntegrationError` — the integrator cannot continue.
+- :class:`NotImplementedError` — a specified element type whose physics is not available yet.
+"""
+from ._core import (  # noqa: F401
+    InputError,
+    IntegrationError,
+    KinematicsError,
+    NotImplementedError,
+    SingularMassError,
+    SpacarError,
+)
+
+__all__ = [
+    "SpacarError",
+    "InputError",
+    "KinematicsError",
+    "SingularMassError",
+    "IntegrationError",
+    "NotImplementedError",
+]

@@ -1,0 +1,154 @@
+"""Reader of the SPACAR95 input format (manual §5; formulation.md §9.1).
+
+Lexical rules: one keyword per line, parameters separated by white space; ``*`` in column 1
+starts a comment line; keywords are case-insensitive and only their first 8 characters count;
+numbers are Fortran-style (``1.``, ``.5``, ``1e-3``, ``1.0D-3``). Input comes in blocks, each
+ended by ``END``; ``EOF`` or the physical end of the file ends the input.
+
+The reader only tokenises and checks each line against the keyword table; applying a line is a
+call of the builder method of the same name on :class:`spacar.Model`. Every error names the
+file, the line number and the keyword.
+"""
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+
+from ..errors import InputError, SpacarError
+from ..keywords import INT, LOOKUP, Keyword
+from ..model import Model, check_args
+
+_INT_RE = re.compile(r"^[+-]?\d+$")
+_REAL_RE = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eEdD][+-]?\d+)?$")
+
+
+@dataclass(frozen=True)
+class Command:
+    """One keyword line: where it came from, the keyword and its parsed numbers."""
+
+    file: str
+    line: int
+    keyword: str
+    args: tuple
+
+    def where(self) -> str:
+        return f"{self.file}, line {self.line}, keyword {self.keyword}"
+
+
+@dataclass
+class Block:
+    """The commands of one input block; ``ended`` is False for trailing lines without END."""
+
+    commands: list = field(default_factory=list)
+    ended: bool = True
+
+
+def _error(file, line, keyword, reason):
+    where = f"{file}, line {line}" + (f", keyword {keyword}" if keyword else "")
+    return InputError(f"{where}: {reason}")
+
+
+def _number(token: str, kind: str):
+    if kind == INT:
+        if _INT_RE.match(token):
+            return int(token)
+        if _REAL_RE.match(token):
+            value = float(token.replace("d", "e").replace("D", "e"))
+            if value.is_integer():
+                return int(value)
+        raise ValueError(f"{token!r} is not an integer")
+    if _REAL_RE.match(token) or _INT_RE.match(token):
+        return float(token.replace("d", "e").replace("D", "e"))
+    raise ValueError(f"{token!r} is not a number")
+
+
+def _parse_line(kw: Keyword, tokens):
+    """Numbers of a line by the keyword's signature (types and counts)."""
+    values = []
+    pos = 0
+    for i, p in enumerate(kw.params):
+        rest = sum(q.count_min for q in kw.params[i + 1:])
+        n = min(max(len(tokens) - pos - rest, p.count_min), p.count_max)
+        for tok in tokens[pos:pos + n]:
+            values.append(_number(tok, p.kind))
+        pos += n
+    for tok in tokens[pos:]:
+        _number(tok, "real")  # a malformed number is reported as such, not as a count
+    return values
+
+
+def parse(text: str, file: str = "<string>") -> list[Block]:
+    """Split an input text into blocks of commands; checks syntax, counts and types."""
+    blocks = [Block()]
+    ended_by_eof = False
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        if raw.startswith("*"):
+            continue
+        tokens = raw.split()
+        if not tokens:
+            continue
+        if ended_by_eof:
+            raise _error(file, lineno, tokens[0].upper()[:8], "text after EOF")
+        head = tokens[0]
+        if not head[0].isalpha():
+            raise _error(file, lineno, None, f"a line must start with a keyword, not {head!r}")
+        kw = LOOKUP.get(head.upper()[:8])
+        if kw is None:
+            raise _error(file, lineno, head.upper(), f"unknown keyword {head!r}")
+        try:
+            values = _parse_line(kw, tokens[1:])
+            check_args(kw, values)
+        except (ValueError, InputError) as err:
+            raise _error(file, lineno, kw.name, str(err).removeprefix(f"{kw.name}: ")) from None
+        if kw.name == "EOF":
+            ended_by_eof = True
+            continue
+        if kw.name == "END":
+            blocks[-1].ended = True
+            blocks.append(Block())
+            continue
+        blocks[-1].ended = False
+        blocks[-1].commands.append(Command(file, lineno, kw.name, tuple(values)))
+    if not blocks[-1].commands:
+        blocks.pop()
+    return blocks
+
+
+def apply_block(model: Model, block: Block) -> None:
+    """Apply the commands of a block to the model, naming the line of any failing command."""
+    for cmd in block.commands:
+        try:
+            model.apply(cmd.keyword, *cmd.args)
+        except SpacarError as err:
+            raise type(err)(f"{cmd.where()}: {err}") from None
+
+
+def read_string(text: str, file: str = "<string>") -> Model:
+    """Read an input text: returns the model with its first block applied and all blocks in
+    ``model.blocks``."""
+    blocks = parse(text, file)
+    model = Model()
+    model.source = file
+    model.blocks = blocks
+    for b in blocks:
+        if not b.ended:
+            last = b.commands[-1]
+            model.warnings.append(
+                f"{file}: the input after line {b.commands[0].line - 1} has no END and is ignored "
+                f"(last line {last.line})")
+    model.blocks = [b for b in blocks if b.ended]
+    if model.blocks:
+        apply_block(model, model.blocks[0])
+    return model
+
+
+def read(path) -> Model:
+    """Read a SPACAR95 input file (see :func:`read_string`)."""
+    path = os.fspath(path)
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            text = fh.read()
+    except OSError as err:
+        raise InputError(f"{path}: cannot read the input file ({err.strerror})") from None
+    return read_string(text, path)
