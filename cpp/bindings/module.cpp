@@ -42,7 +42,10 @@ void bind_errors(py::module_& m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& x) {
-      py::set_error(e.input, x.what());
+      py::object err = py::reinterpret_borrow<py::object>(e.input)(x.what());
+      err.attr("element") = x.element;
+      err.attr("node") = x.node;
+      PyErr_SetObject(e.input.ptr(), err.ptr());
     } catch (const KinematicsError& x) {
       py::set_error(e.kinematics, x.what());
     } catch (const SingularMassError& x) {

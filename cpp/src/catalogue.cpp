@@ -89,12 +89,16 @@ std::vector<ElementType> build_catalogue() {
     e.has_length = true;
     e.n_lgeomy = 9;
     e.has_direction = true;
+    e.reference = reference_beam;
+    e.make = nl ? make_beamnl : make_beam;
   }
   {
     ElementType& e = add(t, "TRUSS", {K::XYZ, K::XYZ}, {"p1", "p2"}, {"elongation"}, "spatial truss");
     set_stiffness(e, 1, "EA");
     set_emass(e, 1, "rhoA");
     e.has_length = true;
+    e.reference = reference_truss;
+    e.make = make_truss;
   }
   {
     ElementType& e = add(t, "HINGE", {K::Lambda, K::Lambda}, {"o1", "o2"},
@@ -104,6 +108,7 @@ std::vector<ElementType> build_catalogue() {
     set_params(e, 3, 3, "x y z: initial axis of rotation");
     set_stiffness(e, 1, "St (torsional stiffness of the rotation)");
     e.has_direction = true;
+    e.make = make_hinge;
   }
   {
     ElementType& e = add(t, "BEARING", {K::XYZ, K::Lambda, K::XYZ, K::Lambda}, beam_nodes,
@@ -122,7 +127,8 @@ std::vector<ElementType> build_catalogue() {
                "c1..c10: coefficients of c1x²+c2y²+c3z²+c4xy+c5yz+c6zx+c7x+c8y+c9z+c10");
   }
   add(t, "L2MIN1", {K::Lambda}, {"o1"}, {"Euler parameter norm λᵀλ − 1"},
-      "constraint on the Euler parameters (created automatically for every LAMBDA node)");
+      "constraint on the Euler parameters (created automatically for every LAMBDA node)")
+      .make = make_l2min1;
   for (const char* name : {"PLBEAM", "PLBEAMNL"}) {
     const bool nl = std::string(name) == "PLBEAMNL";
     ElementType& e = add(t, name, {K::XY, K::Beta, K::XY, K::Beta}, beam_nodes,

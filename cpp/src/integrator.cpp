@@ -379,8 +379,10 @@ size_t Integrator::emit_outputs(const std::vector<double>& touts, size_t next, d
   return next;
 }
 
-void Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
-                           const std::vector<double>& touts, const Output& out) {
+void Integrator::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
+
+double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
+                             const std::vector<double>& touts, const Output& out) {
   if (y.size() != n_) throw std::invalid_argument("Integrator: the state has the wrong size");
   if (!(t_end >= t0)) throw std::invalid_argument("Integrator: t_end must not be before t0");
   for (size_t i = 0; i < touts.size(); ++i)
@@ -392,7 +394,7 @@ void Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorX
   failure_ = "none";
   size_t next = 0;
   for (; next < touts.size() && touts[next] == t0; ++next) out(t0, y);
-  if (t_end == t0) return;
+  if (t_end == t0) return t0;
 
   const Scheme& sc = scheme(method_);
   bool ok = false;
@@ -449,8 +451,10 @@ void Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorX
     y = y_new_;
     std::swap(k_[0], k_[sc.s]);
     rejected = false;
+    if (stop_ && t < t_end && stop_(t, y)) break;
   }
   h_last_ = h;
+  return t;
 }
 
 }  // namespace spacar

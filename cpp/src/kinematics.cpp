@@ -103,6 +103,14 @@ void evaluate_elements(const System& sys, Data& data) {
     for (size_t j = 0; j < se.coords.size(); ++j) w.x[j] = data.x[se.coords[j]];
     se.kernel->first_derivatives(w.x.data(), data.e.data() + se.def_offset, w.B.data());
   }
+  // Angles come from atan2 in (−π, π]: move each to the branch nearest to its target (position
+  // rows) or to its previous value, so that hinges can turn any number of times.
+  for (int k : sys.angle_defs) {
+    const int r = sys.row_P[k];
+    const double ref = r >= 0 ? data.target[r] : data.angle_ref[k];
+    if (std::isfinite(ref)) data.e[k] += 2.0 * M_PI * std::round((ref - data.e[k]) / (2.0 * M_PI));
+    data.angle_ref[k] = data.e[k];
+  }
 }
 
 void check_constraint_counts(const System& sys, Data& data) {

@@ -141,6 +141,8 @@ void Model::add_element(const std::string& type_name, int id, const std::vector<
     fail(et.name, " takes ", et.nodes.size(), " nodes, got ", node_ids.size());
   require_count(params, et.n_params_min, et.n_params_max, (et.name + " parameters").c_str());
   require_finite(params, et.name.c_str());
+  if (et.has_direction && params[0] == 0.0 && params[1] == 0.0 && params[2] == 0.0)
+    fail(et.name, " ", id, ": the direction vector has zero length");
   for (size_t i = 0; i < node_ids.size(); ++i)
     for (size_t j = 0; j < i; ++j)
       if (node_ids[i] == node_ids[j]) fail(et.name, " ", id, " uses node ", node_ids[i], " twice");
@@ -316,6 +318,7 @@ void Model::set_direction(int id, const std::vector<double>& xyz) {
   require_finite(xyz, "DIR");
   Element& el = element(id);
   if (!type_of(el).has_direction) fail(type_of(el).name, " has no direction vector for DIR");
+  if (xyz[0] == 0.0 && xyz[1] == 0.0 && xyz[2] == 0.0) fail("DIR: the direction vector has zero length");
   for (int i = 0; i < 3; ++i) el.params[i] = xyz[i];
 }
 
@@ -472,9 +475,10 @@ void Model::set_linear(int mode) { check_flag(mode, 2, "LINEAR"); settings.linea
 void Model::prepare() {
   if (!frozen_) {
     for (const auto& [id, n] : nodes)
-      if (!n.used) fail("node ", id, " is not used by any element");
-    if (elements.empty()) fail("the model has no elements");
+      if (n.kind == NodeKind::Any)
+        throw InputError("node " + std::to_string(id) + " is not used by any element and has no kind (use XY, BETA, XYZ or LAMBDA)", 0, id);
     add_automatic_constraints();
+    if (elements.empty()) fail("the model has no elements");
     compute_reference_geometry();
     frozen_ = true;
   }
@@ -513,10 +517,11 @@ void Model::compute_reference_geometry() {
     try {
       t.reference(xref.data(), el.params, l0, lgeomy);
     } catch (const InputError& err) {
-      fail(t.name, " ", id, ": ", err.what());
+      throw InputError(t.name + " " + std::to_string(id) + ": " + err.what(), id);
     }
     if (t.has_length && !el.l0) {
-      if (!(l0 > 0.0)) fail(t.name, " ", id, " has zero length: its nodes coincide in the initial positions");
+      if (!(l0 > 0.0))
+        throw InputError(t.name + " " + std::to_string(id) + " has zero length: its nodes coincide in the initial positions", id);
       el.l0 = l0;
     }
     if (t.n_lgeomy > 0 && el.lgeomy.empty()) el.lgeomy = lgeomy;

@@ -21,6 +21,7 @@ std::unique_ptr<System> prepare_and_compile(Model& model) {
 
 Simulation::Simulation(Model& model)
     : model_(model), sys_(prepare_and_compile(model)), data_(*sys_) {
+  for (const FreeRotation& fr : sys_->free_rotations) dependent_[fr.node] = fr.dependent;
   int g = 0;
   for (const auto& [id, n] : model_.nodes)
     for (double v : n.x) data_.x[g++] = v;
@@ -85,22 +86,22 @@ void Simulation::record(BlockResults& res, int k) {
 
 BlockResults Simulation::run(const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  const System& sys = *sys_;
-  const Settings& st = sys.settings;
+  // The system may be recompiled during the run (repartition): keep copies, not references.
+  const Settings st = sys_->settings;
   const int n_out = st.timestep_n;
-  const double t0 = sys.t0, t_end = t0 + st.timestep_tp;
+  const double t0 = sys_->t0, t_end = t0 + st.timestep_tp;
   BlockResults res;
-  res.warnings = sys.warnings;
+  res.warnings = sys_->warnings;
   const int nt = n_out + 1;
   res.t.resize(nt);
-  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd}) m->resize(nt, sys.nx);
-  for (RowMatrix* m : {&res.e, &res.ed, &res.edd, &res.sigma}) m->resize(nt, sys.ne);
+  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd}) m->resize(nt, sys_->nx);
+  for (RowMatrix* m : {&res.e, &res.ed, &res.edd, &res.sigma}) m->resize(nt, sys_->ne);
   std::vector<double> times(nt);
   for (int k = 0; k < nt; ++k) times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
   times.back() = t_end;  // exactly the end of the block, whatever the rounding
 
   assemble();
-  const int nd = sys.n_dof();
+  const int nd = sys_->n_dof();
   int k_out = 0;
   auto output = [&](double t, const Eigen::VectorXd& Y) {
     evaluate(t, Y.data(), Y.data() + nd);
@@ -109,32 +110,85 @@ BlockResults Simulation::run(const RunOptions& options) {
     ++k_out;
   };
   Eigen::VectorXd Y(2 * nd);
-  Y << sys.q0, sys.qd0;
+  Y << sys_->q0, sys_->qd0;
   if (nd == 0 || n_out == 0 || !(t_end > t0)) {
     // Kinematic analysis (or a single analysis at the current time).
     for (double t : times) output(t, Y);
   } else {
-    Integrator integ(2 * nd, options.method);
-    Eigen::VectorXd rtol(2 * nd), atol(2 * nd);
-    rtol.head(nd).setConstant(st.epsint);
-    rtol.tail(nd).setConstant(st.epsind);
-    atol = 1e-3 * rtol;  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
-    integ.set_tolerances(rtol, atol);
-    integ.set_max_step(st.hmax);
-    if (options.initial_step > 0.0) integ.set_initial_step(options.initial_step);
-    auto f = [this](double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(t, y, dy); };
-    integ.integrate(f, t0, t_end, Y, times, output);
-    const IntegratorStats& s = integ.stats();
-    res.rhs_evaluations = s.nfev;
-    res.steps = s.nsteps;
-    res.accepted = s.naccept;
-    res.rejected = s.nreject;
-    res.last_step = integ.last_step();
+    double t = t0, h = options.initial_step;
+    for (;;) {
+      // One segment: integrate until the end, or until a free rotation must be repartitioned.
+      Integrator integ(static_cast<int>(Y.size()), options.method);
+      const int n = sys_->n_dof();
+      Eigen::VectorXd rtol(2 * n);
+      rtol.head(n).setConstant(st.epsint);
+      rtol.tail(n).setConstant(st.epsind);
+      integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
+      integ.set_max_step(st.hmax);
+      if (h > 0.0) integ.set_initial_step(h);
+      if (!sys_->free_rotations.empty())
+        integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+      const std::vector<double> remaining(times.begin() + k_out, times.end());
+      auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
+      const double t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
+      const IntegratorStats& s = integ.stats();
+      res.rhs_evaluations += s.nfev;
+      res.steps += s.nsteps;
+      res.accepted += s.naccept;
+      res.rejected += s.nreject;
+      h = res.last_step = integ.last_step();
+      if (t_reached >= t_end) break;
+      t = t_reached;
+      repartition(rotation_to_repartition(Y), t, Y);
+    }
   }
   res.newton_iterations = data_.total_newton_iterations;
   res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   store_state();
   return res;
+}
+
+int Simulation::rotation_to_repartition(const Eigen::VectorXd& Y) const {
+  for (size_t r = 0; r < sys_->free_rotations.size(); ++r) {
+    const FreeRotation& fr = sys_->free_rotations[r];
+    double others = 0.0;
+    for (int j : fr.dofs) others += Y[j] * Y[j];
+    // On the unit sphere the dependent parameter squared is 1 − others; below ¼ another
+    // parameter is at least as large, and the normalisation row loses its strength.
+    if (1.0 - others < 0.25) return static_cast<int>(r);
+  }
+  return -1;
+}
+
+void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
+  const int nd = sys_->n_dof();
+  evaluate(t, Y.data(), Y.data() + nd);
+  const FreeRotation fr = sys_->free_rotations[which];
+  int best = 0;
+  for (int i = 1; i < 4; ++i)
+    if (std::abs(data_.x[fr.coord + i]) > std::abs(data_.x[fr.coord + best])) best = i;
+  dependent_[fr.node] = best;
+  const Eigen::VectorXd x = data_.x, xd = data_.xd, e = data_.e, ed = data_.ed, angles = data_.angle_ref;
+  const long newton = data_.total_newton_iterations;
+  sys_ = compile(model_, dependent_);
+  data_ = Data(*sys_);
+  data_.x = x;
+  data_.angle_ref = angles;
+  data_.total_newton_iterations = newton;
+  x_base_ = x;
+  have_base_ = false;
+  const System& sys = *sys_;
+  const int n = sys.n_dof();
+  Y.resize(2 * n);
+  int j = 0;
+  for (int c : sys.x_dyn) {
+    Y[j] = x[c];
+    Y[n + j++] = xd[c];
+  }
+  for (int k : sys.e_dyn) {
+    Y[j] = e[k];
+    Y[n + j++] = ed[k];
+  }
 }
 
 void Simulation::store_state() {

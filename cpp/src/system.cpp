@@ -1,5 +1,6 @@
 #include "spacar/system.hpp"
 
+#include <cmath>
 #include <sstream>
 
 #include "spacar/errors.hpp"
@@ -22,13 +23,36 @@ std::string System::def_name(int k) const {
 
 namespace {
 
-void number_coordinates(const Model& model, System& sys, std::map<int, int>& node_offset) {
+// A LAMBDA node with three or four dynamic Euler parameters (the others calculable) rotates
+// freely: returns the dependent parameter, or −1 if the node is not free.
+int free_rotation_dependent(const Node& n, const std::map<int, int>& dependent) {
+  if (n.kind != NodeKind::Lambda) return -1;
+  int n_dyn = 0, calc = -1;
+  for (int i = 0; i < 4; ++i) {
+    if (n.cls[i] == CoordClass::Dynamic) ++n_dyn;
+    else if (n.cls[i] == CoordClass::Calculable) calc = i;
+  }
+  if (!(n_dyn == 4 || (n_dyn == 3 && calc >= 0))) return -1;
+  auto it = dependent.find(n.id);
+  if (it != dependent.end()) return it->second;
+  int best = 0;
+  for (int i = 1; i < 4; ++i)
+    if (std::abs(n.x[i]) > std::abs(n.x[best])) best = i;
+  return n_dyn == 4 || std::abs(n.x[calc]) < 0.5 ? best : calc;
+}
+
+void number_coordinates(const Model& model, System& sys, std::map<int, int>& node_offset,
+                        const std::map<int, int>& dependent) {
   for (const auto& [id, n] : model.nodes) {
     node_offset[id] = sys.nx;
+    const int dep = free_rotation_dependent(n, dependent);
+    if (dep >= 0) sys.free_rotations.push_back({id, sys.nx, dep, {}});
     for (int i = 0; i < node_size(n.kind); ++i) {
       sys.coord_label.push_back({id, i + 1});
       sys.coord_node_kind.push_back(n.kind);
-      sys.coord_class.push_back(n.cls[i]);
+      CoordClass c = n.cls[i];
+      if (dep >= 0) c = i == dep ? CoordClass::Calculable : CoordClass::Dynamic;
+      sys.coord_class.push_back(c);
       ++sys.nx;
     }
     if (n.kind == NodeKind::XYZ || n.kind == NodeKind::Lambda) sys.dim = 3;
@@ -61,6 +85,7 @@ void build_elements(const Model& model, System& sys, const std::map<int, int>& n
     se.has_constitutive = !el.estiff.empty() || !el.edampp.empty();
     se.has_mass = se.kernel->has_mass();
     for (int i = 0; i < se.nd; ++i) {
+      if (se.kernel->is_angle(i)) sys.angle_defs.push_back(sys.ne + i);
       sys.def_label.push_back({id, i + 1});
       sys.def_class.push_back(el.cls[i]);
       sys.e_element.push_back(static_cast<int>(sys.elements.size()));
@@ -128,6 +153,11 @@ void partition(System& sys) {
   for (int g : sys.x_dyn) { sys.dof_cols.push_back(col); sys.qhat_col_x[g] = col++; }
   for (int k : sys.e_input) { sys.input_cols.push_back(col); sys.qhat_col_e[k] = col++; }
   for (int k : sys.e_dyn) { sys.dof_cols.push_back(col); sys.qhat_col_e[k] = col++; }
+  for (FreeRotation& fr : sys.free_rotations) {
+    int j = 0;
+    for (int i = 0; i < 4; ++i)
+      if (i != fr.dependent) fr.dofs[j++] = sys.qhat_col_x[fr.coord + i] - static_cast<int>(sys.x_input.size());
+  }
 }
 
 // Initial values: inputs start at their current value, deformation values not given by E are
@@ -220,12 +250,12 @@ void masses_and_loads(const Model& model, System& sys, const std::map<int, int>&
 
 }  // namespace
 
-std::unique_ptr<System> compile(const Model& model) {
+std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& dependent) {
   if (!model.frozen()) throw Error("compile(): the model has not been prepared (call Model::prepare())");
   auto sys = std::make_unique<System>();
   sys->settings = model.settings;
   std::map<int, int> node_offset;
-  number_coordinates(model, *sys, node_offset);
+  number_coordinates(model, *sys, node_offset, dependent);
   build_elements(model, *sys, node_offset);
   partition(*sys);
   initial_values(model, *sys);

@@ -48,8 +48,9 @@ class Summary:
 def summary(model) -> Summary:
     """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
     nodes are included (they are created at the first END)."""
-    core = model._core.copy()
-    core.prepare()
+    copy = model.copy()
+    copy.prepare()
+    core = copy._core
     nodes = Counter(str(n.kind.name) for n in core.nodes.values())
     elements = Counter(el.type_name for el in core.elements.values())
     coords = Counter(c.name for n in core.nodes.values() for c in n.cls)

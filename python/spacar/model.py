@@ -84,6 +84,7 @@ class Model:
         self.source = None     # input file name, when read from a file
         self.warnings = []     # reader and analysis warnings
         self._continue_step = 0.0  # integrator step to continue with (RESTART 0)
+        self._defined_at = {}      # ("element" | "node", number) -> reader Command that defined it
 
     # --- dispatch used by the reader ---------------------------------------------------------
 
@@ -93,6 +94,22 @@ class Model:
         if kw is None or kw.name in ("END", "EOF"):
             raise InputError(f"unknown keyword {keyword!r}")
         return getattr(self, kw.builder)(*args)
+
+    def prepare(self):
+        """What the first END does before an analysis: create the automatic L2MIN1 elements,
+        compute the reference geometry and freeze the topology. Errors found here name the input
+        line that defined the element or node concerned."""
+        try:
+            self._core.prepare()
+        except InputError as err:
+            raise self._locate(err) from None
+
+    def _locate(self, err):
+        for kind in ("element", "node"):
+            cmd = self._defined_at.get((kind, getattr(err, kind, 0)))
+            if cmd is not None:
+                return type(err)(f"{cmd.where()}: {err}")
+        return err
 
     def _call(self, name, *args):
         kw = KEYWORDS[name]
@@ -331,6 +348,7 @@ class Model:
         other.source = self.source
         other.warnings = list(self.warnings)
         other._continue_step = self._continue_step
+        other._defined_at = dict(self._defined_at)
         return other
 
     def summary(self):

@@ -16,6 +16,7 @@ def simulate(model, *, method: str = "dop853", on_output=None) -> Results:
     ``on_output(k, t)`` is called after output time k is recorded (progress, live output).
     Returns :class:`spacar.Results`.
     """
+    model.prepare()
     sim = _core.Simulation(model._core)
     restart = model._core.settings.restart == 1
     step = 0.0 if restart else model._continue_step

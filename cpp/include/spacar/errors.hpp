@@ -11,9 +11,14 @@ struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Invalid model description: the reader adds file, line and keyword to the message.
+// Invalid model description: the reader adds file, line and keyword to the message. When the
+// error concerns one element or node (found at the first END), its number is carried along so
+// that the reader can name the line that defined it.
 struct InputError : Error {
-  using Error::Error;
+  explicit InputError(const std::string& message, int element_id = 0, int node_id = 0)
+      : Error(message), element(element_id), node(node_id) {}
+  int element = 0;
+  int node = 0;
 };
 
 // The kinematic analysis cannot be solved (constraint block not square or singular, Newton failed).

@@ -50,8 +50,14 @@ class Integrator {
   // [t0, t_end]) call out(t_k, y(t_k)) using the dense output (t_k == t0: the initial value;
   // t_k == t_end: exactly the final state). The last step is clipped to end exactly at t_end.
   // On return y holds y(t_end); if IntegrationError is thrown, y holds the last accepted state.
-  void integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
-                 const std::vector<double>& touts, const Output& out);
+  // Returns the time reached: t_end, or earlier if the stop condition asked to stop.
+  double integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
+                   const std::vector<double>& touts, const Output& out);
+
+  // Checked after every accepted step (t, y): returning true ends integrate() there, e.g. to
+  // change the coordinate partition of the model and continue.
+  using StopCondition = std::function<bool(double t, const Eigen::VectorXd& y)>;
+  void set_stop_condition(StopCondition stop);
 
   const IntegratorStats& stats() const;   // cumulative over all integrate calls
 
@@ -78,6 +84,7 @@ class Integrator {
   double h_last_ = 0.0;
   double err_ = 0.0;                 // error norm of the last attempted step
   std::string failure_;              // why the last step was rejected, for error messages
+  StopCondition stop_;
   IntegratorStats stats_;
   // Work space, allocated once so that the step loop never touches the heap.
   std::vector<Eigen::VectorXd> k_;       // stages; k_[0] = f(t, y)

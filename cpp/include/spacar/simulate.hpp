@@ -59,7 +59,13 @@ class Simulation {
 
  private:
   void record(BlockResults& res, int k);
+  // A free rotation whose dependent Euler parameter has become small, or −1.
+  int rotation_to_repartition(const Eigen::VectorXd& Y) const;
+  // Make the largest Euler parameter of that node the dependent one: recompile the system and
+  // map the state (t, Y) to the new degrees of freedom.
+  void repartition(int which, double t, Eigen::VectorXd& Y);
   Model& model_;
+  std::map<int, int> dependent_;  // dependent Euler parameter of free rotations, by node
   std::unique_ptr<System> sys_;
   Data data_;
   Eigen::VectorXd x_base_, qhat_base_, predictor_;

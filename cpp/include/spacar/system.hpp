@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +25,17 @@ struct SystemElement {
   bool has_constitutive = false;
   Eigen::MatrixXd S, D;         // stiffness and damping matrices (nd x nd)
   bool has_mass = false;
+};
+
+// A LAMBDA node whose rotation is free (at least three Euler parameters are dynamic): three
+// parameters are degrees of freedom and the dependent one is solved from L2MIN1. The engine
+// picks the dependent one with the largest magnitude and re-picks when it gets small, so that
+// rotations through 180° never make the normalisation singular.
+struct FreeRotation {
+  int node = 0;                 // node number
+  int coord = 0;                // first Euler parameter coordinate
+  int dependent = 0;            // 0..3: the calculable parameter
+  std::array<int, 3> dofs{};    // positions in q of the three dynamic parameters
 };
 
 // A rigid body on a LAMBDA node: body-frame inertia tensor J'.
@@ -53,6 +65,7 @@ struct System {
   std::vector<int> rows_V;      // deformations with known rates: velocity constraint rows
   std::vector<int> auto_released;  // fixed rows with no calculable coordinate, checked instead
   std::vector<int> e_element;   // element (index into elements) of each deformation
+  std::vector<int> angle_defs;  // angle-type deformations, unwrapped to continuous values
 
   // Maps from global index to position.
   std::vector<int> calc_pos;    // coordinate → column in the constraint block, −1 if not calculable
@@ -79,6 +92,7 @@ struct System {
   // Mass and loads.
   Eigen::VectorXd point_mass;   // per coordinate: m on position coordinates, Izz on BETA (0 if none)
   std::vector<BodyInertia> bodies;
+  std::vector<FreeRotation> free_rotations;
   Eigen::VectorXd force;        // constant applied loads per coordinate (FORCE)
   std::vector<std::pair<int, Eigen::Vector3d>> torquel;  // (first λ coordinate, body torque)
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
@@ -92,6 +106,7 @@ struct System {
 
 // Compile a prepared model (Model::prepare() has run). Throws InputError for classifications
 // that cannot be analysed and NotImplementedError for element types without physics.
-std::unique_ptr<System> compile(const Model& model);
+// `dependent` overrides the dependent Euler parameter (0..3) of free rotations by node number.
+std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& dependent = {});
 
 }  // namespace spacar

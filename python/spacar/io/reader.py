@@ -15,10 +15,12 @@ import os
 import re
 from dataclasses import dataclass, field
 
+from .. import _core
 from ..errors import InputError, SpacarError
 from ..keywords import INT, LOOKUP, Keyword
 from ..model import Model, check_args
 
+_ELEMENT_KEYWORDS = {t.name for t in _core.element_catalogue()}
 _INT_RE = re.compile(r"^[+-]?\d+$")
 _REAL_RE = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eEdD][+-]?\d+)?$")
 
@@ -122,6 +124,10 @@ def apply_block(model: Model, block: Block) -> None:
             model.apply(cmd.keyword, *cmd.args)
         except SpacarError as err:
             raise type(err)(f"{cmd.where()}: {err}") from None
+        if cmd.keyword in _ELEMENT_KEYWORDS:
+            model._defined_at.setdefault(("element", cmd.args[0]), cmd)
+        elif cmd.keyword in ("X", "XY", "BETA", "XYZ", "LAMBDA"):
+            model._defined_at.setdefault(("node", cmd.args[0]), cmd)
 
 
 def read_string(text: str, file: str = "<string>") -> Model:

@@ -39,6 +39,10 @@ class ElementKernel {
   // G = Σ_i σ_i H_i, n_coords x n_coords, column-major (geometric stiffness, linearization).
   virtual void stress_hessian(const double* x, const double* sigma, double* G) const = 0;
 
+  // Angle-type deformations (atan2 branch): the kinematic analysis unwraps them to continuous
+  // multi-turn values.
+  virtual bool is_angle(int i) const { return false; }
+
   // Constitutive matrix from ESTIFF (or, in the same form, EDAMPP) values: σ = S e (+ D ė).
   // Zero for elements without stiffness data.
   virtual void constitutive(const std::vector<double>& values, double* S) const;

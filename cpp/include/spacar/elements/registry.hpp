@@ -14,9 +14,18 @@ double reference_chord(const double* p, const double* q, int dim);
 
 void reference_pltruss(const double* x_ref, const std::vector<double>& params, double& l0,
                      std::vector<double>& lgeomy);
+void reference_truss(const double* x_ref, const std::vector<double>& params, double& l0,
+                     std::vector<double>& lgeomy);
+void reference_beam(const double* x_ref, const std::vector<double>& params, double& l0,
+                    std::vector<double>& lgeomy);
 void reference_plbeam(const double* x_ref, const std::vector<double>& params, double& l0,
                       std::vector<double>& lgeomy);
 
+std::unique_ptr<ElementKernel> make_truss(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_beam(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_beamnl(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_hinge(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_l2min1(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_pltruss(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_plbeam(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_plbeamnl(const ElementSetup& setup);

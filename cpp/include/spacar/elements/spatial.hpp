@@ -1,0 +1,51 @@
+// Helpers for spatial elements, templated on the scalar type: rotation of a vector by Euler
+// parameters, R(λ)c = (λ0² − λ̄·λ̄) c + 2 λ̄ (λ̄·c) + 2 λ0 λ̄ × c (formulation.md §0). The
+// quadratic form is used also off the unit sphere, where Newton iterates go; all derivatives are
+// exact derivatives of this form.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace spacar {
+
+template <class S>
+using Vec3 = std::array<S, 3>;
+
+template <class S>
+S dot3(const Vec3<S>& a, const Vec3<S>& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+// R(λ) c for a constant vector c; l points to (λ0, λ1, λ2, λ3).
+template <class S>
+Vec3<S> rotate(const S* l, const Eigen::Vector3d& c) {
+  const S s = l[0] * l[0] - (l[1] * l[1] + l[2] * l[2] + l[3] * l[3]);
+  const S lc = l[1] * c[0] + l[2] * c[1] + l[3] * c[2];
+  // λ̄ × c
+  const S cx = l[2] * c[2] - l[3] * c[1];
+  const S cy = l[3] * c[0] - l[1] * c[2];
+  const S cz = l[1] * c[1] - l[2] * c[0];
+  return {s * c[0] + 2.0 * l[1] * lc + 2.0 * l[0] * cx, s * c[1] + 2.0 * l[2] * lc + 2.0 * l[0] * cy,
+          s * c[2] + 2.0 * l[3] * lc + 2.0 * l[0] * cz};
+}
+
+// Orthonormal frame [e_x e_y e_z] with e_x along `axis` and e_y from `y_hint` (its e_x component
+// removed). Throws InputError (message names `what`) if the axis has zero length or the hint is
+// parallel to the axis (remainder below 1e-5 of its length).
+Eigen::Matrix3d frame_from_axis(const Eigen::Vector3d& axis, const Eigen::Vector3d& y_hint, const std::string& what);
+
+// The hinge frame (formulation.md §4.10): e_x the axis, e_y the global unit axis along which
+// the axis has its smallest component, orthogonalised.
+Eigen::Matrix3d hinge_frame(const Eigen::Vector3d& axis, const std::string& what);
+
+// Mass and convective inertia force of rotational kinetic energy
+// T = ½ Σ_ij ω_iᵀ A_ij ω_j with ω_i = 2 G(λ_i) λ̇_i the body angular velocity of LAMBDA block i
+// (coordinates lam[i]..lam[i]+3 of x and v). Adds 4 G_iᵀ A_ij G_j to M (n x n, column-major)
+// and 4 G(λ̇_i)ᵀ Σ_j A_ij ω_j to h. This is the exact Lagrange form (formulation.md §3.2).
+void add_rotational_inertia(int n, const double* x, const double* v, const int* lam, int nblocks,
+                            const Eigen::Matrix3d* A, double* M, double* h);
+
+}  // namespace spacar

@@ -1,0 +1,141 @@
+// BEAM and BEAMNL: spatial beam between p (XYZ), its orientation λp (LAMBDA), q and λq
+// (formulation.md §4.8, §4.9). Reference frame C0 = [e_x0 e_y0 e_z0] (LGEOMY, 9 values):
+// e_x0 the initial chord, e_y0 the principal y-axis of the cross-section. With the current
+// triads e_j^p = R(λp) e_j0, e_j^q = R(λq) e_j0 and e_l the chord direction:
+//   e1 = l − l0                                   elongation
+//   e2 = l0 (e_z^p·e_y^q − e_y^p·e_z^q)/2          torsion (= l0 sin ψ)
+//   e3 = +l0 (e_l·e_z^p),  e4 = −l0 (e_l·e_z^q)    bending about local y
+//   e5 = −l0 (e_l·e_y^p),  e6 = +l0 (e_l·e_y^q)    bending about local z
+// so that motion in the x–y plane with e_y0 = n(α0) reproduces PLBEAM: e5, e6 = PLBEAM e2, e3.
+// BEAMNL adds (2e3² + e3e4 + 2e4² + 2e5² + e5e6 + 2e6²)/(30 l0) to e1.
+// Mass: the cubic Hermite interpolation with nodal tangents R(λ)e_x0 (as PLBEAM); rotary
+// inertia of the cross-section only with the extension EMASS e rhoA rhoIp [rhoIy rhoIz].
+#include <cmath>
+
+#include "spacar/elements/registry.hpp"
+#include "spacar/elements/spatial.hpp"
+
+namespace spacar {
+namespace {
+
+template <bool Nonlinear>
+class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
+  using Base = AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3>;
+
+ public:
+  explicit Beam(const ElementSetup& s) : l0_(s.l0) {
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) C0_(i, j) = s.lgeomy[3 * j + i];
+    const double rhoA = s.emass.empty() ? 0.0 : s.emass[0];
+    mass_.W << 13.0 / 35, 11.0 / 210, 9.0 / 70, -13.0 / 420,  //
+        11.0 / 210, 1.0 / 105, 13.0 / 420, -1.0 / 140,          //
+        9.0 / 70, 13.0 / 420, 13.0 / 35, -11.0 / 210,           //
+        -13.0 / 420, -1.0 / 140, -11.0 / 210, 1.0 / 105;
+    mass_.W *= rhoA * l0_;
+    mass_.w << 0.5, 1.0 / 12, 0.5, -1.0 / 12;
+    mass_.w *= rhoA * l0_;
+    // Rotary inertia: T = (l0/6)(Ω_pᵀJΩ_p + Ω_pᵀJΩ_q + Ω_qᵀJΩ_q), Ω the section angular velocity.
+    const Eigen::Vector3d Js(s.emass.size() > 1 ? s.emass[1] : 0.0, s.emass.size() > 2 ? s.emass[2] : 0.0,
+                             s.emass.size() > 3 ? s.emass[3] : 0.0);
+    rotary_ = Js.any();
+    const Eigen::Matrix3d A = C0_ * Js.asDiagonal() * C0_.transpose();
+    A_[0] = A_[3] = (l0_ / 3.0) * A;
+    A_[1] = A_[2] = (l0_ / 6.0) * A;
+  }
+
+  template <class S>
+  void deform(const S* x, S* e) const {
+    const S dx = x[7] - x[0], dy = x[8] - x[1], dz = x[9] - x[2];
+    const S l = sqrt(dx * dx + dy * dy + dz * dz);
+    const Vec3<S> el = {dx / l, dy / l, dz / l};
+    const S* lp = x + 3;
+    const S* lq = x + 10;
+    const Vec3<S> yp = rotate(lp, C0_.col(1)), zp = rotate(lp, C0_.col(2));
+    const Vec3<S> yq = rotate(lq, C0_.col(1)), zq = rotate(lq, C0_.col(2));
+    e[1] = 0.5 * l0_ * (dot3(zp, yq) - dot3(yp, zq));
+    e[2] = l0_ * dot3(el, zp);
+    e[3] = -l0_ * dot3(el, zq);
+    e[4] = -l0_ * dot3(el, yp);
+    e[5] = l0_ * dot3(el, yq);
+    e[0] = l - l0_;
+    if constexpr (Nonlinear)
+      e[0] += (2.0 * e[2] * e[2] + e[2] * e[3] + 2.0 * e[3] * e[3] + 2.0 * e[4] * e[4] + e[4] * e[5] +
+               2.0 * e[5] * e[5]) /
+              (30.0 * l0_);
+  }
+
+  // Mass points x_p, l0 R(λp)e_x0, x_q, l0 R(λq)e_x0.
+  template <class S>
+  void mass_points(const S* x, S* g) const {
+    const Vec3<S> tp = rotate(x + 3, C0_.col(0)), tq = rotate(x + 10, C0_.col(0));
+    for (int i = 0; i < 3; ++i) {
+      g[i] = x[i];
+      g[3 + i] = l0_ * tp[i];
+      g[6 + i] = x[7 + i];
+      g[9 + i] = l0_ * tq[i];
+    }
+  }
+  const MassPoints<4, 3>& mass_model() const { return mass_; }
+
+  bool has_mass() const override { return Base::has_mass() || rotary_; }
+
+  void mass(const double* x, const double* v, double* M, double* h) const override {
+    Base::mass(x, v, M, h);
+    if (rotary_) {
+      const int lam[2] = {3, 10};
+      add_rotational_inertia(14, x, v, lam, 2, A_, M, h);
+    }
+  }
+
+  double kinetic_energy(const double* x, const double* v) const override {
+    double T = Base::kinetic_energy(x, v);
+    if (rotary_) {
+      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(14, 14);
+      Eigen::VectorXd h = Eigen::VectorXd::Zero(14);
+      const int lam[2] = {3, 10};
+      add_rotational_inertia(14, x, v, lam, 2, A_, M.data(), h.data());
+      const Eigen::Map<const Eigen::VectorXd> vm(v, 14);
+      T += 0.5 * vm.dot(M * vm);
+    }
+    return T;
+  }
+
+  // σ1 = (EA/l0) e1, σ2 = (GIp/l0³) e2, bending pairs (EI/l0³)[[4, −2], [−2, 4]].
+  void constitutive(const std::vector<double>& v, double* S) const override {
+    auto val = [&](size_t i) { return i < v.size() ? v[i] : 0.0; };
+    Eigen::Map<Eigen::Matrix<double, 6, 6>> Sm(S);
+    Sm.setZero();
+    const double l3 = l0_ * l0_ * l0_;
+    Sm(0, 0) = val(0) / l0_;
+    Sm(1, 1) = val(1) / l3;
+    for (int pair = 0; pair < 2; ++pair) {
+      const double k = val(2 + pair) / l3;
+      const int a = 2 + 2 * pair;
+      Sm(a, a) = Sm(a + 1, a + 1) = 4.0 * k;
+      Sm(a, a + 1) = Sm(a + 1, a) = -2.0 * k;
+    }
+  }
+
+ private:
+  double l0_;
+  Eigen::Matrix3d C0_;
+  MassPoints<4, 3> mass_;
+  bool rotary_ = false;
+  Eigen::Matrix3d A_[4];
+};
+
+}  // namespace
+
+void reference_beam(const double* x, const std::vector<double>& params, double& l0, std::vector<double>& lgeomy) {
+  // x = (p(3), λp(4), q(3), λq(4)) with the orientations at the reference.
+  const Eigen::Vector3d chord(x[7] - x[0], x[8] - x[1], x[9] - x[2]);
+  l0 = chord.norm();
+  if (!(l0 > 0.0)) return;  // the caller reports the zero length
+  const Eigen::Matrix3d C = frame_from_axis(chord, Eigen::Vector3d(params[0], params[1], params[2]), "");
+  lgeomy.assign(C.data(), C.data() + 9);
+}
+
+std::unique_ptr<ElementKernel> make_beam(const ElementSetup& s) { return std::make_unique<Beam<false>>(s); }
+std::unique_ptr<ElementKernel> make_beamnl(const ElementSetup& s) { return std::make_unique<Beam<true>>(s); }
+
+}  // namespace spacar

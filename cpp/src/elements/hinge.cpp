@@ -1,0 +1,42 @@
+// HINGE: relative rotation of two LAMBDA nodes about an axis (formulation.md §4.10).
+// Hinge frame C0 = [e_x0 e_y0 e_z0] from the axis; e_j^{oi} = R(λ_oi) e_j0 and
+// R̂_ab = e_a^{o1} · e_b^{o2}:
+//   e1 = atan2((R̂32 − R̂23)/2, (R̂22 + R̂33)/2)   rotation of o2 relative to o1 about the axis
+//   e2 = R̂13,  e3 = −R̂12                       misalignments, regular at every hinge angle
+// e1 is an angle: the kinematic analysis unwraps it to a continuous multi-turn value.
+#include "spacar/elements/registry.hpp"
+#include "spacar/elements/spatial.hpp"
+
+namespace spacar {
+namespace {
+
+class Hinge : public AutoDiffElement<Hinge, 8, 3> {
+ public:
+  explicit Hinge(const ElementSetup& s)
+      : C0_(hinge_frame(Eigen::Vector3d(s.params[0], s.params[1], s.params[2]), "HINGE")) {}
+
+  template <class S>
+  void deform(const S* x, S* e) const {
+    const Vec3<S> x1 = rotate(x, C0_.col(0)), y1 = rotate(x, C0_.col(1)), z1 = rotate(x, C0_.col(2));
+    const Vec3<S> y2 = rotate(x + 4, C0_.col(1)), z2 = rotate(x + 4, C0_.col(2));
+    e[0] = atan2(0.5 * (dot3(z1, y2) - dot3(y1, z2)), 0.5 * (dot3(y1, y2) + dot3(z1, z2)));
+    e[1] = dot3(x1, z2);
+    e[2] = -dot3(x1, y2);
+  }
+
+  bool is_angle(int i) const override { return i == 0; }
+
+  void constitutive(const std::vector<double>& v, double* S) const override {
+    for (int i = 0; i < 9; ++i) S[i] = 0.0;
+    S[0] = v.empty() ? 0.0 : v[0];
+  }
+
+ private:
+  Eigen::Matrix3d C0_;
+};
+
+}  // namespace
+
+std::unique_ptr<ElementKernel> make_hinge(const ElementSetup& s) { return std::make_unique<Hinge>(s); }
+
+}  // namespace spacar

@@ -1,0 +1,68 @@
+#include "spacar/elements/spatial.hpp"
+
+#include <sstream>
+
+#include "spacar/errors.hpp"
+
+namespace spacar {
+
+Eigen::Matrix3d frame_from_axis(const Eigen::Vector3d& axis, const Eigen::Vector3d& y_hint, const std::string& what) {
+  const std::string prefix = what.empty() ? "" : what + ": ";
+  const double la = axis.norm();
+  if (!(la > 0.0)) throw InputError(prefix + "the axis has zero length");
+  const Eigen::Vector3d ex = axis / la;
+  const Eigen::Vector3d y = y_hint - ex.dot(y_hint) * ex;
+  if (!(y.norm() > 1e-5 * y_hint.norm()) || y_hint.norm() == 0.0) {
+    std::ostringstream os;
+    os << prefix << "the direction vector (" << y_hint[0] << ", " << y_hint[1] << ", " << y_hint[2]
+       << ") is parallel to the element axis (" << ex[0] << ", " << ex[1] << ", " << ex[2] << ")";
+    throw InputError(os.str());
+  }
+  Eigen::Matrix3d C;
+  C.col(0) = ex;
+  C.col(1) = y.normalized();
+  C.col(2) = C.col(0).cross(C.col(1));
+  return C;
+}
+
+Eigen::Matrix3d hinge_frame(const Eigen::Vector3d& axis, const std::string& what) {
+  if (!(axis.norm() > 0.0)) throw InputError(what + ": the axis of rotation has zero length");
+  int k = 0;
+  const Eigen::Vector3d a = axis.cwiseAbs();
+  for (int i = 1; i < 3; ++i)
+    if (a[i] < a[k]) k = i;
+  return frame_from_axis(axis, Eigen::Vector3d::Unit(k), what);
+}
+
+namespace {
+Eigen::Matrix<double, 3, 4> G_of(const double* l) {
+  Eigen::Matrix<double, 3, 4> G;
+  G << -l[1], l[0], l[3], -l[2],  //
+      -l[2], -l[3], l[0], l[1],   //
+      -l[3], l[2], -l[1], l[0];
+  return G;
+}
+}  // namespace
+
+void add_rotational_inertia(int n, const double* x, const double* v, const int* lam, int nblocks,
+                            const Eigen::Matrix3d* A, double* M, double* h) {
+  Eigen::Map<Eigen::MatrixXd> Mm(M, n, n);
+  Eigen::Map<Eigen::VectorXd> hm(h, n);
+  Eigen::Matrix<double, 3, 4> G[4];
+  Eigen::Vector3d w[4];
+  for (int i = 0; i < nblocks; ++i) {
+    G[i] = G_of(x + lam[i]);
+    w[i] = 2.0 * G[i] * Eigen::Map<const Eigen::Vector4d>(v + lam[i]);
+  }
+  for (int i = 0; i < nblocks; ++i) {
+    Eigen::Vector3d Aw = Eigen::Vector3d::Zero();
+    for (int j = 0; j < nblocks; ++j) {
+      const Eigen::Matrix3d& Aij = A[i * nblocks + j];
+      Mm.block<4, 4>(lam[i], lam[j]) += 4.0 * G[i].transpose() * Aij * G[j];
+      Aw += Aij * w[j];
+    }
+    hm.segment<4>(lam[i]) += 4.0 * G_of(v + lam[i]).transpose() * Aw;
+  }
+}
+
+}  // namespace spacar
