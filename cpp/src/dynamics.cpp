@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
 
@@ -13,27 +14,12 @@ bool constitutive_class(DefClass c) {
   return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
 }
 
-// G(λ) of the Euler parameters: ω' = 2 G λ̇ (body angular velocity).
-Eigen::Matrix<double, 3, 4> G_matrix(const double* l) {
-  Eigen::Matrix<double, 3, 4> G;
-  G << -l[1], l[0], l[3], -l[2],  //
-      -l[2], -l[3], l[0], l[1],   //
-      -l[3], l[2], -l[1], l[0];
-  return G;
-}
-
+// Rigid bodies on LAMBDA nodes and body-fixed torques (formulation.md §3.2, §3.4).
 void add_bodies(const System& sys, Data& data) {
-  for (const BodyInertia& b : sys.bodies) {
-    const double* l = data.x.data() + b.coord;
-    const double* ld = data.xd.data() + b.coord;
-    const Eigen::Matrix<double, 3, 4> G = G_matrix(l), Gd = G_matrix(ld);
-    const Eigen::Vector3d omega = 2.0 * G * Eigen::Map<const Eigen::Vector4d>(ld);
-    data.M.block<4, 4>(b.coord, b.coord) += 4.0 * G.transpose() * b.J * G;
-    // Exact Lagrange term d/dt(∂T/∂λ̇) − ∂T/∂λ minus M λ̈ (formulation.md §3.2).
-    data.h.segment<4>(b.coord) += 4.0 * Gd.transpose() * (b.J * omega);
-  }
+  for (const BodyInertia& b : sys.bodies)
+    add_rotational_inertia(sys.nx, data.x.data(), data.xd.data(), &b.coord, 1, &b.J, data.M.data(), data.h.data());
   for (const auto& [coord, T] : sys.torquel)
-    data.f.segment<4>(coord) += 2.0 * G_matrix(data.x.data() + coord).transpose() * T;
+    data.f.segment<4>(coord) += 2.0 * euler_G(data.x.data() + coord).transpose() * T;
 }
 
 }  // namespace
