@@ -8,6 +8,7 @@
 #include "spacar/catalogue.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/integrator.hpp"
+#include "spacar/kinematics.hpp"
 #include "spacar/model.hpp"
 #include "spacar/simulate.hpp"
 
@@ -198,6 +199,23 @@ void bind_model(py::module_& m) {
       .def_readonly("gravity_given", &Model::gravity_given);
 }
 
+py::dict linearization_to_dict(const Linearization& l) {
+  py::dict d;
+  d["t"] = l.t;
+  d["z_label"] = l.z_label;
+  d["n_line"] = l.n_line;
+  d["M0"] = l.M0;
+  d["C0"] = l.C0;
+  d["D0"] = l.D0;
+  d["K0"] = l.K0;
+  d["N0"] = l.N0;
+  d["G0"] = l.G0;
+  d["r0"] = l.r0;
+  d["DFz"] = l.DFz;
+  d["DFez"] = l.DFez;
+  return d;
+}
+
 py::dict block_results_to_dict(BlockResults&& r) {
   py::dict d;
   d["t"] = std::move(r.t);
@@ -208,6 +226,10 @@ py::dict block_results_to_dict(BlockResults&& r) {
   d["ed"] = std::move(r.ed);
   d["edd"] = std::move(r.edd);
   d["sigma"] = std::move(r.sigma);
+  d["reaction"] = std::move(r.reaction);
+  py::list lins;
+  for (const Linearization& l : r.linearizations) lins.append(linearization_to_dict(l));
+  d["linearizations"] = lins;
   d["rhs_evaluations"] = r.rhs_evaluations;
   d["steps"] = r.steps;
   d["accepted"] = r.accepted;
@@ -261,6 +283,7 @@ void bind_simulation(py::module_& m) {
       .def_readonly("M", &Data::M)
       .def_readonly("Mbar", &Data::Mbar)
       .def_readonly("qdd", &Data::qdd)
+      .def_readonly("reaction", &Data::reaction)
       .def_readonly("newton_iterations", &Data::newton_iterations);
 
   py::class_<Simulation>(m, "Simulation")
@@ -268,6 +291,24 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", &Simulation::assemble)
+      .def("forces", &Simulation::forces)
+      .def("linearize", [](Simulation& s) { return linearization_to_dict(s.linearize()); })
+      .def("diagnose",
+           [](Simulation& s) {
+             const ConstraintDiagnosis d = diagnose(s.system(), s.data());
+             const System& sys = s.system();
+             py::dict out;
+             out["n_constraints"] = d.n_constraints;
+             out["n_calculable"] = d.n_calculable;
+             out["rank"] = d.rank;
+             py::list red, und;
+             for (int k : d.redundant) red.append(py::make_tuple(sys.def_label[k][0], sys.def_label[k][1]));
+             for (int g : d.undetermined) und.append(py::make_tuple(sys.coord_label[g][0], sys.coord_label[g][1]));
+             out["redundant"] = red;
+             out["undetermined"] = und;
+             out["text"] = d.text;
+             return out;
+           })
       .def("evaluate",
            [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
              if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())

@@ -68,18 +68,25 @@ void assemble_inertia_and_loads(const System& sys, Data& data) {
   add_bodies(sys, data);
 }
 
-void solve_dynamics(const System& sys, Data& data) {
+void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R) {
   const int nd = sys.n_dof();
-  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = 0.0;
-  solve_accelerations(sys, data);  // ẍ with q̈ = 0: inputs' accelerations and convective terms
+  solve_accelerations(sys, data);
   assemble_inertia_and_loads(sys, data);
   constitutive_stresses(sys, data);
   data.g.noalias() = data.M * data.xdd;
   data.g += data.h - data.f;
   for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
+  R.noalias() = data.DFq.transpose() * data.g;
+  for (int j = 0; j < nd; ++j) R[j] += data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
+}
+
+void solve_dynamics(const System& sys, Data& data) {
+  const int nd = sys.n_dof();
+  // The residual at q̈ = 0 holds the inputs' accelerations, convective, applied and elastic forces.
+  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = 0.0;
+  reduced_residual(sys, data, data.rhs);
+  data.rhs = -data.rhs;
   data.Mbar.noalias() = data.DFq.transpose() * data.M * data.DFq;
-  data.rhs.noalias() = -data.DFq.transpose() * data.g;
-  for (int j = 0; j < nd; ++j) data.rhs[j] -= data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
   data.llt.compute(data.Mbar);
   if (data.llt.info() != Eigen::Success || nd == 0) {
     if (nd == 0) return;
@@ -105,6 +112,43 @@ void solve_dynamics(const System& sys, Data& data) {
   data.qdd = data.llt.solve(data.rhs);
   for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
   solve_accelerations(sys, data);
+}
+
+Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::VectorXd& sigma) {
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(sys.nx, sys.nx);
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const ElementWork& w = data.work[i];
+    const int n = static_cast<int>(se.coords.size());
+    Eigen::VectorXd s = sigma.segment(se.def_offset, se.nd);
+    if (s.any()) {
+      Eigen::MatrixXd G(n, n);
+      se.kernel->stress_hessian(w.x.data(), s.data(), G.data());
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) K(se.coords[a], se.coords[b]) += G(a, b);
+    }
+    // Position-dependent gravity loads of the element mass (beam tangent terms).
+    if (se.has_mass && sys.gravity.squaredNorm() > 0.0) {
+      Eigen::VectorXd xp = w.x, fp(n), fm(n);
+      for (int b = 0; b < n; ++b) {
+        const double h = 1e-6 * std::max(1.0, std::abs(w.x[b]));
+        xp[b] = w.x[b] + h;
+        se.kernel->gravity(xp.data(), sys.gravity.data(), fp.data());
+        xp[b] = w.x[b] - h;
+        se.kernel->gravity(xp.data(), sys.gravity.data(), fm.data());
+        xp[b] = w.x[b];
+        for (int a = 0; a < n; ++a) K(se.coords[a], se.coords[b]) -= (fp[a] - fm[a]) / (2.0 * h);
+      }
+    }
+  }
+  // Body-fixed torques: f_λ = 2 G(λ)ᵀ T' is linear in λ.
+  for (const auto& [coord, T] : sys.torquel)
+    for (int b = 0; b < 4; ++b) {
+      double unit[4] = {0, 0, 0, 0};
+      unit[b] = 1.0;
+      K.block<4, 1>(coord, coord + b) -= 2.0 * euler_G(unit).transpose() * T;
+    }
+  return K;
 }
 
 double kinetic_energy(const System&, const Data& data) { return 0.5 * data.xd.dot(data.M * data.xd); }
