@@ -66,8 +66,10 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   try {
     evaluate(t, Y.data(), Y.data() + nd);
   } catch (const KinematicsError& err) {
+    kinematic_failure_ = err.what();
     throw StepRejected(err.what());
   }
+  kinematic_failure_.clear();
   dY.head(nd) = Y.segment(nd, nd);
   dY.tail(nd) = data_.qdd;
 }
@@ -123,7 +125,19 @@ BlockResults Simulation::run(const RunOptions& options) {
     integ.set_max_step(st.hmax);
     if (options.initial_step > 0.0) integ.set_initial_step(options.initial_step);
     auto f = [this](double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(t, y, dy); };
-    integ.integrate(f, t0, t_end, Y, times, output);
+    kinematic_failure_.clear();
+    try {
+      integ.integrate(f, t0, t_end, Y, times, output);
+    } catch (const IntegrationError& err) {
+      // The step collapsed because the kinematics has no solution (the last right-hand side
+      // failed in the Newton iteration): that is a KinematicsError (formulation.md §2.2).
+      if (kinematic_failure_.empty()) throw;
+      std::string integrator = err.what();
+      const size_t cut = integrator.find(" (last rejection");
+      if (cut != std::string::npos) integrator.resize(cut);
+      throw KinematicsError(kinematic_failure_ + "\nNo kinematic solution down to the minimum step (" +
+                            integrator + ").");
+    }
     const IntegratorStats& s = integ.stats();
     res.rhs_evaluations = s.nfev;
     res.steps = s.nsteps;

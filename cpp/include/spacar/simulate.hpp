@@ -64,6 +64,7 @@ class Simulation {
   Data data_;
   Eigen::VectorXd x_base_, qhat_base_, predictor_;
   bool have_base_ = false;
+  std::string kinematic_failure_;  // message of the last right-hand side that failed in Newton
 };
 
 }  // namespace spacar
