@@ -459,6 +459,8 @@ def test_fourbar_against_closed_form(branch, theta0, speed, accel):
         theta_d = speed + accel * t
         ref = fourbar_closed_form(theta, theta_d, accel, branch)
         assert res.x[k, jb] == pytest.approx(theta - theta0, abs=1e-12)
+        assert res.xd[k, jb] == pytest.approx(theta_d, abs=1e-12)
+        assert res.xdd[k, jb] == accel
         assert abs(wrap(psi0 + res.x[k, jr] - ref["psi"])) < 1e-8
         assert res.xd[k, jr] == pytest.approx(ref["psi_d"], abs=1e-8 * (1 + abs(ref["psi_d"])))
         assert res.xdd[k, jr] == pytest.approx(ref["psi_dd"], abs=1e-8 * (1 + abs(ref["psi_dd"])))
