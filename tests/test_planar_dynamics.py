@@ -376,11 +376,11 @@ def test_cantilever_first_mode_time_domain():
     eta, eta_d = q @ Mbar @ v, qd @ Mbar @ v   # modal coordinate (Mbar-weighted projection)
     # Period: the modal velocity vanishes at t = T1 (turning point estimate as for the pendulum).
     period_error = eta_d[-1] / (w1**2 * eta[0])
-    assert abs(period_error) / T1 < 1e-6
+    assert abs(period_error) / T1 < 1e-7       # measured 2e-9
     assert eta / eta[0] == pytest.approx([1, 0, -1, 0, 1], abs=1e-5)
     # It stays in the mode shape.
-    assert np.abs(q[2] + q0).max() < 1e-4 * amplitude
-    assert np.abs(q[4] - q0).max() < 1e-4 * amplitude
+    assert np.abs(q[2] + q0).max() < 1e-6 * amplitude
+    assert np.abs(q[4] - q0).max() < 1e-6 * amplitude
 
 
 # --------------------------------------------------------------------------------------------
