@@ -1,6 +1,10 @@
 #include "spacar/dynamics.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <sstream>
+#include <vector>
 
 #include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
@@ -91,13 +95,22 @@ void solve_dynamics(const System& sys, Data& data) {
   if (data.llt.info() != Eigen::Success || nd == 0) {
     if (nd == 0) return;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(data.Mbar);
-    const Eigen::VectorXd v = eig.eigenvectors().col(0);
-    const double vmax = v.cwiseAbs().maxCoeff();
+    const Eigen::VectorXd& lam = eig.eigenvalues();  // ascending
+    // Every eigenvector of a (numerically) zero eigenvalue belongs to the null space; with
+    // several massless DOFs the null space has several dimensions and any single eigenvector
+    // names an arbitrary combination of them, so all of them are reported.
+    const double null_tol = 1e-12 * std::max(std::abs(lam[nd - 1]), std::numeric_limits<double>::min());
+    std::vector<bool> named(nd, false);
+    for (int i = 0; i < nd && (i == 0 || lam[i] <= null_tol); ++i) {
+      const Eigen::VectorXd v = eig.eigenvectors().col(i);
+      const double vmax = v.cwiseAbs().maxCoeff();
+      for (int j = 0; j < nd; ++j) named[j] = named[j] || std::abs(v[j]) >= 0.1 * vmax;
+    }
     std::ostringstream os;
     os << "the reduced mass matrix is singular at t = " << data.t << " (smallest eigenvalue "
-       << eig.eigenvalues()[0] << "): the degrees of freedom";
+       << lam[0] << "): the degrees of freedom";
     for (int j = 0; j < nd; ++j) {
-      if (std::abs(v[j]) < 0.1 * vmax) continue;
+      if (!named[j]) continue;
       const int col = sys.dof_cols[j];
       os << " [";
       for (int g = 0; g < sys.nx; ++g)

@@ -76,8 +76,10 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   try {
     evaluate(t, Y.data(), Y.data() + nd);
   } catch (const KinematicsError& err) {
+    kinematic_failure_ = err.what();
     throw StepRejected(err.what());
   }
+  kinematic_failure_.clear();
   dY.head(nd) = Y.segment(nd, nd);
   dY.tail(nd) = data_.qdd;
 }
@@ -130,6 +132,7 @@ BlockResults Simulation::run(const RunOptions& options) {
     for (double t : times) output(t, Y);
   } else {
     double t = t0, h = options.initial_step;
+    kinematic_failure_.clear();
     for (;;) {
       // One segment: integrate until the end, or until a free rotation must be repartitioned.
       Integrator integ(static_cast<int>(Y.size()), options.method);
@@ -144,7 +147,19 @@ BlockResults Simulation::run(const RunOptions& options) {
         integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
       const std::vector<double> remaining(times.begin() + k_out, times.end());
       auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
-      const double t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
+      double t_reached = t;
+      try {
+        t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
+      } catch (const IntegrationError& err) {
+        // The step collapsed because the kinematics has no solution (the last right-hand side
+        // failed in the Newton iteration): that is a KinematicsError (formulation.md §2.2).
+        if (kinematic_failure_.empty()) throw;
+        std::string integrator = err.what();
+        const size_t cut = integrator.find(" (last rejection");
+        if (cut != std::string::npos) integrator.resize(cut);
+        throw KinematicsError(kinematic_failure_ + "\nNo kinematic solution down to the minimum step (" +
+                              integrator + ").");
+      }
       const IntegratorStats& s = integ.stats();
       res.rhs_evaluations += s.nfev;
       res.steps += s.nsteps;

@@ -78,6 +78,7 @@ class Simulation {
   Eigen::VectorXd x_base_, qhat_base_, predictor_;
   std::unique_ptr<Linearizer> linearizer_;
   bool have_base_ = false;
+  std::string kinematic_failure_;  // message of the last right-hand side that failed in Newton
 };
 
 }  // namespace spacar
