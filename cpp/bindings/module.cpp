@@ -324,9 +324,19 @@ void bind_simulation(py::module_& m) {
             else if (method == "dopri5") opt.method = Method::DOPRI5;
             else throw InputError("unknown integration method '" + method + "' (dop853, dopri5)");
             if (!on_output.is_none()) {
-              opt.on_output = [on_output](int k, double t) {
+              opt.on_output = [on_output](int k, const Data& d) {
                 py::gil_scoped_acquire gil;
-                on_output(k, t);
+                py::dict state;
+                state["t"] = d.t;
+                state["x"] = d.x;
+                state["xd"] = d.xd;
+                state["xdd"] = d.xdd;
+                state["e"] = d.e;
+                state["ed"] = d.ed;
+                state["edd"] = d.edd;
+                state["sigma"] = d.sigma;
+                state["reaction"] = d.reaction;
+                on_output(k, state);
               };
             }
             BlockResults r;

@@ -122,7 +122,7 @@ BlockResults Simulation::run(const RunOptions& options) {
     if (st.forcemode >= 1 || linear) forces();
     if (linear) res.linearizations.push_back(linearize());
     record(res, k_out);
-    if (options.on_output) options.on_output(k_out, t);
+    if (options.on_output) options.on_output(k_out, data_);
     ++k_out;
   };
   Eigen::VectorXd Y(2 * nd);

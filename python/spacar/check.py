@@ -1,5 +1,7 @@
-"""Summary of a model: nodes and elements by type, coordinates and deformations per class,
-degrees of freedom (``spacar check``)."""
+"""Checks of a model before an analysis (``spacar check``): nodes and elements by type,
+coordinates and deformations per class, degrees of freedom, and the diagnosis of the constraint
+block — which rigid deformations are redundant and could be released, which coordinates are
+undetermined (formulation.md §2.3)."""
 from __future__ import annotations
 
 from collections import Counter
@@ -45,6 +47,42 @@ class Summary:
         return "\n".join(self.lines())
 
 
+@dataclass
+class Diagnosis:
+    """Solvability of the position constraints at the given geometry."""
+
+    n_constraints: int
+    n_calculable: int
+    rank: int
+    redundant: list      # (element, deformation): release these (RLSE) to remove the redundancy
+    undetermined: list   # (node, component): fix them, make them DOFs or add elements
+    text: str
+
+    @property
+    def ok(self) -> bool:
+        return not self.redundant and not self.undetermined and self.n_constraints == self.n_calculable
+
+
+@dataclass
+class Check:
+    summary: Summary
+    diagnosis: Diagnosis
+
+    def __str__(self):
+        verdict = "the constraints determine the calculable coordinates" if self.diagnosis.ok else "problems:"
+        return f"{self.summary}\nconstraints: {verdict}\n{self.diagnosis.text}"
+
+
+def check(model) -> Check:
+    """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly)."""
+    copy = model.copy()
+    copy.prepare()
+    d = _core.Simulation(copy._core).diagnose()
+    diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
+                          list(d["undetermined"]), d["text"])
+    return Check(summary(model), diagnosis)
+
+
 def summary(model) -> Summary:
     """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
     nodes are included (they are created at the first END)."""
@@ -58,4 +96,4 @@ def summary(model) -> Summary:
     return Summary(nodes, elements, coords, defs)
 
 
-__all__ = ["Summary", "summary", "_core"]
+__all__ = ["Summary", "Diagnosis", "Check", "summary", "check"]

@@ -24,6 +24,17 @@ def _comment(text: str, stream=sys.stdout):
         print(f"* {line}", file=stream)
 
 
+def _print_linearization(res) -> None:
+    """Eigenfrequencies at the end of a block that asked for linearization (LINE, LINEAR)."""
+    if not res.linearizations:
+        return
+    lin = res.linearizations[-1]
+    _comment(f"linearized equations at t = {lin.t:g}: {len(lin.z_labels)} coordinates")
+    _comment("eigenfrequencies [Hz] (negative: unstable): " + " ".join(f"{f:.6g}" for f in lin.eigenfrequencies()))
+    if res.settings_linear == 2:
+        _comment("buckling factors: " + " ".join(f"{m:.6g}" for m in lin.buckling_factors()))
+
+
 def _run(args) -> int:
     model = read(args.file)
     _comment(f"spacar {__version__}: {args.file}")
@@ -43,6 +54,7 @@ def _run(args) -> int:
         _comment(f"block {k + 1}: t = {res.t[0]:g} .. {res.t[-1]:g}, {len(res.t)} output times, "
                  f"{s['rhs_evaluations']} right-hand sides, {s['accepted']} steps "
                  f"({s['rejected']} rejected), {s['wall_time'] * 1e3:.1f} ms")
+        _print_linearization(res)
         sys.stdout.write(dump(model, digits=args.dump_digits))
         sys.stdout.flush()
     return 0
@@ -53,7 +65,7 @@ def _check(args) -> int:
     _comment(f"spacar check: {args.file}")
     for w in model.warnings:
         _comment(f"warning: {w}")
-    _comment(model.summary())
+    _comment(model.check())
     return 0
 
 

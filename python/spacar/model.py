@@ -357,6 +357,13 @@ class Model:
 
         return summary(self)
 
+    def check(self):
+        """Summary and constraint diagnosis (redundant deformations, undetermined coordinates);
+        see :mod:`spacar.check`."""
+        from .check import check
+
+        return check(self)
+
     def run(self, **kwargs):
         """Run the analysis of the current block; see :func:`spacar.simulate`."""
         from .simulate import simulate
