@@ -112,6 +112,8 @@ class Model:
 
     def _node(self, kind, args):
         n, values = self._call(kind, *args)
+        if not isinstance(values, list):  # BETA: a single value
+            values = [values]
         self._core.set_coordinates(n, _NODE_KIND[kind], values)
 
     def x(self, n, *values):
