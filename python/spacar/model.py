@@ -84,15 +84,22 @@ class Model:
         self.source = None     # input file name, when read from a file
         self.warnings = []     # reader and analysis warnings
         self._continue_step = 0.0  # integrator step to continue with (RESTART 0)
+        self._origin = ""      # input line being applied (file, line, keyword), for later messages
 
     # --- dispatch used by the reader ---------------------------------------------------------
 
-    def apply(self, keyword: str, *args):
-        """Apply one keyword line: ``model.apply("FIX", 8, 2)``."""
+    def apply(self, keyword: str, *args, origin: str = ""):
+        """Apply one keyword line: ``model.apply("FIX", 8, 2)``. ``origin`` (file, line, keyword)
+        is remembered with the elements and nodes the line defines, for errors found at the
+        first END (e.g. an element of zero length)."""
         kw = KEYWORDS.get(keyword.upper())
         if kw is None or kw.name in ("END", "EOF"):
             raise InputError(f"unknown keyword {keyword!r}")
-        return getattr(self, kw.builder)(*args)
+        self._origin = origin
+        try:
+            return getattr(self, kw.builder)(*args)
+        finally:
+            self._origin = ""
 
     def _call(self, name, *args):
         kw = KEYWORDS[name]
@@ -106,7 +113,7 @@ class Model:
         has_params = kw.params[-1].name == "params"
         nodes = vals[1:-1] if has_params else vals[1:]
         params = vals[-1] if has_params else []
-        self._core.add_element(type_name, vals[0], nodes, params)
+        self._core.add_element(type_name, vals[0], nodes, params, self._origin)
 
     # --- nodes ------------------------------------------------------------------------------
 
@@ -114,7 +121,7 @@ class Model:
         n, values = self._call(kind, *args)
         if not isinstance(values, list):  # BETA: a single value
             values = [values]
-        self._core.set_coordinates(n, _NODE_KIND[kind], values)
+        self._core.set_coordinates(n, _NODE_KIND[kind], values, self._origin)
 
     def x(self, n, *values):
         """X n x1..x4: coordinates of any node (usually one created by an element)."""

@@ -127,7 +127,7 @@ def apply_block(model: Model, block: Block) -> None:
     """Apply the commands of a block to the model, naming the line of any failing command."""
     for cmd in block.commands:
         try:
-            model.apply(cmd.keyword, *cmd.args)
+            model.apply(cmd.keyword, *cmd.args, origin=cmd.where())
         except SpacarError as err:
             raise type(err)(f"{cmd.where()}: {err}") from None
 
