@@ -19,9 +19,10 @@ from .io.writer import dump
 from .simulate import simulate
 
 
-def _comment(text: str, stream=sys.stdout):
+def _comment(text: str, stream=None):
+    # sys.stdout is looked up at call time, so that redirecting it (tests, embedding) works.
     for line in str(text).splitlines():
-        print(f"* {line}", file=stream)
+        print(f"* {line}", file=stream or sys.stdout)
 
 
 def _run(args) -> int:
