@@ -199,3 +199,15 @@ def test_dump_digits_option(capsys):
     assert re.search(r"^XY\s+3\s+-?\d\.\d{16}E[+-]\d\d\s", stdout, re.M), stdout
     restart = spacar.read_string(stdout)
     assert restart.current_time == 5.0
+
+
+@pytest.mark.parametrize("digits", ["0", "18", "x"])
+def test_dump_digits_out_of_range_is_a_usage_error(capsys, digits):
+    from spacar.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["run", "--dump-digits", digits, str(EXAMPLE)])
+    assert info.value.code == 2
+    out = capsys.readouterr()
+    assert "--dump-digits" in out.err and "Traceback" not in out.err
+    assert out.out == ""  # rejected before any analysis
