@@ -5,8 +5,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
-DATA = Path(__file__).resolve().parent / "data"
-MANUAL_OUTPUT = DATA / "manual_output.dat"
 
 
 @pytest.fixture

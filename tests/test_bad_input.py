@@ -7,6 +7,7 @@ found at the first END (zero length, unused node) are provoked with ``model.summ
 name the line that defined the element or node.
 """
 import re
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -15,7 +16,7 @@ from hypothesis import strategies as st
 import spacar
 from spacar import InputError
 
-from conftest import EXAMPLE
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
 
 BASE = EXAMPLE.read_text().splitlines()  # 23 lines, END on line 23
 

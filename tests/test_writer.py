@@ -8,12 +8,14 @@ the number format are checked, and that dumps are restartable input.
 """
 import math
 import re
+from pathlib import Path
 
 import pytest
 
 import spacar
 
-from conftest import EXAMPLE, MANUAL_OUTPUT
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
+MANUAL_OUTPUT = Path(__file__).resolve().parent / "data" / "manual_output.dat"
 
 INT_FIELD = re.compile(r"[+-]?\d+")
 REAL_FIELD = re.compile(r"-?\d\.\d{3}E[+-]\d{2}")  # %10.3E, as the manual prints
