@@ -43,10 +43,7 @@ void bind_errors(py::module_& m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& x) {
-      py::object err = py::reinterpret_borrow<py::object>(e.input)(x.what());
-      err.attr("element") = x.element;
-      err.attr("node") = x.node;
-      PyErr_SetObject(e.input.ptr(), err.ptr());
+      py::set_error(e.input, x.what());
     } catch (const KinematicsError& x) {
       py::set_error(e.kinematics, x.what());
     } catch (const SingularMassError& x) {
@@ -119,7 +116,8 @@ void bind_model(py::module_& m) {
       .def_readonly("force", &Node::force)
       .def_readonly("mass", &Node::mass)
       .def_readonly("torquel", &Node::torquel)
-      .def_readonly("used", &Node::used);
+      .def_readonly("used", &Node::used)
+      .def_readonly("origin", &Node::origin);
   py::class_<Element>(m, "Element")
       .def_readonly("id", &Element::id)
       .def_readonly("type", &Element::type)
@@ -137,7 +135,8 @@ void bind_model(py::module_& m) {
       .def_readonly("edd", &Element::edd)
       .def_readonly("e_given", &Element::e_given)
       .def_readonly("kinematic_of", &Element::kinematic_of)
-      .def_readonly("automatic", &Element::automatic);
+      .def_readonly("automatic", &Element::automatic)
+      .def_readonly("origin", &Element::origin);
   py::class_<Settings>(m, "Settings")
       .def_readonly("timestep_n", &Settings::timestep_n)
       .def_readonly("timestep_tp", &Settings::timestep_tp)
@@ -156,8 +155,10 @@ void bind_model(py::module_& m) {
   py::class_<Model>(m, "Model")
       .def(py::init<>())
       .def("copy", [](const Model& self) { return Model(self); })
-      .def("add_element", &Model::add_element)
-      .def("set_coordinates", &Model::set_coordinates)
+      .def("add_element", &Model::add_element, py::arg("type"), py::arg("id"), py::arg("nodes"),
+           py::arg("params"), py::arg("origin") = "")
+      .def("set_coordinates", &Model::set_coordinates, py::arg("node"), py::arg("kind"), py::arg("values"),
+           py::arg("origin") = "")
       .def("set_coordinate_class", &Model::set_coordinate_class)
       .def("set_deformation_class", &Model::set_deformation_class)
       .def("set_nonholonomic", &Model::set_nonholonomic)

@@ -35,12 +35,13 @@ class Summary:
     def lines(self):
         def fmt(counter, order=None):
             keys = order or sorted(counter)
-            return ", ".join(f"{counter[k]} {k}" for k in keys if counter[k])
+            parts = ", ".join(f"{counter[k]} {k}" for k in keys if counter[k])
+            return f"{sum(counter.values())} ({parts})" if parts else "0"
 
-        yield f"nodes: {sum(self.nodes.values())} ({fmt(self.nodes)})"
-        yield f"elements: {sum(self.elements.values())} ({fmt(self.elements)})"
-        yield f"nodal coordinates: {self.n_coordinates} ({fmt(self.coordinates, COORD_CLASSES)})"
-        yield f"deformations: {self.n_deformations} ({fmt(self.deformations, DEF_CLASSES)})"
+        yield f"nodes: {fmt(self.nodes)}"
+        yield f"elements: {fmt(self.elements)}"
+        yield f"nodal coordinates: {fmt(self.coordinates, COORD_CLASSES)}"
+        yield f"deformations: {fmt(self.deformations, DEF_CLASSES)}"
         yield f"degrees of freedom: {self.degrees_of_freedom}"
 
     def __str__(self):
@@ -75,6 +76,8 @@ class Check:
 
 def check(model) -> Check:
     """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly)."""
+    if not model.nodes and not model.elements:
+        return Check(summary(model), Diagnosis(0, 0, 0, [], [], "  the model is empty"))
     copy = model.copy()
     copy.prepare()
     d = _core.Simulation(copy._core).diagnose()
@@ -85,10 +88,12 @@ def check(model) -> Check:
 
 def summary(model) -> Summary:
     """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
-    nodes are included (they are created at the first END)."""
-    copy = model.copy()
-    copy.prepare()
-    core = copy._core
+    nodes are included (they are created at the first END). An empty model (e.g. an input of
+    comments only) has all counts zero."""
+    core = model._core.copy()
+    if not core.nodes and not core.elements:
+        return Summary(Counter(), Counter(), Counter(), Counter())
+    core.prepare()
     nodes = Counter(str(n.kind.name) for n in core.nodes.values())
     elements = Counter(el.type_name for el in core.elements.values())
     coords = Counter(c.name for n in core.nodes.values() for c in n.cls)

@@ -19,9 +19,10 @@ from .io.writer import dump
 from .simulate import simulate
 
 
-def _comment(text: str, stream=sys.stdout):
+def _comment(text: str, stream=None):
+    # sys.stdout is looked up at call time, so that redirecting it (tests, embedding) works.
     for line in str(text).splitlines():
-        print(f"* {line}", file=stream)
+        print(f"* {line}", file=stream or sys.stdout)
 
 
 def _print_linearization(res) -> None:
@@ -69,13 +70,20 @@ def _check(args) -> int:
     return 0
 
 
+def _digits(text: str) -> int:
+    value = int(text)
+    if not 1 <= value <= 17:
+        raise argparse.ArgumentTypeError(f"must be between 1 and 17, got {value}")
+    return value
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="spacar", description="Kinematic and dynamic analysis of multibody systems (SPACAR95 input format).")
     parser.add_argument("--version", action="version", version=f"spacar {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run the analysis of every block and print the state dumps")
     run.add_argument("file")
-    run.add_argument("--dump-digits", type=int, default=4, metavar="N",
+    run.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                      help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
     run.add_argument("--method", choices=["dop853", "dopri5"], default="dop853", help="integration method")
     run.set_defaults(func=_run)
