@@ -23,17 +23,82 @@ Data::Data(const System& sys) {
   target = residual = Eigen::VectorXd::Zero(nP);
   e_integrated = sys.e_target;
   angle_ref = Eigen::VectorXd::Constant(ne, std::numeric_limits<double>::quiet_NaN());
-  A = Eigen::MatrixXd::Zero(std::max(nP, nV), nc);
-  rhs_DF = Eigen::MatrixXd::Zero(nV, nq);
-  DF = Eigen::MatrixXd::Zero(nx, nq);
-  DFe = Eigen::MatrixXd::Zero(ne, nq);
   acc0 = Eigen::VectorXd::Zero(nx);
   step = Eigen::VectorXd::Zero(std::max(nc, std::max(nP, nV)));
+  rhs_V = Eigen::VectorXd::Zero(nV);
+  sol_V = Eigen::VectorXd::Zero(nc);
+  h = f = g = reaction = acc_known = Eigen::VectorXd::Zero(nx);
+  rhs = qdd = Eigen::VectorXd::Zero(nd);
+  body_M.assign(sys.bodies.size(), Eigen::Matrix4d::Zero());
+  body_h.assign(sys.bodies.size(), Eigen::Vector4d::Zero());
+  build_constraint_blocks(sys);
+  build_equations_of_motion(sys);
+}
+
+void Data::build_constraint_blocks(const System& sys) {
+  const int nc = static_cast<int>(sys.x_calc.size());
+  AP.reset(static_cast<int>(sys.rows_P.size()), nc);
+  AV.reset(static_cast<int>(sys.rows_V.size()), nc);
+  for (const SystemElement& se : sys.elements) {
+    std::vector<int> rp(se.nd), rv(se.nd), cols(se.coords.size());
+    for (int a = 0; a < se.nd; ++a) {
+      rp[a] = sys.row_P[se.def_offset + a];
+      rv[a] = sys.row_V[se.def_offset + a];
+    }
+    for (size_t j = 0; j < se.coords.size(); ++j) cols[j] = sys.calc_pos[se.coords[j]];
+    AP_block.push_back(AP.add_block(rp, cols));
+    AV_block.push_back(AV.add_block(rv, cols));
+  }
+  AP.finalize();
+  AV.finalize();
+  if (AP.rows() == nc) luP.analyze(AP.matrix());
+  if (AV.rows() == nc) luV.analyze(AV.matrix());
+}
+
+void Data::build_equations_of_motion(const System& sys) {
+  free_index.assign(sys.nx, -1);
+  for (int g : sys.x_calc) free_index[g] = n_free++;
+  for (int g : sys.x_dyn) free_index[g] = n_free++;
+  c_row.assign(sys.ne, -1);
+  for (int k : sys.rows_V)
+    if (sys.def_class[k] != DefClass::Dynamic) c_row[k] = n_c_rows++;
+  const int n = n_free + n_c_rows;
+  KKT.reset(n, n);
+  for (const SystemElement& se : sys.elements) {
+    std::vector<int> fi(se.coords.size()), cr(se.nd, -1);
+    for (size_t j = 0; j < se.coords.size(); ++j) fi[j] = free_index[se.coords[j]];
+    bool any_row = false;
+    for (int a = 0; a < se.nd; ++a) {
+      const int r = c_row[se.def_offset + a];
+      cr[a] = r >= 0 ? n_free + r : -1;
+      any_row = any_row || r >= 0;
+    }
+    KKT_mass.push_back(se.has_mass ? KKT.add_block(fi, fi) : -1);
+    KKT_B.push_back(any_row ? KKT.add_block(cr, fi) : -1);
+    KKT_Bt.push_back(any_row ? KKT.add_block(fi, cr) : -1);
+  }
+  for (int g = 0; g < sys.nx; ++g)
+    KKT_point.push_back(sys.point_mass[g] != 0.0 ? KKT.add_block({free_index[g]}, {free_index[g]}) : -1);
+  for (const BodyInertia& b : sys.bodies) {
+    std::vector<int> fi(4);
+    for (int i = 0; i < 4; ++i) fi[i] = free_index[b.coord + i];
+    KKT_body.push_back(KKT.add_block(fi, fi));
+  }
+  KKT.finalize();
+  luK.analyze(KKT.matrix());
+  kkt_rhs = kkt_sol = Eigen::VectorXd::Zero(n);
+}
+
+void Data::ensure_dense(const System& sys) {
+  if (dense_ready) return;
+  const int nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
+  rhs_DF = Eigen::MatrixXd::Zero(static_cast<int>(sys.rows_V.size()), nq);
+  DF = Eigen::MatrixXd::Zero(nx, nq);
+  DFe = Eigen::MatrixXd::Zero(ne, nq);
   M = Eigen::MatrixXd::Zero(nx, nx);
-  h = f = g = reaction = Eigen::VectorXd::Zero(nx);
   DFq = Eigen::MatrixXd::Zero(nx, nd);
   Mbar = Eigen::MatrixXd::Zero(nd, nd);
-  rhs = qdd = Eigen::VectorXd::Zero(nd);
+  dense_ready = true;
 }
 
 }  // namespace spacar

@@ -18,12 +18,48 @@ bool constitutive_class(DefClass c) {
   return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
 }
 
-// Rigid bodies on LAMBDA nodes and body-fixed torques (formulation.md §3.2, §3.4).
-void add_bodies(const System& sys, Data& data) {
-  for (const BodyInertia& b : sys.bodies)
-    add_rotational_inertia(sys.nx, data.x.data(), data.xd.data(), &b.coord, 1, &b.J, data.M.data(), data.h.data());
-  for (const auto& [coord, T] : sys.torquel)
-    data.f.segment<4>(coord) += 2.0 * euler_G(data.x.data() + coord).transpose() * T;
+// The DOFs with the largest components of the null vector of M̄: those that move no mass.
+[[noreturn]] void throw_singular_mass(const System& sys, const Data& data, const Eigen::MatrixXd& Mbar) {
+  const int nd = sys.n_dof();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Mbar);
+  const Eigen::VectorXd lam = eig.eigenvalues();
+  const double tol = 1e-10 * std::max(lam.cwiseAbs().maxCoeff(), 1e-300);
+  std::vector<bool> named(nd, false);
+  for (int m = 0; m < nd && (m == 0 || lam[m] <= tol); ++m) {
+    const Eigen::VectorXd v = eig.eigenvectors().col(m);
+    const double vmax = v.cwiseAbs().maxCoeff();
+    for (int j = 0; j < nd; ++j) named[j] = named[j] || std::abs(v[j]) >= 0.1 * vmax;
+  }
+  std::ostringstream os;
+  os << "the reduced mass matrix is singular at t = " << data.t << " (smallest eigenvalue " << lam[0]
+     << "): the degrees of freedom";
+  for (int j = 0; j < nd; ++j) {
+    if (!named[j]) continue;
+    const int col = sys.dof_cols[j];
+    os << " [";
+    for (int g = 0; g < sys.nx; ++g)
+      if (sys.qhat_col_x[g] == col) os << "DYNX " << sys.coord_name(g);
+    for (int k = 0; k < sys.ne; ++k)
+      if (sys.qhat_col_e[k] == col) os << "DYNE " << sys.def_name(k);
+    os << "]";
+  }
+  os << " move no mass; add MASS or EMASS to the nodes or elements they move";
+  throw SingularMassError(os.str());
+}
+
+// out = M acc, element by element (point masses, element masses, rigid bodies).
+void inertia_times(const System& sys, const Data& data, const Eigen::VectorXd& acc, Eigen::VectorXd& out) {
+  out = sys.point_mass.cwiseProduct(acc);
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    if (!se.has_mass) continue;
+    const ElementWork& w = data.work[i];
+    const int n = static_cast<int>(se.coords.size());
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) out[se.coords[a]] += w.M(a, b) * acc[se.coords[b]];
+  }
+  for (size_t b = 0; b < sys.bodies.size(); ++b)
+    out.segment<4>(sys.bodies[b].coord) += data.body_M[b] * acc.segment<4>(sys.bodies[b].coord);
 }
 
 }  // namespace
@@ -41,13 +77,11 @@ void constitutive_stresses(const System& sys, Data& data) {
   }
 }
 
-void assemble_inertia_and_loads(const System& sys, Data& data) {
-  data.M.setZero();
+void compute_inertia_and_loads(const System& sys, Data& data) {
   data.h.setZero();
   data.f = sys.force;
-  for (int g = 0; g < sys.nx; ++g) data.M(g, g) = sys.point_mass[g];
-  // Gravity on point masses (position coordinates only).
-  if (sys.gravity.squaredNorm() > 0.0) {
+  const bool gravity = sys.gravity.squaredNorm() > 0.0;
+  if (gravity) {  // on point masses (position coordinates only)
     for (int g = 0; g < sys.nx; ++g) {
       const NodeKind k = sys.coord_node_kind[g];
       if ((k == NodeKind::XY || k == NodeKind::XYZ) && sys.point_mass[g] != 0.0)
@@ -60,25 +94,52 @@ void assemble_inertia_and_loads(const System& sys, Data& data) {
     ElementWork& w = data.work[i];
     const int n = static_cast<int>(se.coords.size());
     se.kernel->mass(w.x.data(), w.v.data(), w.M.data(), w.h.data());
-    for (int a = 0; a < n; ++a) {
-      data.h[se.coords[a]] += w.h[a];
-      for (int b = 0; b < n; ++b) data.M(se.coords[a], se.coords[b]) += w.M(a, b);
-    }
-    if (sys.gravity.squaredNorm() > 0.0) {
+    for (int a = 0; a < n; ++a) data.h[se.coords[a]] += w.h[a];
+    if (gravity) {
       se.kernel->gravity(w.x.data(), sys.gravity.data(), w.f.data());
       for (int a = 0; a < n; ++a) data.f[se.coords[a]] += w.f[a];
     }
   }
-  add_bodies(sys, data);
+  // Rigid bodies on LAMBDA nodes and body-fixed torques (formulation.md §3.2, §3.4).
+  const int four[1] = {0};
+  for (size_t b = 0; b < sys.bodies.size(); ++b) {
+    const int c = sys.bodies[b].coord;
+    data.body_M[b].setZero();
+    data.body_h[b].setZero();
+    add_rotational_inertia(4, data.x.data() + c, data.xd.data() + c, four, 1, &sys.bodies[b].J,
+                           data.body_M[b].data(), data.body_h[b].data());
+    data.h.segment<4>(c) += data.body_h[b];
+  }
+  for (const auto& [coord, T] : sys.torquel)
+    data.f.segment<4>(coord) += 2.0 * euler_G(data.x.data() + coord).transpose() * T;
+}
+
+void inertia_force(const System& sys, Data& data) {
+  inertia_times(sys, data, data.xdd, data.g);
+  data.g += data.h - data.f;
+}
+
+void assemble_mass_matrix(const System& sys, Data& data) {
+  data.ensure_dense(sys);
+  data.M.setZero();
+  data.M.diagonal() = sys.point_mass;
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    if (!se.has_mass) continue;
+    const int n = static_cast<int>(se.coords.size());
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) data.M(se.coords[a], se.coords[b]) += data.work[i].M(a, b);
+  }
+  for (size_t b = 0; b < sys.bodies.size(); ++b)
+    data.M.block<4, 4>(sys.bodies[b].coord, sys.bodies[b].coord) += data.body_M[b];
 }
 
 void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R) {
   const int nd = sys.n_dof();
   solve_accelerations(sys, data);
-  assemble_inertia_and_loads(sys, data);
+  compute_inertia_and_loads(sys, data);
   constitutive_stresses(sys, data);
-  data.g.noalias() = data.M * data.xdd;
-  data.g += data.h - data.f;
+  inertia_force(sys, data);
   for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
   R.noalias() = data.DFq.transpose() * data.g;
   for (int j = 0; j < nd; ++j) R[j] += data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
@@ -90,41 +151,99 @@ void solve_dynamics(const System& sys, Data& data) {
   for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = 0.0;
   reduced_residual(sys, data, data.rhs);
   data.rhs = -data.rhs;
+  assemble_mass_matrix(sys, data);
   data.Mbar.noalias() = data.DFq.transpose() * data.M * data.DFq;
   data.llt.compute(data.Mbar);
-  if (data.llt.info() != Eigen::Success || nd == 0) {
-    if (nd == 0) return;
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(data.Mbar);
-    const Eigen::VectorXd& lam = eig.eigenvalues();  // ascending
-    // Every eigenvector of a (numerically) zero eigenvalue belongs to the null space; with
-    // several massless DOFs the null space has several dimensions and any single eigenvector
-    // names an arbitrary combination of them, so all of them are reported.
-    const double null_tol = 1e-12 * std::max(std::abs(lam[nd - 1]), std::numeric_limits<double>::min());
-    std::vector<bool> named(nd, false);
-    for (int i = 0; i < nd && (i == 0 || lam[i] <= null_tol); ++i) {
-      const Eigen::VectorXd v = eig.eigenvectors().col(i);
-      const double vmax = v.cwiseAbs().maxCoeff();
-      for (int j = 0; j < nd; ++j) named[j] = named[j] || std::abs(v[j]) >= 0.1 * vmax;
-    }
-    std::ostringstream os;
-    os << "the reduced mass matrix is singular at t = " << data.t << " (smallest eigenvalue "
-       << lam[0] << "): the degrees of freedom";
-    for (int j = 0; j < nd; ++j) {
-      if (!named[j]) continue;
-      const int col = sys.dof_cols[j];
-      os << " [";
-      for (int g = 0; g < sys.nx; ++g)
-        if (sys.qhat_col_x[g] == col) os << "DYNX " << sys.coord_name(g);
-      for (int k = 0; k < sys.ne; ++k)
-        if (sys.qhat_col_e[k] == col) os << "DYNE " << sys.def_name(k);
-      os << "]";
-    }
-    os << " move no mass; add MASS or EMASS to the nodes or elements they move";
-    throw SingularMassError(os.str());
-  }
+  if (nd == 0) return;
+  if (data.llt.info() != Eigen::Success) throw_singular_mass(sys, data, data.Mbar);
   data.qdd = data.llt.solve(data.rhs);
   for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
   solve_accelerations(sys, data);
+}
+
+void solve_dynamics_direct(const System& sys, Data& data) {
+  const int nd = sys.n_dof();
+  const int nf = data.n_free;
+  compute_inertia_and_loads(sys, data);
+  constitutive_stresses(sys, data);
+  // Known accelerations: the inputs'. g = M ẍ_known + h − f + B_Wᵀ σ^W on every coordinate.
+  data.acc_known.setZero();
+  for (int g : sys.x_input) data.acc_known[g] = data.qhat_dd[sys.qhat_col_x[g]];
+  inertia_times(sys, data, data.acc_known, data.g);
+  data.g += data.h - data.f;
+  data.KKT.set_zero();
+  data.kkt_rhs.setZero();
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    ElementWork& w = data.work[i];
+    if (data.KKT_mass[i] >= 0) data.KKT.add(data.KKT_mass[i], w.M);
+    for (int a = 0; a < se.nd; ++a) {
+      const int k = se.def_offset + a;
+      if (data.sigma[k] != 0.0)
+        for (size_t j = 0; j < se.coords.size(); ++j) data.g[se.coords[j]] += w.B(a, j) * data.sigma[k];
+    }
+    if (data.KKT_B[i] < 0) continue;
+    data.KKT.add(data.KKT_B[i], w.B);
+    data.KKT.add_transposed(data.KKT_Bt[i], w.B);
+    // Constraint rows: B_C ẍ_f = ë^C − c^C − B_C ẍ_known, ë^C = p̈ for inputs, 0 otherwise.
+    for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.acc_known[se.coords[j]];
+    for (int a = 0; a < se.nd; ++a) {
+      const int r = data.c_row[se.def_offset + a];
+      if (r < 0) continue;
+      const int col = sys.qhat_col_e[se.def_offset + a];
+      data.kkt_rhs[nf + r] = (col >= 0 ? data.qhat_dd[col] : 0.0) - w.c[a] - w.B.row(a).dot(w.a);
+    }
+  }
+  for (int g = 0; g < sys.nx; ++g)
+    if (data.KKT_point[g] >= 0) data.KKT.add_value(data.KKT_point[g], 0, 0, sys.point_mass[g]);
+  for (size_t b = 0; b < sys.bodies.size(); ++b) data.KKT.add(data.KKT_body[b], data.body_M[b]);
+  for (int g = 0; g < sys.nx; ++g)
+    if (data.free_index[g] >= 0) data.kkt_rhs[data.free_index[g]] = -data.g[g];
+  if (!data.luK.factorize(data.KKT.matrix())) {
+    // Name the degrees of freedom without inertia through the reduced equations.
+    solve_transfer(sys, data);
+    solve_velocities(sys, data);
+    solve_dynamics(sys, data);
+    throw SingularMassError("the equations of motion are singular at t = " + std::to_string(data.t));
+  }
+  data.luK.solve(data.kkt_rhs, data.kkt_sol);
+  data.xdd = data.acc_known;
+  for (int g = 0; g < sys.nx; ++g)
+    if (data.free_index[g] >= 0) data.xdd[g] = data.kkt_sol[data.free_index[g]];
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    ElementWork& w = data.work[i];
+    for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.xdd[se.coords[j]];
+    data.edd.segment(se.def_offset, se.nd).noalias() = w.B * w.a + w.c;
+  }
+  // Stresses of the constraint rows are the multipliers: the reactions of (6.1).
+  for (int k = 0; k < sys.ne; ++k)
+    if (data.c_row[k] >= 0) data.sigma[k] = data.kkt_sol[nf + data.c_row[k]];
+  int j = 0;
+  for (int g : sys.x_dyn) data.qdd[j++] = data.xdd[g];
+  for (int k : sys.e_dyn) data.qdd[j++] = data.edd[k];
+  for (j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
+  if (!data.qdd.allFinite() || !data.xdd.allFinite())
+    throw SingularMassError("the equations of motion have no finite solution at t = " + std::to_string(data.t));
+}
+
+void nodal_reactions(const System& sys, Data& data) {
+  // r = M ẍ + h − f + Bᵀσ on fixed and input coordinates (6.2), σ complete.
+  inertia_force(sys, data);
+  data.reaction = data.g;
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const ElementWork& w = data.work[i];
+    for (int a = 0; a < se.nd; ++a) {
+      const double s = data.sigma[se.def_offset + a];
+      if (s != 0.0)
+        for (size_t j = 0; j < se.coords.size(); ++j) data.reaction[se.coords[j]] += w.B(a, j) * s;
+    }
+  }
+  for (int g = 0; g < sys.nx; ++g) {
+    const CoordClass c = sys.coord_class[g];
+    if (c != CoordClass::Fixed && c != CoordClass::Input) data.reaction[g] = 0.0;
+  }
 }
 
 Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::VectorXd& sigma) {
@@ -164,7 +283,11 @@ Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::
   return K;
 }
 
-double kinetic_energy(const System&, const Data& data) { return 0.5 * data.xd.dot(data.M * data.xd); }
+double kinetic_energy(const System& sys, const Data& data) {
+  Eigen::VectorXd Mv;
+  inertia_times(sys, data, data.xd, Mv);
+  return 0.5 * data.xd.dot(Mv);
+}
 
 double potential_energy(const System& sys, const Data& data) {
   double V = 0.0;

@@ -50,22 +50,10 @@ void compute_residual(const System& sys, Data& data) {
   for (size_t r = 0; r < sys.rows_P.size(); ++r) data.residual[r] = data.e[sys.rows_P[r]] - data.target[r];
 }
 
-// A(rows, x^c) from the element derivatives, for the rows given by row_of (row_P or row_V).
-void assemble_block(const System& sys, Data& data, const std::vector<int>& row_of, int n_rows) {
-  auto A = data.A.topRows(n_rows);
-  A.setZero();
-  for (size_t i = 0; i < sys.elements.size(); ++i) {
-    const SystemElement& se = sys.elements[i];
-    const Eigen::MatrixXd& B = data.work[i].B;
-    for (int a = 0; a < se.nd; ++a) {
-      const int r = row_of[se.def_offset + a];
-      if (r < 0) continue;
-      for (size_t j = 0; j < se.coords.size(); ++j) {
-        const int c = sys.calc_pos[se.coords[j]];
-        if (c >= 0) A(r, c) += B(a, j);
-      }
-    }
-  }
+// A block of rows (AP: positions, AV: velocities) from the element derivatives B.
+void assemble_block(const System& sys, Data& data, BlockMatrix& A, const std::vector<int>& block) {
+  A.set_zero();
+  for (size_t i = 0; i < sys.elements.size(); ++i) A.add(block[i], data.work[i].B);
 }
 
 // A number for a message: non-finite values are named as such, never printed as "nan".
@@ -97,21 +85,21 @@ double max_abs(const Eigen::VectorXd& v) {
   return v.size() ? v.cwiseAbs().maxCoeff() : 0.0;
 }
 
-// Factorize the current block; a (numerically) singular block raises the diagnosis.
-void factorize(const System& sys, Data& data, int n_rows, const char* what) {
-  const int nc = static_cast<int>(sys.x_calc.size());
-  if (nc == 0) return;
-  data.lu.compute(data.A.topRows(n_rows));
-  // An exactly zero pivot makes Eigen's estimate NaN (0/0): report it as 0, never as "nan".
-  const double rc_estimate = data.lu.rcond();
-  const double rc = std::isfinite(rc_estimate) ? rc_estimate : 0.0;
-  if (!(rc > 1e-13)) {
+// Factorize a block; a (numerically) singular block raises the diagnosis.
+void factorize(const System& sys, Data& data, const BlockMatrix& A, LinearSolver& lu, const char* what) {
+  if (sys.x_calc.empty()) return;
+  if (!lu.factorize(A.matrix())) {
     std::ostringstream os;
-    os << "the " << what << " constraint block is singular at t = " << data.t << " (reciprocal condition "
-       << rc << ").\n"
+    os << "the " << what << " constraint block is singular at t = " << data.t << ".\n"
        << diagnose_constraints(sys, data);
     throw KinematicsError(os.str());
   }
+}
+
+// Assemble and factorize the velocity block A_V at the current positions.
+void factorize_velocity_block(const System& sys, Data& data) {
+  assemble_block(sys, data, data.AV, data.AV_block);
+  factorize(sys, data, data.AV, data.luV, "velocity");
 }
 
 }  // namespace
@@ -147,7 +135,6 @@ void check_constraint_counts(const System& sys, Data& data) {
 }
 
 void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly) {
-  const int nP = static_cast<int>(sys.rows_P.size());
   const int nc = static_cast<int>(sys.x_calc.size());
   set_targets(sys, data);
   evaluate_elements(sys, data);
@@ -167,9 +154,10 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
     converged = rmax <= tol;
     if (it == limit && !converged) break;
     history << (it ? ", " : "") << rmax;
-    assemble_block(sys, data, sys.row_P, nP);
-    factorize(sys, data, nP, "position");
-    data.step.head(nc) = data.lu.solve(data.residual);
+    assemble_block(sys, data, data.AP, data.AP_block);
+    factorize(sys, data, data.AP, data.luP, "position");
+    data.luP.solve(data.residual, data.sol_V);
+    data.step.head(nc) = data.sol_V;
     double lambda = 1.0;
     const double norm0 = data.residual.norm();
     for (int back = 0;; ++back) {
@@ -205,9 +193,8 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
 }
 
 void solve_transfer(const System& sys, Data& data) {
-  const int nV = static_cast<int>(sys.rows_V.size());
+  data.ensure_dense(sys);
   const int nc = static_cast<int>(sys.x_calc.size());
-  const int nq = sys.n_qhat();
   // Right-hand sides: −∂D^V/∂x̄ for the independent coordinates, unit rates of e^p and e^d.
   data.rhs_DF.setZero();
   for (size_t i = 0; i < sys.elements.size(); ++i) {
@@ -228,9 +215,9 @@ void solve_transfer(const System& sys, Data& data) {
   for (int g = 0; g < sys.nx; ++g)
     if (sys.qhat_col_x[g] >= 0) data.DF(g, sys.qhat_col_x[g]) = 1.0;
   if (nc > 0) {
-    assemble_block(sys, data, sys.row_V, nV);
-    factorize(sys, data, nV, "velocity");
-    const Eigen::MatrixXd sol = data.lu.solve(data.rhs_DF);
+    factorize_velocity_block(sys, data);
+    Eigen::MatrixXd sol(nc, data.rhs_DF.cols());
+    data.luV.solve(data.rhs_DF, sol);
     for (int j = 0; j < nc; ++j) data.DF.row(sys.x_calc[j]) = sol.row(j);
   }
   // DFe = B DF, element by element.
@@ -241,12 +228,11 @@ void solve_transfer(const System& sys, Data& data) {
     for (size_t j = 0; j < se.coords.size(); ++j)
       data.DFe.middleRows(se.def_offset, se.nd).noalias() += B.col(j) * data.DF.row(se.coords[j]);
   }
-  (void)nq;
 }
 
-void solve_velocities(const System& sys, Data& data) {
-  data.xd.noalias() = data.DF * data.qhat_d;
-  data.ed.noalias() = data.DFe * data.qhat_d;
+namespace {
+// Convective terms c of all deformations at the current positions and velocities.
+void convective_terms(const System& sys, Data& data) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
     ElementWork& w = data.work[i];
@@ -254,16 +240,55 @@ void solve_velocities(const System& sys, Data& data) {
     se.kernel->convective(w.x.data(), w.v.data(), w.c.data());
     data.conv.segment(se.def_offset, se.nd) = w.c;
   }
+}
+}  // namespace
+
+void solve_velocities(const System& sys, Data& data) {
+  data.xd.noalias() = data.DF * data.qhat_d;
+  data.ed.noalias() = data.DFe * data.qhat_d;
+  convective_terms(sys, data);
   // acc0: accelerations at q̂̈ = 0; calculable rows from A_V ẍ^c = −c^V.
   data.acc0.setZero();
   const int nc = static_cast<int>(sys.x_calc.size());
   if (nc > 0) {
-    const int nV = static_cast<int>(sys.rows_V.size());
-    Eigen::VectorXd::SegmentReturnType cv = data.step.head(nV);
-    for (int r = 0; r < nV; ++r) cv[r] = -data.conv[sys.rows_V[r]];
-    const Eigen::VectorXd sol = data.lu.solve(cv);
-    for (int j = 0; j < nc; ++j) data.acc0[sys.x_calc[j]] = sol[j];
+    for (size_t r = 0; r < sys.rows_V.size(); ++r) data.rhs_V[r] = -data.conv[sys.rows_V[r]];
+    data.luV.solve(data.rhs_V, data.sol_V);
+    for (int j = 0; j < nc; ++j) data.acc0[sys.x_calc[j]] = data.sol_V[j];
   }
+}
+
+void solve_velocities_direct(const System& sys, Data& data) {
+  // Known rates: inputs and DOF coordinates; fixed coordinates rest.
+  data.xd.setZero();
+  for (int g : sys.x_input) data.xd[g] = data.qhat_d[sys.qhat_col_x[g]];
+  for (int g : sys.x_dyn) data.xd[g] = data.qhat_d[sys.qhat_col_x[g]];
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc > 0) {
+    factorize_velocity_block(sys, data);
+    // A_V ẋ^c = ė^V − B_{V,x̄} ẋ_x̄, ė^V the known rates (inputs, DOFs; 0 for the rest).
+    for (size_t r = 0; r < sys.rows_V.size(); ++r) {
+      const int col = sys.qhat_col_e[sys.rows_V[r]];
+      data.rhs_V[r] = col >= 0 ? data.qhat_d[col] : 0.0;
+    }
+    for (size_t i = 0; i < sys.elements.size(); ++i) {
+      const SystemElement& se = sys.elements[i];
+      const Eigen::MatrixXd& B = data.work[i].B;
+      for (int a = 0; a < se.nd; ++a) {
+        const int r = sys.row_V[se.def_offset + a];
+        if (r < 0) continue;
+        for (size_t j = 0; j < se.coords.size(); ++j) data.rhs_V[r] -= B(a, j) * data.xd[se.coords[j]];
+      }
+    }
+    data.luV.solve(data.rhs_V, data.sol_V);
+    for (int j = 0; j < nc; ++j) data.xd[sys.x_calc[j]] = data.sol_V[j];
+  }
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    ElementWork& w = data.work[i];
+    for (size_t j = 0; j < se.coords.size(); ++j) w.v[j] = data.xd[se.coords[j]];
+    data.ed.segment(se.def_offset, se.nd).noalias() = w.B * w.v;
+  }
+  convective_terms(sys, data);
 }
 
 void solve_accelerations(const System& sys, Data& data) {
@@ -308,8 +333,8 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data) {
   d.n_calculable = nc;
   if (nP > 0 && nc > 0) {
     evaluate_elements(sys, data);
-    assemble_block(sys, data, sys.row_P, nP);
-    const Eigen::MatrixXd A = data.A.topRows(nP);
+    assemble_block(sys, data, data.AP, data.AP_block);
+    const Eigen::MatrixXd A = Eigen::MatrixXd(data.AP.matrix());
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const Eigen::VectorXd& s = svd.singularValues();
     const double tol = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(s[0], 1e-300);
@@ -374,5 +399,25 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data) {
 }
 
 std::string diagnose_constraints(const System& sys, Data& data) { return diagnose(sys, data).text; }
+
+std::string weakest_constraint(const System& sys, Data& data) {
+  const int nV = static_cast<int>(sys.rows_V.size()), nc = static_cast<int>(sys.x_calc.size());
+  if (nV != nc || nc == 0) return "";
+  assemble_block(sys, data, data.AV, data.AV_block);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(data.AV.matrix()), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd& s = svd.singularValues();
+  const double ratio = s[nc - 1] / s[0];
+  if (!(ratio < 1e-6)) return "";
+  std::ostringstream os;
+  os << "  the velocity constraint block is nearly singular (smallest/largest singular value " << ratio
+     << ");\n  constraints that lose their independence:";
+  const Eigen::VectorXd u = svd.matrixU().col(nc - 1), v = svd.matrixV().col(nc - 1);
+  for (int r = 0; r < nV; ++r)
+    if (std::abs(u[r]) > 0.1 * u.cwiseAbs().maxCoeff()) os << " " << sys.def_name(sys.rows_V[r]);
+  os << "\n  coordinates of the singular motion:";
+  for (int j = 0; j < nc; ++j)
+    if (std::abs(v[j]) > 0.1 * v.cwiseAbs().maxCoeff()) os << " " << sys.coord_name(sys.x_calc[j]);
+  return os.str();
+}
 
 }  // namespace spacar

@@ -33,7 +33,7 @@ Eigen::MatrixXd global_constitutive(const System& sys, bool damping) {
 }  // namespace
 
 Linearizer::Linearizer(const Model& model, const std::map<int, int>& dependent)
-    : lin_(compile(model, dependent, true)), ld_(*lin_) {}
+    : lin_(compile(model, dependent, true)), ld_(std::make_unique<Data>(*lin_)) {}
 
 void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd) {
   const System& L = *lin_;
@@ -43,20 +43,20 @@ void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd) {
     q[order_[i]] = z[i];
     qd[order_[i]] = zd[i];
   }
-  set_inputs(L, ld_, ld_.t);
-  set_dofs(L, ld_, q.data(), qd.data());
+  set_inputs(L, *ld_, ld_->t);
+  set_dofs(L, *ld_, q.data(), qd.data());
   const double tol = std::min(L.settings.epskin, 1e-10);
-  solve_positions(L, ld_, std::max(L.settings.maxiterat, 50), tol, false);
-  solve_transfer(L, ld_);
-  solve_velocities(L, ld_);
+  solve_positions(L, *ld_, std::max(L.settings.maxiterat, 50), tol, false);
+  solve_transfer(L, *ld_);
+  solve_velocities(L, *ld_);
 }
 
 void Linearizer::residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R) {
   const System& L = *lin_;
   const int nz = L.n_dof();
-  for (int i = 0; i < nz; ++i) ld_.qhat_dd[L.dof_cols[order_[i]]] = zdd[i];
+  for (int i = 0; i < nz; ++i) ld_->qhat_dd[L.dof_cols[order_[i]]] = zdd[i];
   Eigen::VectorXd RL(nz);
-  reduced_residual(L, ld_, RL);
+  reduced_residual(L, *ld_, RL);
   R.resize(nz);
   for (int i = 0; i < nz; ++i) R[i] = RL[order_[i]];
 }
@@ -108,38 +108,39 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
   const int nk = static_cast<int>(y.size());
 
   // Nominal state.
-  ld_.t = data.t;
-  ld_.x = data.x;
-  ld_.angle_ref = data.angle_ref;
-  ld_.e_integrated = data.e_integrated;
+  ld_->t = data.t;
+  ld_->x = data.x;
+  ld_->angle_ref = data.angle_ref;
+  ld_->e_integrated = data.e_integrated;
   set_z(z, zd);
-  const Eigen::VectorXd x_nominal = ld_.x, angles_nominal = ld_.angle_ref;
+  const Eigen::VectorXd x_nominal = ld_->x, angles_nominal = ld_->angle_ref;
   residual(zdd, lin.r0);
   lin.r0 = -lin.r0;
   lin.DFz.resize(L.nx, nz);
   lin.DFez.resize(L.ne, nz);
   for (int i = 0; i < nz; ++i) {
-    lin.DFz.col(i) = ld_.DF.col(L.dof_cols[order_[i]]);
-    lin.DFez.col(i) = ld_.DFe.col(L.dof_cols[order_[i]]);
+    lin.DFz.col(i) = ld_->DF.col(L.dof_cols[order_[i]]);
+    lin.DFez.col(i) = ld_->DFe.col(L.dof_cols[order_[i]]);
   }
-  lin.M0 = lin.DFz.transpose() * ld_.M * lin.DFz;
+  assemble_mass_matrix(L, *ld_);
+  lin.M0 = lin.DFz.transpose() * ld_->M * lin.DFz;
   lin.K0 = lin.DFez.transpose() * global_constitutive(L, false) * lin.DFez;
   lin.D0 = lin.DFez.transpose() * global_constitutive(L, true) * lin.DFez;
-  lin.G0 = lin.DFz.transpose() * geometric_stiffness(L, ld_, data.sigma) * lin.DFz;
+  lin.G0 = lin.DFz.transpose() * geometric_stiffness(L, *ld_, data.sigma) * lin.DFz;
   lin.AK0.resize(nk, nz);
   for (int j = 0; j < nk; ++j) lin.AK0.row(j) = lin.DFez.row(sys.e_kinematic[j]);
 
   // Residual R and kinematic rates ẏ^k at perturbed positions (kinematics re-solved) or rates.
   auto response = [&](const Eigen::VectorXd& zz, const Eigen::VectorXd& zzd, const Eigen::VectorXd& yy) {
-    ld_.x = x_nominal;
-    ld_.angle_ref = angles_nominal;
-    for (int j = 0; j < nk; ++j) ld_.e_integrated[sys.e_kinematic[j]] = yy[j];
+    ld_->x = x_nominal;
+    ld_->angle_ref = angles_nominal;
+    for (int j = 0; j < nk; ++j) ld_->e_integrated[sys.e_kinematic[j]] = yy[j];
     set_z(zz, zzd);
     Eigen::VectorXd R;
     residual(zdd, R);
     Eigen::VectorXd out(nz + nk);
     out.head(nz) = R;
-    for (int j = 0; j < nk; ++j) out[nz + j] = ld_.ed[sys.e_kinematic[j]];
+    for (int j = 0; j < nk; ++j) out[nz + j] = ld_->ed[sys.e_kinematic[j]];
     return out;
   };
   // Central differences with one Richardson extrapolation: error O(h⁴) + round-off/h, so that

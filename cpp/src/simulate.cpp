@@ -6,7 +6,6 @@
 
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
-#include "spacar/forces.hpp"
 #include "spacar/kinematics.hpp"
 
 namespace spacar {
@@ -21,60 +20,89 @@ std::unique_ptr<System> prepare_and_compile(Model& model) {
 }  // namespace
 
 Simulation::Simulation(Model& model)
-    : model_(model), sys_(prepare_and_compile(model)), data_(*sys_) {
+    : model_(model), sys_(prepare_and_compile(model)), data_(std::make_unique<Data>(*sys_)) {
+  xd_base_ = xdd_base_ = Eigen::VectorXd::Zero(sys_->nx);
   for (const FreeRotation& fr : sys_->free_rotations) dependent_[fr.node] = fr.dependent;
   int g = 0;
   for (const auto& [id, n] : model_.nodes)
-    for (double v : n.x) data_.x[g++] = v;
-  x_base_ = data_.x;
-  qhat_base_ = data_.qhat;
-  predictor_ = Eigen::VectorXd::Zero(sys_->nx);
+    for (double v : n.x) data_->x[g++] = v;
+  x_base_ = data_->x;
 }
 
 void Simulation::assemble() {
   const System& sys = *sys_;
-  set_inputs(sys, data_, sys.t0);
-  set_dofs(sys, data_, sys.q0.data(), sys.qd0.data());
-  check_constraint_counts(sys, data_);
-  solve_positions(sys, data_, sys.settings.maxiterat, sys.settings.epskin, true);
-  x_base_ = data_.x;
-  qhat_base_ = data_.qhat;
-  have_base_ = false;  // DF not yet available for the predictor
+  set_inputs(sys, *data_, sys.t0);
+  set_dofs(sys, *data_, sys.q0.data(), sys.qd0.data());
+  check_constraint_counts(sys, *data_);
+  solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, true);
+  x_base_ = data_->x;
+  have_base_ = false;  // no velocities yet for the predictor
+}
+
+void Simulation::solve_state(double t, const double* q, const double* qd, bool transfer_predictor) {
+  const System& sys = *sys_;
+  set_inputs(sys, *data_, t);
+  set_dofs(sys, *data_, q, qd);
+  // Predictor of the positions: from the last solved state, a second-order Taylor step in time
+  // (integration stages), or the first-order transfer function applied to the change of the
+  // independent coordinates (states given by the user, when DF of the last state is known).
+  data_->x = x_base_;
+  for (int g : sys.x_input) data_->x[g] = data_->qhat[sys.qhat_col_x[g]];
+  for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_->x[sys.x_dyn[j]] = q[j];
+  bool predicted = true;
+  if (transfer_predictor && have_transfer_) {
+    const Eigen::VectorXd dx = data_->DF * (data_->qhat - qhat_base_);
+    for (int c : sys.x_calc) data_->x[c] += dx[c];
+  } else if (have_base_ && t != t_base_) {
+    const double dt = t - t_base_;
+    for (int c : sys.x_calc) data_->x[c] += dt * (xd_base_[c] + 0.5 * dt * xdd_base_[c]);
+  } else {
+    predicted = false;
+  }
+  try {
+    solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
+  } catch (const KinematicsError&) {
+    if (!predicted) throw;
+    // A long extrapolation (e.g. the integrator's trial of its first step) may overshoot: start
+    // again from the last solved positions.
+    for (int c : sys.x_calc) data_->x[c] = x_base_[c];
+    solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
+  }
+  solve_velocities_direct(sys, *data_);
+  solve_dynamics_direct(sys, *data_);
+  x_base_ = data_->x;
+  xd_base_ = data_->xd;
+  xdd_base_ = data_->xdd;
+  qhat_base_ = data_->qhat;
+  t_base_ = t;
+  have_base_ = true;
+  have_transfer_ = false;
 }
 
 void Simulation::evaluate(double t, const double* q, const double* qd) {
+  solve_state(t, q, qd, true);
+  // Transfer functions and the reduced mass matrix, for users, tests and teaching.
   const System& sys = *sys_;
-  set_inputs(sys, data_, t);
-  set_dofs(sys, data_, q, qd);
-  // Predictor: the last solved positions advanced with the first-order transfer function.
-  data_.x = x_base_;
-  for (size_t i = 0; i < sys.x_input.size(); ++i) data_.x[sys.x_input[i]] = data_.qhat[sys.qhat_col_x[sys.x_input[i]]];
-  for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_.x[sys.x_dyn[j]] = q[j];
-  if (have_base_) {
-    predictor_.noalias() = data_.DF * (data_.qhat - qhat_base_);
-    for (int c : sys.x_calc) data_.x[c] += predictor_[c];
-  }
-  solve_positions(sys, data_, sys.settings.maxiterat, sys.settings.epskin, false);
-  solve_transfer(sys, data_);
-  solve_velocities(sys, data_);
-  solve_dynamics(sys, data_);
-  x_base_ = data_.x;
-  qhat_base_ = data_.qhat;
-  have_base_ = true;
+  solve_transfer(sys, *data_);
+  solve_velocities(sys, *data_);
+  assemble_mass_matrix(sys, *data_);
+  for (int j = 0; j < sys.n_dof(); ++j) data_->DFq.col(j) = data_->DF.col(sys.dof_cols[j]);
+  data_->Mbar.noalias() = data_->DFq.transpose() * data_->M * data_->DFq;
+  have_transfer_ = true;
 }
 
-void Simulation::forces() { solve_reactions(*sys_, data_); }
+void Simulation::forces() { nodal_reactions(*sys_, *data_); }
 
 Linearization Simulation::linearize() {
   forces();
   if (!linearizer_) linearizer_ = std::make_unique<Linearizer>(model_, dependent_);
-  return linearizer_->compute(*sys_, data_);
+  return linearizer_->compute(*sys_, *data_);
 }
 
 void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
-  for (int i = 0; i < ny; ++i) data_.e_integrated[sys_->y_defs[i]] = Y[nd + i];
-  evaluate(t, Y.data(), Y.data() + nd + ny);
+  for (int i = 0; i < ny; ++i) data_->e_integrated[sys_->y_defs[i]] = Y[nd + i];
+  solve_state(t, Y.data(), Y.data() + nd + ny, false);
 }
 
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
@@ -85,22 +113,21 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
     kinematic_failure_ = err.what();
     throw StepRejected(err.what());
   }
-  kinematic_failure_.clear();
   dY.head(nd) = Y.tail(nd);
-  for (int i = 0; i < ny; ++i) dY[nd + i] = data_.ed[sys_->y_defs[i]];
-  dY.tail(nd) = data_.qdd;
+  for (int i = 0; i < ny; ++i) dY[nd + i] = data_->ed[sys_->y_defs[i]];
+  dY.tail(nd) = data_->qdd;
 }
 
 void Simulation::record(BlockResults& res, int k) {
-  res.t[k] = data_.t;
-  res.x.row(k) = data_.x;
-  res.xd.row(k) = data_.xd;
-  res.xdd.row(k) = data_.xdd;
-  res.e.row(k) = data_.e;
-  res.ed.row(k) = data_.ed;
-  res.edd.row(k) = data_.edd;
-  res.sigma.row(k) = data_.sigma;
-  res.reaction.row(k) = data_.reaction;
+  res.t[k] = data_->t;
+  res.x.row(k) = data_->x;
+  res.xd.row(k) = data_->xd;
+  res.xdd.row(k) = data_->xdd;
+  res.e.row(k) = data_->e;
+  res.ed.row(k) = data_->ed;
+  res.edd.row(k) = data_->edd;
+  res.sigma.row(k) = data_->sigma;
+  res.reaction.row(k) = data_->reaction;
 }
 
 BlockResults Simulation::run(const RunOptions& options) {
@@ -129,7 +156,7 @@ BlockResults Simulation::run(const RunOptions& options) {
     if (st.forcemode >= 1 || linear) forces();
     if (linear) res.linearizations.push_back(linearize());
     record(res, k_out);
-    if (options.on_output) options.on_output(k_out, data_);
+    if (options.on_output) options.on_output(k_out, *data_);
     ++k_out;
   };
   // State Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
@@ -150,22 +177,20 @@ BlockResults Simulation::run(const RunOptions& options) {
       integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
       integ.set_max_step(st.hmax);
       if (h > 0.0) integ.set_initial_step(h);
-      if (!sys_->free_rotations.empty())
-        integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+      // After every accepted step: forget kinematic failures of rejected trials; stop to
+      // repartition a free rotation whose dependent Euler parameter became small.
+      integ.set_stop_condition([this](double, const Eigen::VectorXd& y) {
+        kinematic_failure_.clear();
+        return !sys_->free_rotations.empty() && rotation_to_repartition(y) >= 0;
+      });
       const std::vector<double> remaining(times.begin() + k_out, times.end());
       auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
       double t_reached = t;
       try {
         t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
       } catch (const IntegrationError& err) {
-        // The step collapsed because the kinematics has no solution (the last right-hand side
-        // failed in the Newton iteration): that is a KinematicsError (formulation.md §2.2).
-        if (kinematic_failure_.empty()) throw;
-        std::string integrator = err.what();
-        const size_t cut = integrator.find(" (last rejection");
-        if (cut != std::string::npos) integrator.resize(cut);
-        throw KinematicsError(kinematic_failure_ + "\nNo kinematic solution down to the minimum step (" +
-                              integrator + ").");
+        explain_collapse(err, Y);
+        throw;
       }
       const IntegratorStats& s = integ.stats();
       res.rhs_evaluations += s.nfev;
@@ -178,10 +203,35 @@ BlockResults Simulation::run(const RunOptions& options) {
       repartition(rotation_to_repartition(Y), t, Y);
     }
   }
-  res.newton_iterations = data_.total_newton_iterations;
+  res.newton_iterations = data_->total_newton_iterations;
   res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   store_state();
   return res;
+}
+
+void Simulation::explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y) {
+  std::string integrator = err.what();
+  const size_t cut = integrator.find(" (last rejection");
+  if (cut != std::string::npos) integrator.resize(cut);
+  // The step collapsed because the kinematics has no solution (a right-hand side since the last
+  // accepted step failed in the Newton iteration): a KinematicsError (formulation.md §2.2).
+  if (!kinematic_failure_.empty())
+    throw KinematicsError(kinematic_failure_ + "\nNo kinematic solution down to the minimum step (" + integrator +
+                          ").");
+  // Or the mechanism runs into a singular configuration (a dead point): the accelerations grow
+  // without bound as the velocity constraint block loses rank.
+  if (sys_->x_calc.empty() || sys_->x_calc.size() > 2000) return;
+  try {
+    solve_state(data_->t, Y.data(), Y.data() + sys_->n_dof() + sys_->y_defs.size());
+  } catch (const Error&) {
+    return;
+  }
+  const std::string weak = weakest_constraint(*sys_, *data_);
+  if (!weak.empty())
+    throw KinematicsError("the mechanism reaches a singular configuration at t = " + std::to_string(data_->t) +
+                          " (" + integrator + "); max Newton residual " +
+                          std::to_string(data_->residual.size() ? data_->residual.cwiseAbs().maxCoeff() : 0.0) +
+                          ".\n" + weak);
 }
 
 int Simulation::rotation_to_repartition(const Eigen::VectorXd& Y) const {
@@ -201,20 +251,20 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   const FreeRotation fr = sys_->free_rotations[which];
   int best = 0;
   for (int i = 1; i < 4; ++i)
-    if (std::abs(data_.x[fr.coord + i]) > std::abs(data_.x[fr.coord + best])) best = i;
+    if (std::abs(data_->x[fr.coord + i]) > std::abs(data_->x[fr.coord + best])) best = i;
   dependent_[fr.node] = best;
   linearizer_.reset();
-  const Eigen::VectorXd x = data_.x, xd = data_.xd, e = data_.e, ed = data_.ed, angles = data_.angle_ref,
-                        integrated = data_.e_integrated;
-  const long newton = data_.total_newton_iterations;
+  const Eigen::VectorXd x = data_->x, xd = data_->xd, e = data_->e, ed = data_->ed, angles = data_->angle_ref,
+                        integrated = data_->e_integrated;
+  const long newton = data_->total_newton_iterations;
   sys_ = compile(model_, dependent_);
-  data_ = Data(*sys_);
-  data_.x = x;
-  data_.angle_ref = angles;
-  data_.e_integrated = integrated;
-  data_.total_newton_iterations = newton;
+  data_ = std::make_unique<Data>(*sys_);
+  data_->x = x;
+  data_->angle_ref = angles;
+  data_->e_integrated = integrated;
+  data_->total_newton_iterations = newton;
   x_base_ = x;
-  have_base_ = false;
+  have_base_ = have_transfer_ = false;
   // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;
   const int n = sys.n_dof(), ny = static_cast<int>(sys.y_defs.size());
@@ -234,21 +284,21 @@ void Simulation::store_state() {
   int g = 0;
   for (auto& [id, n] : model_.nodes)
     for (size_t i = 0; i < n.x.size(); ++i, ++g) {
-      n.x[i] = data_.x[g];
-      n.xd[i] = data_.xd[g];
-      n.xdd[i] = data_.xdd[g];
+      n.x[i] = data_->x[g];
+      n.xd[i] = data_->xd[g];
+      n.xdd[i] = data_->xdd[g];
     }
   int k = 0;
   for (auto& [id, el] : model_.elements)
     for (size_t i = 0; i < el.e.size(); ++i, ++k) {
       const DefClass c = sys.def_class[k];
       const bool target = (c == DefClass::Fixed || c == DefClass::Linearization) && el.e_given[i];
-      if (!target) el.e[i] = data_.e[k];  // a given target stays exact for the next block
-      el.ed[i] = data_.ed[k];
-      el.edd[i] = data_.edd[k];
+      if (!target) el.e[i] = data_->e[k];  // a given target stays exact for the next block
+      el.ed[i] = data_->ed[k];
+      el.edd[i] = data_->edd[k];
       if (c == DefClass::Input || c == DefClass::Dynamic || c == DefClass::Kinematic) el.e_given[i] = true;
     }
-  model_.time = data_.t;
+  model_.time = data_->t;
 }
 
 }  // namespace spacar

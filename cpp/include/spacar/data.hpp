@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
+#include "spacar/sparse.hpp"
 #include "spacar/system.hpp"
 
 namespace spacar {
@@ -19,7 +20,15 @@ struct ElementWork {
 
 struct Data {
   explicit Data(const System& sys);
+  // Allocate the dense matrices of the full path (transfer functions, reduced mass matrix).
+  void ensure_dense(const System& sys);
+  bool dense_ready = false;
 
+ private:
+  void build_constraint_blocks(const System& sys);
+  void build_equations_of_motion(const System& sys);
+
+ public:
   double t = 0.0;
   Eigen::VectorXd x, xd, xdd;   // nodal coordinates and their derivatives (nx)
   Eigen::VectorXd e, ed, edd;   // deformations and their derivatives (ne)
@@ -32,8 +41,11 @@ struct Data {
   Eigen::VectorXd e_integrated; // current values of the integrated deformations y (ne; others unused)
   Eigen::VectorXd angle_ref;    // last value of each angle-type deformation (unwrapping), NaN: none
   Eigen::VectorXd residual;     // D^P(x) − target (|P|)
-  Eigen::MatrixXd A;            // constraint block ∂D^P/∂x^c (|P| x n_c), later ∂D^V/∂x^c
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+  BlockMatrix AP, AV;           // constraint blocks ∂D^P/∂x^c and ∂D^V/∂x^c (sparse, fixed pattern)
+  std::vector<int> AP_block, AV_block;  // block id of each element in AP / AV
+  LinearSolver luP, luV;        // their factorizations
+  Eigen::VectorXd rhs_V, sol_V; // right-hand side and solution of a velocity-level solve (|V|, n_c)
+  // Dense transfer functions, allocated on first use (linearization, Simulation::evaluate).
   Eigen::MatrixXd rhs_DF;       // right-hand sides of the transfer functions (|V| x n_qhat)
   Eigen::MatrixXd DF;           // first-order transfer function ∂x/∂q̂ (nx x n_qhat)
   Eigen::MatrixXd DFe;          // ∂e/∂q̂ (ne x n_qhat)
@@ -43,7 +55,22 @@ struct Data {
   int newton_iterations = 0;    // of the last position solve
   long total_newton_iterations = 0;
 
-  // Dynamics.
+  // Dynamics in the coordinates (the integration path): the equations of motion of the free
+  // coordinates f = (x^c, x^d) with the constraint rows C (fixed, input, LINE, nonholonomic
+  // deformations) as one sparse system  [M_ff B_Cfᵀ; B_Cf 0] [ẍ_f; σ^C] = [−g_f; ë^C − c^C].
+  std::vector<int> free_index;  // coordinate → position among the free coordinates, −1
+  std::vector<int> c_row;       // deformation → constraint row of C, −1
+  int n_free = 0, n_c_rows = 0;
+  BlockMatrix KKT;
+  std::vector<int> KKT_mass, KKT_B, KKT_Bt;  // block ids per element (−1: none)
+  std::vector<int> KKT_point, KKT_body;      // block ids of point masses and rigid bodies
+  LinearSolver luK;
+  Eigen::VectorXd kkt_rhs, kkt_sol;
+  Eigen::VectorXd acc_known;    // accelerations known before the solve: inputs (nx)
+  std::vector<Eigen::Matrix4d> body_M;  // rigid-body inertia of each LAMBDA body (Euler parameters)
+  std::vector<Eigen::Vector4d> body_h;
+
+  // Dense dynamics of the reduced equations (full path, allocated on first use).
   Eigen::MatrixXd M;            // global mass matrix (nx x nx)
   Eigen::VectorXd h, f;         // convective inertia and applied forces (nx)
   Eigen::MatrixXd DFq;          // DF restricted to the DOF columns (nx x n_dof)

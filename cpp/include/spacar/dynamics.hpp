@@ -11,8 +11,13 @@ namespace spacar {
 // kinematic); the others are reactions and are set to 0 here.
 void constitutive_stresses(const System& sys, Data& data);
 
-// Global M, h and f at the current x, ẋ (the element work vectors must hold x and v).
-void assemble_inertia_and_loads(const System& sys, Data& data);
+// Element mass matrices and convective forces, rigid-body inertias, and the global h and f at
+// the current x, ẋ (the element work vectors must hold x and v).
+void compute_inertia_and_loads(const System& sys, Data& data);
+// g = M ẍ + h − f (after compute_inertia_and_loads).
+void inertia_force(const System& sys, Data& data);
+// The dense global mass matrix (full path).
+void assemble_mass_matrix(const System& sys, Data& data);
 
 // Residual of the reduced equations of motion at the current q̂̈ (formulation.md §7.2):
 // R = DF_qᵀ [M ẍ + h − f] + DFe_qᵀ σ. Requires positions, DF and velocities.
@@ -26,7 +31,15 @@ Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::
 // Throws SingularMassError naming the degrees of freedom without inertia.
 void solve_dynamics(const System& sys, Data& data);
 
-// Kinetic energy T = ½ ẋᵀ M ẋ (requires assemble_inertia_and_loads) and potential energy of
+// The same motion without transfer functions (the integration path): one sparse solve of the
+// equations of motion of the free coordinates with the constraint rows,
+//   [M_ff B_Cfᵀ; B_Cf 0] [ẍ_f; σ^C] = [−g_f; ë^C − c^C],
+// which also yields the reaction stresses σ^C. Requires positions and solve_velocities_direct.
+void solve_dynamics_direct(const System& sys, Data& data);
+// Nodal reactions (6.2) from the complete stresses (after solve_dynamics_direct).
+void nodal_reactions(const System& sys, Data& data);
+
+// Kinetic energy T = ½ ẋᵀ M ẋ (requires compute_inertia_and_loads) and potential energy of
 // the constitutive springs and of gravity; for tests and energy balances.
 double kinetic_energy(const System& sys, const Data& data);
 double potential_energy(const System& sys, const Data& data);

@@ -31,6 +31,10 @@ void solve_transfer(const System& sys, Data& data);
 // ẋ = DF q̂̇, ė = DFe q̂̇; convective terms c and acc0 = ẍ at q̂̈ = 0 (the D2F term).
 void solve_velocities(const System& sys, Data& data);
 
+// Velocities without transfer functions (the integration path): ẋ^c from one solve with the
+// velocity block, ė = B ẋ, and the convective terms c.
+void solve_velocities_direct(const System& sys, Data& data);
+
 // ẍ = DF q̂̈ + acc0 and ë = B ẍ + c, for the current q̂̈.
 void solve_accelerations(const System& sys, Data& data);
 
@@ -45,6 +49,9 @@ struct ConstraintDiagnosis {
 };
 ConstraintDiagnosis diagnose(const System& sys, Data& data);
 std::string diagnose_constraints(const System& sys, Data& data);
+// If the velocity constraint block is nearly singular (a dead point): which constraints lose
+// their independence and which coordinates move; "" otherwise.
+std::string weakest_constraint(const System& sys, Data& data);
 
 // Check that the constraint block is square; throws KinematicsError with the diagnosis.
 void check_constraint_counts(const System& sys, Data& data);

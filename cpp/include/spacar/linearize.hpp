@@ -38,14 +38,14 @@ class Linearizer {
   // Euler parameters of free rotations (as in the analysed system).
   explicit Linearizer(const Model& model, const std::map<int, int>& dependent = {});
   // Linearize about the state of an analysis: sys/data hold a complete evaluation at time
-  // data.t, with the complete stresses of solve_reactions.
+  // data.t, with the complete stresses (the multipliers of the equations of motion).
   Linearization compute(const System& sys, const Data& data);
 
  private:
   void residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R);
   void set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd);
   std::unique_ptr<System> lin_;
-  Data ld_;
+  std::unique_ptr<Data> ld_;
   std::vector<int> order_;      // z index → DOF index of the linearization system
 };
 

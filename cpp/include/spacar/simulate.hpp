@@ -47,12 +47,16 @@ class Simulation {
   explicit Simulation(Model& model);
 
   const System& system() const { return *sys_; }
-  Data& data() { return data_; }
+  Data& data() { return *data_; }
 
   // Assemble at the block start: inputs at t0, DOFs at their initial values, Newton on the
   // calculable coordinates (with the relaxed limits of an initial assembly).
   void assemble();
-  // Complete state at (t, q, q̇): positions, DF, velocities, q̈, accelerations, stresses.
+  // State at (t, q, q̇) as the integrator needs it: positions, velocities, q̈, accelerations
+  // and the complete stresses, without transfer functions (sparse, allocation-free).
+  void solve_state(double t, const double* q, const double* qd, bool transfer_predictor = false);
+  // Complete state at (t, q, q̇): solve_state plus the transfer functions DF, DFe and the
+  // reduced mass matrix M̄ (for users, tests and teaching).
   void evaluate(double t, const double* q, const double* qd);
   // Reactions and complete stresses (FORCEMODE) at the state of the last evaluate().
   void forces();
@@ -69,6 +73,8 @@ class Simulation {
 
  private:
   void record(BlockResults& res, int k);
+  // After the integrator gave up: rethrow as a KinematicsError if the kinematics is the cause.
+  void explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y);
   // A free rotation whose dependent Euler parameter has become small, or −1.
   int rotation_to_repartition(const Eigen::VectorXd& Y) const;
   // Make the largest Euler parameter of that node the dependent one: recompile the system and
@@ -77,8 +83,11 @@ class Simulation {
   Model& model_;
   std::map<int, int> dependent_;  // dependent Euler parameter of free rotations, by node
   std::unique_ptr<System> sys_;
-  Data data_;
-  Eigen::VectorXd x_base_, qhat_base_, predictor_;
+  std::unique_ptr<Data> data_;  // replaced when the system is recompiled (repartition)
+  // Last solved state: the predictor of the next position solve.
+  Eigen::VectorXd x_base_, xd_base_, xdd_base_, qhat_base_;
+  double t_base_ = 0.0;
+  bool have_transfer_ = false;  // data holds DF of the last state (set by evaluate)
   std::unique_ptr<Linearizer> linearizer_;
   bool have_base_ = false;
   std::string kinematic_failure_;  // message of the last right-hand side that failed in Newton

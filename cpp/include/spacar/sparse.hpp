@@ -1,0 +1,68 @@
+// Sparse assembly with a fixed pattern, and a linear solver that is dense for small systems
+// and sparse for large ones. The constraint blocks and the equations of motion of a mechanism
+// are assembled from element blocks whose places never change: the pattern is built once per
+// System, and every evaluation only writes values (no allocation in the step loop).
+#pragma once
+
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <vector>
+
+namespace spacar {
+
+class BlockMatrix {
+ public:
+  // Start a matrix of the given size; blocks are registered next, then finalize().
+  void reset(int rows, int cols);
+  // Register a block: rows[a] and cols[b] are the global row and column of local entry (a, b);
+  // −1 leaves that local row or column out. Returns the block id.
+  int add_block(const std::vector<int>& rows, const std::vector<int>& cols);
+  // Build the compressed pattern and the value position of every block entry.
+  void finalize();
+
+  void set_zero();
+  // Add local (rows.size() x cols.size()) to the block, or its transpose (cols x rows) read as
+  // local(b, a).
+  void add(int id, const Eigen::MatrixXd& local);
+  void add_transposed(int id, const Eigen::MatrixXd& local);
+  void add_value(int id, int a, int b, double v) {
+    const int i = blocks_[id].index[a + b * static_cast<int>(blocks_[id].rows.size())];
+    if (i >= 0) A_.valuePtr()[i] += v;
+  }
+
+  const Eigen::SparseMatrix<double>& matrix() const { return A_; }
+  int rows() const { return static_cast<int>(A_.rows()); }
+  int cols() const { return static_cast<int>(A_.cols()); }
+
+ private:
+  struct Block {
+    std::vector<int> rows, cols;
+    std::vector<int> index;  // position in the value array of each local entry (column-major), −1
+  };
+  std::vector<Block> blocks_;
+  Eigen::SparseMatrix<double> A_;
+};
+
+// LU factorization of a square matrix given in sparse form: dense partial pivoting up to
+// kDenseLimit unknowns (most mechanisms; no sparse overhead), sparse LU with a column ordering
+// computed once (analyze) above.
+class LinearSolver {
+ public:
+  static constexpr int kDenseLimit = 80;
+
+  void analyze(const Eigen::SparseMatrix<double>& A);
+  // False if the matrix is (numerically) singular.
+  bool factorize(const Eigen::SparseMatrix<double>& A);
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+  void solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const;
+  int size() const { return n_; }
+
+ private:
+  int n_ = 0;
+  bool dense_ = true;
+  Eigen::MatrixXd dense_matrix_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu_;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> sparse_lu_;
+};
+
+}  // namespace spacar
