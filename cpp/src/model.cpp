@@ -54,6 +54,15 @@ void require_nonnegative(const std::vector<double>& values, const char* what) {
     if (values[i] < 0.0) fail(what, " value ", i + 1, " is negative (", values[i], ")");
 }
 
+// Euler parameters must be of unit length (within 1e-3); the L2MIN1 constraint keeps them so.
+void require_unit_euler(int id, const std::vector<double>& x) {
+  double norm2 = 0.0;
+  for (double v : x) norm2 += v * v;
+  if (std::abs(std::sqrt(norm2) - 1.0) > 1e-3)
+    fail("Euler parameters of node ", id, " have norm ", std::sqrt(norm2),
+         "; they must be of unit length (within 1e-3)");
+}
+
 void require_count(const std::vector<double>& values, size_t lo, size_t hi, const char* what) {
   if (values.size() < lo || values.size() > hi) {
     if (lo == hi) fail(what, " takes ", lo, " value(s), got ", values.size());
@@ -157,6 +166,10 @@ void Model::add_element(const std::string& type_name, int id, const std::vector<
         it->second.x_given > node_size(et.nodes[i]))
       fail("node ", node_ids[i], " was given ", it->second.x_given, " coordinates but ", et.name, " ", id,
            " uses it as a ", node_keyword(et.nodes[i]), " node with ", node_size(et.nodes[i]));
+    // Coordinates given by X before the node became a LAMBDA node: check them now.
+    if (it != nodes.end() && it->second.kind == NodeKind::Any && et.nodes[i] == NodeKind::Lambda &&
+        it->second.x_given > 0)
+      require_unit_euler(node_ids[i], it->second.x);
   }
   for (size_t i = 0; i < node_ids.size(); ++i) attach_node(node_ids[i], et.nodes[i], et.name);
   Element el;
@@ -182,9 +195,29 @@ void Model::set_coordinates(int id, NodeKind kind, const std::vector<double>& va
   } else if (static_cast<int>(values.size()) != node_size(kind)) {
     fail(node_keyword(kind), " takes ", node_size(kind), " coordinates, got ", values.size());
   }
+  // Validate everything before changing anything, so that a failing line leaves the model intact.
   auto it = nodes.find(id);
-  if (it == nodes.end()) {
-    if (frozen_) fail("node ", id, " is not defined");
+  const bool exists = it != nodes.end();
+  if (!exists && frozen_) fail("node ", id, " is not defined");
+  const NodeKind current = exists ? it->second.kind : NodeKind::Any;
+  if (kind != NodeKind::Any && current != NodeKind::Any && current != kind)
+    fail("node ", id, " is a ", node_keyword(current), " node, not a ", node_keyword(kind), " node");
+  if (current != NodeKind::Any && static_cast<int>(values.size()) > node_size(current))
+    fail("node ", id, " (", node_keyword(current), ") has ", node_size(current), " coordinates, got ",
+         values.size());
+  // A typed keyword declares the kind of a node no element has used yet.
+  if (kind != NodeKind::Any && current == NodeKind::Any && frozen_)
+    fail("node ", id, " is not used by any element");
+  if (kind != NodeKind::Any && current == NodeKind::Any && exists && it->second.x_given > node_size(kind))
+    fail("node ", id, " was given ", it->second.x_given, " coordinates but a ", node_keyword(kind), " node has ",
+         node_size(kind));
+  if (kind == NodeKind::Lambda || current == NodeKind::Lambda) {
+    // The Euler parameters as they will be (X may set only the first few).
+    std::vector<double> x = exists ? it->second.x : std::vector<double>(4, 0.0);
+    for (size_t i = 0; i < values.size(); ++i) x[i] = values[i];
+    require_unit_euler(id, x);
+  }
+  if (!exists) {
     Node n;
     n.id = id;
     n.kind = NodeKind::Any;
@@ -195,14 +228,7 @@ void Model::set_coordinates(int id, NodeKind kind, const std::vector<double>& va
     it = nodes.emplace(id, std::move(n)).first;
   }
   Node& n = it->second;
-  if (kind != NodeKind::Any && n.kind != NodeKind::Any && n.kind != kind)
-    fail("node ", id, " is a ", node_keyword(n.kind), " node, not a ", node_keyword(kind), " node");
-  if (n.kind != NodeKind::Any && static_cast<int>(values.size()) > node_size(n.kind))
-    fail("node ", id, " (", node_keyword(n.kind), ") has ", node_size(n.kind), " coordinates, got ",
-         values.size());
   if (kind != NodeKind::Any && n.kind == NodeKind::Any) {
-    // A typed keyword declares the kind of a node no element has used yet.
-    if (frozen_) fail("node ", id, " is not used by any element");
     n.kind = kind;
     n.x.resize(node_size(kind));
     n.cls.resize(node_size(kind));
@@ -211,13 +237,6 @@ void Model::set_coordinates(int id, NodeKind kind, const std::vector<double>& va
   }
   for (size_t i = 0; i < values.size(); ++i) n.x[i] = values[i];
   n.x_given = std::max(n.x_given, static_cast<int>(values.size()));
-  if (n.kind == NodeKind::Lambda) {
-    double norm2 = 0.0;
-    for (double v : n.x) norm2 += v * v;
-    if (values.size() == 4 && std::abs(std::sqrt(norm2) - 1.0) > 1e-3)
-      fail("Euler parameters of node ", id, " have norm ", std::sqrt(norm2),
-           "; they must be of unit length (within 1e-3)");
-  }
 }
 
 // --- boundary conditions ---
