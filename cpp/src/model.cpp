@@ -504,6 +504,16 @@ void Model::prepare() {
     compute_reference_geometry();
     frozen_ = true;
   }
+  // Euler parameters are accepted within 1e-3 of unit length (4-digit input, the dump). The
+  // L2MIN1 constraint makes calculable ones exact, but nothing moves a fully fixed LAMBDA node,
+  // whose automatically released L2MIN1 is then checked to EPSKIN: normalise them all here.
+  for (auto& [id, n] : nodes) {
+    if (n.kind != NodeKind::Lambda) continue;
+    double norm2 = 0.0;
+    for (double v : n.x) norm2 += v * v;
+    if (norm2 > 0.0 && norm2 != 1.0)
+      for (double& v : n.x) v /= std::sqrt(norm2);
+  }
 }
 
 void Model::add_automatic_constraints() {
