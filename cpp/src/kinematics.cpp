@@ -66,25 +66,43 @@ void assemble_block(const System& sys, Data& data, const std::vector<int>& row_o
   }
 }
 
-std::string worst_rows(const System& sys, const Data& data, int count) {
-  std::vector<int> order(data.residual.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return std::abs(data.residual[a]) > std::abs(data.residual[b]); });
+// A number for a message: non-finite values are named as such, never printed as "nan".
+std::string number(double v) {
+  if (!std::isfinite(v)) return "non-finite";
   std::ostringstream os;
-  for (int i = 0; i < count && i < static_cast<int>(order.size()); ++i)
-    os << (i ? "; " : "") << sys.def_name(sys.rows_P[order[i]]) << " residual " << data.residual[order[i]];
+  os << v;
   return os.str();
 }
 
-double max_abs(const Eigen::VectorXd& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
+std::string worst_rows(const System& sys, const Data& data, int count) {
+  std::vector<int> order(data.residual.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  // Non-finite residuals first (as the largest); NaN must not reach the comparison itself.
+  auto size = [&](int r) {
+    const double v = std::abs(data.residual[r]);
+    return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
+  };
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return size(a) > size(b); });
+  std::ostringstream os;
+  for (int i = 0; i < count && i < static_cast<int>(order.size()); ++i)
+    os << (i ? "; " : "") << sys.def_name(sys.rows_P[order[i]]) << " residual " << number(data.residual[order[i]]);
+  return os.str();
+}
+
+// Largest magnitude; +inf if any entry is not finite (maxCoeff alone may skip a NaN).
+double max_abs(const Eigen::VectorXd& v) {
+  if (!v.allFinite()) return std::numeric_limits<double>::infinity();
+  return v.size() ? v.cwiseAbs().maxCoeff() : 0.0;
+}
 
 // Factorize the current block; a (numerically) singular block raises the diagnosis.
 void factorize(const System& sys, Data& data, int n_rows, const char* what) {
   const int nc = static_cast<int>(sys.x_calc.size());
   if (nc == 0) return;
   data.lu.compute(data.A.topRows(n_rows));
-  const double rc = data.lu.rcond();
+  // An exactly zero pivot makes Eigen's estimate NaN (0/0): report it as 0, never as "nan".
+  const double rc_estimate = data.lu.rcond();
+  const double rc = std::isfinite(rc_estimate) ? rc_estimate : 0.0;
   if (!(rc > 1e-13)) {
     std::ostringstream os;
     os << "the " << what << " constraint block is singular at t = " << data.t << " (reciprocal condition "
@@ -137,7 +155,7 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
     const double rmax = max_abs(data.residual);
     if (!std::isfinite(rmax)) {
       converged = false;
-      history << (it ? ", " : "") << rmax;
+      history << (it ? ", " : "") << number(rmax);
       break;
     }
     if (converged) break;  // the polish iteration after convergence has been done
