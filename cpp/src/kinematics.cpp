@@ -102,7 +102,13 @@ void factorize(const System& sys, Data& data, int n_rows, const char* what) {
   data.lu.compute(data.A.topRows(n_rows));
   // An exactly zero pivot makes Eigen's estimate NaN (0/0): report it as 0, never as "nan".
   const double rc_estimate = data.lu.rcond();
-  const double rc = std::isfinite(rc_estimate) ? rc_estimate : 0.0;
+  double rc = std::isfinite(rc_estimate) ? rc_estimate : 0.0;
+  // The estimate is only a bound from a few solves: with an exactly zero pivot it can come out
+  // finite and large (0.083 for a spatial slider-crank with a released hinge misalignment and a
+  // fixed slider), and the solves then fill DF with NaN. A pivot that is small against the
+  // largest entry proves near-singularity (σ_min(A) ≤ n·min|u_kk|), so bound rc by it as well.
+  const double amax = data.A.topRows(n_rows).cwiseAbs().maxCoeff();
+  if (amax > 0.0) rc = std::min(rc, data.lu.matrixLU().diagonal().cwiseAbs().minCoeff() / amax);
   if (!(rc > 1e-13)) {
     std::ostringstream os;
     os << "the " << what << " constraint block is singular at t = " << data.t << " (reciprocal condition "
