@@ -28,7 +28,12 @@ truncation error is far below the 1e-7 bound while the steps stay large enough t
 ‖A − A_fd‖ / max(‖A‖, 1) (Frobenius norm).
 
 Node kinds: XY, BETA (planar), XYZ, LAMBDA (spatial, unit Euler parameters), so spatial element
-types need only their own reference-geometry generator where `chord` does not fit.
+types need only their own reference-geometry generator where `chord` does not fit. R(λ) is used
+as a quadratic form also off the unit sphere (Newton iterates go there, formulation.md §0), so
+for element types with LAMBDA nodes every derivative check is repeated at N_CONFIGS further
+configurations whose Euler parameters have random norms in OFF_SPHERE_NORMS. Angle-type
+deformations (`ElementCase.angles`, e.g. the HINGE rotation, an atan2 branch) are compared
+modulo 2π and differenced on the branch of the base point.
 """
 
 from __future__ import annotations
@@ -58,6 +63,7 @@ STEP_SECOND = 1e-2    # second differences in x; x-derivatives of difference quo
 STEP_VELOCITY = 1e-1  # differences of T in v (T is quadratic in v: no truncation error)
 RICHARDSON_LEVELS = 3
 SYMMETRY_TOL = 1e-13  # ‖A − Aᵀ‖/max(‖A‖, 1) of Hessians and mass matrices (round-off only)
+OFF_SPHERE_NORMS = (0.7, 1.4)  # range of |λ| of the off-sphere derivative checks
 
 POSITION_KINDS = (NodeKind.XY, NodeKind.XYZ)
 PLANAR_KINDS = (NodeKind.XY, NodeKind.BETA)
@@ -173,9 +179,11 @@ class Reference:
 class ElementCase:
     type: str
     reference: Callable[["ElementCase", np.random.Generator], Reference]  # random reference geometry
+    label: str = ""        # test id and seed name when one type has several cases (default: type)
+    angles: tuple = ()     # 0-based indices of angle-type deformations (atan2 branch, mod 2π)
 
     def __str__(self):
-        return self.type
+        return self.label or self.type
 
     @property
     def info(self):
@@ -196,16 +204,54 @@ class ElementCase:
         return _core.element_kernel(self.type, params=list(ref.params), l0=ref.l0,
                                     lgeomy=list(ref.lgeomy), emass=list(ref.emass))
 
-    def rng(self, check: str):
-        """Deterministic generator per (element type, check)."""
-        return np.random.default_rng(zlib.crc32(f"{self.type}/{check}".encode()))
+    @property
+    def has_lambda(self):
+        return NodeKind.LAMBDA in self.kinds
 
-    def samples(self, check: str, n: int = N_CONFIGS):
-        """n tuples (rng, reference, kernel, random configuration x)."""
-        rng = self.rng(check)
+    def rng(self, check: str):
+        """Deterministic generator per (element case, check)."""
+        return np.random.default_rng(zlib.crc32(f"{self}/{check}".encode()))
+
+    def samples(self, check: str, n: int = N_CONFIGS, off_sphere: bool = False):
+        """n tuples (rng, reference, kernel, random configuration x); off_sphere: Euler
+        parameters with random norms in OFF_SPHERE_NORMS."""
+        rng = self.rng(check + ("@off-sphere" if off_sphere else ""))
         for _ in range(n):
             ref = self.reference(self, rng)
-            yield rng, ref, self.kernel(ref), random_configuration(rng, self.kinds, ref)
+            x = random_configuration(rng, self.kinds, ref,
+                                     lambda_norms=OFF_SPHERE_NORMS if off_sphere else None)
+            yield rng, ref, self.kernel(ref), x
+
+    def derivative_samples(self, check: str):
+        """(suffix, samples) for the derivative checks: unit Euler parameters and, for element
+        types with LAMBDA nodes, also Euler parameters off the unit sphere."""
+        yield "", self.samples(check)
+        if self.has_lambda:
+            yield "@|λ|≠1", self.samples(check, off_sphere=True)
+
+    def unwrapped(self, k, x):
+        """The kernel k with its angle-type deformations taken on the branch of their values at
+        x (so that differences about x do not jump by 2π); k itself without angles."""
+        return _Unwrapped(k, self.angles, k.deformations(x)) if self.angles else k
+
+
+def wrap_to_pi(a):
+    """a reduced to [−π, π)."""
+    return (np.asarray(a) + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class _Unwrapped:
+    def __init__(self, k, angles, e0):
+        self._k, self._angles, self._e0 = k, list(angles), np.asarray(e0)
+
+    def deformations(self, x):
+        e = np.array(self._k.deformations(x))
+        a = self._angles
+        e[a] = self._e0[a] + wrap_to_pi(e[a] - self._e0[a])
+        return e
+
+    def __getattr__(self, name):
+        return getattr(self._k, name)
 
 
 def node_slices(kinds: Sequence) -> list:
@@ -265,10 +311,11 @@ def orientations_only(case: ElementCase, rng) -> Reference:
     return Reference(x=assemble(case.kinds, []))
 
 
-def random_configuration(rng, kinds, ref: Reference, spread: float = 0.2):
+def random_configuration(rng, kinds, ref: Reference, spread: float = 0.2, lambda_norms=None):
     """Position nodes moved independently by up to ±spread·scale per component from the
     reference (for a chord this keeps l ≥ (1 − 2√2·spread) l0); BETA uniform in [−π, π];
-    LAMBDA random unit Euler parameters."""
+    LAMBDA random unit Euler parameters, or, with lambda_norms = (lo, hi), random Euler
+    parameters of norm uniform in [lo, hi]."""
     x = np.array(ref.x, dtype=float)
     for k, s in zip(kinds, node_slices(kinds)):
         if k in POSITION_KINDS:
@@ -277,6 +324,8 @@ def random_configuration(rng, kinds, ref: Reference, spread: float = 0.2):
             x[s] = rng.uniform(-math.pi, math.pi)
         elif k == NodeKind.LAMBDA:
             x[s] = random_unit_quaternion(rng)
+            if lambda_norms is not None:
+                x[s] *= rng.uniform(*lambda_norms)
         else:
             raise NotImplementedError(f"node kind {k}")
     return x
@@ -375,38 +424,51 @@ def record(record_property):
 
 class GenericElementChecks:
     """Generic §10.1 checks; a test module subclasses this, defines a `case` fixture
-    and imports the `record` fixture."""
+    and imports the `record` fixture. The derivative checks run at unit Euler parameters and,
+    for element types with LAMBDA nodes, also off the unit sphere (recorded as `check@|λ|≠1`)."""
 
     def test_first_derivatives_match_differences(self, case, record):
-        worst = 0.0
-        for _, ref, k, x in case.samples("B"):
-            worst = max(worst, first_derivative_error(k, x, coordinate_scales(case.kinds, ref)))
-        record(case, "B", worst)
-        assert worst < REL_TOL
+        worst_all = 0.0
+        for suffix, samples in case.derivative_samples("B"):
+            worst = 0.0
+            for _, ref, k, x in samples:
+                worst = max(worst, first_derivative_error(case.unwrapped(k, x), x,
+                                                          coordinate_scales(case.kinds, ref)))
+            record(case, "B" + suffix, worst)
+            worst_all = max(worst_all, worst)
+        assert worst_all < REL_TOL
 
     def test_convective_term_matches_second_differences(self, case, record):
-        worst = 0.0
-        for rng, ref, k, x in case.samples("c"):
-            v = rng.normal(size=x.size) * coordinate_scales(case.kinds, ref)
-            worst = max(worst, convective_error(k, x, v))
-        record(case, "c", worst)
-        assert worst < REL_TOL
+        worst_all = 0.0
+        for suffix, samples in case.derivative_samples("c"):
+            worst = 0.0
+            for rng, ref, k, x in samples:
+                v = rng.normal(size=x.size) * coordinate_scales(case.kinds, ref)
+                worst = max(worst, convective_error(case.unwrapped(k, x), x, v))
+            record(case, "c" + suffix, worst)
+            worst_all = max(worst_all, worst)
+        assert worst_all < REL_TOL
 
     def test_stress_hessian_matches_differences(self, case, record):
-        worst = 0.0
-        for rng, ref, k, x in case.samples("G"):
-            sigma = rng.normal(size=k.n_deformations)
-            G = k.stress_hessian(x, sigma)
-            assert rel_err(G, G.T) < SYMMETRY_TOL
-            worst = max(worst, stress_hessian_error(k, x, sigma, coordinate_scales(case.kinds, ref)))
-        record(case, "G", worst)
-        assert worst < REL_TOL
+        worst_all = 0.0
+        for suffix, samples in case.derivative_samples("G"):
+            worst = 0.0
+            for rng, ref, k, x in samples:
+                sigma = rng.normal(size=k.n_deformations)
+                G = k.stress_hessian(x, sigma)
+                assert rel_err(G, G.T) < SYMMETRY_TOL
+                worst = max(worst, stress_hessian_error(k, x, sigma, coordinate_scales(case.kinds, ref)))
+            record(case, "G" + suffix, worst)
+            worst_all = max(worst_all, worst)
+        assert worst_all < REL_TOL
 
     def test_deformations_invariant_under_rigid_motion(self, case, record):
         worst = 0.0
         for rng, ref, k, x in case.samples("rigid"):
             move = random_rigid_motion(rng, case.kinds, ref.scale)
-            worst = max(worst, float(np.max(np.abs(k.deformations(move(x)) - k.deformations(x)))))
+            d = k.deformations(move(x)) - k.deformations(x)
+            d[list(case.angles)] = wrap_to_pi(d[list(case.angles)])
+            worst = max(worst, float(np.max(np.abs(d))))
         record(case, "rigid", worst)
         assert worst < INVARIANCE_TOL
 
@@ -421,31 +483,37 @@ class GenericElementChecks:
 
     def test_mass_matches_lagrange_equations(self, case, record):
         worst_M = worst_h = 0.0
-        for rng, ref, k, x in case.samples("mass"):
-            v = rng.normal(size=x.size) * coordinate_scales(case.kinds, ref)
-            M, h = k.mass(x, v)
-            if not case.has_emass:  # no distributed mass: everything vanishes
-                assert not k.has_mass
-                assert not M.any() and not h.any() and k.kinetic_energy(x, v) == 0.0
-                continue
-            assert k.has_mass
-            assert rel_err(M, M.T) < SYMMETRY_TOL
-            assert np.min(np.linalg.eigvalsh(0.5 * (M + M.T))) > -1e-12 * np.max(np.abs(M))
-            scales = coordinate_scales(case.kinds, ref)
-            worst_M = max(worst_M, mass_matrix_error(k, x, v, scales))
-            worst_h = max(worst_h, convective_inertia_error(k, x, v, scales))
-        record(case, "M", worst_M)
-        record(case, "h", worst_h)
+        for suffix, samples in case.derivative_samples("mass"):
+            wM = wh = 0.0
+            for rng, ref, k, x in samples:
+                v = rng.normal(size=x.size) * coordinate_scales(case.kinds, ref)
+                M, h = k.mass(x, v)
+                if not case.has_emass:  # no distributed mass: everything vanishes
+                    assert not k.has_mass
+                    assert not M.any() and not h.any() and k.kinetic_energy(x, v) == 0.0
+                    continue
+                assert k.has_mass
+                assert rel_err(M, M.T) < SYMMETRY_TOL
+                assert np.min(np.linalg.eigvalsh(0.5 * (M + M.T))) > -1e-12 * np.max(np.abs(M))
+                scales = coordinate_scales(case.kinds, ref)
+                wM = max(wM, mass_matrix_error(k, x, v, scales))
+                wh = max(wh, convective_inertia_error(k, x, v, scales))
+            record(case, "M" + suffix, wM)
+            record(case, "h" + suffix, wh)
+            worst_M, worst_h = max(worst_M, wM), max(worst_h, wh)
         assert worst_M < REL_TOL
         assert worst_h < REL_TOL
 
     def test_gravity_is_minus_potential_gradient(self, case, record):
-        worst = 0.0
-        for rng, ref, k, x in case.samples("gravity"):
-            g = rng.normal(size=3) * 10.0
-            if not case.has_emass:
-                assert not k.gravity(x, g).any() and k.gravity_potential(x, g) == 0.0
-                continue
-            worst = max(worst, gravity_error(k, x, g, coordinate_scales(case.kinds, ref)))
-        record(case, "gravity", worst)
-        assert worst < REL_TOL
+        worst_all = 0.0
+        for suffix, samples in case.derivative_samples("gravity"):
+            worst = 0.0
+            for rng, ref, k, x in samples:
+                g = rng.normal(size=3) * 10.0
+                if not case.has_emass:
+                    assert not k.gravity(x, g).any() and k.gravity_potential(x, g) == 0.0
+                    continue
+                worst = max(worst, gravity_error(k, x, g, coordinate_scales(case.kinds, ref)))
+            record(case, "gravity" + suffix, worst)
+            worst_all = max(worst_all, worst)
+        assert worst_all < REL_TOL

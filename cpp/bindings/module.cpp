@@ -8,6 +8,7 @@
 #include "spacar/catalogue.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/integrator.hpp"
+#include "spacar/kinematics.hpp"
 #include "spacar/model.hpp"
 #include "spacar/simulate.hpp"
 
@@ -42,10 +43,7 @@ void bind_errors(py::module_& m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& x) {
-      py::object err = py::reinterpret_borrow<py::object>(e.input)(x.what());
-      err.attr("element") = x.element;
-      err.attr("node") = x.node;
-      PyErr_SetObject(e.input.ptr(), err.ptr());
+      py::set_error(e.input, x.what());
     } catch (const KinematicsError& x) {
       py::set_error(e.kinematics, x.what());
     } catch (const SingularMassError& x) {
@@ -118,7 +116,8 @@ void bind_model(py::module_& m) {
       .def_readonly("force", &Node::force)
       .def_readonly("mass", &Node::mass)
       .def_readonly("torquel", &Node::torquel)
-      .def_readonly("used", &Node::used);
+      .def_readonly("used", &Node::used)
+      .def_readonly("origin", &Node::origin);
   py::class_<Element>(m, "Element")
       .def_readonly("id", &Element::id)
       .def_readonly("type", &Element::type)
@@ -136,7 +135,8 @@ void bind_model(py::module_& m) {
       .def_readonly("edd", &Element::edd)
       .def_readonly("e_given", &Element::e_given)
       .def_readonly("kinematic_of", &Element::kinematic_of)
-      .def_readonly("automatic", &Element::automatic);
+      .def_readonly("automatic", &Element::automatic)
+      .def_readonly("origin", &Element::origin);
   py::class_<Settings>(m, "Settings")
       .def_readonly("timestep_n", &Settings::timestep_n)
       .def_readonly("timestep_tp", &Settings::timestep_tp)
@@ -155,8 +155,10 @@ void bind_model(py::module_& m) {
   py::class_<Model>(m, "Model")
       .def(py::init<>())
       .def("copy", [](const Model& self) { return Model(self); })
-      .def("add_element", &Model::add_element)
-      .def("set_coordinates", &Model::set_coordinates)
+      .def("add_element", &Model::add_element, py::arg("type"), py::arg("id"), py::arg("nodes"),
+           py::arg("params"), py::arg("origin") = "")
+      .def("set_coordinates", &Model::set_coordinates, py::arg("node"), py::arg("kind"), py::arg("values"),
+           py::arg("origin") = "")
       .def("set_coordinate_class", &Model::set_coordinate_class)
       .def("set_deformation_class", &Model::set_deformation_class)
       .def("set_nonholonomic", &Model::set_nonholonomic)
@@ -198,6 +200,23 @@ void bind_model(py::module_& m) {
       .def_readonly("gravity_given", &Model::gravity_given);
 }
 
+py::dict linearization_to_dict(const Linearization& l) {
+  py::dict d;
+  d["t"] = l.t;
+  d["z_label"] = l.z_label;
+  d["n_line"] = l.n_line;
+  d["M0"] = l.M0;
+  d["C0"] = l.C0;
+  d["D0"] = l.D0;
+  d["K0"] = l.K0;
+  d["N0"] = l.N0;
+  d["G0"] = l.G0;
+  d["r0"] = l.r0;
+  d["DFz"] = l.DFz;
+  d["DFez"] = l.DFez;
+  return d;
+}
+
 py::dict block_results_to_dict(BlockResults&& r) {
   py::dict d;
   d["t"] = std::move(r.t);
@@ -208,6 +227,10 @@ py::dict block_results_to_dict(BlockResults&& r) {
   d["ed"] = std::move(r.ed);
   d["edd"] = std::move(r.edd);
   d["sigma"] = std::move(r.sigma);
+  d["reaction"] = std::move(r.reaction);
+  py::list lins;
+  for (const Linearization& l : r.linearizations) lins.append(linearization_to_dict(l));
+  d["linearizations"] = lins;
   d["rhs_evaluations"] = r.rhs_evaluations;
   d["steps"] = r.steps;
   d["accepted"] = r.accepted;
@@ -261,6 +284,7 @@ void bind_simulation(py::module_& m) {
       .def_readonly("M", &Data::M)
       .def_readonly("Mbar", &Data::Mbar)
       .def_readonly("qdd", &Data::qdd)
+      .def_readonly("reaction", &Data::reaction)
       .def_readonly("newton_iterations", &Data::newton_iterations);
 
   py::class_<Simulation>(m, "Simulation")
@@ -268,6 +292,24 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", &Simulation::assemble)
+      .def("forces", &Simulation::forces)
+      .def("linearize", [](Simulation& s) { return linearization_to_dict(s.linearize()); })
+      .def("diagnose",
+           [](Simulation& s) {
+             const ConstraintDiagnosis d = diagnose(s.system(), s.data());
+             const System& sys = s.system();
+             py::dict out;
+             out["n_constraints"] = d.n_constraints;
+             out["n_calculable"] = d.n_calculable;
+             out["rank"] = d.rank;
+             py::list red, und;
+             for (int k : d.redundant) red.append(py::make_tuple(sys.def_label[k][0], sys.def_label[k][1]));
+             for (int g : d.undetermined) und.append(py::make_tuple(sys.coord_label[g][0], sys.coord_label[g][1]));
+             out["redundant"] = red;
+             out["undetermined"] = und;
+             out["text"] = d.text;
+             return out;
+           })
       .def("evaluate",
            [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
              if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
@@ -283,9 +325,19 @@ void bind_simulation(py::module_& m) {
             else if (method == "dopri5") opt.method = Method::DOPRI5;
             else throw InputError("unknown integration method '" + method + "' (dop853, dopri5)");
             if (!on_output.is_none()) {
-              opt.on_output = [on_output](int k, double t) {
+              opt.on_output = [on_output](int k, const Data& d) {
                 py::gil_scoped_acquire gil;
-                on_output(k, t);
+                py::dict state;
+                state["t"] = d.t;
+                state["x"] = d.x;
+                state["xd"] = d.xd;
+                state["xdd"] = d.xdd;
+                state["e"] = d.e;
+                state["ed"] = d.ed;
+                state["edd"] = d.edd;
+                state["sigma"] = d.sigma;
+                state["reaction"] = d.reaction;
+                on_output(k, state);
               };
             }
             BlockResults r;

@@ -1,7 +1,12 @@
 #include "spacar/dynamics.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <sstream>
+#include <vector>
 
+#include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
 
@@ -13,27 +18,12 @@ bool constitutive_class(DefClass c) {
   return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
 }
 
-// G(λ) of the Euler parameters: ω' = 2 G λ̇ (body angular velocity).
-Eigen::Matrix<double, 3, 4> G_matrix(const double* l) {
-  Eigen::Matrix<double, 3, 4> G;
-  G << -l[1], l[0], l[3], -l[2],  //
-      -l[2], -l[3], l[0], l[1],   //
-      -l[3], l[2], -l[1], l[0];
-  return G;
-}
-
+// Rigid bodies on LAMBDA nodes and body-fixed torques (formulation.md §3.2, §3.4).
 void add_bodies(const System& sys, Data& data) {
-  for (const BodyInertia& b : sys.bodies) {
-    const double* l = data.x.data() + b.coord;
-    const double* ld = data.xd.data() + b.coord;
-    const Eigen::Matrix<double, 3, 4> G = G_matrix(l), Gd = G_matrix(ld);
-    const Eigen::Vector3d omega = 2.0 * G * Eigen::Map<const Eigen::Vector4d>(ld);
-    data.M.block<4, 4>(b.coord, b.coord) += 4.0 * G.transpose() * b.J * G;
-    // Exact Lagrange term d/dt(∂T/∂λ̇) − ∂T/∂λ minus M λ̈ (formulation.md §3.2).
-    data.h.segment<4>(b.coord) += 4.0 * Gd.transpose() * (b.J * omega);
-  }
+  for (const BodyInertia& b : sys.bodies)
+    add_rotational_inertia(sys.nx, data.x.data(), data.xd.data(), &b.coord, 1, &b.J, data.M.data(), data.h.data());
   for (const auto& [coord, T] : sys.torquel)
-    data.f.segment<4>(coord) += 2.0 * G_matrix(data.x.data() + coord).transpose() * T;
+    data.f.segment<4>(coord) += 2.0 * euler_G(data.x.data() + coord).transpose() * T;
 }
 
 }  // namespace
@@ -82,29 +72,45 @@ void assemble_inertia_and_loads(const System& sys, Data& data) {
   add_bodies(sys, data);
 }
 
-void solve_dynamics(const System& sys, Data& data) {
+void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R) {
   const int nd = sys.n_dof();
-  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = 0.0;
-  solve_accelerations(sys, data);  // ẍ with q̈ = 0: inputs' accelerations and convective terms
+  solve_accelerations(sys, data);
   assemble_inertia_and_loads(sys, data);
   constitutive_stresses(sys, data);
   data.g.noalias() = data.M * data.xdd;
   data.g += data.h - data.f;
   for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
+  R.noalias() = data.DFq.transpose() * data.g;
+  for (int j = 0; j < nd; ++j) R[j] += data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
+}
+
+void solve_dynamics(const System& sys, Data& data) {
+  const int nd = sys.n_dof();
+  // The residual at q̈ = 0 holds the inputs' accelerations, convective, applied and elastic forces.
+  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = 0.0;
+  reduced_residual(sys, data, data.rhs);
+  data.rhs = -data.rhs;
   data.Mbar.noalias() = data.DFq.transpose() * data.M * data.DFq;
-  data.rhs.noalias() = -data.DFq.transpose() * data.g;
-  for (int j = 0; j < nd; ++j) data.rhs[j] -= data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
   data.llt.compute(data.Mbar);
   if (data.llt.info() != Eigen::Success || nd == 0) {
     if (nd == 0) return;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(data.Mbar);
-    const Eigen::VectorXd v = eig.eigenvectors().col(0);
-    const double vmax = v.cwiseAbs().maxCoeff();
+    const Eigen::VectorXd& lam = eig.eigenvalues();  // ascending
+    // Every eigenvector of a (numerically) zero eigenvalue belongs to the null space; with
+    // several massless DOFs the null space has several dimensions and any single eigenvector
+    // names an arbitrary combination of them, so all of them are reported.
+    const double null_tol = 1e-12 * std::max(std::abs(lam[nd - 1]), std::numeric_limits<double>::min());
+    std::vector<bool> named(nd, false);
+    for (int i = 0; i < nd && (i == 0 || lam[i] <= null_tol); ++i) {
+      const Eigen::VectorXd v = eig.eigenvectors().col(i);
+      const double vmax = v.cwiseAbs().maxCoeff();
+      for (int j = 0; j < nd; ++j) named[j] = named[j] || std::abs(v[j]) >= 0.1 * vmax;
+    }
     std::ostringstream os;
     os << "the reduced mass matrix is singular at t = " << data.t << " (smallest eigenvalue "
-       << eig.eigenvalues()[0] << "): the degrees of freedom";
+       << lam[0] << "): the degrees of freedom";
     for (int j = 0; j < nd; ++j) {
-      if (std::abs(v[j]) < 0.1 * vmax) continue;
+      if (!named[j]) continue;
       const int col = sys.dof_cols[j];
       os << " [";
       for (int g = 0; g < sys.nx; ++g)
@@ -119,6 +125,43 @@ void solve_dynamics(const System& sys, Data& data) {
   data.qdd = data.llt.solve(data.rhs);
   for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
   solve_accelerations(sys, data);
+}
+
+Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::VectorXd& sigma) {
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(sys.nx, sys.nx);
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const ElementWork& w = data.work[i];
+    const int n = static_cast<int>(se.coords.size());
+    Eigen::VectorXd s = sigma.segment(se.def_offset, se.nd);
+    if (s.any()) {
+      Eigen::MatrixXd G(n, n);
+      se.kernel->stress_hessian(w.x.data(), s.data(), G.data());
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) K(se.coords[a], se.coords[b]) += G(a, b);
+    }
+    // Position-dependent gravity loads of the element mass (beam tangent terms).
+    if (se.has_mass && sys.gravity.squaredNorm() > 0.0) {
+      Eigen::VectorXd xp = w.x, fp(n), fm(n);
+      for (int b = 0; b < n; ++b) {
+        const double h = 1e-6 * std::max(1.0, std::abs(w.x[b]));
+        xp[b] = w.x[b] + h;
+        se.kernel->gravity(xp.data(), sys.gravity.data(), fp.data());
+        xp[b] = w.x[b] - h;
+        se.kernel->gravity(xp.data(), sys.gravity.data(), fm.data());
+        xp[b] = w.x[b];
+        for (int a = 0; a < n; ++a) K(se.coords[a], se.coords[b]) -= (fp[a] - fm[a]) / (2.0 * h);
+      }
+    }
+  }
+  // Body-fixed torques: f_λ = 2 G(λ)ᵀ T' is linear in λ.
+  for (const auto& [coord, T] : sys.torquel)
+    for (int b = 0; b < 4; ++b) {
+      double unit[4] = {0, 0, 0, 0};
+      unit[b] = 1.0;
+      K.block<4, 1>(coord, coord + b) -= 2.0 * euler_G(unit).transpose() * T;
+    }
+  return K;
 }
 
 double kinetic_energy(const System&, const Data& data) { return 0.5 * data.xd.dot(data.M * data.xd); }

@@ -278,53 +278,102 @@ void solve_accelerations(const System& sys, Data& data) {
   }
 }
 
-std::string diagnose_constraints(const System& sys, Data& data) {
+namespace {
+
+// Greedy selection in the given order: vectors (columns of V) that add rank are kept, the others
+// are dependent on those before them. Returns the dependent ones.
+std::vector<int> dependent_columns(const Eigen::MatrixXd& V, const std::vector<int>& order) {
+  std::vector<Eigen::VectorXd> basis;
+  std::vector<int> dependent;
+  for (int j : order) {
+    Eigen::VectorXd v = V.col(j);
+    const double norm0 = v.norm();
+    for (int pass = 0; pass < 2; ++pass)  // twice: Gram-Schmidt with reorthogonalisation
+      for (const Eigen::VectorXd& b : basis) v -= b.dot(v) * b;
+    if (norm0 == 0.0 || v.norm() <= 1e-8 * norm0) {
+      dependent.push_back(j);
+    } else {
+      basis.push_back(v / v.norm());
+    }
+  }
+  return dependent;
+}
+
+}  // namespace
+
+ConstraintDiagnosis diagnose(const System& sys, Data& data) {
+  ConstraintDiagnosis d;
   const int nP = static_cast<int>(sys.rows_P.size());
   const int nc = static_cast<int>(sys.x_calc.size());
+  d.n_constraints = nP;
+  d.n_calculable = nc;
+  if (nP > 0 && nc > 0) {
+    evaluate_elements(sys, data);
+    assemble_block(sys, data, sys.row_P, nP);
+    const Eigen::MatrixXd A = data.A.topRows(nP);
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::VectorXd& s = svd.singularValues();
+    const double tol = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(s[0], 1e-300);
+    for (int i = 0; i < s.size(); ++i) d.rank += s[i] > tol;
+    for (int i = d.rank; i < nP; ++i) {  // left null vectors: combinations of redundant rows
+      const Eigen::VectorXd u = svd.matrixU().col(i);
+      std::vector<std::pair<int, double>> group;
+      for (int r = 0; r < nP; ++r)
+        if (std::abs(u[r]) > 0.1 * u.cwiseAbs().maxCoeff()) group.push_back({sys.rows_P[r], u[r] / u.cwiseAbs().maxCoeff()});
+      d.redundant_groups.push_back(group);
+    }
+    for (int i = d.rank; i < nc; ++i) {  // right null vectors: undetermined motions
+      const Eigen::VectorXd v = svd.matrixV().col(i);
+      std::vector<std::pair<int, double>> group;
+      for (int j = 0; j < nc; ++j)
+        if (std::abs(v[j]) > 0.1 * v.cwiseAbs().maxCoeff()) group.push_back({sys.x_calc[j], v[j] / v.cwiseAbs().maxCoeff()});
+      d.undetermined_groups.push_back(group);
+    }
+    // A concrete set to release: keep prescribed rows (inputs, DOFs) first, then fixed ones in
+    // ascending order; each row dependent on the kept ones is redundant.
+    std::vector<int> order;
+    for (int pass = 0; pass < 2; ++pass)
+      for (int r = 0; r < nP; ++r) {
+        const bool fixed = sys.def_class[sys.rows_P[r]] == DefClass::Fixed;
+        if ((pass == 1) == fixed) order.push_back(r);
+      }
+    for (int r : dependent_columns(A.transpose(), order)) d.redundant.push_back(sys.rows_P[r]);
+    std::sort(d.redundant.begin(), d.redundant.end());
+    std::vector<int> cols(nc);
+    for (int j = 0; j < nc; ++j) cols[j] = j;
+    for (int j : dependent_columns(A, cols)) d.undetermined.push_back(sys.x_calc[j]);
+  } else if (nc > 0) {
+    d.undetermined = sys.x_calc;
+  } else {
+    d.redundant = sys.rows_P;
+  }
+
   std::ostringstream os;
   os << "  " << nP << " constraint equations (fixed, input, dynamic deformations) for " << nc
      << " calculable coordinates";
   if (nP > nc) os << ": over-constrained by " << nP - nc;
   if (nP < nc) os << ": under-constrained by " << nc - nP;
-  os << ".";
-  if (nP == 0 || nc == 0) {
-    if (nc > 0) {
-      os << "\n  undetermined coordinates:";
-      for (int g : sys.x_calc) os << " (" << sys.coord_name(g) << ")";
-    }
-    return os.str();
-  }
-  evaluate_elements(sys, data);
-  assemble_block(sys, data, sys.row_P, nP);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(data.A.topRows(nP), Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::VectorXd& s = svd.singularValues();
-  const double smax = s.size() ? s[0] : 0.0;
-  const double tol = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(smax, 1e-300);
-  int rank = 0;
-  for (int i = 0; i < s.size(); ++i) rank += s[i] > tol;
-  const Eigen::MatrixXd& U = svd.matrixU();
-  const Eigen::MatrixXd& V = svd.matrixV();
-  if (rank < nP) {
-    os << "\n  redundant constraints (candidates for RLSE):";
-    for (int i = rank; i < nP; ++i) {
-      const Eigen::VectorXd u = U.col(i);
-      const double umax = u.cwiseAbs().maxCoeff();
-      os << "\n   -";
-      for (int r = 0; r < nP; ++r)
-        if (std::abs(u[r]) > 0.1 * umax) os << " " << sys.def_name(sys.rows_P[r]) << " (weight " << u[r] / umax << ")";
+  os << "; rank " << d.rank << ".";
+  if (!d.redundant.empty()) {
+    os << "\n  redundant constraints; release these (RLSE) to remove the redundancy:";
+    for (int k : d.redundant) os << "\n   - RLSE " << sys.def_label[k][0] << " " << sys.def_label[k][1] << "   (" << sys.def_name(k) << ")";
+    for (const auto& group : d.redundant_groups) {
+      os << "\n  dependent combination:";
+      for (const auto& [k, w] : group) os << " " << sys.def_name(k) << " (weight " << w << ")";
     }
   }
-  if (rank < nc) {
-    os << "\n  undetermined coordinates (candidates for FIX, DYNX or a missing element):";
-    for (int i = rank; i < nc; ++i) {
-      const Eigen::VectorXd v = V.col(i);
-      const double vmax = v.cwiseAbs().maxCoeff();
-      os << "\n   -";
-      for (int j = 0; j < nc; ++j)
-        if (std::abs(v[j]) > 0.1 * vmax) os << " " << sys.coord_name(sys.x_calc[j]) << " (weight " << v[j] / vmax << ")";
+  if (!d.undetermined.empty()) {
+    os << "\n  undetermined coordinates; fix them (FIX), make them degrees of freedom (DYNX) or add elements:";
+    for (int g : d.undetermined) os << "\n   - " << sys.coord_name(g);
+    for (const auto& group : d.undetermined_groups) {
+      os << "\n  free motion:";
+      for (const auto& [g, w] : group) os << " " << sys.coord_name(g) << " (weight " << w << ")";
     }
   }
-  return os.str();
+  d.text = os.str();
+  return d;
 }
+
+std::string diagnose_constraints(const System& sys, Data& data) { return diagnose(sys, data).text; }
 
 }  // namespace spacar

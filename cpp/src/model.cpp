@@ -56,6 +56,9 @@ void require_nonnegative(const std::vector<double>& values, const char* what) {
     if (values[i] < 0.0) fail(what, " value ", i + 1, " is negative (", values[i], ")");
 }
 
+// Prefix of a message about an item defined at `origin` (file, line, keyword), if known.
+std::string located(const std::string& origin) { return origin.empty() ? "" : origin + ": "; }
+
 // Euler parameters must be of unit length (within 1e-3); the L2MIN1 constraint keeps them so.
 void require_unit_euler(int id, const std::vector<double>& x) {
   double norm2 = 0.0;
@@ -141,7 +144,7 @@ Node& Model::attach_node(int id, NodeKind kind, const std::string& element_name)
 }
 
 void Model::add_element(const std::string& type_name, int id, const std::vector<int>& node_ids,
-                        const std::vector<double>& params) {
+                        const std::vector<double>& params, const std::string& origin) {
   require_open("new elements");
   const int type = find_element_type(type_name);
   if (type < 0) fail("unknown element type ", type_name);
@@ -179,6 +182,7 @@ void Model::add_element(const std::string& type_name, int id, const std::vector<
   el.type = type;
   el.nodes = node_ids;
   el.params = params;
+  el.origin = origin;
   const size_t nd = et.deformations.size();
   el.cls.assign(nd, DefClass::Fixed);
   el.e.assign(nd, 0.0);
@@ -189,7 +193,8 @@ void Model::add_element(const std::string& type_name, int id, const std::vector<
   elements.emplace(id, std::move(el));
 }
 
-void Model::set_coordinates(int id, NodeKind kind, const std::vector<double>& values) {
+void Model::set_coordinates(int id, NodeKind kind, const std::vector<double>& values,
+                            const std::string& origin) {
   require_finite(values, node_keyword(kind));
   if (id <= 0) fail("node numbers must be positive, got ", id);
   if (kind == NodeKind::Any) {
@@ -227,6 +232,7 @@ void Model::set_coordinates(int id, NodeKind kind, const std::vector<double>& va
     n.cls.assign(4, CoordClass::Calculable);
     n.xd.assign(4, 0.0);
     n.xdd.assign(4, 0.0);
+    n.origin = origin;
     it = nodes.emplace(id, std::move(n)).first;
   }
   Node& n = it->second;
@@ -498,7 +504,7 @@ void Model::prepare() {
   if (!frozen_) {
     for (const auto& [id, n] : nodes)
       if (n.kind == NodeKind::Any)
-        throw InputError("node " + std::to_string(id) + " is not used by any element and has no kind (use XY, BETA, XYZ or LAMBDA)", 0, id);
+        fail(located(n.origin), "node ", id, " is not used by any element and has no kind (use XY, BETA, XYZ or LAMBDA)");
     add_automatic_constraints();
     if (elements.empty()) fail("the model has no elements");
     compute_reference_geometry();
@@ -549,11 +555,12 @@ void Model::compute_reference_geometry() {
     try {
       t.reference(xref.data(), el.params, l0, lgeomy);
     } catch (const InputError& err) {
-      throw InputError(t.name + " " + std::to_string(id) + ": " + err.what(), id);
+      fail(located(el.origin), t.name, " ", id, ": ", err.what());
     }
     if (t.has_length && !el.l0) {
       if (!(l0 > 0.0))
-        throw InputError(t.name + " " + std::to_string(id) + " has zero length: its nodes coincide in the initial positions", id);
+        fail(located(el.origin), t.name, " ", id,
+             " has zero length: its nodes coincide in the initial positions");
       el.l0 = l0;
     }
     if (t.n_lgeomy > 0 && el.lgeomy.empty()) el.lgeomy = lgeomy;

@@ -6,6 +6,7 @@
 
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
+#include "spacar/forces.hpp"
 #include "spacar/kinematics.hpp"
 
 namespace spacar {
@@ -62,13 +63,23 @@ void Simulation::evaluate(double t, const double* q, const double* qd) {
   have_base_ = true;
 }
 
+void Simulation::forces() { solve_reactions(*sys_, data_); }
+
+Linearization Simulation::linearize() {
+  forces();
+  if (!linearizer_) linearizer_ = std::make_unique<Linearizer>(model_, dependent_);
+  return linearizer_->compute(*sys_, data_);
+}
+
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof();
   try {
     evaluate(t, Y.data(), Y.data() + nd);
   } catch (const KinematicsError& err) {
+    kinematic_failure_ = err.what();
     throw StepRejected(err.what());
   }
+  kinematic_failure_.clear();
   dY.head(nd) = Y.segment(nd, nd);
   dY.tail(nd) = data_.qdd;
 }
@@ -82,6 +93,7 @@ void Simulation::record(BlockResults& res, int k) {
   res.ed.row(k) = data_.ed;
   res.edd.row(k) = data_.edd;
   res.sigma.row(k) = data_.sigma;
+  res.reaction.row(k) = data_.reaction;
 }
 
 BlockResults Simulation::run(const RunOptions& options) {
@@ -94,7 +106,9 @@ BlockResults Simulation::run(const RunOptions& options) {
   res.warnings = sys_->warnings;
   const int nt = n_out + 1;
   res.t.resize(nt);
-  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd}) m->resize(nt, sys_->nx);
+  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd, &res.reaction}) m->resize(nt, sys_->nx);
+  res.reaction.setZero();
+  const bool linear = !sys_->e_line.empty() || st.linear.value_or(0) >= 1;
   for (RowMatrix* m : {&res.e, &res.ed, &res.edd, &res.sigma}) m->resize(nt, sys_->ne);
   std::vector<double> times(nt);
   for (int k = 0; k < nt; ++k) times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
@@ -105,8 +119,10 @@ BlockResults Simulation::run(const RunOptions& options) {
   int k_out = 0;
   auto output = [&](double t, const Eigen::VectorXd& Y) {
     evaluate(t, Y.data(), Y.data() + nd);
+    if (st.forcemode >= 1 || linear) forces();
+    if (linear) res.linearizations.push_back(linearize());
     record(res, k_out);
-    if (options.on_output) options.on_output(k_out, t);
+    if (options.on_output) options.on_output(k_out, data_);
     ++k_out;
   };
   Eigen::VectorXd Y(2 * nd);
@@ -116,6 +132,7 @@ BlockResults Simulation::run(const RunOptions& options) {
     for (double t : times) output(t, Y);
   } else {
     double t = t0, h = options.initial_step;
+    kinematic_failure_.clear();
     for (;;) {
       // One segment: integrate until the end, or until a free rotation must be repartitioned.
       Integrator integ(static_cast<int>(Y.size()), options.method);
@@ -130,7 +147,19 @@ BlockResults Simulation::run(const RunOptions& options) {
         integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
       const std::vector<double> remaining(times.begin() + k_out, times.end());
       auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
-      const double t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
+      double t_reached = t;
+      try {
+        t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
+      } catch (const IntegrationError& err) {
+        // The step collapsed because the kinematics has no solution (the last right-hand side
+        // failed in the Newton iteration): that is a KinematicsError (formulation.md §2.2).
+        if (kinematic_failure_.empty()) throw;
+        std::string integrator = err.what();
+        const size_t cut = integrator.find(" (last rejection");
+        if (cut != std::string::npos) integrator.resize(cut);
+        throw KinematicsError(kinematic_failure_ + "\nNo kinematic solution down to the minimum step (" +
+                              integrator + ").");
+      }
       const IntegratorStats& s = integ.stats();
       res.rhs_evaluations += s.nfev;
       res.steps += s.nsteps;
@@ -168,6 +197,7 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   for (int i = 1; i < 4; ++i)
     if (std::abs(data_.x[fr.coord + i]) > std::abs(data_.x[fr.coord + best])) best = i;
   dependent_[fr.node] = best;
+  linearizer_.reset();
   const Eigen::VectorXd x = data_.x, xd = data_.xd, e = data_.e, ed = data_.ed, angles = data_.angle_ref;
   const long newton = data_.total_newton_iterations;
   sys_ = compile(model_, dependent_);

@@ -59,7 +59,7 @@ void number_coordinates(const Model& model, System& sys, std::map<int, int>& nod
   }
 }
 
-void build_elements(const Model& model, System& sys, const std::map<int, int>& node_offset) {
+void build_elements(const Model& model, System& sys, const std::map<int, int>& node_offset, bool line_as_dof) {
   for (const auto& [id, el] : model.elements) {
     const ElementType& t = element_catalogue()[el.type];
     if (!t.make)
@@ -87,7 +87,8 @@ void build_elements(const Model& model, System& sys, const std::map<int, int>& n
     for (int i = 0; i < se.nd; ++i) {
       if (se.kernel->is_angle(i)) sys.angle_defs.push_back(sys.ne + i);
       sys.def_label.push_back({id, i + 1});
-      sys.def_class.push_back(el.cls[i]);
+      const bool line = line_as_dof && el.cls[i] == DefClass::Linearization;
+      sys.def_class.push_back(line ? DefClass::Dynamic : el.cls[i]);
       sys.e_element.push_back(static_cast<int>(sys.elements.size()));
     }
     sys.ne += se.nd;
@@ -248,18 +249,33 @@ void masses_and_loads(const Model& model, System& sys, const std::map<int, int>&
   sys.gravity = Eigen::Vector3d(model.gravity[0], model.gravity[1], model.gravity[2]);
 }
 
+void length_scales(const Model& model, System& sys) {
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& [id, el] : model.elements)
+    if (el.l0) {
+      sum += *el.l0;
+      ++n;
+    }
+  if (n > 0 && sum > 0.0) sys.length_scale = sum / n;
+  for (NodeKind k : sys.coord_node_kind) sys.coord_is_length.push_back(k == NodeKind::XY || k == NodeKind::XYZ);
+  for (int k = 0; k < sys.ne; ++k)
+    sys.def_is_length.push_back(element_catalogue()[sys.elements[sys.e_element[k]].type].has_length);
+}
+
 }  // namespace
 
-std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& dependent) {
+std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& dependent, bool line_as_dof) {
   if (!model.frozen()) throw Error("compile(): the model has not been prepared (call Model::prepare())");
   auto sys = std::make_unique<System>();
   sys->settings = model.settings;
   std::map<int, int> node_offset;
   number_coordinates(model, *sys, node_offset, dependent);
-  build_elements(model, *sys, node_offset);
+  build_elements(model, *sys, node_offset, line_as_dof);
   partition(*sys);
   initial_values(model, *sys);
   masses_and_loads(model, *sys, node_offset);
+  length_scales(model, *sys);
   for (int k : sys->auto_released)
     sys->warnings.push_back(sys->def_name(k) + " is fixed but none of its coordinates is calculable: it is checked, not solved for");
   return sys;

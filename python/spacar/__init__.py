@@ -10,7 +10,7 @@ Quick start::
     print(model.dump())                               # the restartable state dump
 """
 from . import _core
-from .check import Summary, summary
+from .check import Check, Diagnosis, Summary, check, summary
 from .errors import (
     InputError,
     IntegrationError,
@@ -22,6 +22,7 @@ from .errors import (
 from .io.reader import parse, read, read_string
 from .io.writer import dump
 from .keywords import KEYWORDS
+from .linearize import Linearization, linearize
 from .model import Model
 from .results import Results
 from .simulate import simulate
@@ -44,6 +45,8 @@ __all__ = [
     "parse",
     "dump",
     "simulate",
+    "linearize",
+    "Linearization",
     "summary",
     "element_catalogue",
     "SpacarError",

@@ -1,5 +1,7 @@
-"""Summary of a model: nodes and elements by type, coordinates and deformations per class,
-degrees of freedom (``spacar check``)."""
+"""Checks of a model before an analysis (``spacar check``): nodes and elements by type,
+coordinates and deformations per class, degrees of freedom, and the diagnosis of the constraint
+block — which rigid deformations are redundant and could be released, which coordinates are
+undetermined (formulation.md §2.3)."""
 from __future__ import annotations
 
 from collections import Counter
@@ -33,24 +35,65 @@ class Summary:
     def lines(self):
         def fmt(counter, order=None):
             keys = order or sorted(counter)
-            return ", ".join(f"{counter[k]} {k}" for k in keys if counter[k])
+            parts = ", ".join(f"{counter[k]} {k}" for k in keys if counter[k])
+            return f"{sum(counter.values())} ({parts})" if parts else "0"
 
-        yield f"nodes: {sum(self.nodes.values())} ({fmt(self.nodes)})"
-        yield f"elements: {sum(self.elements.values())} ({fmt(self.elements)})"
-        yield f"nodal coordinates: {self.n_coordinates} ({fmt(self.coordinates, COORD_CLASSES)})"
-        yield f"deformations: {self.n_deformations} ({fmt(self.deformations, DEF_CLASSES)})"
+        yield f"nodes: {fmt(self.nodes)}"
+        yield f"elements: {fmt(self.elements)}"
+        yield f"nodal coordinates: {fmt(self.coordinates, COORD_CLASSES)}"
+        yield f"deformations: {fmt(self.deformations, DEF_CLASSES)}"
         yield f"degrees of freedom: {self.degrees_of_freedom}"
 
     def __str__(self):
         return "\n".join(self.lines())
 
 
-def summary(model) -> Summary:
-    """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
-    nodes are included (they are created at the first END)."""
+@dataclass
+class Diagnosis:
+    """Solvability of the position constraints at the given geometry."""
+
+    n_constraints: int
+    n_calculable: int
+    rank: int
+    redundant: list      # (element, deformation): release these (RLSE) to remove the redundancy
+    undetermined: list   # (node, component): fix them, make them DOFs or add elements
+    text: str
+
+    @property
+    def ok(self) -> bool:
+        return not self.redundant and not self.undetermined and self.n_constraints == self.n_calculable
+
+
+@dataclass
+class Check:
+    summary: Summary
+    diagnosis: Diagnosis
+
+    def __str__(self):
+        verdict = "the constraints determine the calculable coordinates" if self.diagnosis.ok else "problems:"
+        return f"{self.summary}\nconstraints: {verdict}\n{self.diagnosis.text}"
+
+
+def check(model) -> Check:
+    """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly)."""
+    if not model.nodes and not model.elements:
+        return Check(summary(model), Diagnosis(0, 0, 0, [], [], "  the model is empty"))
     copy = model.copy()
     copy.prepare()
-    core = copy._core
+    d = _core.Simulation(copy._core).diagnose()
+    diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
+                          list(d["undetermined"]), d["text"])
+    return Check(summary(model), diagnosis)
+
+
+def summary(model) -> Summary:
+    """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
+    nodes are included (they are created at the first END). An empty model (e.g. an input of
+    comments only) has all counts zero."""
+    core = model._core.copy()
+    if not core.nodes and not core.elements:
+        return Summary(Counter(), Counter(), Counter(), Counter())
+    core.prepare()
     nodes = Counter(str(n.kind.name) for n in core.nodes.values())
     elements = Counter(el.type_name for el in core.elements.values())
     coords = Counter(c.name for n in core.nodes.values() for c in n.cls)
@@ -58,4 +101,4 @@ def summary(model) -> Summary:
     return Summary(nodes, elements, coords, defs)
 
 
-__all__ = ["Summary", "summary", "_core"]
+__all__ = ["Summary", "Diagnosis", "Check", "summary", "check"]

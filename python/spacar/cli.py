@@ -19,9 +19,21 @@ from .io.writer import dump
 from .simulate import simulate
 
 
-def _comment(text: str, stream=sys.stdout):
+def _comment(text: str, stream=None):
+    # sys.stdout is looked up at call time, so that redirecting it (tests, embedding) works.
     for line in str(text).splitlines():
-        print(f"* {line}", file=stream)
+        print(f"* {line}", file=stream or sys.stdout)
+
+
+def _print_linearization(res) -> None:
+    """Eigenfrequencies at the end of a block that asked for linearization (LINE, LINEAR)."""
+    if not res.linearizations:
+        return
+    lin = res.linearizations[-1]
+    _comment(f"linearized equations at t = {lin.t:g}: {len(lin.z_labels)} coordinates")
+    _comment("eigenfrequencies [Hz] (negative: unstable): " + " ".join(f"{f:.6g}" for f in lin.eigenfrequencies()))
+    if res.settings_linear == 2:
+        _comment("buckling factors: " + " ".join(f"{m:.6g}" for m in lin.buckling_factors()))
 
 
 def _run(args) -> int:
@@ -43,6 +55,7 @@ def _run(args) -> int:
         _comment(f"block {k + 1}: t = {res.t[0]:g} .. {res.t[-1]:g}, {len(res.t)} output times, "
                  f"{s['rhs_evaluations']} right-hand sides, {s['accepted']} steps "
                  f"({s['rejected']} rejected), {s['wall_time'] * 1e3:.1f} ms")
+        _print_linearization(res)
         sys.stdout.write(dump(model, digits=args.dump_digits))
         sys.stdout.flush()
     return 0
@@ -53,8 +66,15 @@ def _check(args) -> int:
     _comment(f"spacar check: {args.file}")
     for w in model.warnings:
         _comment(f"warning: {w}")
-    _comment(model.summary())
+    _comment(model.check())
     return 0
+
+
+def _digits(text: str) -> int:
+    value = int(text)
+    if not 1 <= value <= 17:
+        raise argparse.ArgumentTypeError(f"must be between 1 and 17, got {value}")
+    return value
 
 
 def main(argv=None) -> int:
@@ -63,7 +83,7 @@ def main(argv=None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run the analysis of every block and print the state dumps")
     run.add_argument("file")
-    run.add_argument("--dump-digits", type=int, default=4, metavar="N",
+    run.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                      help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
     run.add_argument("--method", choices=["dop853", "dopri5"], default="dop853", help="integration method")
     run.set_defaults(func=_run)

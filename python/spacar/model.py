@@ -84,32 +84,28 @@ class Model:
         self.source = None     # input file name, when read from a file
         self.warnings = []     # reader and analysis warnings
         self._continue_step = 0.0  # integrator step to continue with (RESTART 0)
-        self._defined_at = {}      # ("element" | "node", number) -> reader Command that defined it
+        self._origin = ""      # input line being applied (file, line, keyword), for later messages
 
     # --- dispatch used by the reader ---------------------------------------------------------
 
-    def apply(self, keyword: str, *args):
-        """Apply one keyword line: ``model.apply("FIX", 8, 2)``."""
+    def apply(self, keyword: str, *args, origin: str = ""):
+        """Apply one keyword line: ``model.apply("FIX", 8, 2)``. ``origin`` (file, line, keyword)
+        is remembered with the elements and nodes the line defines, for errors found at the
+        first END (e.g. an element of zero length)."""
         kw = KEYWORDS.get(keyword.upper())
         if kw is None or kw.name in ("END", "EOF"):
             raise InputError(f"unknown keyword {keyword!r}")
-        return getattr(self, kw.builder)(*args)
+        self._origin = origin
+        try:
+            return getattr(self, kw.builder)(*args)
+        finally:
+            self._origin = ""
 
     def prepare(self):
         """What the first END does before an analysis: create the automatic L2MIN1 elements,
         compute the reference geometry and freeze the topology. Errors found here name the input
         line that defined the element or node concerned."""
-        try:
-            self._core.prepare()
-        except InputError as err:
-            raise self._locate(err) from None
-
-    def _locate(self, err):
-        for kind in ("element", "node"):
-            cmd = self._defined_at.get((kind, getattr(err, kind, 0)))
-            if cmd is not None:
-                return type(err)(f"{cmd.where()}: {err}")
-        return err
+        self._core.prepare()
 
     def _call(self, name, *args):
         kw = KEYWORDS[name]
@@ -123,13 +119,15 @@ class Model:
         has_params = kw.params[-1].name == "params"
         nodes = vals[1:-1] if has_params else vals[1:]
         params = vals[-1] if has_params else []
-        self._core.add_element(type_name, vals[0], nodes, params)
+        self._core.add_element(type_name, vals[0], nodes, params, self._origin)
 
     # --- nodes ------------------------------------------------------------------------------
 
     def _node(self, kind, args):
         n, values = self._call(kind, *args)
-        self._core.set_coordinates(n, _NODE_KIND[kind], values)
+        if not isinstance(values, list):  # BETA: a single value
+            values = [values]
+        self._core.set_coordinates(n, _NODE_KIND[kind], values, self._origin)
 
     def x(self, n, *values):
         """X n x1..x4: coordinates of any node (usually one created by an element)."""
@@ -348,7 +346,6 @@ class Model:
         other.source = self.source
         other.warnings = list(self.warnings)
         other._continue_step = self._continue_step
-        other._defined_at = dict(self._defined_at)
         return other
 
     def summary(self):
@@ -356,6 +353,13 @@ class Model:
         from .check import summary
 
         return summary(self)
+
+    def check(self):
+        """Summary and constraint diagnosis (redundant deformations, undetermined coordinates);
+        see :mod:`spacar.check`."""
+        from .check import check
+
+        return check(self)
 
     def run(self, **kwargs):
         """Run the analysis of the current block; see :func:`spacar.simulate`."""

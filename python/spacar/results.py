@@ -43,6 +43,8 @@ class Results:
         self.t = arrays["t"]
         self.x, self.xd, self.xdd = arrays["x"], arrays["xd"], arrays["xdd"]
         self.e, self.ed, self.edd, self.sigma = arrays["e"], arrays["ed"], arrays["edd"], arrays["sigma"]
+        self.reaction = arrays["reaction"]  # (nt, nx): loads of supports and drivers (FORCEMODE ≥ 1)
+        self.linearizations = []  # one spacar.Linearization per output time (LINE or LINEAR ≥ 1)
         self.coordinate_labels = [tuple(lbl) for lbl in coordinate_labels]
         self.deformation_labels = [tuple(lbl) for lbl in deformation_labels]
         self.stats = stats

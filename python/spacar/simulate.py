@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from . import _core
+from .linearize import Linearization
 from .results import Results
 
 
@@ -13,7 +14,9 @@ def simulate(model, *, method: str = "dop853", on_output=None) -> Results:
     EPSIND error control), otherwise the kinematic analysis runs at every output time. The state
     reached is stored in the model (see :meth:`spacar.Model.dump`).
 
-    ``on_output(k, t)`` is called after output time k is recorded (progress, live output).
+    ``on_output(k, state)`` is called after output time k is recorded, with ``state`` a dict of
+    NumPy arrays ``t, x, xd, xdd, e, ed, edd, sigma, reaction`` (progress, files written as the
+    run proceeds). It runs at output times only, never inside the integration.
     Returns :class:`spacar.Results`.
     """
     model.prepare()
@@ -26,4 +29,7 @@ def simulate(model, *, method: str = "dop853", on_output=None) -> Results:
     stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
                                     "newton_iterations", "wall_time")}
     model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    return Results(arrays, system.coord_label, system.def_label, stats)
+    res = Results(arrays, system.coord_label, system.def_label, stats)
+    res.linearizations = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
+    res.settings_linear = model.settings.linear
+    return res

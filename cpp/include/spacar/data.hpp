@@ -51,6 +51,7 @@ struct Data {
   Eigen::LLT<Eigen::MatrixXd> llt;
   Eigen::VectorXd qdd;          // DOF accelerations (n_dof)
   Eigen::VectorXd g;            // M ẍ + h − f (nx)
+  Eigen::VectorXd reaction;     // loads of supports and drivers on fixed and input coordinates (nx)
 };
 
 }  // namespace spacar

@@ -14,6 +14,14 @@ void constitutive_stresses(const System& sys, Data& data);
 // Global M, h and f at the current x, ẋ (the element work vectors must hold x and v).
 void assemble_inertia_and_loads(const System& sys, Data& data);
 
+// Residual of the reduced equations of motion at the current q̂̈ (formulation.md §7.2):
+// R = DF_qᵀ [M ẍ + h − f] + DFe_qᵀ σ. Requires positions, DF and velocities.
+void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R);
+
+// Σ σ_k H_k − ∂f/∂x (nx x nx) at the current positions for the stress vector sigma: the
+// geometric stiffness of the stresses and the stiffness of position-dependent loads.
+Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::VectorXd& sigma);
+
 // Solve M̄ q̈ = rhs (3.1) and complete ẍ, ë. Requires positions, DF and velocities.
 // Throws SingularMassError naming the degrees of freedom without inertia.
 void solve_dynamics(const System& sys, Data& data);

@@ -11,14 +11,10 @@ struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Invalid model description: the reader adds file, line and keyword to the message. When the
-// error concerns one element or node (found at the first END), its number is carried along so
-// that the reader can name the line that defined it.
+// Invalid model description: the reader adds file, line and keyword to the message; errors
+// found at the first END name the line that defined the element or node (Element::origin).
 struct InputError : Error {
-  explicit InputError(const std::string& message, int element_id = 0, int node_id = 0)
-      : Error(message), element(element_id), node(node_id) {}
-  int element = 0;
-  int node = 0;
+  using Error::Error;
 };
 
 // The kinematic analysis cannot be solved (constraint block not square or singular, Newton failed).

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "spacar/data.hpp"
 #include "spacar/system.hpp"
@@ -32,8 +34,16 @@ void solve_velocities(const System& sys, Data& data);
 // ẍ = DF q̂̈ + acc0 and ë = B ẍ + c, for the current q̂̈.
 void solve_accelerations(const System& sys, Data& data);
 
-// A readable diagnosis of the constraint block at the current positions: counts, and from an
-// SVD the redundant deformations and the undetermined coordinates.
+// Diagnosis of the position constraint block at the current positions (formulation.md §2.3).
+struct ConstraintDiagnosis {
+  int n_constraints = 0, n_calculable = 0, rank = 0;
+  std::vector<int> redundant;     // deformations whose release removes the redundancy
+  std::vector<int> undetermined;  // calculable coordinates left undetermined
+  // From the SVD: dependent combinations of rows and free motions, (index, weight).
+  std::vector<std::vector<std::pair<int, double>>> redundant_groups, undetermined_groups;
+  std::string text;               // readable report naming elements and nodes
+};
+ConstraintDiagnosis diagnose(const System& sys, Data& data);
 std::string diagnose_constraints(const System& sys, Data& data);
 
 // Check that the constraint block is square; throws KinematicsError with the diagnosis.

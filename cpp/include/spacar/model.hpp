@@ -35,6 +35,7 @@ struct Node {
   std::vector<double> torquel;    // TORQUEL values (empty: none)
   bool used = false;              // referenced by an element
   int x_given = 0;                // number of coordinates given explicitly (X/XY/...)
+  std::string origin;             // where the node was first defined by X/XY/... (for messages)
 };
 
 struct Element {
@@ -50,6 +51,7 @@ struct Element {
   std::vector<bool> e_given;      // E was given (targets of fixed deformations, initial DOF values)
   std::vector<std::array<int, 2>> kinematic_of;  // nonholonomic: (element, index) of its kinematic coordinate; (0,0) if none
   bool automatic = false;         // L2MIN1 created automatically for a LAMBDA node
+  std::string origin;             // where the element was defined, e.g. "f.dat, line 3, keyword PLBEAM"
 };
 
 struct Settings {
@@ -71,10 +73,12 @@ struct Settings {
 class Model {
  public:
   // --- topology (before the first END) ---
+  // `origin` names the input line (file, line, keyword) for errors found later, at prepare().
   void add_element(const std::string& type, int id, const std::vector<int>& nodes,
-                   const std::vector<double>& params);
+                   const std::vector<double>& params, const std::string& origin = "");
   // X (kind Any) or a typed node keyword: set the first values.size() coordinates.
-  void set_coordinates(int node, NodeKind kind, const std::vector<double>& values);
+  void set_coordinates(int node, NodeKind kind, const std::vector<double>& values,
+                       const std::string& origin = "");
 
   // --- boundary conditions; empty index list = all components / deformations ---
   void set_coordinate_class(int node, const std::vector<int>& components, CoordClass cls);

@@ -13,6 +13,7 @@
 
 #include "spacar/data.hpp"
 #include "spacar/integrator.hpp"
+#include "spacar/linearize.hpp"
 #include "spacar/model.hpp"
 #include "spacar/system.hpp"
 
@@ -23,14 +24,17 @@ using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::R
 struct RunOptions {
   Method method = Method::DOP853;
   double initial_step = 0.0;  // > 0: continue with this step (RESTART 0 across blocks)
-  // Called after every output time is recorded (index k, time t): progress bars, live files.
-  std::function<void(int, double)> on_output;
+  // Called after every output time is recorded (index k, data of that state): progress bars,
+  // files written as the run proceeds.
+  std::function<void(int, const Data&)> on_output;
 };
 
 struct BlockResults {
   Eigen::VectorXd t;
   RowMatrix x, xd, xdd;        // nt x nx
-  RowMatrix e, ed, edd, sigma; // nt x ne
+  RowMatrix e, ed, edd, sigma; // nt x ne (sigma complete with the reactions if FORCEMODE ≥ 1)
+  RowMatrix reaction;          // nt x nx: reactions on fixed and input coordinates (FORCEMODE ≥ 1)
+  std::vector<Linearization> linearizations;  // at every output time if LINE or LINEAR ≥ 1
   long rhs_evaluations = 0, steps = 0, accepted = 0, rejected = 0, newton_iterations = 0;
   double last_step = 0.0;
   double wall_time = 0.0;      // seconds spent in the block
@@ -50,6 +54,10 @@ class Simulation {
   void assemble();
   // Complete state at (t, q, q̇): positions, DF, velocities, q̈, accelerations, stresses.
   void evaluate(double t, const double* q, const double* qd);
+  // Reactions and complete stresses (FORCEMODE) at the state of the last evaluate().
+  void forces();
+  // Linearized equations at the state of the last evaluate() (computes the forces first).
+  Linearization linearize();
   // Right-hand side of the first-order system Y = (q, q̇).
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
 
@@ -69,7 +77,9 @@ class Simulation {
   std::unique_ptr<System> sys_;
   Data data_;
   Eigen::VectorXd x_base_, qhat_base_, predictor_;
+  std::unique_ptr<Linearizer> linearizer_;
   bool have_base_ = false;
+  std::string kinematic_failure_;  // message of the last right-hand side that failed in Newton
 };
 
 }  // namespace spacar

@@ -97,6 +97,8 @@ struct System {
   std::vector<std::pair<int, Eigen::Vector3d>> torquel;  // (first λ coordinate, body torque)
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   int dim = 2;                  // 2 for planar models, 3 if any spatial node exists
+  double length_scale = 1.0;    // mean reference length of the elements (1 if none): step sizes
+  std::vector<char> coord_is_length, def_is_length;  // length-type (vs angle-type) quantities
 
   Settings settings;
 
@@ -107,6 +109,8 @@ struct System {
 // Compile a prepared model (Model::prepare() has run). Throws InputError for classifications
 // that cannot be analysed and NotImplementedError for element types without physics.
 // `dependent` overrides the dependent Euler parameter (0..3) of free rotations by node number.
-std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& dependent = {});
+// line_as_dof: LINE parameters become coordinates (dynamic), for the linearized equations.
+std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& dependent = {},
+                                bool line_as_dof = false);
 
 }  // namespace spacar

@@ -14,6 +14,7 @@
 
 #include "spacar/elements/registry.hpp"
 #include "spacar/elements/spatial.hpp"
+#include "spacar/errors.hpp"
 
 namespace spacar {
 namespace {
@@ -24,6 +25,9 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
 
  public:
   explicit Beam(const ElementSetup& s) : l0_(s.l0) {
+    if (s.lgeomy.size() != 9)
+      throw InputError(std::string(Nonlinear ? "BEAMNL" : "BEAM") + ": LGEOMY needs 9 values (e_x0, e_y0, e_z0), got " +
+                       std::to_string(s.lgeomy.size()));
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) C0_(i, j) = s.lgeomy[3 * j + i];
     const double rhoA = s.emass.empty() ? 0.0 : s.emass[0];

@@ -6,14 +6,14 @@
 // e1 is an angle: the kinematic analysis unwraps it to a continuous multi-turn value.
 #include "spacar/elements/registry.hpp"
 #include "spacar/elements/spatial.hpp"
+#include "spacar/errors.hpp"
 
 namespace spacar {
 namespace {
 
 class Hinge : public AutoDiffElement<Hinge, 8, 3> {
  public:
-  explicit Hinge(const ElementSetup& s)
-      : C0_(hinge_frame(Eigen::Vector3d(s.params[0], s.params[1], s.params[2]), "HINGE")) {}
+  explicit Hinge(const ElementSetup& s) : C0_(frame(s.params)) {}
 
   template <class S>
   void deform(const S* x, S* e) const {
@@ -32,6 +32,11 @@ class Hinge : public AutoDiffElement<Hinge, 8, 3> {
   }
 
  private:
+  static Eigen::Matrix3d frame(const std::vector<double>& p) {
+    if (p.size() != 3) throw InputError("HINGE: the axis needs 3 values, got " + std::to_string(p.size()));
+    return hinge_frame(Eigen::Vector3d(p[0], p[1], p[2]), "HINGE");
+  }
+
   Eigen::Matrix3d C0_;
 };
 

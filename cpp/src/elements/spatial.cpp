@@ -34,15 +34,13 @@ Eigen::Matrix3d hinge_frame(const Eigen::Vector3d& axis, const std::string& what
   return frame_from_axis(axis, Eigen::Vector3d::Unit(k), what);
 }
 
-namespace {
-Eigen::Matrix<double, 3, 4> G_of(const double* l) {
+Eigen::Matrix<double, 3, 4> euler_G(const double* l) {
   Eigen::Matrix<double, 3, 4> G;
   G << -l[1], l[0], l[3], -l[2],  //
       -l[2], -l[3], l[0], l[1],   //
       -l[3], l[2], -l[1], l[0];
   return G;
 }
-}  // namespace
 
 void add_rotational_inertia(int n, const double* x, const double* v, const int* lam, int nblocks,
                             const Eigen::Matrix3d* A, double* M, double* h) {
@@ -51,7 +49,7 @@ void add_rotational_inertia(int n, const double* x, const double* v, const int* 
   Eigen::Matrix<double, 3, 4> G[4];
   Eigen::Vector3d w[4];
   for (int i = 0; i < nblocks; ++i) {
-    G[i] = G_of(x + lam[i]);
+    G[i] = euler_G(x + lam[i]);
     w[i] = 2.0 * G[i] * Eigen::Map<const Eigen::Vector4d>(v + lam[i]);
   }
   for (int i = 0; i < nblocks; ++i) {
@@ -61,7 +59,7 @@ void add_rotational_inertia(int n, const double* x, const double* v, const int* 
       Mm.block<4, 4>(lam[i], lam[j]) += 4.0 * G[i].transpose() * Aij * G[j];
       Aw += Aij * w[j];
     }
-    hm.segment<4>(lam[i]) += 4.0 * G_of(v + lam[i]).transpose() * Aw;
+    hm.segment<4>(lam[i]) += 4.0 * euler_G(v + lam[i]).transpose() * Aw;
   }
 }
 

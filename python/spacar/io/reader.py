@@ -15,14 +15,15 @@ import os
 import re
 from dataclasses import dataclass, field
 
-from .. import _core
 from ..errors import InputError, SpacarError
 from ..keywords import INT, LOOKUP, Keyword
 from ..model import Model, check_args
 
-_ELEMENT_KEYWORDS = {t.name for t in _core.element_catalogue()}
-_INT_RE = re.compile(r"^[+-]?\d+$")
-_REAL_RE = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eEdD][+-]?\d+)?$")
+_INT_RE = re.compile(r"^[+-]?\d+$", re.ASCII)
+_REAL_RE = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eEdD][+-]?\d+)?$", re.ASCII)
+# Only these end a line: str.splitlines() would also split at form feeds and other separators
+# and so report wrong line numbers.
+_NEWLINE_RE = re.compile(r"\r\n|\r|\n")
 
 
 @dataclass(frozen=True)
@@ -62,6 +63,8 @@ def _number(token: str, kind: str):
         raise ValueError(f"{token!r} is not an integer")
     if _REAL_RE.match(token) or _INT_RE.match(token):
         return float(token.replace("d", "e").replace("D", "e"))
+    if token.lower().lstrip("+-") in ("nan", "inf", "infinity"):
+        raise ValueError(f"{token!r} is not a number (NaN and infinity are not accepted)")
     raise ValueError(f"{token!r} is not a number")
 
 
@@ -76,7 +79,9 @@ def _parse_line(kw: Keyword, tokens):
             values.append(_number(tok, p.kind))
         pos += n
     for tok in tokens[pos:]:
-        _number(tok, "real")  # a malformed number is reported as such, not as a count
+        # Surplus values: a malformed number is reported as such; otherwise they are kept, so
+        # that the count check reports "too many values".
+        values.append(_number(tok, "real"))
     return values
 
 
@@ -84,7 +89,7 @@ def parse(text: str, file: str = "<string>") -> list[Block]:
     """Split an input text into blocks of commands; checks syntax, counts and types."""
     blocks = [Block()]
     ended_by_eof = False
-    for lineno, raw in enumerate(text.splitlines(), start=1):
+    for lineno, raw in enumerate(_NEWLINE_RE.split(text), start=1):
         if raw.startswith("*"):
             continue
         tokens = raw.split()
@@ -94,7 +99,8 @@ def parse(text: str, file: str = "<string>") -> list[Block]:
             raise _error(file, lineno, tokens[0].upper()[:8], "text after EOF")
         head = tokens[0]
         if not head[0].isalpha():
-            raise _error(file, lineno, None, f"a line must start with a keyword, not {head!r}")
+            raise _error(file, lineno, head.upper(),
+                         f"a line must start with a keyword (a letter first), not {head!r}")
         kw = LOOKUP.get(head.upper()[:8])
         if kw is None:
             raise _error(file, lineno, head.upper(), f"unknown keyword {head!r}")
@@ -121,13 +127,9 @@ def apply_block(model: Model, block: Block) -> None:
     """Apply the commands of a block to the model, naming the line of any failing command."""
     for cmd in block.commands:
         try:
-            model.apply(cmd.keyword, *cmd.args)
+            model.apply(cmd.keyword, *cmd.args, origin=cmd.where())
         except SpacarError as err:
             raise type(err)(f"{cmd.where()}: {err}") from None
-        if cmd.keyword in _ELEMENT_KEYWORDS:
-            model._defined_at.setdefault(("element", cmd.args[0]), cmd)
-        elif cmd.keyword in ("X", "XY", "BETA", "XYZ", "LAMBDA"):
-            model._defined_at.setdefault(("node", cmd.args[0]), cmd)
 
 
 def read_string(text: str, file: str = "<string>") -> Model:
@@ -139,10 +141,9 @@ def read_string(text: str, file: str = "<string>") -> Model:
     model.blocks = blocks
     for b in blocks:
         if not b.ended:
-            last = b.commands[-1]
+            first, last = b.commands[0], b.commands[-1]
             model.warnings.append(
-                f"{file}: the input after line {b.commands[0].line - 1} has no END and is ignored "
-                f"(last line {last.line})")
+                f"{file}, lines {first.line}..{last.line}: input without a closing END is ignored")
     model.blocks = [b for b in blocks if b.ended]
     if model.blocks:
         apply_block(model, model.blocks[0])

@@ -36,12 +36,19 @@ class _Lines:
 
     def add(self, keyword: str, ints=(), reals=()):
         text = f"{keyword:<8s}" + "".join(f" {i:3d}" for i in ints) + "".join(self.real.format(r) for r in reals)
-        self.out.append(text)
+        self.out.append(text.rstrip())
 
 
 def dump(model, digits: int = 4) -> str:
-    """The state dump of ``model`` (a :class:`spacar.Model`) as text, ending with ``END``."""
+    """The state dump of ``model`` (a :class:`spacar.Model`) as text, ending with ``END``.
+
+    Before the first analysis the model is dumped as it will be analysed (a prepared copy: with
+    the reference geometry ``LENGTHO``/``LGEOMY`` and the automatic ``L2MIN1`` elements), so the
+    layout is the same before and after a run."""
     core = model._core
+    if not core.frozen:
+        core = core.copy()
+        core.prepare()
     nodes = core.nodes
     elements = core.elements
     out = _Lines(digits)

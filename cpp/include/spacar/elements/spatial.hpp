@@ -41,6 +41,9 @@ Eigen::Matrix3d frame_from_axis(const Eigen::Vector3d& axis, const Eigen::Vector
 // the axis has its smallest component, orthogonalised.
 Eigen::Matrix3d hinge_frame(const Eigen::Vector3d& axis, const std::string& what);
 
+// G(λ): ω' = 2 G(λ) λ̇ is the body-frame angular velocity (formulation.md §0).
+Eigen::Matrix<double, 3, 4> euler_G(const double* l);
+
 // Mass and convective inertia force of rotational kinetic energy
 // T = ½ Σ_ij ω_iᵀ A_ij ω_j with ω_i = 2 G(λ_i) λ̇_i the body angular velocity of LAMBDA block i
 // (coordinates lam[i]..lam[i]+3 of x and v). Adds 4 G_iᵀ A_ij G_j to M (n x n, column-major)

@@ -1,0 +1,47 @@
+// Linearized equations of motion (formulation.md §7) about a state of the model:
+//   M0 δz̈ + (C0 + D0) δż + (K0 + N0 + G0) δz = r0
+// in the coordinates z = (q, e^ℓ): the degrees of freedom followed by the LINE parameters.
+// M0, D0, K0 and G0 are assembled analytically; C0 and N0 are the remainders of central
+// differences of the reduced residual with the kinematics re-solved at every perturbation.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "spacar/data.hpp"
+#include "spacar/model.hpp"
+#include "spacar/system.hpp"
+
+namespace spacar {
+
+struct Linearization {
+  double t = 0.0;
+  // Each z: {0, node, component} for a coordinate, {1, element, deformation} for a deformation.
+  std::vector<std::array<int, 3>> z_label;
+  int n_line = 0;               // the last n_line entries of z are LINE parameters
+  Eigen::MatrixXd M0, C0, D0, K0, N0, G0;
+  Eigen::VectorXd r0;           // residual at the nominal state (drives the LINE parameters)
+  Eigen::MatrixXd DFz, DFez;    // ∂x/∂z (nx x nz) and ∂e/∂z (ne x nz): mode shapes
+};
+
+class Linearizer {
+ public:
+  // Compiles the model with its LINE parameters as coordinates. `dependent`: the dependent
+  // Euler parameters of free rotations (as in the analysed system).
+  explicit Linearizer(const Model& model, const std::map<int, int>& dependent = {});
+  // Linearize about the state of an analysis: sys/data hold a complete evaluation at time
+  // data.t, with the complete stresses of solve_reactions.
+  Linearization compute(const System& sys, const Data& data);
+
+ private:
+  void residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R);
+  void set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd);
+  std::unique_ptr<System> lin_;
+  Data ld_;
+  std::vector<int> order_;      // z index → DOF index of the linearization system
+};
+
+}  // namespace spacar

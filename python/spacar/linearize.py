@@ -1,0 +1,119 @@
+"""Linearized equations of motion, eigenfrequencies, mode shapes and buckling factors
+(formulation.md §7).
+
+About a state of the model (static or moving), in the coordinates z = (q, e^ℓ) — the degrees of
+freedom followed by the LINE parameters:
+
+    M0 δz̈ + (C0 + D0) δż + (K0 + N0 + G0) δz = r0
+
+M0 reduced mass, C0 velocity sensitivity (Coriolis, centrifugal, gyroscopic), D0 structural
+damping (EDAMPP), K0 structural stiffness (ESTIFF), N0 dynamic stiffness (inertia and
+convective terms), G0 geometric stiffness (stresses incl. reaction stresses, load stiffness).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+from . import _core
+from .errors import InputError
+
+
+class Linearization:
+    """The matrices of the linearized equations at one state, as NumPy arrays, with the
+    eigen-analyses built on them."""
+
+    def __init__(self, d: dict, coordinate_labels, deformation_labels):
+        self.t = d["t"]
+        self.z_labels = [("x" if k == 0 else "e", a, b) for k, a, b in d["z_label"]]
+        self.n_line = d["n_line"]
+        for name in ("M0", "C0", "D0", "K0", "N0", "G0"):
+            setattr(self, name, np.asarray(d[name]))
+        self.r0 = np.asarray(d["r0"])
+        self.DF = np.asarray(d["DFz"])    # ∂x/∂z: nodal coordinates per unit z
+        self.DFe = np.asarray(d["DFez"])  # ∂e/∂z
+        self.coordinate_labels = [tuple(c) for c in coordinate_labels]
+        self.deformation_labels = [tuple(c) for c in deformation_labels]
+
+    @property
+    def stiffness(self) -> np.ndarray:
+        """K0 + N0 + G0."""
+        return self.K0 + self.N0 + self.G0
+
+    @property
+    def damping(self) -> np.ndarray:
+        """C0 + D0."""
+        return self.C0 + self.D0
+
+    def _undamped(self):
+        w2, v = scipy.linalg.eig(self.stiffness, self.M0)
+        w2 = np.real_if_close(w2, tol=1e6)
+        order = np.argsort(np.abs(w2))
+        return np.real(w2[order]), v[:, order]
+
+    def eigenfrequencies(self) -> np.ndarray:
+        """Undamped eigenfrequencies in Hz, sorted, from (K0 + N0 + G0) v = ω² M0 v. An unstable
+        mode (ω² < 0) is returned as a negative number −√|ω²|/2π."""
+        w2, _ = self._undamped()
+        return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi)
+
+    def mode_shapes(self):
+        """(frequencies in Hz, shapes in z (nz x nmodes), shapes in the nodal coordinates
+        (nx x nmodes), each normalised to unit largest component)."""
+        w2, v = self._undamped()
+        v = np.real(v)
+        v = v / np.abs(v).max(axis=0)
+        return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi), v, self.DF @ v
+
+    def state_matrix(self) -> np.ndarray:
+        """A of d/dt [δz; δż] = A [δz; δż]."""
+        n = self.M0.shape[0]
+        Minv = np.linalg.inv(self.M0)
+        return np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ self.stiffness, -Minv @ self.damping]])
+
+    def eigenvalues(self) -> np.ndarray:
+        """Eigenvalues of the first-order system (damping, gyroscopic terms included), sorted by
+        |Im| and then Re."""
+        lam = np.linalg.eigvals(self.state_matrix())
+        return lam[np.lexsort((lam.real, np.abs(lam.imag)))]
+
+    def buckling_factors(self) -> np.ndarray:
+        """Load multipliers μ of (K0 + μ G0) v = 0 for a static state, sorted by |μ|; only the
+        finite ones."""
+        mu = scipy.linalg.eigvals(-self.K0, self.G0)
+        mu = mu[np.isfinite(mu)]
+        mu = np.real_if_close(mu, tol=1e6)
+        return np.real(mu[np.argsort(np.abs(mu))]) if np.isrealobj(mu) else mu[np.argsort(np.abs(mu))]
+
+    def state_space(self, outputs: str = "z"):
+        """(A, B, C, D) of the linearized system with generalized forces on z as inputs and, as
+        outputs, δz (``outputs="z"``) or the nodal coordinates δx = DF δz (``outputs="x"``)."""
+        n = self.M0.shape[0]
+        A = self.state_matrix()
+        B = np.vstack([np.zeros((n, n)), np.linalg.inv(self.M0)])
+        if outputs == "z":
+            C = np.hstack([np.eye(n), np.zeros((n, n))])
+        elif outputs == "x":
+            C = np.hstack([self.DF, np.zeros((self.DF.shape[0], n))])
+        else:
+            raise InputError("outputs must be 'z' or 'x'")
+        return A, B, C, np.zeros((C.shape[0], n))
+
+    def __repr__(self):
+        return f"<spacar.Linearization at t = {self.t:g}: {len(self.z_labels)} coordinates ({self.n_line} LINE)>"
+
+
+def linearize(model, state=None) -> Linearization:
+    """Linearized equations of ``model`` at ``state``: None for the model's current state, or
+    ``(t, q, qd)`` with the degrees of freedom in their order (DYNX coordinates ascending, then
+    DYNE deformations ascending). The mechanism is assembled first."""
+    model.prepare()
+    sim = _core.Simulation(model._core)
+    sim.assemble()
+    system = sim.system
+    if state is None:
+        t, q, qd = model.current_time, system.q0, system.qd0
+    else:
+        t, q, qd = state
+    sim.evaluate(float(t), np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
+    return Linearization(sim.linearize(), system.coord_label, system.def_label)
