@@ -422,6 +422,18 @@ def test_cantilever_torsion_converges_from_above_at_second_order(cantilever_mode
     assert errors[1][-1][1] < 1e-3  # n = 16: 0.04 % above the exact 15.70796
 
 
+@pytest.mark.parametrize("n", [1, 4, 8])
+def test_cantilever_numerical_linearization_agrees_with_linearize(n):
+    """The finite-difference K = −M̄ ∂q̈/∂q and M̄ used above equal M0 and K0 + N0 + G0 of
+    spacar.linearize (formulation.md §7) in the straight, unloaded state (N0 = G0 = 0)."""
+    Mbar, K, labels = linearize(cantilever(n, EIy=EI_Y, EIz=EI_Z, GIp=GI_P, rhoA=RHO_A, rhoIp=RHO_IP))
+    lin = spacar.linearize(cantilever(n, EIy=EI_Y, EIz=EI_Z, GIp=GI_P, rhoA=RHO_A, rhoIp=RHO_IP))
+    assert [lbl[1:] for lbl in lin.z_labels] == labels
+    np.testing.assert_allclose(lin.M0, Mbar, rtol=0, atol=1e-14 * np.abs(Mbar).max())
+    np.testing.assert_allclose(lin.stiffness, K, rtol=0, atol=1e-10 * np.abs(K).max())
+    np.testing.assert_allclose(lin.K0, K, rtol=0, atol=1e-10 * np.abs(K).max())
+
+
 # =============================================================================================
 # Spatial closed loops: RSSR (truss coupler, spherical joints) and RSUR (beam coupler, spherical
 # joint at the crank, universal joint of two hinges at the rocker)
