@@ -6,7 +6,8 @@
 * Rigid bodies on LAMBDA nodes: a torque-free asymmetric body (energy, angular momentum, the
   period of the intermediate-axis flip against Landau–Lifshitz §37), a body with a body-fixed
   torque (TORQUEL) against Euler's equations, a free-flying rigid BEAM with rotary inertia
-  (momenta, energy), and the steady precession of a heavy symmetric top.
+  (momenta, energy), and the steady precession of a heavy symmetric top (point mass with a
+  rigid body on a rigid BEAM; a uniform BEAM rod with its own gravity load).
 * A BEAM cantilever: bending in both planes (formulation.md §10.3 table) and torsion (converging
   from above at second order, exactly the discrete dispersion relation of linear elements).
 * A spatial four-bar (RSSR and RSUR) driven kinematically (closed-form loop solution) and free
@@ -289,11 +290,17 @@ def test_free_flying_rigid_beam_conserves_momenta_and_energy():
 
 
 class Top:
-    """Heavy symmetric top on a fixed point: XYZ node 1 fixed (the pivot), BEAM 1 from (1, λ2)
-    to the centre of mass (3, λ4), rigid (all six deformations fixed, no EMASS), λ2 DYNX (free
-    rotation); MASS m on node 3 (it carries the gravity load), MASS J_cm = diag(Jt, Jt, Ja) on
-    λ4 (inertia about the centre of mass in the body frame, symmetry axis = beam axis = body z).
-    This is the textbook top with I1 = Jt + m l² about the pivot, I3 = Ja.
+    """Heavy symmetric top on a fixed point, two equivalent constructions:
+
+    * "point mass": XYZ node 1 fixed (the pivot), BEAM 1 from (1, λ2) to the centre of mass
+      (3, λ4), rigid (all six deformations fixed, no EMASS), λ2 DYNX (free rotation); MASS m on
+      node 3 (it carries the gravity load), MASS J_cm = diag(Jt, Jt, Ja) on λ4 (inertia about
+      the centre of mass in the body frame; symmetry axis = beam axis = body z). About the
+      pivot I1 = Jt + m l², I3 = Ja, m g l with l the distance to node 3.
+    * "uniform rod": the same rigid BEAM with distributed mass and rotary inertia
+      (EMASS ρA ρIp ρIy ρIy) instead of MASS — gravity then acts through the BEAM's mass model
+      (formulation.md §4.8: ½ρAl0 g on the nodes, (ρAl0²/12) T_{e_x0}ᵀ g on the orientations).
+      I1 = ρA L³/3 + ρIy L, I3 = ρIp L, m g l = ρA L g L/2.
 
     Steady precession (Euler angles φ precession, θ nutation from the upward vertical, ψ spin):
     the θ equation I1θ̈ = sin θ (I1 φ̇² cos θ − I3 ω3 φ̇ + m g l) vanishes for φ̇ = Ω with
@@ -301,67 +308,81 @@ class Top:
     Ω = 2 m g l / (I3 ω3 + √(I3²ω3² − 4 I1 m g l cos θ)). Initial state: tilt θ about global x,
     global angular velocity ω = Ω e_z + (ω3 − Ω cos θ) k (k the symmetry axis), λ̇ = ½ Eᵀω."""
 
-    m, g, l = 1.0, 9.81, 0.5
-    Jt, Ja = 0.05, 0.08
-    theta = math.radians(30.0)
-    w3 = 40.0
-    I1, I3 = Jt + m * l**2, Ja
-    Omega = 2 * m * g * l / (I3 * w3 + math.sqrt((I3 * w3) ** 2 - 4 * I1 * m * g * l * math.cos(theta)))
-    lam0 = np.array([math.cos(theta / 2), math.sin(theta / 2), 0.0, 0.0])
+    g = 9.81
 
-    @classmethod
-    def model(cls, periods=4, n_out=400, eps=1e-12):
-        k = R_(cls.lam0) @ [0.0, 0.0, 1.0]
-        omega = cls.Omega * np.array([0.0, 0.0, 1.0]) + (cls.w3 - cls.Omega * math.cos(cls.theta)) * k
-        lamd = 0.5 * E_(cls.lam0).T @ omega
+    def __init__(self, kind):
+        self.kind = kind
+        if kind == "point mass":
+            self.m, self.l, self.Jt, self.Ja = 1.0, 0.5, 0.05, 0.08
+            self.length = self.l
+            self.I1, self.I3 = self.Jt + self.m * self.l**2, self.Ja
+            self.mgl = self.m * self.g * self.l
+            self.theta, self.w3 = math.radians(30.0), 40.0
+        else:
+            self.rho_a, self.rho_ip, self.rho_iy, self.length = 2.0, 0.05, 0.02, 0.6
+            L = self.length
+            self.I1, self.I3 = self.rho_a * L**3 / 3 + self.rho_iy * L, self.rho_ip * L
+            self.mgl = self.rho_a * L * self.g * L / 2
+            self.theta, self.w3 = math.radians(40.0), 60.0
+        disc = (self.I3 * self.w3) ** 2 - 4 * self.I1 * self.mgl * math.cos(self.theta)
+        self.Omega = 2 * self.mgl / (self.I3 * self.w3 + math.sqrt(disc))
+        self.lam0 = np.array([math.cos(self.theta / 2), math.sin(self.theta / 2), 0.0, 0.0])
+
+    def model(self, periods, n_out=400, eps=1e-12):
+        k = R_(self.lam0) @ [0.0, 0.0, 1.0]
+        omega = self.Omega * np.array([0.0, 0.0, 1.0]) + (self.w3 - self.Omega * math.cos(self.theta)) * k
+        lamd = 0.5 * E_(self.lam0).T @ omega
         m = spacar.Model()
         m.beam(1, 1, 2, 3, 4, 1.0, 0.0, 0.0)
-        m.x(3, 0.0, 0.0, cls.l)  # reference: upright; the assembly tilts it with λ2
+        m.x(3, 0.0, 0.0, self.length)  # reference: upright; the assembly tilts it with λ2
         m.fix(1)
-        m.x(2, *cls.lam0)
-        m.x(4, *cls.lam0)
+        m.x(2, *self.lam0)
+        m.x(4, *self.lam0)
         m.dynx(2)
         for i in range(4):
             m.xd(2, i + 1, lamd[i])
-        m.mass(3, cls.m)
-        m.mass(4, cls.Jt, 0.0, 0.0, cls.Jt, 0.0, cls.Ja)
-        m.gravity(0.0, 0.0, -cls.g)
-        m.timestep(n_out, periods * 2 * math.pi / cls.Omega)
+        if self.kind == "point mass":
+            m.mass(3, self.m)
+            m.mass(4, self.Jt, 0.0, 0.0, self.Jt, 0.0, self.Ja)
+        else:
+            m.emass(1, self.rho_a, self.rho_ip, self.rho_iy, self.rho_iy)
+        m.gravity(0.0, 0.0, -self.g)
+        m.timestep(n_out, periods * 2 * math.pi / self.Omega)
         return tighten(m, eps=eps)
 
 
-def test_heavy_symmetric_top_steady_precession():
-    """Four precession periods (≈ 14 s, spin 40 rad/s, θ = 30°, Ω = 1.794 rad/s — not the
-    gyroscopic approximation m g l/(I3 ω3) = 1.533) at EPSINT = EPSIND = 1e-12: θ stays
-    constant to 1e-8 rad and the azimuth of the symmetry axis advances as Ω t to 1e-8
-    (relative to the total precession angle); the spin component ω′3, the energy and the
-    angular momentum about the vertical through the pivot are conserved (formulation.md §10.2)."""
-    top = Top
+@pytest.mark.parametrize("kind, periods", [("point mass", 4), ("uniform rod", 3)])
+def test_heavy_symmetric_top_steady_precession(kind, periods):
+    """Several precession periods at EPSINT = EPSIND = 1e-12 (point mass: spin 40 rad/s,
+    θ = 30°, Ω = 1.794 rad/s, 14 s; rod: spin 60 rad/s, θ = 40°, Ω = 2.319 rad/s — neither is
+    the gyroscopic approximation m g l/(I3 ω3)): θ stays constant to 1e-8 rad and the azimuth
+    of the symmetry axis advances as Ω t to 1e-8 (relative to the total precession angle); the
+    spin component ω′3, the energy ½ω′ᵀI_Oω′ + m g l cos θ and the angular momentum about the
+    vertical through the pivot are conserved (formulation.md §10.2)."""
+    top = Top(kind)
     assert top.Omega * (top.I3 * top.w3 - top.I1 * top.Omega * math.cos(top.theta)) == pytest.approx(
-        top.m * top.g * top.l, rel=1e-14)
-    res = spacar.simulate(top.model())
+        top.mgl, rel=1e-14)
+    assert top.Omega > 1.15 * top.mgl / (top.I3 * top.w3)
+    res = spacar.simulate(top.model(periods))
     t = res.t
-    x3, xd3 = res.node(3).x, res.node(3).xd
-    k = x3 / top.l
+    k = res.node(3).x / top.length
     np.testing.assert_allclose(np.linalg.norm(k, axis=1), 1.0, rtol=0, atol=1e-12)
     theta = np.arccos(k[:, 2])
     assert np.abs(theta - top.theta).max() < 1e-8
     phi = np.unwrap(np.arctan2(k[:, 1], k[:, 0]))
     total = top.Omega * t[-1]
-    assert total > 4 * 2 * math.pi - 1e-9
+    assert total > periods * 2 * math.pi - 1e-9
     assert np.abs(phi - phi[0] - top.Omega * t).max() / total < 1e-8
     assert abs(np.polyfit(t, phi, 1)[0] / top.Omega - 1.0) < 1e-8
-    # Body of the top: λ4 follows λ2 (rigid beam); spin, energy, vertical angular momentum.
-    lam, lamd = res.node(4).x, res.node(4).xd
-    np.testing.assert_allclose(np.abs(np.einsum("ti,ti->t", lam, res.node(2).x)), 1.0, rtol=0, atol=1e-12)
+    # The rigid body: λ4 follows λ2 (rigid beam); spin, energy, vertical angular momentum.
+    lam, lamd = res.node(2).x, res.node(2).xd
+    np.testing.assert_allclose(np.abs(np.einsum("ti,ti->t", lam, res.node(4).x)), 1.0, rtol=0, atol=1e-12)
     w = body_angular_velocity(lam, lamd)
     assert np.abs(w[:, 2] - top.w3).max() < 1e-8 * top.w3
-    J = np.diag([top.Jt, top.Jt, top.Ja])
-    T = 0.5 * top.m * (xd3**2).sum(axis=1) + 0.5 * np.einsum("ti,ij,tj->t", w, J, w)
-    V = top.m * top.g * x3[:, 2]
-    energy = T + V
+    I_O = np.diag([top.I1, top.I1, top.I3])
+    energy = 0.5 * np.einsum("ti,ij,tj->t", w, I_O, w) + top.mgl * k[:, 2]
     assert np.abs(energy - energy[0]).max() / abs(energy[0]) < 1e-9
-    Hz = top.m * np.cross(x3, xd3)[:, 2] + np.array([(R_(l) @ J @ wi)[2] for l, wi in zip(lam, w)])
+    Hz = np.array([(R_(lk) @ I_O @ wk)[2] for lk, wk in zip(lam, w)])
     assert np.abs(Hz - Hz[0]).max() / abs(Hz[0]) < 1e-9
 
 
