@@ -119,12 +119,15 @@ std::vector<ElementType> build_catalogue() {
     set_params(e, 3, 3, "x y z: initial axis of rotation");
     e.n_lgeomy = 3;
     e.has_direction = true;
+    e.reference = reference_bearing;
+    e.make = make_bearing;
   }
   {
     ElementType& e = add(t, "SURFACE", {K::XYZ}, {"p1"}, {"surface function value"},
                          "point on a quadratic surface");
     set_params(e, 10, 10,
                "c1..c10: coefficients of c1x²+c2y²+c3z²+c4xy+c5yz+c6zx+c7x+c8y+c9z+c10");
+    e.make = make_surface;
   }
   add(t, "L2MIN1", {K::Lambda}, {"o1"}, {"Euler parameter norm λᵀλ − 1"},
       "constraint on the Euler parameters (created automatically for every LAMBDA node)")
@@ -164,6 +167,8 @@ std::vector<ElementType> build_catalogue() {
     set_emass(e, 3, "rhoA a1 a2 (belt wound on the pulleys: a1*r1 and a2*r2)");
     e.has_length = true;
     e.n_lgeomy = 1;
+    e.reference = reference_plbelt;
+    e.make = make_plbelt;
   }
   {
     ElementType& e = add(t, "PLBEAR", {K::XY, K::Beta, K::XY, K::Beta}, beam_nodes,
@@ -172,6 +177,8 @@ std::vector<ElementType> build_catalogue() {
                          "planar bearing");
     set_stiffness(e, 3, "Sx Sy St (linear and torsional stiffness)");
     e.n_lgeomy = 2;
+    e.reference = reference_plbear;
+    e.make = make_plbear;
   }
   {
     ElementType& e = add(t, "PLWHEEL", {K::XY, K::Beta, K::Beta}, {"p1", "o1", "o2"},
@@ -179,6 +186,7 @@ std::vector<ElementType> build_catalogue() {
     set_params(e, 3, 3, "r x y: radius and initial axis of rotation");
     e.edampp = "d1 d2: linear creep damping of the released slips (extension)";
     e.n_estiff = 2;
+    e.make = make_plwheel;
   }
   {
     ElementType& e = add(t, "WHEEL", {K::XYZ, K::Lambda}, {"p1", "o1"},
@@ -186,6 +194,7 @@ std::vector<ElementType> build_catalogue() {
                          "knife-edge wheel rolling on a plane (extension)");
     set_params(e, 4, 7, "ax ay az r [nx ny nz]: initial axle direction, radius, ground-plane normal");
     e.extension = true;
+    e.make = make_wheel;
   }
   return t;
 }

@@ -21,6 +21,7 @@ Data::Data(const System& sys) {
     w.M = Eigen::MatrixXd::Zero(n, n);
   }
   target = residual = Eigen::VectorXd::Zero(nP);
+  e_integrated = sys.e_target;
   angle_ref = Eigen::VectorXd::Constant(ne, std::numeric_limits<double>::quiet_NaN());
   A = Eigen::MatrixXd::Zero(std::max(nP, nV), nc);
   rhs_DF = Eigen::MatrixXd::Zero(nV, nq);

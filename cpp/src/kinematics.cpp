@@ -40,7 +40,9 @@ void set_targets(const System& sys, Data& data) {
   for (size_t r = 0; r < sys.rows_P.size(); ++r) {
     const int k = sys.rows_P[r];
     const int col = sys.qhat_col_e[k];
-    data.target[r] = col >= 0 ? data.qhat[col] : sys.e_target[k];
+    if (col >= 0) data.target[r] = data.qhat[col];
+    else if (sys.def_class[k] == DefClass::Kinematic) data.target[r] = data.e_integrated[k];
+    else data.target[r] = sys.e_target[k];
   }
 }
 
@@ -128,11 +130,14 @@ void evaluate_elements(const System& sys, Data& data) {
     se.kernel->first_derivatives(w.x.data(), data.e.data() + se.def_offset, w.B.data());
   }
   // Angles come from atan2 in (−π, π]: move each to the branch nearest to its target (position
-  // rows) or to its previous value, so that hinges can turn any number of times.
-  for (int k : sys.angle_defs) {
+  // rows) or to its previous value, so that hinges can turn any number of times. Velocity-level
+  // deformations have no value as a function of x: theirs is integrated (data.e_integrated).
+  for (int k = 0; k < sys.ne; ++k)
+    if (sys.def_velocity_level[k]) data.e[k] = data.e_integrated[k];
+  for (const auto& [k, period] : sys.periodic_defs) {
     const int r = sys.row_P[k];
     const double ref = r >= 0 ? data.target[r] : data.angle_ref[k];
-    if (std::isfinite(ref)) data.e[k] += 2.0 * M_PI * std::round((ref - data.e[k]) / (2.0 * M_PI));
+    if (std::isfinite(ref)) data.e[k] += period * std::round((ref - data.e[k]) / period);
     data.angle_ref[k] = data.e[k];
   }
 }

@@ -71,16 +71,23 @@ Linearization Simulation::linearize() {
   return linearizer_->compute(*sys_, data_);
 }
 
+void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  for (int i = 0; i < ny; ++i) data_.e_integrated[sys_->y_defs[i]] = Y[nd + i];
+  evaluate(t, Y.data(), Y.data() + nd + ny);
+}
+
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
-  const int nd = sys_->n_dof();
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   try {
-    evaluate(t, Y.data(), Y.data() + nd);
+    evaluate_state(t, Y);
   } catch (const KinematicsError& err) {
     kinematic_failure_ = err.what();
     throw StepRejected(err.what());
   }
   kinematic_failure_.clear();
-  dY.head(nd) = Y.segment(nd, nd);
+  dY.head(nd) = Y.tail(nd);
+  for (int i = 0; i < ny; ++i) dY[nd + i] = data_.ed[sys_->y_defs[i]];
   dY.tail(nd) = data_.qdd;
 }
 
@@ -115,19 +122,20 @@ BlockResults Simulation::run(const RunOptions& options) {
   times.back() = t_end;  // exactly the end of the block, whatever the rounding
 
   assemble();
-  const int nd = sys_->n_dof();
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   int k_out = 0;
   auto output = [&](double t, const Eigen::VectorXd& Y) {
-    evaluate(t, Y.data(), Y.data() + nd);
+    evaluate_state(t, Y);
     if (st.forcemode >= 1 || linear) forces();
     if (linear) res.linearizations.push_back(linearize());
     record(res, k_out);
     if (options.on_output) options.on_output(k_out, data_);
     ++k_out;
   };
-  Eigen::VectorXd Y(2 * nd);
-  Y << sys_->q0, sys_->qd0;
-  if (nd == 0 || n_out == 0 || !(t_end > t0)) {
+  // State Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
+  Eigen::VectorXd Y(2 * nd + ny);
+  Y << sys_->q0, sys_->y0, sys_->qd0;
+  if ((nd == 0 && ny == 0) || n_out == 0 || !(t_end > t0)) {
     // Kinematic analysis (or a single analysis at the current time).
     for (double t : times) output(t, Y);
   } else {
@@ -136,10 +144,9 @@ BlockResults Simulation::run(const RunOptions& options) {
     for (;;) {
       // One segment: integrate until the end, or until a free rotation must be repartitioned.
       Integrator integ(static_cast<int>(Y.size()), options.method);
-      const int n = sys_->n_dof();
-      Eigen::VectorXd rtol(2 * n);
-      rtol.head(n).setConstant(st.epsint);
-      rtol.tail(n).setConstant(st.epsind);
+      Eigen::VectorXd rtol(Y.size());
+      rtol.head(nd + ny).setConstant(st.epsint);
+      rtol.tail(nd).setConstant(st.epsind);
       integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
       integ.set_max_step(st.hmax);
       if (h > 0.0) integ.set_initial_step(h);
@@ -190,34 +197,35 @@ int Simulation::rotation_to_repartition(const Eigen::VectorXd& Y) const {
 }
 
 void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
-  const int nd = sys_->n_dof();
-  evaluate(t, Y.data(), Y.data() + nd);
+  evaluate_state(t, Y);
   const FreeRotation fr = sys_->free_rotations[which];
   int best = 0;
   for (int i = 1; i < 4; ++i)
     if (std::abs(data_.x[fr.coord + i]) > std::abs(data_.x[fr.coord + best])) best = i;
   dependent_[fr.node] = best;
   linearizer_.reset();
-  const Eigen::VectorXd x = data_.x, xd = data_.xd, e = data_.e, ed = data_.ed, angles = data_.angle_ref;
+  const Eigen::VectorXd x = data_.x, xd = data_.xd, e = data_.e, ed = data_.ed, angles = data_.angle_ref,
+                        integrated = data_.e_integrated;
   const long newton = data_.total_newton_iterations;
   sys_ = compile(model_, dependent_);
   data_ = Data(*sys_);
   data_.x = x;
   data_.angle_ref = angles;
+  data_.e_integrated = integrated;
   data_.total_newton_iterations = newton;
   x_base_ = x;
   have_base_ = false;
+  // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;
-  const int n = sys.n_dof();
-  Y.resize(2 * n);
+  const int n = sys.n_dof(), ny = static_cast<int>(sys.y_defs.size());
   int j = 0;
   for (int c : sys.x_dyn) {
     Y[j] = x[c];
-    Y[n + j++] = xd[c];
+    Y[n + ny + j++] = xd[c];
   }
   for (int k : sys.e_dyn) {
     Y[j] = e[k];
-    Y[n + j++] = ed[k];
+    Y[n + ny + j++] = ed[k];
   }
 }
 

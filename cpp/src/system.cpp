@@ -85,7 +85,8 @@ void build_elements(const Model& model, System& sys, const std::map<int, int>& n
     se.has_constitutive = !el.estiff.empty() || !el.edampp.empty();
     se.has_mass = se.kernel->has_mass();
     for (int i = 0; i < se.nd; ++i) {
-      if (se.kernel->is_angle(i)) sys.angle_defs.push_back(sys.ne + i);
+      if (se.kernel->period(i) > 0.0) sys.periodic_defs.push_back({sys.ne + i, se.kernel->period(i)});
+      sys.def_velocity_level.push_back(se.kernel->velocity_level(i));
       sys.def_label.push_back({id, i + 1});
       const bool line = line_as_dof && el.cls[i] == DefClass::Linearization;
       sys.def_class.push_back(line ? DefClass::Dynamic : el.cls[i]);
@@ -96,7 +97,19 @@ void build_elements(const Model& model, System& sys, const std::map<int, int>& n
   }
 }
 
+void check_velocity_level(const System& sys) {
+  for (int k = 0; k < sys.ne; ++k) {
+    const DefClass c = sys.def_class[k];
+    if (sys.def_velocity_level[k] && c != DefClass::Nonholonomic && c != DefClass::Released)
+      throw InputError(sys.def_name(k) + " is defined by its rate only (velocity level): declare it nonholonomic "
+                       "(ENHC, rolling without slip) or released (RLSE, slipping), not " + def_class_name(c));
+    if (c == DefClass::Kinematic && sys.def_velocity_level[k])
+      throw InputError(sys.def_name(k) + " is defined by its rate only and cannot be a kinematic coordinate (ENHC)");
+  }
+}
+
 void partition(System& sys) {
+  check_velocity_level(sys);
   for (int g = 0; g < sys.nx; ++g) {
     switch (sys.coord_class[g]) {
       case CoordClass::Fixed: sys.x_fixed.push_back(g); break;
@@ -217,7 +230,7 @@ void initial_values(const Model& model, System& sys) {
     sys.qd0[j++] = ed[k];
   }
   for (int k = 0; k < sys.ne; ++k)
-    if (sys.def_class[k] == DefClass::Released && given[k])
+    if (sys.def_class[k] == DefClass::Released && given[k] && !sys.def_velocity_level[k])
       sys.warnings.push_back("E of released " + sys.def_name(k) + " is ignored: released deformations are computed");
   sys.e_target = Eigen::VectorXd::Zero(sys.ne);
   for (int k = 0; k < sys.ne; ++k) {
@@ -225,6 +238,14 @@ void initial_values(const Model& model, System& sys) {
     if (c == DefClass::Fixed || c == DefClass::Linearization) sys.e_target[k] = given[k] ? e_given[k] : 0.0;
     else sys.e_target[k] = value_of_def(k);  // DOF, kinematic: initial values
   }
+  // Integrated deformations: kinematic coordinates and the values of velocity-level ones.
+  for (int k = 0; k < sys.ne; ++k) {
+    if (sys.def_class[k] == DefClass::Kinematic || (sys.def_velocity_level[k] && sys.def_class[k] == DefClass::Released))
+      sys.y_defs.push_back(k);
+    if (sys.def_velocity_level[k]) sys.e_target[k] = given[k] ? e_given[k] : 0.0;
+  }
+  sys.y0.resize(sys.y_defs.size());
+  for (size_t i = 0; i < sys.y_defs.size(); ++i) sys.y0[i] = sys.e_target[sys.y_defs[i]];
 }
 
 void masses_and_loads(const Model& model, System& sys, const std::map<int, int>& node_offset) {

@@ -29,6 +29,7 @@ struct Data {
 
   // Kinematics.
   Eigen::VectorXd target;       // targets of the position rows P (|P|)
+  Eigen::VectorXd e_integrated; // current values of the integrated deformations y (ne; others unused)
   Eigen::VectorXd angle_ref;    // last value of each angle-type deformation (unwrapping), NaN: none
   Eigen::VectorXd residual;     // D^P(x) − target (|P|)
   Eigen::MatrixXd A;            // constraint block ∂D^P/∂x^c (|P| x n_c), later ∂D^V/∂x^c

@@ -58,7 +58,9 @@ class Simulation {
   void forces();
   // Linearized equations at the state of the last evaluate() (computes the forces first).
   Linearization linearize();
-  // Right-hand side of the first-order system Y = (q, q̇).
+  // Complete state at (t, Y), Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
+  void evaluate_state(double t, const Eigen::VectorXd& Y);
+  // Right-hand side of the first-order system Y = (q, y, q̇).
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
 
   BlockResults run(const RunOptions& options = {});

@@ -65,7 +65,9 @@ struct System {
   std::vector<int> rows_V;      // deformations with known rates: velocity constraint rows
   std::vector<int> auto_released;  // fixed rows with no calculable coordinate, checked instead
   std::vector<int> e_element;   // element (index into elements) of each deformation
-  std::vector<int> angle_defs;  // angle-type deformations, unwrapped to continuous values
+  // Deformations defined up to a period (angles), unwrapped to continuous values: (index, period).
+  std::vector<std::pair<int, double>> periodic_defs;
+  std::vector<char> def_velocity_level;  // only the rate is defined: the value is integrated
 
   // Maps from global index to position.
   std::vector<int> calc_pos;    // coordinate → column in the constraint block, −1 if not calculable
@@ -86,6 +88,10 @@ struct System {
   Eigen::VectorXd e_target;
   // Initial values of the degrees of freedom and their rates.
   Eigen::VectorXd q0, qd0;
+  // Deformations integrated as first-order states y (ascending): the kinematic coordinates of
+  // nonholonomic constraints and the values of released velocity-level deformations; y0 initial.
+  std::vector<int> y_defs;
+  Eigen::VectorXd y0;
   // Warnings found while compiling (printed as comments by the front ends).
   std::vector<std::string> warnings;
 

@@ -4,6 +4,8 @@
 //   e1 = atan2((R̂32 − R̂23)/2, (R̂22 + R̂33)/2)   rotation of o2 relative to o1 about the axis
 //   e2 = R̂13,  e3 = −R̂12                       misalignments, regular at every hinge angle
 // e1 is an angle: the kinematic analysis unwraps it to a continuous multi-turn value.
+#include <cmath>
+
 #include "spacar/elements/registry.hpp"
 #include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
@@ -24,7 +26,7 @@ class Hinge : public AutoDiffElement<Hinge, 8, 3> {
     e[2] = -dot3(x1, y2);
   }
 
-  bool is_angle(int i) const override { return i == 0; }
+  double period(int i) const override { return i == 0 ? 2.0 * M_PI : 0.0; }
 
   void constitutive(const std::vector<double>& v, double* S) const override {
     for (int i = 0; i < 9; ++i) S[i] = 0.0;

@@ -1,13 +1,20 @@
 // The element interface. An element type is written once, as templates on the scalar type:
 //   template <class S> void deform(const S* x, S* e) const;      the deformation functions D(x)
-// and, for elements with distributed mass, the points whose velocities carry the kinetic energy:
+// Velocity-level deformations (wheel slips, only their rates are defined) are flagged by the
+// bit mask `static constexpr unsigned kVelocityRows` and given by
+//   template <class S> void slip_rates(const S* x, const S* v, S* edot) const;  (linear in v)
+// For distributed mass, either the points whose velocities carry the kinetic energy,
 //   template <class S> void mass_points(const S* x, S* g) const;
-// AutoDiffElement derives the exact first derivatives B = ∂e/∂x, the convective terms ẋᵀHẋ,
-// the stress-weighted Hessians Σσ_i H_i, the consistent mass matrix and convective inertia
-// forces from these by forward-mode dual numbers (see autodiff.hpp).
+// or (general case) the kinetic energy and the gravity potential themselves,
+//   template <class S> S kinetic(const S* x, const S* v) const;
+//   template <class S> S potential(const S* x, const double* g) const;
+// AutoDiffElement derives the exact first derivatives B = ∂e/∂x, the convective terms, the
+// stress-weighted Hessians Σσ_i Γ_i, the mass matrix and convective inertia forces (Lagrange's
+// equations) from these by forward-mode dual numbers (see autodiff.hpp).
 #pragma once
 
 #include <Eigen/Dense>
+#include <type_traits>
 #include <vector>
 
 #include "spacar/autodiff.hpp"
@@ -39,9 +46,11 @@ class ElementKernel {
   // G = Σ_i σ_i H_i, n_coords x n_coords, column-major (geometric stiffness, linearization).
   virtual void stress_hessian(const double* x, const double* sigma, double* G) const = 0;
 
-  // Angle-type deformations (atan2 branch): the kinematic analysis unwraps them to continuous
-  // multi-turn values.
-  virtual bool is_angle(int i) const { return false; }
+  // Deformations defined only up to a period (an angle from atan2: 2π; a belt length: 2π|r2 −
+  // r1|), 0 otherwise: the kinematic analysis unwraps them to continuous values.
+  virtual double period(int i) const { return 0.0; }
+  // Velocity-level deformation (only its rate is defined): its value is integrated, not computed.
+  virtual bool velocity_level(int i) const { return false; }
 
   // Constitutive matrix from ESTIFF (or, in the same form, EDAMPP) values: σ = S e (+ D ė).
   // Zero for elements without stiffness data.
@@ -67,7 +76,18 @@ struct MassPoints {
   Eigen::Matrix<double, NG, 1> w = Eigen::Matrix<double, NG, 1>::Zero();
 };
 
-// Implements the kernel from the templated deformation (and mass point) functions of Derived.
+namespace detail {
+template <class T, class = void>
+struct velocity_rows : std::integral_constant<unsigned, 0> {};
+template <class T>
+struct velocity_rows<T, std::void_t<decltype(T::kVelocityRows)>> : std::integral_constant<unsigned, T::kVelocityRows> {};
+template <class T, class = void>
+struct has_kinetic : std::false_type {};
+template <class T>
+struct has_kinetic<T, std::void_t<decltype(&T::template kinetic<double>)>> : std::true_type {};
+}  // namespace detail
+
+// Implements the kernel from the templated deformation (and mass) functions of Derived.
 // NC: local coordinates, ND: deformations, NG/DIM: mass points (NG = 0: no distributed mass).
 template <class Derived, int NC, int ND, int NG = 0, int DIM = 2>
 class AutoDiffElement : public ElementKernel {
@@ -75,7 +95,13 @@ class AutoDiffElement : public ElementKernel {
   int n_coords() const override { return NC; }
   int n_deformations() const override { return ND; }
 
-  void deformations(const double* x, double* e) const override { self().deform(x, e); }
+  bool velocity_level(int i) const override { return (kVelocity >> i) & 1u; }
+
+  void deformations(const double* x, double* e) const override {
+    self().deform(x, e);
+    for (int i = 0; i < ND; ++i)
+      if (velocity_level(i)) e[i] = 0.0;
+  }
 
   void first_derivatives(const double* x, double* e, double* B) const override {
     using J = Jet<double, NC>;
@@ -86,6 +112,20 @@ class AutoDiffElement : public ElementKernel {
       e[i] = ej[i].a;
       for (int k = 0; k < NC; ++k) B[i + ND * k] = ej[i].d[k];
     }
+    if constexpr (kVelocity != 0) {
+      // Rows of velocity-level deformations: ė = B(x) v, B from the rates with v as variables.
+      J xc[NC], vj[NC], rj[ND];
+      for (int k = 0; k < NC; ++k) {
+        xc[k] = J(x[k]);
+        vj[k] = J::variable(0.0, k);
+      }
+      self().slip_rates(xc, vj, rj);
+      for (int i = 0; i < ND; ++i) {
+        if (!velocity_level(i)) continue;
+        e[i] = 0.0;
+        for (int k = 0; k < NC; ++k) B[i + ND * k] = rj[i].d[k];
+      }
+    }
   }
 
   void convective(const double* x, const double* v, double* c) const override {
@@ -95,6 +135,17 @@ class AutoDiffElement : public ElementKernel {
     for (int k = 0; k < NC; ++k) xj[k] = J2(J1(x[k], {v[k]}), {J1(v[k], {0.0})});
     self().deform(xj, ej);
     for (int i = 0; i < ND; ++i) c[i] = ej[i].d[0].d[0];
+    if constexpr (kVelocity != 0) {
+      // c = ∂(B(x) v)/∂x v for velocity-level rows.
+      J1 xv[NC], vc[NC], rj[ND];
+      for (int k = 0; k < NC; ++k) {
+        xv[k] = J1(x[k], {v[k]});
+        vc[k] = J1(v[k]);
+      }
+      self().slip_rates(xv, vc, rj);
+      for (int i = 0; i < ND; ++i)
+        if (velocity_level(i)) c[i] = rj[i].d[0];
+    }
   }
 
   void stress_hessian(const double* x, const double* sigma, double* G) const override {
@@ -110,13 +161,29 @@ class AutoDiffElement : public ElementKernel {
     for (int j = 0; j < NC; ++j)
       for (int k = 0; k < NC; ++k) {
         double s = 0.0;
-        for (int i = 0; i < ND; ++i) s += sigma[i] * ej[i].d[j].d[k];
+        for (int i = 0; i < ND; ++i)
+          if (!velocity_level(i)) s += sigma[i] * ej[i].d[j].d[k];
         G[j + NC * k] = s;
       }
+    if constexpr (kVelocity != 0) {
+      // Γ_i = ∂(B_iᵀ)/∂x: outer jet over x, inner jet over the unit rates v_j.
+      J2 xo[NC], vo[NC], rj[ND];
+      for (int k = 0; k < NC; ++k) {
+        xo[k] = J2(J1(x[k]), {});
+        xo[k].d[k] = J1(1.0);
+        vo[k] = J2(J1::variable(0.0, k), {});
+      }
+      self().slip_rates(xo, vo, rj);
+      for (int j = 0; j < NC; ++j)
+        for (int k = 0; k < NC; ++k)
+          for (int i = 0; i < ND; ++i)
+            if (velocity_level(i)) G[j + NC * k] += sigma[i] * rj[i].d[k].d[j];
+    }
   }
 
   bool has_mass() const override {
     if constexpr (NG > 0) return self().mass_model().W.any();
+    if constexpr (detail::has_kinetic<Derived>::value) return self().has_distributed_mass();
     return false;
   }
 
@@ -125,6 +192,7 @@ class AutoDiffElement : public ElementKernel {
     Eigen::Map<Eigen::Matrix<double, NC, 1>> hm(h);
     Mm.setZero();
     hm.setZero();
+    if constexpr (detail::has_kinetic<Derived>::value) lagrange(x, v, Mm, hm);
     if constexpr (NG > 0) {
       const auto& mp = self().mass_model();
       Eigen::Matrix<double, NG * DIM, NC> Jg;
@@ -139,6 +207,13 @@ class AutoDiffElement : public ElementKernel {
   void gravity(const double* x, const double* g, double* f) const override {
     Eigen::Map<Eigen::Matrix<double, NC, 1>> fm(f);
     fm.setZero();
+    if constexpr (detail::has_kinetic<Derived>::value) {
+      using J = Jet<double, NC>;
+      J xj[NC];
+      for (int k = 0; k < NC; ++k) xj[k] = J::variable(x[k], k);
+      const J V = self().potential(xj, g);
+      for (int k = 0; k < NC; ++k) fm[k] = -V.d[k];
+    }
     if constexpr (NG > 0) {
       const auto& mp = self().mass_model();
       Eigen::Matrix<double, NG * DIM, NC> Jg;
@@ -154,6 +229,7 @@ class AutoDiffElement : public ElementKernel {
 
   double gravity_potential(const double* x, const double* g) const override {
     double V = 0.0;
+    if constexpr (detail::has_kinetic<Derived>::value) V += self().potential(x, g);
     if constexpr (NG > 0) {
       double points[NG * DIM];
       self().mass_points(x, points);
@@ -164,6 +240,7 @@ class AutoDiffElement : public ElementKernel {
   }
 
   double kinetic_energy(const double* x, const double* v) const override {
+    if constexpr (detail::has_kinetic<Derived>::value) return self().kinetic(x, v);
     if constexpr (NG > 0) {
       Eigen::Matrix<double, NG * DIM, NC> Jg;
       Eigen::Matrix<double, NG * DIM, 1> gamma;
@@ -176,7 +253,47 @@ class AutoDiffElement : public ElementKernel {
   }
 
  private:
+  static constexpr unsigned kVelocity = detail::velocity_rows<Derived>::value;
   const Derived& self() const { return static_cast<const Derived&>(*this); }
+
+  // Lagrange's equations from T(x, v): M = ∂²T/∂v², h = (∂²T/∂v∂x) v − ∂T/∂x.
+  template <class MM, class MH>
+  void lagrange(const double* x, const double* v, MM& M, MH& h) const {
+    using J1 = Jet<double, NC>;
+    using J2 = Jet<J1, NC>;
+    {  // Hessian in v.
+      J2 xc[NC], vj[NC];
+      for (int k = 0; k < NC; ++k) {
+        xc[k] = J2(J1(x[k]), {});
+        vj[k] = J2(J1::variable(v[k], k), {});
+        vj[k].d[k] = J1(1.0);
+      }
+      const J2 T = self().kinetic(xc, vj);
+      for (int a = 0; a < NC; ++a)
+        for (int b = 0; b < NC; ++b) M(a, b) = T.d[a].d[b];
+    }
+    {  // (∂²T/∂v∂x) v: outer jet over v, inner directional derivative along x + εv.
+      using D1 = Jet<double, 1>;
+      using JD = Jet<D1, NC>;
+      JD xv[NC], vj[NC];
+      for (int k = 0; k < NC; ++k) {
+        xv[k] = JD(D1(x[k], {v[k]}), {});
+        vj[k] = JD(D1(v[k]), {});
+        vj[k].d[k] = D1(1.0);
+      }
+      const JD T = self().kinetic(xv, vj);
+      for (int a = 0; a < NC; ++a) h[a] = T.d[a].d[0];
+    }
+    {  // − ∂T/∂x
+      J1 xj[NC], vc[NC];
+      for (int k = 0; k < NC; ++k) {
+        xj[k] = J1::variable(x[k], k);
+        vc[k] = J1(v[k]);
+      }
+      const J1 T = self().kinetic(xj, vc);
+      for (int a = 0; a < NC; ++a) h[a] -= T.d[a];
+    }
+  }
 
   static Eigen::Matrix<double, NG * DIM, NG * DIM> kron(const Eigen::Matrix<double, NG, NG>& W) {
     Eigen::Matrix<double, NG * DIM, NG * DIM> K = Eigen::Matrix<double, NG * DIM, NG * DIM>::Zero();

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "spacar/elements/element.hpp"
+#include "spacar/errors.hpp"
 
 namespace spacar {
 
@@ -18,6 +19,12 @@ void reference_truss(const double* x_ref, const std::vector<double>& params, dou
                      std::vector<double>& lgeomy);
 void reference_beam(const double* x_ref, const std::vector<double>& params, double& l0,
                     std::vector<double>& lgeomy);
+void reference_plbear(const double* x_ref, const std::vector<double>& params, double& l0,
+                      std::vector<double>& lgeomy);
+void reference_bearing(const double* x_ref, const std::vector<double>& params, double& l0,
+                       std::vector<double>& lgeomy);
+void reference_plbelt(const double* x_ref, const std::vector<double>& params, double& l0,
+                      std::vector<double>& lgeomy);
 void reference_plbeam(const double* x_ref, const std::vector<double>& params, double& l0,
                       std::vector<double>& lgeomy);
 
@@ -26,6 +33,12 @@ std::unique_ptr<ElementKernel> make_beam(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_beamnl(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_hinge(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_l2min1(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_bearing(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_surface(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_plbelt(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_plbear(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_plwheel(const ElementSetup& setup);
+std::unique_ptr<ElementKernel> make_wheel(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_pltruss(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_plbeam(const ElementSetup& setup);
 std::unique_ptr<ElementKernel> make_plbeamnl(const ElementSetup& setup);
