@@ -105,6 +105,23 @@ def test_hinge_axis_of_zero_length(action):
     raises_located(text, line, "HINGE", r"HINGE 5.*zero length", action)
 
 
+@pytest.mark.parametrize("old, new", [
+    ("HINGE 5 ", "HINGE 5 4 5 0. 0. 1e-300"),
+    ("HINGE 5 ", "HINGE 5 4 5 0. 0. 1e300"),
+    ("BEAM 2 ", "BEAM 2 3 5 6 7 0. 1e-300 0."),
+    ("BEAM 2 ", "BEAM 2 3 5 6 7 0. 1e300 0."),
+], ids=["tiny hinge axis", "huge hinge axis", "tiny beam direction", "huge beam direction"])
+def test_only_the_direction_of_axes_and_direction_vectors_matters(old, new):
+    """A tiny but non-zero vector is not of zero length (its norm used to underflow: an
+    unlocated 'HINGE: the axis of rotation has zero length' at the first END) and a huge one
+    does not overflow: the run equals the example's."""
+    text, _ = replace(old, new)
+    res = spacar.simulate(spacar.read_string(text, FILE))
+    ref = spacar.simulate(spacar.read(SPATIAL_EXAMPLE))
+    np.testing.assert_allclose(res.x, ref.x, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(res.e, ref.e, rtol=0, atol=1e-13)
+
+
 # ---------------------------------------------------------------------------------------------
 # Inertia tensors (MASS on a LAMBDA node: Ixx Ixy Ixz Iyy Iyz Izz)
 # ---------------------------------------------------------------------------------------------
