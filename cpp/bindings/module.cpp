@@ -214,6 +214,10 @@ py::dict linearization_to_dict(const Linearization& l) {
   d["r0"] = l.r0;
   d["DFz"] = l.DFz;
   d["DFez"] = l.DFez;
+  d["y_label"] = l.y_label;
+  d["Kk"] = l.Kk;
+  d["AK0"] = l.AK0;
+  d["BK0"] = l.BK0;
   return d;
 }
 

@@ -1,6 +1,7 @@
 #include "spacar/linearize.hpp"
 
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "spacar/dynamics.hpp"
@@ -96,12 +97,23 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
   lin.n_line = static_cast<int>(sys.e_line.size());
   if (static_cast<int>(order_.size()) != nz) throw Error("linearize: the coordinates of the two systems differ");
 
+  // Kinematic coordinates of nonholonomic constraints: y^k, integrated in the motion.
+  Eigen::VectorXd y(sys.e_kinematic.size()), yscale(sys.e_kinematic.size());
+  for (size_t j = 0; j < sys.e_kinematic.size(); ++j) {
+    const int k = sys.e_kinematic[j];
+    y[j] = data.e_integrated[k];
+    yscale[j] = sys.def_is_length[k] ? L.length_scale : 1.0;
+    lin.y_label.push_back({1, sys.def_label[k][0], sys.def_label[k][1]});
+  }
+  const int nk = static_cast<int>(y.size());
+
   // Nominal state.
   ld_.t = data.t;
   ld_.x = data.x;
   ld_.angle_ref = data.angle_ref;
+  ld_.e_integrated = data.e_integrated;
   set_z(z, zd);
-  const Eigen::VectorXd x_nominal = ld_.x;
+  const Eigen::VectorXd x_nominal = ld_.x, angles_nominal = ld_.angle_ref;
   residual(zdd, lin.r0);
   lin.r0 = -lin.r0;
   lin.DFz.resize(L.nx, nz);
@@ -114,40 +126,50 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
   lin.K0 = lin.DFez.transpose() * global_constitutive(L, false) * lin.DFez;
   lin.D0 = lin.DFez.transpose() * global_constitutive(L, true) * lin.DFez;
   lin.G0 = lin.DFz.transpose() * geometric_stiffness(L, ld_, data.sigma) * lin.DFz;
+  lin.AK0.resize(nk, nz);
+  for (int j = 0; j < nk; ++j) lin.AK0.row(j) = lin.DFez.row(sys.e_kinematic[j]);
 
-  // Velocity sensitivity: R is quadratic in ż, so central differences are exact to round-off.
-  Eigen::MatrixXd dRdzd(nz, nz), dRdz(nz, nz);
-  Eigen::VectorXd Rp, Rm;
+  // Residual R and kinematic rates ẏ^k at perturbed positions (kinematics re-solved) or rates.
+  auto response = [&](const Eigen::VectorXd& zz, const Eigen::VectorXd& zzd, const Eigen::VectorXd& yy) {
+    ld_.x = x_nominal;
+    ld_.angle_ref = angles_nominal;
+    for (int j = 0; j < nk; ++j) ld_.e_integrated[sys.e_kinematic[j]] = yy[j];
+    set_z(zz, zzd);
+    Eigen::VectorXd R;
+    residual(zdd, R);
+    Eigen::VectorXd out(nz + nk);
+    out.head(nz) = R;
+    for (int j = 0; j < nk; ++j) out[nz + j] = ld_.ed[sys.e_kinematic[j]];
+    return out;
+  };
+  // Central differences with one Richardson extrapolation: error O(h⁴) + round-off/h, so that
+  // the matrices are accurate to about 1e-11 relative (formulation.md §7.2).
+  auto derivative = [&](auto&& f, double h) -> Eigen::VectorXd {
+    const Eigen::VectorXd d1 = (f(h) - f(-h)) / (2.0 * h);
+    const Eigen::VectorXd d2 = (f(0.5 * h) - f(-0.5 * h)) / h;
+    return (4.0 * d2 - d1) / 3.0;
+  };
+  const double eps5 = std::pow(std::numeric_limits<double>::epsilon(), 0.2);
+  Eigen::MatrixXd dzd(nz + nk, nz), dz(nz + nk, nz), dy(nz + nk, nk);
   for (int i = 0; i < nz; ++i) {
+    // R is quadratic in ż: the differences are exact up to round-off for any step.
     const double h = 1e-3 * std::max(scale[i], std::abs(zd[i]));
-    const int col = L.dof_cols[order_[i]];
-    ld_.qhat_d[col] = zd[i] + h;
-    solve_velocities(L, ld_);
-    residual(zdd, Rp);
-    ld_.qhat_d[col] = zd[i] - h;
-    solve_velocities(L, ld_);
-    residual(zdd, Rm);
-    ld_.qhat_d[col] = zd[i];
-    dRdzd.col(i) = (Rp - Rm) / (2.0 * h);
+    dzd.col(i) = derivative([&](double d) { Eigen::VectorXd v = zd; v[i] += d; return response(z, v, y); }, h);
   }
-  // Position sensitivity, with the kinematics re-solved at every perturbation.
-  const double eps3 = std::cbrt(std::numeric_limits<double>::epsilon());
   for (int i = 0; i < nz; ++i) {
-    const double h = eps3 * std::max(scale[i], std::abs(z[i]));
-    Eigen::VectorXd zp = z;
-    zp[i] = z[i] + h;
-    ld_.x = x_nominal;
-    set_z(zp, zd);
-    residual(zdd, Rp);
-    zp[i] = z[i] - h;
-    ld_.x = x_nominal;
-    set_z(zp, zd);
-    residual(zdd, Rm);
-    dRdz.col(i) = (Rp - Rm) / (2.0 * h);
+    const double h = eps5 * std::max(scale[i], std::abs(z[i]));
+    dz.col(i) = derivative([&](double d) { Eigen::VectorXd v = z; v[i] += d; return response(v, zd, y); }, h);
   }
-  ld_.x = x_nominal;
-  lin.C0 = dRdzd - lin.D0;
-  lin.N0 = dRdz - lin.K0 - lin.G0;
+  for (int j = 0; j < nk; ++j) {
+    const double h = eps5 * std::max(yscale[j], std::abs(y[j]));
+    dy.col(j) = derivative([&](double d) { Eigen::VectorXd v = y; v[j] += d; return response(z, zd, v); }, h);
+  }
+  response(z, zd, y);  // leave the work data at the nominal state
+  lin.C0 = dzd.topRows(nz) - lin.D0;
+  lin.N0 = dz.topRows(nz) - lin.K0 - lin.G0;
+  lin.Kk = dy.topRows(nz);
+  lin.BK0.resize(nk, nz + nk);
+  lin.BK0 << dz.bottomRows(nk), dy.bottomRows(nk);
   return lin;
 }
 

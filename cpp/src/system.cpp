@@ -298,7 +298,8 @@ std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& de
   masses_and_loads(model, *sys, node_offset);
   length_scales(model, *sys);
   for (int k : sys->auto_released)
-    sys->warnings.push_back(sys->def_name(k) + " is fixed but none of its coordinates is calculable: it is checked, not solved for");
+    if (element_catalogue()[sys->elements[sys->e_element[k]].type].name != "L2MIN1")  // a fixed LAMBDA node is normal
+      sys->warnings.push_back(sys->def_name(k) + " is fixed but none of its coordinates is calculable: it is checked, not solved for");
   return sys;
 }
 

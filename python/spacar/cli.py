@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+import numpy as np
+
 from . import __version__
 from .errors import SpacarError
 from .io.reader import apply_block, read
@@ -31,7 +33,12 @@ def _print_linearization(res) -> None:
         return
     lin = res.linearizations[-1]
     _comment(f"linearized equations at t = {lin.t:g}: {len(lin.z_labels)} coordinates")
-    _comment("eigenfrequencies [Hz] (negative: unstable): " + " ".join(f"{f:.6g}" for f in lin.eigenfrequencies()))
+    _comment("undamped eigenfrequencies [Hz] (negative: unstable): " + " ".join(f"{f:.6g}" for f in lin.eigenfrequencies()))
+    lam = lin.eigenvalues()
+    scale = max(1.0, float(np.abs(lam).max(initial=0.0)))
+    nonzero = [z for z in lam if abs(z) > 1e-6 * scale]
+    _comment(f"eigenvalues [1/s] ({len(lam) - len(nonzero)} zero): " +
+             " ".join(f"{z.real:.8g}{z.imag:+.8g}i" if abs(z.imag) > 0 else f"{z.real:.8g}" for z in nonzero))
     if res.settings_linear == 2:
         _comment("buckling factors: " + " ".join(f"{m:.6g}" for m in lin.buckling_factors()))
 

@@ -4,7 +4,8 @@
 About a state of the model (static or moving), in the coordinates z = (q, e^ℓ) — the degrees of
 freedom followed by the LINE parameters:
 
-    M0 δz̈ + (C0 + D0) δż + (K0 + N0 + G0) δz = r0
+    M0 δz̈ + (C0 + D0) δż + (K0 + N0 + G0) δz + K_k δy^k = r0
+    δẏ^k = AK0 δż + BK0 [δz; δy^k]            (nonholonomic systems: y^k kinematic coordinates)
 
 M0 reduced mass, C0 velocity sensitivity (Coriolis, centrifugal, gyroscopic), D0 structural
 damping (EDAMPP), K0 structural stiffness (ESTIFF), N0 dynamic stiffness (inertia and
@@ -30,6 +31,10 @@ class Linearization:
         for name in ("M0", "C0", "D0", "K0", "N0", "G0"):
             setattr(self, name, np.asarray(d[name]))
         self.r0 = np.asarray(d["r0"])
+        self.y_labels = [("e", a, b) for _, a, b in d["y_label"]]
+        self.Kk = np.asarray(d["Kk"]).reshape(len(self.z_labels), len(self.y_labels))
+        self.AK0 = np.asarray(d["AK0"]).reshape(len(self.y_labels), len(self.z_labels))
+        self.BK0 = np.asarray(d["BK0"]).reshape(len(self.y_labels), len(self.z_labels) + len(self.y_labels))
         self.DF = np.asarray(d["DFz"])    # ∂x/∂z: nodal coordinates per unit z
         self.DFe = np.asarray(d["DFez"])  # ∂e/∂z
         self.coordinate_labels = [tuple(c) for c in coordinate_labels]
@@ -66,10 +71,15 @@ class Linearization:
         return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi), v, self.DF @ v
 
     def state_matrix(self) -> np.ndarray:
-        """A of d/dt [δz; δż] = A [δz; δż]."""
-        n = self.M0.shape[0]
+        """A of d/dt [δz; δy^k; δż] = A [δz; δy^k; δż] (formulation.md §7.3); without
+        nonholonomic constraints just d/dt [δz; δż]."""
+        n, k = self.M0.shape[0], len(self.y_labels)
         Minv = np.linalg.inv(self.M0)
-        return np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ self.stiffness, -Minv @ self.damping]])
+        return np.block([
+            [np.zeros((n, n)), np.zeros((n, k)), np.eye(n)],
+            [self.BK0[:, :n], self.BK0[:, n:], self.AK0],
+            [-Minv @ self.stiffness, -Minv @ self.Kk, -Minv @ self.damping],
+        ])
 
     def eigenvalues(self) -> np.ndarray:
         """Eigenvalues of the first-order system (damping, gyroscopic terms included), sorted by
@@ -86,15 +96,16 @@ class Linearization:
         return np.real(mu[np.argsort(np.abs(mu))]) if np.isrealobj(mu) else mu[np.argsort(np.abs(mu))]
 
     def state_space(self, outputs: str = "z"):
-        """(A, B, C, D) of the linearized system with generalized forces on z as inputs and, as
-        outputs, δz (``outputs="z"``) or the nodal coordinates δx = DF δz (``outputs="x"``)."""
-        n = self.M0.shape[0]
+        """(A, B, C, D) of the linearized system in the state [δz; δy^k; δż] with generalized
+        forces on z as inputs and, as outputs, δz (``outputs="z"``) or the nodal coordinates
+        δx = DF δz (``outputs="x"``; the kinematic coordinates' own effect is not included)."""
+        n, k = self.M0.shape[0], len(self.y_labels)
         A = self.state_matrix()
-        B = np.vstack([np.zeros((n, n)), np.linalg.inv(self.M0)])
+        B = np.vstack([np.zeros((n + k, n)), np.linalg.inv(self.M0)])
         if outputs == "z":
-            C = np.hstack([np.eye(n), np.zeros((n, n))])
+            C = np.hstack([np.eye(n), np.zeros((n, n + k))])
         elif outputs == "x":
-            C = np.hstack([self.DF, np.zeros((self.DF.shape[0], n))])
+            C = np.hstack([self.DF, np.zeros((self.DF.shape[0], n + k))])
         else:
             raise InputError("outputs must be 'z' or 'x'")
         return A, B, C, np.zeros((C.shape[0], n))

@@ -1,8 +1,11 @@
 // Linearized equations of motion (formulation.md §7) about a state of the model:
-//   M0 δz̈ + (C0 + D0) δż + (K0 + N0 + G0) δz = r0
-// in the coordinates z = (q, e^ℓ): the degrees of freedom followed by the LINE parameters.
-// M0, D0, K0 and G0 are assembled analytically; C0 and N0 are the remainders of central
-// differences of the reduced residual with the kinematics re-solved at every perturbation.
+//   M0 δz̈ + (C0 + D0) δż + (K0 + N0 + G0) δz + K_k δy^k = r0
+//   δẏ^k = AK0 δż + BK0 [δz; δy^k]                     (nonholonomic systems only)
+// in the coordinates z = (q, e^ℓ): the degrees of freedom followed by the LINE parameters, and
+// y^k the kinematic coordinates of nonholonomic constraints. M0, D0, K0 and G0 are assembled
+// analytically (with the velocity transfer function); C0 and N0 are the remainders of central
+// differences (Richardson-extrapolated) of the reduced residual with the kinematics re-solved
+// at every perturbation; K_k and BK0 are such differences too.
 #pragma once
 
 #include <Eigen/Dense>
@@ -24,6 +27,8 @@ struct Linearization {
   int n_line = 0;               // the last n_line entries of z are LINE parameters
   Eigen::MatrixXd M0, C0, D0, K0, N0, G0;
   Eigen::VectorXd r0;           // residual at the nominal state (drives the LINE parameters)
+  std::vector<std::array<int, 3>> y_label;  // kinematic coordinates {1, element, deformation}
+  Eigen::MatrixXd Kk, AK0, BK0; // nz x nk, nk x nz, nk x (nz + nk)
   Eigen::MatrixXd DFz, DFez;    // ∂x/∂z (nx x nz) and ∂e/∂z (ne x nz): mode shapes
 };
 
