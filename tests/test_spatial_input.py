@@ -179,7 +179,7 @@ def test_euler_parameters_far_from_unit_length(new, keyword, reason):
 
 def test_fully_fixed_lambda_node_runs():
     """FIX 10 and FIX 11 fix all Euler parameters of the ground orientations; their L2MIN1
-    rows are checked instead of solved (a warning each) and the mechanism runs."""
+    rows are checked instead of solved and the mechanism runs."""
     model = spacar.read(SPATIAL_EXAMPLE)
     assert model.summary().coordinates["fixed"] == 3 + 4 + 4 + 1
     res = spacar.simulate(model)
