@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Dense>
+
 #include "spacar/errors.hpp"
 
 namespace spacar {
@@ -381,13 +383,14 @@ void Model::set_mass(int id, const std::vector<double>& values) {
       break;
     case NodeKind::Lambda: {
       require_count(values, 6, 6, "MASS of a LAMBDA node (Ixx Ixy Ixz Iyy Iyz Izz)");
-      // The tensor must be positive semidefinite: check the leading principal minors of J + εI.
-      const double a = values[0], b = values[1], c = values[2], d = values[3], e = values[4], f = values[5];
-      const double det2 = a * d - b * b;
-      const double det3 = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
-      const double scale = std::max({std::abs(a), std::abs(d), std::abs(f), 1e-300});
-      if (a < 0 || d < 0 || f < 0 || det2 < -1e-12 * scale * scale || det3 < -1e-12 * scale * scale * scale)
-        fail("the inertia tensor of node ", id, " is not positive semidefinite");
+      // The tensor must be positive semidefinite. Leading principal minors do not decide that
+      // (diag(0, 1, 0) with Iyz = 1 passes them), so look at the principal moments.
+      Eigen::Matrix3d J;
+      J << values[0], values[1], values[2], values[1], values[3], values[4], values[2], values[4], values[5];
+      const Eigen::Vector3d moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(J, Eigen::EigenvaluesOnly).eigenvalues();
+      if (moments[0] < -1e-12 * std::max(moments.cwiseAbs().maxCoeff(), 1e-300))
+        fail("the inertia tensor of node ", id, " is not positive semidefinite (principal moments ", moments[0],
+             ", ", moments[1], ", ", moments[2], ")");
       break;
     }
     case NodeKind::Any:
@@ -506,6 +509,16 @@ void Model::prepare() {
     if (elements.empty()) fail("the model has no elements");
     compute_reference_geometry();
     frozen_ = true;
+  }
+  // Euler parameters are accepted within 1e-3 of unit length (4-digit input, the dump). The
+  // L2MIN1 constraint makes calculable ones exact, but nothing moves a fully fixed LAMBDA node,
+  // whose automatically released L2MIN1 is then checked to EPSKIN: normalise them all here.
+  for (auto& [id, n] : nodes) {
+    if (n.kind != NodeKind::Lambda) continue;
+    double norm2 = 0.0;
+    for (double v : n.x) norm2 += v * v;
+    if (norm2 > 0.0 && norm2 != 1.0)
+      for (double& v : n.x) v /= std::sqrt(norm2);
   }
 }
 

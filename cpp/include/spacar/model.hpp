@@ -120,7 +120,8 @@ class Model {
   void set_linear(int mode);
 
   // First END: create the automatic L2MIN1 elements, compute the reference geometry, check that
-  // every node is used by an element, freeze the topology. Later calls only validate.
+  // every node is used by an element, freeze the topology. Every call (every END) normalises the
+  // Euler parameters of the LAMBDA nodes (accepted within 1e-3 of unit length).
   void prepare();
   bool frozen() const { return frozen_; }
 

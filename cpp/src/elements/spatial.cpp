@@ -1,20 +1,31 @@
 #include "spacar/elements/spatial.hpp"
 
+#include <cmath>
 #include <sstream>
 
 #include "spacar/errors.hpp"
 
 namespace spacar {
 
-Eigen::Matrix3d frame_from_axis(const Eigen::Vector3d& axis, const Eigen::Vector3d& y_hint, const std::string& what) {
+namespace {
+// Only the direction of an axis or direction vector matters: scale it by its largest component,
+// so that a tiny (1e-300) or huge vector does not underflow or overflow in the norm.
+Eigen::Vector3d scaled(const Eigen::Vector3d& v) {
+  const double m = v.cwiseAbs().maxCoeff();
+  return m > 0.0 && std::isfinite(m) ? Eigen::Vector3d(v / m) : v;
+}
+}  // namespace
+
+Eigen::Matrix3d frame_from_axis(const Eigen::Vector3d& axis_in, const Eigen::Vector3d& y_in, const std::string& what) {
   const std::string prefix = what.empty() ? "" : what + ": ";
+  const Eigen::Vector3d axis = scaled(axis_in), y_hint = scaled(y_in);
   const double la = axis.norm();
   if (!(la > 0.0)) throw InputError(prefix + "the axis has zero length");
   const Eigen::Vector3d ex = axis / la;
   const Eigen::Vector3d y = y_hint - ex.dot(y_hint) * ex;
   if (!(y.norm() > 1e-5 * y_hint.norm()) || y_hint.norm() == 0.0) {
     std::ostringstream os;
-    os << prefix << "the direction vector (" << y_hint[0] << ", " << y_hint[1] << ", " << y_hint[2]
+    os << prefix << "the direction vector (" << y_in[0] << ", " << y_in[1] << ", " << y_in[2]
        << ") is parallel to the element axis (" << ex[0] << ", " << ex[1] << ", " << ex[2] << ")";
     throw InputError(os.str());
   }
@@ -25,7 +36,8 @@ Eigen::Matrix3d frame_from_axis(const Eigen::Vector3d& axis, const Eigen::Vector
   return C;
 }
 
-Eigen::Matrix3d hinge_frame(const Eigen::Vector3d& axis, const std::string& what) {
+Eigen::Matrix3d hinge_frame(const Eigen::Vector3d& axis_in, const std::string& what) {
+  const Eigen::Vector3d axis = scaled(axis_in);
   if (!(axis.norm() > 0.0)) throw InputError(what + ": the axis of rotation has zero length");
   int k = 0;
   const Eigen::Vector3d a = axis.cwiseAbs();
