@@ -285,6 +285,8 @@ void bind_simulation(py::module_& m) {
       .def_readonly("Mbar", &Data::Mbar)
       .def_readonly("qdd", &Data::qdd)
       .def_readonly("reaction", &Data::reaction)
+      .def_readonly("residual_load", &Data::residual_load)
+      .def_readonly("sigma_equilibrium", &Data::sigma_equilibrium)
       .def_readonly("newton_iterations", &Data::newton_iterations);
 
   py::class_<Simulation>(m, "Simulation")

@@ -29,7 +29,8 @@ Data::Data(const System& sys) {
   acc0 = Eigen::VectorXd::Zero(nx);
   step = Eigen::VectorXd::Zero(std::max(nc, std::max(nP, nV)));
   M = Eigen::MatrixXd::Zero(nx, nx);
-  h = f = g = reaction = Eigen::VectorXd::Zero(nx);
+  h = f = g = reaction = residual_load = Eigen::VectorXd::Zero(nx);
+  sigma_equilibrium = Eigen::VectorXd::Zero(ne);
   DFq = Eigen::MatrixXd::Zero(nx, nd);
   Mbar = Eigen::MatrixXd::Zero(nd, nd);
   rhs = qdd = Eigen::VectorXd::Zero(nd);

@@ -14,7 +14,8 @@ namespace spacar {
 
 // Requires a complete evaluation (positions, DF with the velocity factorization, velocities,
 // accelerations, M, h, f and constitutive stresses). Fills data.sigma (complete) and
-// data.reaction.
+// data.reaction, and for the consistency checks of §6 data.residual_load (g + DDᵀσ on every
+// coordinate) and data.sigma_equilibrium (σ of every velocity row from (6.1)).
 void solve_reactions(const System& sys, Data& data);
 
 }  // namespace spacar
