@@ -318,6 +318,12 @@ void bind_simulation(py::module_& m) {
                throw InputError("evaluate(): q and qd must have one value per degree of freedom");
              s.evaluate(t, q.data(), qd.data());
            })
+      .def("move_to",
+           [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
+               throw InputError("move_to(): q and qd must have one value per degree of freedom");
+             s.move_to(t, q.data(), qd.data());
+           })
       .def(
           "run",
           [](Simulation& s, py::object on_output, double initial_step, const std::string& method) {

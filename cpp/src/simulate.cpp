@@ -1,5 +1,6 @@
 #include "spacar/simulate.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -61,6 +62,63 @@ void Simulation::evaluate(double t, const double* q, const double* qd) {
   x_base_ = data_.x;
   qhat_base_ = data_.qhat;
   have_base_ = true;
+}
+
+void Simulation::move_to(double t, const double* q, const double* qd) {
+  const System& sys = *sys_;
+  const int nd = sys.n_dof();
+  const Eigen::Map<const Eigen::VectorXd> q1(q, nd), qd1(qd, nd);
+  Eigen::VectorXd q0(nd), qd0(nd);
+  for (int j = 0; j < nd; ++j) {
+    q0[j] = data_.qhat[sys.dof_cols[j]];
+    qd0[j] = data_.qhat_d[sys.dof_cols[j]];
+  }
+  const double t0 = data_.t;
+  if (!have_base_) evaluate(t0, q0.data(), qd0.data());
+  // A step is accepted when Newton only corrected the predicted positions by a small fraction
+  // of the predicted change (the correction of a smooth path shrinks with the step squared; a
+  // jump to another branch does not) or by a negligible amount.
+  const double tiny = 1e-6 * sys.length_scale;
+  double s = 0.0, ds = 1.0;
+  Eigen::VectorXd qs(nd), qds(nd);
+  auto at = [&](double u) {
+    qs = q0 + u * (q1 - q0);
+    qds = qd0 + u * (qd1 - qd0);
+    return t0 + u * (t - t0);
+  };
+  while (s < 1.0) {
+    const double s1 = ds >= 1.0 - s ? 1.0 : s + ds;
+    const Eigen::VectorXd x_from = x_base_, angles_from = data_.angle_ref;
+    bool ok = true;
+    try {
+      evaluate(at(s1), qs.data(), qds.data());
+      double predicted = 0.0, corrected = 0.0;
+      for (int c : sys.x_calc) {
+        predicted = std::max(predicted, std::abs(predictor_[c]));
+        corrected = std::max(corrected, std::abs(data_.x[c] - x_from[c] - predictor_[c]));
+      }
+      ok = corrected <= 0.1 * predicted || corrected <= tiny;
+    } catch (const KinematicsError&) {
+      ok = false;
+    }
+    if (ok) {
+      s = s1;
+      ds *= 2.0;
+      continue;
+    }
+    if (ds < 1e-6) {
+      std::ostringstream os;
+      os << "cannot follow the kinematic solution from t = " << t0 << " to t = " << t
+         << ": the mechanism does not move continuously near t = " << at(s1);
+      throw KinematicsError(os.str());
+    }
+    // Back to the last accepted state (exact positions, its DF for the predictor).
+    x_base_ = x_from;
+    data_.angle_ref = angles_from;
+    have_base_ = false;
+    evaluate(at(s), qs.data(), qds.data());
+    ds *= 0.5;
+  }
 }
 
 void Simulation::forces() { solve_reactions(*sys_, data_); }

@@ -106,7 +106,9 @@ class Linearization:
 def linearize(model, state=None) -> Linearization:
     """Linearized equations of ``model`` at ``state``: None for the model's current state, or
     ``(t, q, qd)`` with the degrees of freedom in their order (DYNX coordinates ascending, then
-    DYNE deformations ascending). The mechanism is assembled first."""
+    DYNE deformations ascending). The mechanism is assembled at the model's current state first
+    and then moved continuously to ``state`` (the inputs at time t), so that the calculable
+    coordinates stay on the branch of the assembled mechanism."""
     model.prepare()
     sim = _core.Simulation(model._core)
     sim.assemble()
@@ -115,5 +117,5 @@ def linearize(model, state=None) -> Linearization:
         t, q, qd = model.current_time, system.q0, system.qd0
     else:
         t, q, qd = state
-    sim.evaluate(float(t), np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
+    sim.move_to(float(t), np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
     return Linearization(sim.linearize(), system.coord_label, system.def_label)

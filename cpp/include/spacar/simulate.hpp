@@ -54,6 +54,11 @@ class Simulation {
   void assemble();
   // Complete state at (t, q, q̇): positions, DF, velocities, q̈, accelerations, stresses.
   void evaluate(double t, const double* q, const double* qd);
+  // Complete state at (t, q, q̇) reached from the last evaluated (or assembled) state along the
+  // straight path in (t, q, q̇), in steps small enough that the first-order predictor keeps the
+  // kinematic solution on its branch: one Newton solve from a distant state may converge to
+  // another assembly of the mechanism (e.g. a beam folded back on a crank turned by > 90°).
+  void move_to(double t, const double* q, const double* qd);
   // Reactions and complete stresses (FORCEMODE) at the state of the last evaluate().
   void forces();
   // Linearized equations at the state of the last evaluate() (computes the forces first).
