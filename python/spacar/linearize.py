@@ -59,7 +59,9 @@ class Linearization:
 
     def mode_shapes(self):
         """(frequencies in Hz, shapes in z (nz x nmodes), shapes in the nodal coordinates
-        (nx x nmodes), each normalised to unit largest component)."""
+        (nx x nmodes)). Each shape in z is normalised to unit largest component (sign
+        arbitrary); the nodal shapes are DF times the same vectors, so both describe the same
+        motion (their largest component is generally not 1)."""
         w2, v = self._undamped()
         v = np.real(v)
         v = v / np.abs(v).max(axis=0)
