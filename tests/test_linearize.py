@@ -742,3 +742,21 @@ def test_spacar_run_prints_eigenfrequencies_and_buckling_factors(tmp_path, capsy
     path.write_text(COLUMN.format(load="0.", mode=0))
     assert main(["run", str(path)]) == 0
     assert "eigenfrequencies" not in capsys.readouterr().out
+
+
+def test_mechanism_without_coordinates_to_linearize(tmp_path, capsys):
+    """A rigid driven mechanism (no DOF, no LINE) with LINEAR 2: every result is empty, and
+    `spacar run` says so instead of printing empty lists."""
+    text = "".join(line for line in EXAMPLE.read_text().splitlines(keepends=True) if not line.startswith("DYNE"))
+    text = text.replace("Timestep 100 5.0", "Timestep 2 1.0\nLINEAR 2")
+    lin = spacar.linearize(spacar.read_string(text))
+    assert lin.M0.shape == (0, 0) and lin.eigenfrequencies().size == 0 and lin.eigenvalues().size == 0
+    freq, shapes_z, shapes_x = lin.mode_shapes()
+    assert freq.size == 0 and shapes_z.shape == (0, 0) and shapes_x.shape == (lin.DF.shape[0], 0)
+    assert lin.buckling_factors().size == 0 and lin.state_space()[0].shape == (0, 0)
+    path = tmp_path / "rigid.dat"
+    path.write_text(text)
+    assert main(["run", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "* linearized equations at t = 1: 0 coordinates" in out
+    assert "eigenfrequencies" not in out and "buckling" not in out

@@ -31,6 +31,8 @@ def _print_linearization(res) -> None:
         return
     lin = res.linearizations[-1]
     _comment(f"linearized equations at t = {lin.t:g}: {len(lin.z_labels)} coordinates")
+    if not lin.z_labels:  # no degrees of freedom and no LINE parameters
+        return
     _comment("eigenfrequencies [Hz] (negative: unstable): " + " ".join(f"{f:.6g}" for f in lin.eigenfrequencies()))
     if res.settings_linear == 2:
         _comment("buckling factors: " + " ".join(f"{m:.6g}" for m in lin.buckling_factors()))

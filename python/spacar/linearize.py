@@ -64,7 +64,8 @@ class Linearization:
         motion (their largest component is generally not 1)."""
         w2, v = self._undamped()
         v = np.real(v)
-        v = v / np.abs(v).max(axis=0)
+        if v.size:
+            v = v / np.abs(v).max(axis=0)
         return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi), v, self.DF @ v
 
     def state_matrix(self) -> np.ndarray:
