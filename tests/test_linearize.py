@@ -462,6 +462,27 @@ def test_static_equilibrium_has_no_velocity_or_dynamic_stiffness_terms():
     assert np.allclose(omegas(lin) ** 2, [(2 - math.sqrt(2)) * 9.81, (2 + math.sqrt(2)) * 9.81], rtol=1e-9)
 
 
+@pytest.mark.parametrize("element", ["BEAM", "BEAMNL"])
+def test_static_equilibrium_spatial_follower_torque_and_gravity(element):
+    """Spatial cantilever deflected by a dead force, a body-fixed torque (TORQUEL, follower)
+    and gravity on the beam masses, in static equilibrium: N0 = 0, so the analytic G0 — stress
+    Hessians plus the load stiffness of TORQUEL and of the beam gravity tangent terms — makes
+    up the whole difference Jacobian beyond K0."""
+    m = spatial_beam_chain(3, element)
+    m.fix(1)
+    m.fix(2)
+    m.torquel(8, 0.3, -0.2, 0.5)
+    m.force(7, 0.2, 0.1, -0.4)
+    m.gravity(0.1, -0.5, -1.0)
+    m.epskin(1e-13)
+    q = static_equilibrium(m)
+    lin = spacar.linearize(m, (0.0, q, np.zeros(len(q))))
+    scale = np.abs(lin.K0).max()
+    assert np.abs(q).max() > 0.01 and np.abs(lin.G0).max() > 0.02 * scale
+    assert np.abs(lin.C0).max() == 0.0 and np.abs(lin.N0).max() <= 1e-9 * scale
+    assert np.abs(lin.G0 - lin.G0.T).max() > 1e-3  # the follower torque is not conservative
+
+
 def test_damping_matrix_from_edampp():
     """D0 = DF^eᵀ D_v DF^e: for PLBEAM EDAMPP (0, d) the same form as ESTIFF (0, EI), so
     D0 = (d/EI) K0; only D0 changes."""
