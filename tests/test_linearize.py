@@ -354,6 +354,9 @@ def test_rotating_linearization_is_the_same_all_along_the_steady_motion():
     assert len(res.linearizations) == 5
     for lin in res.linearizations:
         assert np.allclose(omegas(lin), ref, rtol=1e-9)
+    spatial = rotating_spatial(3, 2.0)
+    ref = omegas(spacar.linearize(spatial, steady(12, 0.0)))
+    assert np.allclose(omegas(spacar.linearize(spatial, steady(12, 5.0))), ref, rtol=1e-9)
 
 
 # --------------------------------------------------------------------------------------------
