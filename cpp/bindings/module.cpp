@@ -289,6 +289,8 @@ void bind_simulation(py::module_& m) {
       .def_readonly("Mbar", &Data::Mbar)
       .def_readonly("qdd", &Data::qdd)
       .def_readonly("reaction", &Data::reaction)
+      .def_readonly("residual_load", &Data::residual_load)
+      .def_readonly("sigma_equilibrium", &Data::sigma_equilibrium)
       .def_readonly("newton_iterations", &Data::newton_iterations);
 
   py::class_<Simulation>(m, "Simulation")
@@ -319,6 +321,12 @@ void bind_simulation(py::module_& m) {
              if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
                throw InputError("evaluate(): q and qd must have one value per degree of freedom");
              s.evaluate(t, q.data(), qd.data());
+           })
+      .def("move_to",
+           [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
+               throw InputError("move_to(): q and qd must have one value per degree of freedom");
+             s.move_to(t, q.data(), qd.data());
            })
       .def(
           "run",

@@ -227,19 +227,42 @@ void solve_dynamics_direct(const System& sys, Data& data) {
     throw SingularMassError("the equations of motion have no finite solution at t = " + std::to_string(data.t));
 }
 
-void nodal_reactions(const System& sys, Data& data) {
-  // r = M ẍ + h − f + Bᵀσ on fixed and input coordinates (6.2), σ complete.
-  inertia_force(sys, data);
-  data.reaction = data.g;
+namespace {
+// Σ_k B_kᵀ σ_k added to out, over the deformations selected by `take`.
+template <class Take>
+void add_element_loads(const System& sys, const Data& data, Take take, Eigen::VectorXd& out) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
     const ElementWork& w = data.work[i];
     for (int a = 0; a < se.nd; ++a) {
-      const double s = data.sigma[se.def_offset + a];
-      if (s != 0.0)
-        for (size_t j = 0; j < se.coords.size(); ++j) data.reaction[se.coords[j]] += w.B(a, j) * s;
+      const int k = se.def_offset + a;
+      if (data.sigma[k] == 0.0 || !take(k)) continue;
+      for (size_t j = 0; j < se.coords.size(); ++j) out[se.coords[j]] += w.B(a, j) * data.sigma[k];
     }
   }
+}
+}  // namespace
+
+void nodal_reactions(const System& sys, Data& data) {
+  // r = M ẍ + h − f + Bᵀσ on fixed and input coordinates (6.2), σ complete.
+  inertia_force(sys, data);
+  // Consistency (formulation.md §6): σ of every velocity row from (6.1) with only the released
+  // and kinematic stresses known, A_Vᵀ σ^V = −[g + B_Wᵀ σ^W]_c; its DOF rows equal the
+  // constitutive stresses iff q̈ satisfies the equations of motion.
+  data.residual_load = data.g;
+  add_element_loads(sys, data, [&](int k) {
+    return sys.def_class[k] == DefClass::Released || sys.def_class[k] == DefClass::Kinematic; }, data.residual_load);
+  data.sigma_equilibrium.setZero();
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc > 0 && static_cast<int>(sys.rows_V.size()) == nc) {
+    Eigen::VectorXd rhs(nc), sV(nc);
+    for (int j = 0; j < nc; ++j) rhs[j] = -data.residual_load[sys.x_calc[j]];
+    data.luV.solve_transposed(rhs, sV);
+    for (int r = 0; r < nc; ++r) data.sigma_equilibrium[sys.rows_V[r]] = sV[r];
+  }
+  data.residual_load = data.g;
+  add_element_loads(sys, data, [](int) { return true; }, data.residual_load);
+  data.reaction = data.residual_load;
   for (int g = 0; g < sys.nx; ++g) {
     const CoordClass c = sys.coord_class[g];
     if (c != CoordClass::Fixed && c != CoordClass::Input) data.reaction[g] = 0.0;

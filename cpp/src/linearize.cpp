@@ -153,9 +153,13 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
   const double eps5 = std::pow(std::numeric_limits<double>::epsilon(), 0.2);
   Eigen::MatrixXd dzd(nz + nk, nz), dz(nz + nk, nz), dy(nz + nk, nk);
   for (int i = 0; i < nz; ++i) {
-    // R is quadratic in ż: the differences are exact up to round-off for any step.
+    // R is quadratic in ż: one central difference is exact up to round-off for any step.
     const double h = 1e-3 * std::max(scale[i], std::abs(zd[i]));
-    dzd.col(i) = derivative([&](double d) { Eigen::VectorXd v = zd; v[i] += d; return response(z, v, y); }, h);
+    Eigen::VectorXd v = zd;
+    v[i] = zd[i] + h;
+    const Eigen::VectorXd Rp = response(z, v, y);
+    v[i] = zd[i] - h;
+    dzd.col(i) = (Rp - response(z, v, y)) / (2.0 * h);
   }
   for (int i = 0; i < nz; ++i) {
     const double h = eps5 * std::max(scale[i], std::abs(z[i]));

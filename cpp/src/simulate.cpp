@@ -1,5 +1,6 @@
 #include "spacar/simulate.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -21,7 +22,7 @@ std::unique_ptr<System> prepare_and_compile(Model& model) {
 
 Simulation::Simulation(Model& model)
     : model_(model), sys_(prepare_and_compile(model)), data_(std::make_unique<Data>(*sys_)) {
-  xd_base_ = xdd_base_ = Eigen::VectorXd::Zero(sys_->nx);
+  xd_base_ = xdd_base_ = predicted_ = Eigen::VectorXd::Zero(sys_->nx);
   for (const FreeRotation& fr : sys_->free_rotations) dependent_[fr.node] = fr.dependent;
   int g = 0;
   for (const auto& [id, n] : model_.nodes)
@@ -50,9 +51,10 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
   for (int g : sys.x_input) data_->x[g] = data_->qhat[sys.qhat_col_x[g]];
   for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_->x[sys.x_dyn[j]] = q[j];
   bool predicted = true;
+  predicted_.setZero();
   if (transfer_predictor && have_transfer_) {
-    const Eigen::VectorXd dx = data_->DF * (data_->qhat - qhat_base_);
-    for (int c : sys.x_calc) data_->x[c] += dx[c];
+    predicted_.noalias() = data_->DF * (data_->qhat - qhat_base_);
+    for (int c : sys.x_calc) data_->x[c] += predicted_[c];
   } else if (have_base_ && t != t_base_) {
     const double dt = t - t_base_;
     for (int c : sys.x_calc) data_->x[c] += dt * (xd_base_[c] + 0.5 * dt * xdd_base_[c]);
@@ -89,6 +91,63 @@ void Simulation::evaluate(double t, const double* q, const double* qd) {
   for (int j = 0; j < sys.n_dof(); ++j) data_->DFq.col(j) = data_->DF.col(sys.dof_cols[j]);
   data_->Mbar.noalias() = data_->DFq.transpose() * data_->M * data_->DFq;
   have_transfer_ = true;
+}
+
+void Simulation::move_to(double t, const double* q, const double* qd) {
+  const System& sys = *sys_;
+  const int nd = sys.n_dof();
+  const Eigen::Map<const Eigen::VectorXd> q1(q, nd), qd1(qd, nd);
+  Eigen::VectorXd q0(nd), qd0(nd);
+  for (int j = 0; j < nd; ++j) {
+    q0[j] = data_->qhat[sys.dof_cols[j]];
+    qd0[j] = data_->qhat_d[sys.dof_cols[j]];
+  }
+  const double t0 = data_->t;
+  if (!have_base_) evaluate(t0, q0.data(), qd0.data());
+  // A step is accepted when Newton only corrected the predicted positions by a small fraction
+  // of the predicted change (the correction of a smooth path shrinks with the step squared; a
+  // jump to another branch does not) or by a negligible amount.
+  const double tiny = 1e-6 * sys.length_scale;
+  double s = 0.0, ds = 1.0;
+  Eigen::VectorXd qs(nd), qds(nd);
+  auto at = [&](double u) {
+    qs = q0 + u * (q1 - q0);
+    qds = qd0 + u * (qd1 - qd0);
+    return t0 + u * (t - t0);
+  };
+  while (s < 1.0) {
+    const double s1 = ds >= 1.0 - s ? 1.0 : s + ds;
+    const Eigen::VectorXd x_from = x_base_, angles_from = data_->angle_ref;
+    bool ok = true;
+    try {
+      evaluate(at(s1), qs.data(), qds.data());
+      double predicted = 0.0, corrected = 0.0;
+      for (int c : sys.x_calc) {
+        predicted = std::max(predicted, std::abs(predicted_[c]));
+        corrected = std::max(corrected, std::abs(data_->x[c] - x_from[c] - predicted_[c]));
+      }
+      ok = corrected <= 0.1 * predicted || corrected <= tiny;
+    } catch (const KinematicsError&) {
+      ok = false;
+    }
+    if (ok) {
+      s = s1;
+      ds *= 2.0;
+      continue;
+    }
+    if (ds < 1e-6) {
+      std::ostringstream os;
+      os << "cannot follow the kinematic solution from t = " << t0 << " to t = " << t
+         << ": the mechanism does not move continuously near t = " << at(s1);
+      throw KinematicsError(os.str());
+    }
+    // Back to the last accepted state (exact positions, its DF for the predictor).
+    x_base_ = x_from;
+    data_->angle_ref = angles_from;
+    have_base_ = have_transfer_ = false;
+    evaluate(at(s), qs.data(), qds.data());
+    ds *= 0.5;
+  }
 }
 
 void Simulation::forces() { nodal_reactions(*sys_, *data_); }
@@ -154,6 +213,7 @@ BlockResults Simulation::run(const RunOptions& options) {
   auto output = [&](double t, const Eigen::VectorXd& Y) {
     evaluate_state(t, Y);
     if (st.forcemode >= 1 || linear) forces();
+    else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
     if (linear) res.linearizations.push_back(linearize());
     record(res, k_out);
     if (options.on_output) options.on_output(k_out, *data_);

@@ -99,6 +99,12 @@ void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
   else x = sparse_lu_.solve(b);
 }
 
+void LinearSolver::solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  if (n_ == 0) return;
+  if (dense_) x = dense_lu_.transpose().solve(b);
+  else x = sparse_lu_.transpose().solve(b);
+}
+
 void LinearSolver::solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
   if (n_ == 0) return;
   if (dense_) x = dense_lu_.solve(b);

@@ -33,7 +33,9 @@ def _print_linearization(res) -> None:
         return
     lin = res.linearizations[-1]
     _comment(f"linearized equations at t = {lin.t:g}: {len(lin.z_labels)} coordinates")
-    _comment("undamped eigenfrequencies [Hz] (negative: unstable): " + " ".join(f"{f:.6g}" for f in lin.eigenfrequencies()))
+    if not lin.z_labels:  # no degrees of freedom and no LINE parameters
+        return
+    _comment("eigenfrequencies [Hz] (undamped; negative: unstable): " + " ".join(f"{f:.6g}" for f in lin.eigenfrequencies()))
     lam = lin.eigenvalues()
     scale = max(1.0, float(np.abs(lam).max(initial=0.0)))
     nonzero = [z for z in lam if abs(z) > 1e-6 * scale]

@@ -64,10 +64,13 @@ class Linearization:
 
     def mode_shapes(self):
         """(frequencies in Hz, shapes in z (nz x nmodes), shapes in the nodal coordinates
-        (nx x nmodes), each normalised to unit largest component)."""
+        (nx x nmodes)). Each shape in z is normalised to unit largest component (sign
+        arbitrary); the nodal shapes are DF times the same vectors, so both describe the same
+        motion (their largest component is generally not 1)."""
         w2, v = self._undamped()
         v = np.real(v)
-        v = v / np.abs(v).max(axis=0)
+        if v.size:
+            v = v / np.abs(v).max(axis=0)
         return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi), v, self.DF @ v
 
     def state_matrix(self) -> np.ndarray:
@@ -117,7 +120,9 @@ class Linearization:
 def linearize(model, state=None) -> Linearization:
     """Linearized equations of ``model`` at ``state``: None for the model's current state, or
     ``(t, q, qd)`` with the degrees of freedom in their order (DYNX coordinates ascending, then
-    DYNE deformations ascending). The mechanism is assembled first."""
+    DYNE deformations ascending). The mechanism is assembled at the model's current state first
+    and then moved continuously to ``state`` (the inputs at time t), so that the calculable
+    coordinates stay on the branch of the assembled mechanism."""
     model.prepare()
     sim = _core.Simulation(model._core)
     sim.assemble()
@@ -126,5 +131,5 @@ def linearize(model, state=None) -> Linearization:
         t, q, qd = model.current_time, system.q0, system.qd0
     else:
         t, q, qd = state
-    sim.evaluate(float(t), np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
+    sim.move_to(float(t), np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
     return Linearization(sim.linearize(), system.coord_label, system.def_label)

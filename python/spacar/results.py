@@ -43,7 +43,10 @@ class Results:
         self.t = arrays["t"]
         self.x, self.xd, self.xdd = arrays["x"], arrays["xd"], arrays["xdd"]
         self.e, self.ed, self.edd, self.sigma = arrays["e"], arrays["ed"], arrays["edd"], arrays["sigma"]
-        self.reaction = arrays["reaction"]  # (nt, nx): loads of supports and drivers (FORCEMODE ≥ 1)
+        # (nt, nx): loads exerted by the supports and drivers on the fixed and input coordinates
+        # (FORCEMODE ≥ 1; zero on the other coordinates); sigma then includes the reaction
+        # stresses of fixed, input and LINE deformations (formulation.md §6).
+        self.reaction = arrays["reaction"]
         self.linearizations = []  # one spacar.Linearization per output time (LINE or LINEAR ≥ 1)
         self.coordinate_labels = [tuple(lbl) for lbl in coordinate_labels]
         self.deformation_labels = [tuple(lbl) for lbl in deformation_labels]
@@ -84,6 +87,20 @@ class Results:
     def deformation(self, e: int, i: int) -> np.ndarray:
         """Values of element e deformation i over time."""
         return self.e[:, self.deformation_index(e, i)]
+
+    def reaction_moment(self, n: int) -> np.ndarray:
+        """Reaction on the orientation node ``n`` (LAMBDA) as a global moment, shape (nt, 3):
+        m = ½ E(λ) r_λ (formulation.md §6), the moment exerted by the support or driver. The
+        component of r_λ along λ (the normalisation) does no work and has no moment."""
+        cols = self._columns(self._coord, n, "node")
+        if len(cols) != 4:
+            raise InputError(f"node {n} is not a LAMBDA node")
+        lam, r = self.x[:, cols], self.reaction[:, cols]
+        l0, l1, l2, l3 = lam.T
+        E = np.stack([np.stack([-l1, l0, -l3, l2], -1),
+                      np.stack([-l2, l3, l0, -l1], -1),
+                      np.stack([-l3, -l2, l1, l0], -1)], 1)  # (nt, 3, 4)
+        return 0.5 * np.einsum("tij,tj->ti", E, r)
 
     def __len__(self):
         return len(self.t)

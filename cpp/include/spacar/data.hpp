@@ -80,6 +80,11 @@ struct Data {
   Eigen::VectorXd qdd;          // DOF accelerations (n_dof)
   Eigen::VectorXd g;            // M ẍ + h − f (nx)
   Eigen::VectorXd reaction;     // loads of supports and drivers on fixed and input coordinates (nx)
+  // Consistency of the reactions with the motion (formulation.md §6): g + DDᵀσ on every
+  // coordinate (the reactions on fixed and input rows, ≈ 0 on the others) and σ of every
+  // velocity row from (6.1), degree-of-freedom rows included (0 on the other rows).
+  Eigen::VectorXd residual_load;      // (nx)
+  Eigen::VectorXd sigma_equilibrium;  // (ne)
 };
 
 }  // namespace spacar

@@ -58,6 +58,11 @@ class Simulation {
   // Complete state at (t, q, q̇): solve_state plus the transfer functions DF, DFe and the
   // reduced mass matrix M̄ (for users, tests and teaching).
   void evaluate(double t, const double* q, const double* qd);
+  // Complete state at (t, q, q̇) reached from the last evaluated (or assembled) state along the
+  // straight path in (t, q, q̇), in steps small enough that the first-order predictor keeps the
+  // kinematic solution on its branch: one Newton solve from a distant state may converge to
+  // another assembly of the mechanism (e.g. a beam folded back on a crank turned by > 90°).
+  void move_to(double t, const double* q, const double* qd);
   // Reactions and complete stresses (FORCEMODE) at the state of the last evaluate().
   void forces();
   // Linearized equations at the state of the last evaluate() (computes the forces first).
@@ -86,6 +91,7 @@ class Simulation {
   std::unique_ptr<Data> data_;  // replaced when the system is recompiled (repartition)
   // Last solved state: the predictor of the next position solve.
   Eigen::VectorXd x_base_, xd_base_, xdd_base_, qhat_base_;
+  Eigen::VectorXd predicted_;   // change of the positions predicted by the transfer function
   double t_base_ = 0.0;
   bool have_transfer_ = false;  // data holds DF of the last state (set by evaluate)
   std::unique_ptr<Linearizer> linearizer_;

@@ -55,6 +55,7 @@ class LinearSolver {
   bool factorize(const Eigen::SparseMatrix<double>& A);
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
   void solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const;
+  void solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   int size() const { return n_; }
 
  private:
