@@ -13,7 +13,6 @@ convective terms), G0 geometric stiffness (stresses incl. reaction stresses, loa
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 from . import _core
 from .errors import InputError
@@ -46,6 +45,8 @@ class Linearization:
         return self.C0 + self.D0
 
     def _undamped(self):
+        import scipy.linalg  # lazily: `import spacar` stays light
+
         w2, v = scipy.linalg.eig(self.stiffness, self.M0)
         w2 = np.real_if_close(w2, tol=1e6)
         order = np.argsort(np.abs(w2))
@@ -80,6 +81,8 @@ class Linearization:
     def buckling_factors(self) -> np.ndarray:
         """Load multipliers μ of (K0 + μ G0) v = 0 for a static state, sorted by |μ|; only the
         finite ones."""
+        import scipy.linalg
+
         mu = scipy.linalg.eigvals(-self.K0, self.G0)
         mu = mu[np.isfinite(mu)]
         mu = np.real_if_close(mu, tol=1e6)
