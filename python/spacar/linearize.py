@@ -34,6 +34,20 @@ class Linearization:
         self.coordinate_labels = [tuple(c) for c in coordinate_labels]
         self.deformation_labels = [tuple(c) for c in deformation_labels]
 
+    @classmethod
+    def from_arrays(cls, t, z_labels, n_line, matrices: dict, coordinate_labels, deformation_labels):
+        """Rebuild from saved arrays (``matrices``: M0 C0 D0 K0 N0 G0 r0 DF DFe); used by
+        :meth:`spacar.Results.load`."""
+        self = cls.__new__(cls)
+        self.t = float(t)
+        self.z_labels = [(str(k), int(a), int(b)) for k, a, b in z_labels]
+        self.n_line = int(n_line)
+        for name in ("M0", "C0", "D0", "K0", "N0", "G0", "r0", "DF", "DFe"):
+            setattr(self, name, np.asarray(matrices[name]))
+        self.coordinate_labels = [tuple(int(v) for v in c) for c in coordinate_labels]
+        self.deformation_labels = [tuple(int(v) for v in c) for c in deformation_labels]
+        return self
+
     @property
     def stiffness(self) -> np.ndarray:
         """K0 + N0 + G0."""
