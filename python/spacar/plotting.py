@@ -54,14 +54,15 @@ def plot(res: Results, y, x="t", ax=None, **kwargs):
 
     A quantity is a MATASC label (``"x(8,1)"``, ``"e(2,2)"``, ``"s(2,1)"`` for σ, ``"r(1,1)"``
     for a reaction), a keyword line (``"XD 2 1"``) or a tuple (``("EDD", 2, 3)``). Extra keyword
-    arguments go to ``Axes.plot``. Returns the axes."""
+    arguments go to ``Axes.plot`` (``label`` names a single curve in a legend). Returns the axes."""
     if ax is None:
         _, ax = plt.subplots()
     ys = y if isinstance(y, list) else [y]
+    label = kwargs.pop("label", None)  # a legend entry of the user's (single quantity)
     xv, xlabel = _series(res, x)
     for spec in ys:
         yv, ylabel = _series(res, spec)
-        ax.plot(xv, yv, label=ylabel, **kwargs)
+        ax.plot(xv, yv, label=label if label is not None and len(ys) == 1 else ylabel, **kwargs)
     ax.set_xlabel("t [s]" if xlabel == "t" else xlabel)
     if len(ys) == 1:
         ax.set_ylabel(ylabel)
