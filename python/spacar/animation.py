@@ -31,7 +31,7 @@ def _non_interactive_backend() -> bool:
     return "inline" in backend or backend in ("agg", "pdf", "svg", "ps", "cairo", "template")
 
 
-def animate(res: Results, *, step: int = 1, max_frames: int | None = 300, interval: float | None = None,
+def animate(res: Results, *, step: int = 1, max_frames: int | None = 200, interval: float | None = None,
             ax=None, figsize=(6.0, 4.5), dpi: int = 80, labels: bool = False, trace=(), beam_points: int = 21,
             close: bool | None = None, repeat: bool = True) -> Animation:
     """Animation of the mechanism over the output times of ``res``.

@@ -12,12 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
-import matplotlib
 import matplotlib.pyplot as plt
 
 from .errors import InputError
 from .geometry import frame_coordinates, shapes
-from .results import Results, parse_spec
+from .results import Results
 
 STYLE = {
     "beam": dict(color="C0", lw=2.5, solid_capstyle="round", zorder=3),
