@@ -174,6 +174,26 @@ def test_multi_block_run_appends(tmp_path):
                                rtol=2e-15, atol=1e-300)
 
 
+def test_later_blocks_may_add_files_and_change_the_reaction_columns(tmp_path):
+    """Block 2 frees the crank (DYNX instead of INPUTX: no reaction on it any more) and asks for
+    the stresses (FORCEMODE 2): `_rx` gets a new column line, `_sig` starts with block 2."""
+    path = example(tmp_path, blocks="DYNX 2 1\nFORCEMODE 2\nTIMESTEP 20 0.5\nEND\n")
+    out = subprocess.run([sys.executable, "-m", "spacar", "run", str(path)], capture_output=True, text=True,
+                         check=True)
+    assert "MATASC files" in out.stdout
+    rx = (tmp_path / "slidercrank_rx.asc").read_text().splitlines()
+    column_lines = [i for i, ln in enumerate(rx) if ln.startswith("% columns:")]
+    assert len(column_lines) == 2
+    assert rx[column_lines[1]].split()[2:] == ["t", "r(1,1)", "r(1,2)", "r(8,2)"]
+    before = [ln for ln in rx[:column_lines[1]] if not ln.startswith("%")]
+    after = rx[column_lines[1] + 1:]
+    assert len(before) == 101 and all(len(ln.split()) == 5 for ln in before)
+    assert len(after) == 21 and all(len(ln.split()) == 4 for ln in after)
+    sig = np.loadtxt(tmp_path / "slidercrank_sig.asc", comments="%")
+    assert sig.shape == (21, 10) and sig[0, 0] == 5.0
+    assert len(data_lines(tmp_path / "slidercrank_x.asc")) == 122
+
+
 def test_cli_writes_the_files_next_to_the_input(tmp_path):
     (tmp_path / "in").mkdir()
     path = example(tmp_path / "in", blocks="TIMESTEP 20 1.0\nEND\n")
