@@ -8,6 +8,12 @@ Quick start::
     res = spacar.simulate(model)                      # integrates the first block
     print(res.node(8).x[-1])                          # slider position at t = 5 s
     print(model.dump())                               # the restartable state dump
+    spacar.plot(res, "e(2,2)")                        # matplotlib (imported when first used)
+    spacar.animate(res)                               # an animation, inline in Jupyter
+
+``import spacar`` stays light: matplotlib, pandas and tqdm are imported only by the functions
+that use them (``plot``, ``draw``, ``animate``, ``save_animation``; ``Results.to_pandas``; the
+progress bar).
 """
 from . import _core
 from .check import Check, Diagnosis, Summary, check, summary
@@ -24,6 +30,7 @@ from .io.writer import dump
 from .keywords import KEYWORDS
 from .linearize import Linearization, linearize
 from .model import Model
+from .geometry import Geometry
 from .results import Results
 from .simulate import simulate
 
@@ -35,9 +42,38 @@ def element_catalogue():
     return list(_core.element_catalogue())
 
 
+_LAZY = {
+    "plot": ("plotting", "plot"),
+    "draw": ("plotting", "draw"),
+    "animate": ("animation", "animate"),
+    "save_animation": ("animation", "save_animation"),
+}
+
+
+def __getattr__(name):
+    # The plotting functions import matplotlib: only when first used (PEP 562).
+    if name in _LAZY:
+        import importlib
+
+        module, attr = _LAZY[name]
+        value = getattr(importlib.import_module(f".{module}", __name__), attr)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_LAZY))
+
+
 __all__ = [
     "Model",
     "Results",
+    "Geometry",
+    "plot",
+    "draw",
+    "animate",
+    "save_animation",
     "Summary",
     "KEYWORDS",
     "read",

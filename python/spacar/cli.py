@@ -1,7 +1,11 @@
 """The ``spacar`` command line.
 
 ``spacar run FILE``    process the blocks of an input file in order: at every END run the
-                       analysis and print the state dump (a restartable input block).
+                       analysis and print the state dump (a restartable input block). With
+                       MATASC 1 the state goes to the files ``<stem>_x.asc``, ... as the run
+                       proceeds; with ANIMATE 1 the animation of those blocks is written to
+                       ``<stem>.gif`` (``--animation`` for another file or format), where
+                       ``<stem>`` is the input file name without extension.
 ``spacar check FILE``  summary of the model of the first block: nodes and elements by type,
                        coordinates and deformations per class, degrees of freedom.
 
@@ -10,14 +14,18 @@ Everything that is not the dump is printed as ``*`` comment lines, so the output
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+from pathlib import Path
 
 import numpy as np
 
 from . import __version__
 from .errors import SpacarError
 from .io.reader import apply_block, read
+from .io.matasc import default_stem
 from .io.writer import dump
+from .results import Results
 from .simulate import simulate
 
 
@@ -53,11 +61,16 @@ def _run(args) -> int:
     if not model.blocks:
         _comment("no input block ended with END: nothing to analyse")
         return 0
+    if args.output_stem:
+        model.output_stem = args.output_stem
+    animated = []
     for k, block in enumerate(model.blocks):
         if k > 0:
             apply_block(model, block)
         n_warn = len(model.warnings)
-        res = simulate(model, method=args.method)
+        res = simulate(model, method=args.method, progress=args.progress)
+        if model.settings.animate == 1:
+            animated.append(res)
         for w in model.warnings[n_warn:]:
             _comment(f"warning: {w}")
         s = res.stats
@@ -65,9 +78,31 @@ def _run(args) -> int:
                  f"{s['rhs_evaluations']} right-hand sides, {s['accepted']} steps "
                  f"({s['rejected']} rejected), {s['wall_time'] * 1e3:.1f} ms")
         _print_linearization(res)
+        if model.settings.matasc == 1:
+            _comment(f"MATASC files: {default_stem(model)}_*.asc")
         sys.stdout.write(dump(model, digits=args.dump_digits))
         sys.stdout.flush()
+    if animated:
+        _write_animation(Results.concatenate(animated), args.animation or default_stem(model) + ".gif")
     return 0
+
+
+def _write_animation(res, path) -> None:
+    """ANIMATE 1: the animation of the blocks that asked for it (matplotlib, pillow for GIF)."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .animation import save_animation
+    except ImportError:
+        _comment("warning: ANIMATE 1 needs matplotlib (pip install matplotlib pillow): no animation written")
+        return
+    try:
+        path = save_animation(res, path)
+    except (RuntimeError, ValueError) as err:
+        _comment(f"warning: no animation written: {err}")
+        return
+    _comment(f"animation: {os.fspath(Path(path))} ({len(res.t)} output times)")
 
 
 def _check(args) -> int:
@@ -95,6 +130,13 @@ def main(argv=None) -> int:
     run.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                      help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
     run.add_argument("--method", choices=["dop853", "dopri5"], default="dop853", help="integration method")
+    run.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                     help="progress bar over simulated time on standard error (default: in a terminal, "
+                          "for runs longer than a second; needs tqdm)")
+    run.add_argument("--output-stem", metavar="STEM",
+                     help="stem of the MATASC and animation files (default: the input file without extension)")
+    run.add_argument("--animation", metavar="FILE",
+                     help="file of the ANIMATE 1 animation: .gif (default <stem>.gif), .mp4 (ffmpeg) or .html")
     run.set_defaults(func=_run)
     check = sub.add_parser("check", help="summarise the model: nodes, elements, classes, degrees of freedom")
     check.add_argument("file")

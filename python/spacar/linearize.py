@@ -14,7 +14,6 @@ convective terms), G0 geometric stiffness (stresses incl. reaction stresses, loa
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 from . import _core
 from .errors import InputError
@@ -40,6 +39,20 @@ class Linearization:
         self.coordinate_labels = [tuple(c) for c in coordinate_labels]
         self.deformation_labels = [tuple(c) for c in deformation_labels]
 
+    @classmethod
+    def from_arrays(cls, t, z_labels, n_line, matrices: dict, coordinate_labels, deformation_labels):
+        """Rebuild from saved arrays (``matrices``: M0 C0 D0 K0 N0 G0 r0 DF DFe); used by
+        :meth:`spacar.Results.load`."""
+        self = cls.__new__(cls)
+        self.t = float(t)
+        self.z_labels = [(str(k), int(a), int(b)) for k, a, b in z_labels]
+        self.n_line = int(n_line)
+        for name in ("M0", "C0", "D0", "K0", "N0", "G0", "r0", "DF", "DFe"):
+            setattr(self, name, np.asarray(matrices[name]))
+        self.coordinate_labels = [tuple(int(v) for v in c) for c in coordinate_labels]
+        self.deformation_labels = [tuple(int(v) for v in c) for c in deformation_labels]
+        return self
+
     @property
     def stiffness(self) -> np.ndarray:
         """K0 + N0 + G0."""
@@ -51,6 +64,8 @@ class Linearization:
         return self.C0 + self.D0
 
     def _undamped(self):
+        import scipy.linalg  # lazily: `import spacar` stays light
+
         w2, v = scipy.linalg.eig(self.stiffness, self.M0)
         w2 = np.real_if_close(w2, tol=1e6)
         order = np.argsort(np.abs(w2))
@@ -93,6 +108,8 @@ class Linearization:
     def buckling_factors(self) -> np.ndarray:
         """Load multipliers μ of (K0 + μ G0) v = 0 for a static state, sorted by |μ|; only the
         finite ones."""
+        import scipy.linalg
+
         mu = scipy.linalg.eigvals(-self.K0, self.G0)
         mu = mu[np.isfinite(mu)]
         mu = np.real_if_close(mu, tol=1e6)

@@ -85,6 +85,8 @@ class Model:
         self.warnings = []     # reader and analysis warnings
         self._continue_step = 0.0  # integrator step to continue with (RESTART 0)
         self._origin = ""      # input line being applied (file, line, keyword), for later messages
+        self.output_stem = None  # stem of the MATASC files (None: input file name or "spacar")
+        self._matasc_files = {}  # MATASC files created by this model's runs (later blocks append)
 
     # --- dispatch used by the reader ---------------------------------------------------------
 
@@ -346,6 +348,7 @@ class Model:
         other.source = self.source
         other.warnings = list(self.warnings)
         other._continue_step = self._continue_step
+        other.output_stem = self.output_stem
         return other
 
     def summary(self):

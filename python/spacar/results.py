@@ -1,12 +1,77 @@
 """Results of an analysis block as NumPy arrays over the output times, with lookup by node and
-element numbers (``res.node(8).x``, ``res.deformation(2, 2)``)."""
+element numbers and by the input keyword names::
+
+    res.t                      # (nt,) output times
+    res.x, res.xd, res.xdd     # (nt, nx) nodal coordinates, ascending (node, component)
+    res.e, res.ed, res.edd     # (nt, ne) deformations, ascending (element, deformation)
+    res.sigma                  # (nt, ne) generalized stresses (FORCEMODE 2: complete)
+    res.reaction               # (nt, nx) reactions on fixed and input coordinates (FORCEMODE ≥ 1)
+    res.node(8).x              # (nt, 2) coordinates of node 8
+    res.element(2).e           # (nt, 3) deformations of element 2
+    res.deformation(2, 2)      # (nt,) element 2 deformation 2
+    res["XD", 2, 1]            # by keyword name: velocity of node 2 component 1
+    res["e(2,2)"]              # by MATASC column label
+
+``to_pandas()`` (pandas optional), ``save``/``load`` (NumPy ``.npz``) and the plot helpers
+``plot``, ``draw``, ``animate`` (matplotlib, imported only when used).
+"""
 from __future__ import annotations
 
+import json
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from .errors import InputError
+from .geometry import Geometry
+
+# name: (attribute, over coordinates or deformations, MATASC label prefix, description)
+QUANTITIES = {
+    "x": ("x", "coordinate", "x", "position"),
+    "xd": ("xd", "coordinate", "xd", "velocity"),
+    "xdd": ("xdd", "coordinate", "xdd", "acceleration"),
+    "e": ("e", "deformation", "e", "deformation"),
+    "ed": ("ed", "deformation", "ed", "deformation rate"),
+    "edd": ("edd", "deformation", "edd", "deformation acceleration"),
+    "sigma": ("sigma", "deformation", "s", "stress"),
+    "reaction": ("reaction", "coordinate", "r", "reaction"),
+}
+# Accepted spellings (case-insensitive): the input keywords X, XD, XDD, E, ED, EDD and the
+# MATASC label prefixes.
+ALIASES = {
+    "x": "x", "xd": "xd", "xdd": "xdd", "e": "e", "ed": "ed", "edd": "edd",
+    "sigma": "sigma", "s": "sigma", "sig": "sigma", "stress": "sigma",
+    "reaction": "reaction", "reactions": "reaction", "r": "reaction", "rx": "reaction",
+}
+_LABEL_RE = re.compile(r"^\s*([A-Za-z]+)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)\s*$")
+_LINE_RE = re.compile(r"^\s*([A-Za-z]+)\s+(\d+)\s+(\d+)\s*$")
+_ARRAYS = ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")
+
+
+def quantity(name: str) -> str:
+    """The canonical quantity name (``x``, ``xd``, ..., ``sigma``, ``reaction``) of a keyword
+    name or label prefix."""
+    try:
+        return ALIASES[str(name).lower()]
+    except KeyError:
+        raise InputError(f"unknown quantity {name!r}: use one of X, XD, XDD, E, ED, EDD, SIGMA, "
+                         "REACTION (or the MATASC prefixes s, r)") from None
+
+
+def parse_spec(spec) -> tuple:
+    """(quantity, number, index) of a column specification: a tuple ``("XD", 2, 1)``, a MATASC
+    label ``"xd(2,1)"`` or a keyword line ``"XD 2 1"``."""
+    if isinstance(spec, str):
+        m = _LABEL_RE.match(spec) or _LINE_RE.match(spec)
+        if not m:
+            raise InputError(f"cannot read {spec!r} as a quantity: write e.g. 'x(8,1)', 'e(2,2)' or 'XD 2 1'")
+        return quantity(m.group(1)), int(m.group(2)), int(m.group(3))
+    try:
+        name, number, index = spec
+    except (TypeError, ValueError):
+        raise InputError(f"a quantity is (name, number, index) or a label like 'x(8,1)', not {spec!r}") from None
+    return quantity(name), int(number), int(index)
 
 
 @dataclass(frozen=True)
@@ -17,6 +82,7 @@ class NodeResults:
     x: np.ndarray
     xd: np.ndarray
     xdd: np.ndarray
+    reaction: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -31,28 +97,41 @@ class ElementResults:
 
 
 class Results:
-    """Arrays over the output times of one block.
+    """Arrays over the output times of one block (or of several, see :meth:`concatenate`).
 
-    ``t`` (nt,), ``x``, ``xd``, ``xdd`` (nt, nx) for all nodal coordinates in ascending
-    (node, component) order, ``e``, ``ed``, ``edd``, ``sigma`` (nt, ne) for all deformations in
-    ascending (element, deformation) order; ``coordinate_labels`` and ``deformation_labels``
-    give the (node, component) and (element, deformation) of each column.
+    ``t`` (nt,), ``x``, ``xd``, ``xdd``, ``reaction`` (nt, nx) for all nodal coordinates in
+    ascending (node, component) order, ``e``, ``ed``, ``edd``, ``sigma`` (nt, ne) for all
+    deformations in ascending (element, deformation) order; ``coordinate_labels`` and
+    ``deformation_labels`` give the (node, component) and (element, deformation) of each column.
+    ``geometry`` (a :class:`spacar.geometry.Geometry`) describes the model for drawing,
+    ``linearizations`` holds one :class:`spacar.Linearization` per output time when the model
+    asks for them (LINE, LINEAR), ``stats`` the integrator's work.
     """
 
-    def __init__(self, arrays: dict, coordinate_labels, deformation_labels, stats: dict):
-        self.t = arrays["t"]
+    def __init__(self, arrays: dict, coordinate_labels, deformation_labels, stats: dict,
+                 geometry: Geometry | None = None, linearizations=(), settings_linear=None):
+        self.t = np.asarray(arrays["t"], dtype=float)
         self.x, self.xd, self.xdd = arrays["x"], arrays["xd"], arrays["xdd"]
         self.e, self.ed, self.edd, self.sigma = arrays["e"], arrays["ed"], arrays["edd"], arrays["sigma"]
         # (nt, nx): loads exerted by the supports and drivers on the fixed and input coordinates
         # (FORCEMODE ≥ 1; zero on the other coordinates); sigma then includes the reaction
         # stresses of fixed, input and LINE deformations (formulation.md §6).
         self.reaction = arrays["reaction"]
-        self.linearizations = []  # one spacar.Linearization per output time (LINE or LINEAR ≥ 1)
-        self.coordinate_labels = [tuple(lbl) for lbl in coordinate_labels]
-        self.deformation_labels = [tuple(lbl) for lbl in deformation_labels]
-        self.stats = stats
+        self.linearizations = list(linearizations)  # one spacar.Linearization per output time
+        self.settings_linear = settings_linear
+        self.coordinate_labels = [tuple(int(v) for v in lbl) for lbl in coordinate_labels]
+        self.deformation_labels = [tuple(int(v) for v in lbl) for lbl in deformation_labels]
+        self.stats = dict(stats)
+        self.geometry = geometry
         self._coord = {lbl: i for i, lbl in enumerate(self.coordinate_labels)}
         self._def = {lbl: i for i, lbl in enumerate(self.deformation_labels)}
+
+    @property
+    def reactions(self) -> np.ndarray:
+        """Alias of :attr:`reaction`."""
+        return self.reaction
+
+    # --- lookup by numbers -------------------------------------------------------------------
 
     def _columns(self, table, number, what):
         cols = [i for (n, _), i in table.items() if n == number]
@@ -60,11 +139,21 @@ class Results:
             raise InputError(f"there is no {what} {number} in the results")
         return cols
 
+    @property
+    def node_columns(self) -> dict:
+        """{node: [columns of x]} in ascending node order."""
+        out: dict = {}
+        for i, (n, _) in enumerate(self.coordinate_labels):
+            out.setdefault(n, []).append(i)
+        return out
+
     def node(self, n: int) -> NodeResults:
+        """Coordinates, rates, accelerations and reactions of node n over time."""
         cols = self._columns(self._coord, n, "node")
-        return NodeResults(n, self.x[:, cols], self.xd[:, cols], self.xdd[:, cols])
+        return NodeResults(n, self.x[:, cols], self.xd[:, cols], self.xdd[:, cols], self.reaction[:, cols])
 
     def element(self, e: int) -> ElementResults:
+        """Deformations, rates, accelerations and stresses of element e over time."""
         cols = self._columns(self._def, e, "element")
         return ElementResults(e, self.e[:, cols], self.ed[:, cols], self.edd[:, cols], self.sigma[:, cols])
 
@@ -80,13 +169,184 @@ class Results:
         except KeyError:
             raise InputError(f"element {e} has no deformation {i}") from None
 
-    def coordinate(self, n: int, i: int) -> np.ndarray:
-        """Values of node n component i over time."""
-        return self.x[:, self.coordinate_index(n, i)]
+    def coordinate(self, n: int, i: int, what: str = "x") -> np.ndarray:
+        """Node n component i over time; ``what`` = ``x`` (default), ``xd``, ``xdd`` or
+        ``reaction``."""
+        q = quantity(what)
+        if QUANTITIES[q][1] != "coordinate":
+            raise InputError(f"{what!r} is a deformation quantity: use deformation()")
+        return getattr(self, QUANTITIES[q][0])[:, self.coordinate_index(n, i)]
 
-    def deformation(self, e: int, i: int) -> np.ndarray:
-        """Values of element e deformation i over time."""
-        return self.e[:, self.deformation_index(e, i)]
+    def deformation(self, e: int, i: int, what: str = "e") -> np.ndarray:
+        """Element e deformation i over time; ``what`` = ``e`` (default), ``ed``, ``edd`` or
+        ``sigma``."""
+        q = quantity(what)
+        if QUANTITIES[q][1] != "deformation":
+            raise InputError(f"{what!r} is a coordinate quantity: use coordinate()")
+        return getattr(self, QUANTITIES[q][0])[:, self.deformation_index(e, i)]
+
+    def stress(self, e: int, i: int) -> np.ndarray:
+        """Generalized stress σ of element e deformation i over time."""
+        return self.deformation(e, i, "sigma")
+
+    # --- lookup by keyword names and labels ---------------------------------------------------
+
+    def column(self, spec) -> tuple:
+        """(array name, column index) of a specification (see :func:`parse_spec`)."""
+        q, number, index = parse_spec(spec)
+        attr, over, _, _ = QUANTITIES[q]
+        col = self.coordinate_index(number, index) if over == "coordinate" else self.deformation_index(number, index)
+        return attr, col
+
+    def get(self, name, number: int | None = None, index: int | None = None) -> np.ndarray:
+        """Values over time by keyword name: ``res.get("XD", 2, 1)``, ``res.get("E", 2, 2)``,
+        ``res.get("SIGMA", 1, 1)``, or a label ``res.get("xd(2,1)")``; ``"t"`` gives the times."""
+        if isinstance(name, str) and name.lower() == "t" and number is None:
+            return self.t
+        spec = name if number is None else (name, number, index)
+        attr, col = self.column(spec)
+        return getattr(self, attr)[:, col]
+
+    def __getitem__(self, key):
+        if isinstance(key, tuple):
+            return self.get(*key)
+        return self.get(key)
+
+    @staticmethod
+    def label(spec) -> str:
+        """The MATASC column label of a specification: ``label(("XD", 2, 1)) == "xd(2,1)"``."""
+        q, number, index = parse_spec(spec)
+        return f"{QUANTITIES[q][2]}({number},{index})"
+
+    @staticmethod
+    def describe(spec) -> str:
+        """A readable name: ``"xd(2,1): velocity of node 2, component 1"``."""
+        q, number, index = parse_spec(spec)
+        _, over, prefix, text = QUANTITIES[q]
+        where = f"node {number}, component {index}" if over == "coordinate" else f"element {number}, deformation {index}"
+        return f"{prefix}({number},{index}): {text}, {where}"
+
+    def labels(self, name: str) -> list:
+        """Column labels of one quantity (``labels("x") == ["x(1,1)", "x(1,2)", ...]``)."""
+        q = quantity(name)
+        _, over, prefix, _ = QUANTITIES[q]
+        table = self.coordinate_labels if over == "coordinate" else self.deformation_labels
+        return [f"{prefix}({a},{b})" for a, b in table]
+
+    def time_index(self, t: float) -> int:
+        """Index of the output time nearest to t."""
+        return int(np.argmin(np.abs(self.t - t)))
+
+    # --- conversions --------------------------------------------------------------------------
+
+    def supported_columns(self) -> list:
+        """Columns of the fixed and input coordinates (where reactions act); all columns when the
+        geometry is unknown."""
+        if self.geometry is None:
+            return list(range(len(self.coordinate_labels)))
+        cls = self.geometry.coordinate_classes
+        return [i for i, (n, c) in enumerate(self.coordinate_labels)
+                if c - 1 < len(cls.get(n, ())) and cls[n][c - 1] in ("fixed", "input")]
+
+    def to_pandas(self, quantities=("x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")):
+        """A ``pandas.DataFrame`` indexed by ``t`` with one column per quantity and coordinate
+        or deformation, named by the MATASC labels (``x(8,1)``, ``e(2,2)``, ``s(2,1)``,
+        ``r(1,1)``; reactions only on the fixed and input coordinates). Needs pandas."""
+        try:
+            import pandas as pd
+        except ImportError:  # pragma: no cover - depends on the environment
+            raise ImportError("Results.to_pandas() needs pandas: pip install pandas") from None
+        parts = {}
+        for name in quantities:
+            q = quantity(name)
+            values = getattr(self, QUANTITIES[q][0])
+            labels = self.labels(q)
+            cols = self.supported_columns() if q == "reaction" else range(values.shape[1])
+            for c in cols:
+                parts[labels[c]] = values[:, c]
+        return pd.DataFrame(parts, index=pd.Index(self.t, name="t"))
+
+    def save(self, path) -> None:
+        """Save to a NumPy ``.npz`` file (arrays, labels, statistics, geometry and
+        linearizations); read back with :meth:`Results.load`."""
+        data = {name: np.asarray(getattr(self, name)) for name in _ARRAYS}
+        data["coordinate_labels"] = np.asarray(self.coordinate_labels, dtype=np.int64).reshape(-1, 2)
+        data["deformation_labels"] = np.asarray(self.deformation_labels, dtype=np.int64).reshape(-1, 2)
+        lin_meta = []
+        for k, lin in enumerate(self.linearizations):
+            lin_meta.append({"t": float(lin.t), "z_labels": [list(z) for z in lin.z_labels], "n_line": int(lin.n_line)})
+            for name in ("M0", "C0", "D0", "K0", "N0", "G0", "r0", "DF", "DFe"):
+                data[f"lin{k}_{name}"] = np.asarray(getattr(lin, name))
+        meta = {
+            "format": "spacar.Results",
+            "version": 1,
+            "stats": {k: (v if isinstance(v, (int, float, str)) else float(v)) for k, v in self.stats.items()},
+            "settings_linear": self.settings_linear,
+            "geometry": None if self.geometry is None else self.geometry.to_dict(),
+            "linearizations": lin_meta,
+        }
+        data["meta"] = np.array(json.dumps(meta))
+        np.savez_compressed(path, **data)
+
+    @classmethod
+    def load(cls, path) -> "Results":
+        """Read a file written by :meth:`save`."""
+        from .linearize import Linearization
+
+        with np.load(path, allow_pickle=False) as f:
+            meta = json.loads(str(f["meta"]))
+            if meta.get("format") != "spacar.Results":
+                raise InputError(f"{path}: not a spacar results file")
+            arrays = {name: f[name] for name in _ARRAYS}
+            coord, defs = f["coordinate_labels"], f["deformation_labels"]
+            lins = []
+            for k, lm in enumerate(meta["linearizations"]):
+                mats = {name: f[f"lin{k}_{name}"] for name in ("M0", "C0", "D0", "K0", "N0", "G0", "r0", "DF", "DFe")}
+                lins.append(Linearization.from_arrays(lm["t"], [tuple(z) for z in lm["z_labels"]], lm["n_line"],
+                                                      mats, coord, defs))
+        geometry = None if meta["geometry"] is None else Geometry.from_dict(meta["geometry"])
+        return cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"])
+
+    @classmethod
+    def concatenate(cls, results) -> "Results":
+        """One Results of several consecutive blocks of the same model (a block boundary time
+        appears twice, as in the MATASC files)."""
+        results = list(results)
+        if not results:
+            raise InputError("concatenate() needs at least one Results")
+        first = results[0]
+        for r in results[1:]:
+            if r.coordinate_labels != first.coordinate_labels or r.deformation_labels != first.deformation_labels:
+                raise InputError("concatenate(): the results are of different models")
+        arrays = {name: np.concatenate([getattr(r, name) for r in results]) for name in _ARRAYS}
+        stats: dict = {}
+        for r in results:
+            for k, v in r.stats.items():
+                if isinstance(v, (int, float)) and not isinstance(v, bool):
+                    stats[k] = stats.get(k, 0) + v
+        lins = [lin for r in results for lin in r.linearizations]
+        return cls(arrays, first.coordinate_labels, first.deformation_labels, stats,
+                   results[-1].geometry or first.geometry, lins, results[-1].settings_linear)
+
+    # --- plots (matplotlib, imported when used) ------------------------------------------------
+
+    def plot(self, y, x="t", **kwargs):
+        """Plot quantities against time or against another quantity; see :func:`spacar.plot`."""
+        from .plotting import plot
+
+        return plot(self, y, x, **kwargs)
+
+    def draw(self, k: int = -1, **kwargs):
+        """Draw the mechanism at output index k; see :func:`spacar.draw`."""
+        from .plotting import draw
+
+        return draw(self, k, **kwargs)
+
+    def animate(self, **kwargs):
+        """Animation of the run; see :func:`spacar.animate`."""
+        from .animation import animate
+
+        return animate(self, **kwargs)
 
     def reaction_moment(self, n: int) -> np.ndarray:
         """Reaction on the orientation node ``n`` (LAMBDA) as a global moment, shape (nt, 3):
@@ -106,5 +366,7 @@ class Results:
         return len(self.t)
 
     def __repr__(self):
+        if len(self.t) == 0:
+            return "<spacar.Results: no output times>"
         return (f"<spacar.Results: {len(self.t)} output times from t = {self.t[0]:g} to {self.t[-1]:g}, "
                 f"{self.x.shape[1]} coordinates, {self.e.shape[1]} deformations>")

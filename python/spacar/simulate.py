@@ -2,11 +2,13 @@
 from __future__ import annotations
 
 from . import _core
+from .geometry import Geometry
+from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
 from .results import Results
 
 
-def simulate(model, *, method: str = "dop853", on_output=None) -> Results:
+def simulate(model, *, method: str = "dop853", on_output=None, progress=None, output_stem=None) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
     The mechanism is assembled at the current time; with degrees of freedom the reduced
@@ -17,19 +19,62 @@ def simulate(model, *, method: str = "dop853", on_output=None) -> Results:
     ``on_output(k, state)`` is called after output time k is recorded, with ``state`` a dict of
     NumPy arrays ``t, x, xd, xdd, e, ed, edd, sigma, reaction`` (progress, files written as the
     run proceeds). It runs at output times only, never inside the integration.
-    Returns :class:`spacar.Results`.
+
+    ``progress``: a tqdm bar over simulated time; ``None`` shows it in interactive sessions for
+    runs longer than a second, ``True`` always, ``False`` never (see :mod:`spacar.progress`).
+
+    With ``MATASC 1`` the output times also go to the MATASC files ``<stem>_x.asc``, ...
+    (docs/matasc.md), line by line as the run proceeds; the stem is ``output_stem``, else
+    ``model.output_stem``, else the input file name without extension, else ``spacar``.
+
+    Returns :class:`spacar.Results` (with ``res.geometry`` for drawing).
     """
+    from . import __version__, progress as _progress
+
     model.prepare()
     sim = _core.Simulation(model._core)
-    restart = model._core.settings.restart == 1
+    system = sim.system
+    settings = model._core.settings
+    callbacks = []
+    writer = None
+    if settings.matasc == 1:
+        stem = output_stem if output_stem is not None else default_stem(model)
+        writer = MatascWriter(stem, source=model.source, jobid=settings.jobid, version=__version__,
+                              coordinate_labels=system.coord_label, deformation_labels=system.def_label,
+                              coordinate_classes=[c.name for c in system.coord_class],
+                              forcemode=settings.forcemode, created=model._matasc_files)
+        callbacks.append(writer.write)
+    bar = _progress.make(progress, model.current_time, settings.timestep_tp)
+    if bar is not None:
+        callbacks.append(bar)
+    if on_output is not None:
+        callbacks.append(on_output)
+    if not callbacks:
+        callback = None
+    elif len(callbacks) == 1:
+        callback = callbacks[0]
+    else:
+        def callback(k, state):
+            for c in callbacks:
+                c(k, state)
+
+    restart = settings.restart == 1
     step = 0.0 if restart else model._continue_step
-    arrays = sim.run(on_output=on_output, initial_step=step, method=method)
+    try:
+        arrays = sim.run(on_output=callback, initial_step=step, method=method)
+    finally:
+        if writer is not None:
+            writer.close()
+        if bar is not None:
+            bar.close()
     model._continue_step = arrays["last_step"]
     system = sim.system
     stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
                                     "newton_iterations", "wall_time")}
     model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    res = Results(arrays, system.coord_label, system.def_label, stats)
-    res.linearizations = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
-    res.settings_linear = model.settings.linear
+    lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
+    res = Results(arrays, system.coord_label, system.def_label, stats, Geometry.from_model(model), lins,
+                  model.settings.linear)
+    if writer is not None and lins:
+        writer.write_linearizations(lins, model.settings.linear)
     return res

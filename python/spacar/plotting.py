@@ -1,0 +1,238 @@
+"""Plots of results and drawings of mechanisms, with matplotlib only (imported when this module
+is; ``import spacar`` does not import it).
+
+* :func:`plot` — any coordinate, deformation, stress or reaction against time or against another
+  (``plot(res, "e(2,2)")``, ``plot(res, ("X", 8, 1), x=("X", 2, 1))``).
+* :func:`draw` — the mechanism at one output time: beams with their cubic deflection shape,
+  trusses as lines, joints and supports as symbols, wheels and pulleys as circles, rigid bodies
+  (LAMBDA nodes with inertia) as body-frame triads; 2-D for planar models, 3-D otherwise.
+* :func:`spacar.animate` (module :mod:`spacar.animation`) — the same drawing over all output times.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+import matplotlib.pyplot as plt
+
+from .errors import InputError
+from .geometry import frame_coordinates, shapes
+from .results import Results
+
+STYLE = {
+    "beam": dict(color="C0", lw=2.5, solid_capstyle="round", zorder=3),
+    "truss": dict(color="C1", lw=2.0, zorder=3),
+    "link": dict(color="0.4", lw=1.2, ls="--", zorder=2),
+    "belt": dict(color="C2", lw=1.5, zorder=3),
+    "wheel": dict(color="k", lw=2.0, zorder=3),
+    "spoke": dict(color="k", lw=1.0, zorder=3),
+    "axis": dict(color="0.35", lw=1.2, zorder=3),
+    "triad-x": dict(color="tab:red", lw=2.0, zorder=4),
+    "triad-y": dict(color="tab:green", lw=2.0, zorder=4),
+    "triad-z": dict(color="tab:blue", lw=2.0, zorder=4),
+    "pin": dict(marker="o", ms=7, mfc="white", mec="k", mew=1.5, ls="none", zorder=6),
+    "ground": dict(marker="^", ms=13, mfc="0.6", mec="0.3", ls="none", zorder=1),
+    "slider": dict(marker="s", ms=13, mfc="0.75", mec="k", ls="none", zorder=5),
+    "mass": dict(marker="o", ms=9, mfc="k", mec="k", ls="none", zorder=5),
+    "point": dict(marker="x", ms=8, color="k", ls="none", zorder=5),
+}
+
+
+# --------------------------------------------------------------------------------------------
+# Time histories and transfer plots
+# --------------------------------------------------------------------------------------------
+
+def _series(res: Results, spec):
+    if isinstance(spec, str) and spec.strip().lower() == "t":
+        return res.t, "t"
+    attr, col = res.column(spec)
+    return getattr(res, attr)[:, col], Results.describe(spec)
+
+
+def plot(res: Results, y, x="t", ax=None, **kwargs):
+    """Plot one or more quantities ``y`` against time (``x="t"``) or against another quantity.
+
+    A quantity is a MATASC label (``"x(8,1)"``, ``"e(2,2)"``, ``"s(2,1)"`` for σ, ``"r(1,1)"``
+    for a reaction), a keyword line (``"XD 2 1"``) or a tuple (``("EDD", 2, 3)``). Extra keyword
+    arguments go to ``Axes.plot`` (``label`` names a single curve in a legend). Returns the axes."""
+    if ax is None:
+        _, ax = plt.subplots()
+    ys = y if isinstance(y, list) else [y]
+    label = kwargs.pop("label", None)  # a legend entry of the user's (single quantity)
+    xv, xlabel = _series(res, x)
+    for spec in ys:
+        yv, ylabel = _series(res, spec)
+        ax.plot(xv, yv, label=label if label is not None and len(ys) == 1 else ylabel, **kwargs)
+    ax.set_xlabel("t [s]" if xlabel == "t" else xlabel)
+    if len(ys) == 1:
+        ax.set_ylabel(ylabel)
+    else:
+        ax.legend()
+    ax.grid(True, alpha=0.3)
+    return ax
+
+
+# --------------------------------------------------------------------------------------------
+# Drawings of the mechanism
+# --------------------------------------------------------------------------------------------
+
+class Scene:
+    """The artists of a mechanism drawing, updated frame by frame (:meth:`update`)."""
+
+    def __init__(self, res: Results, ax=None, k: int = 0, *, labels: bool = False, trace=(),
+                 beam_points: int = 21, title: bool = True, figsize=None, dpi=None):
+        if res.geometry is None:
+            raise InputError("these results have no geometry to draw (results of spacar.simulate have)")
+        if len(res.t) == 0:
+            raise InputError("these results have no output times")
+        self.res = res
+        self.geometry = res.geometry
+        self.spatial = self.geometry.spatial
+        self.dim = 3 if self.spatial else 2
+        self.node_columns = res.node_columns
+        self.beam_points = beam_points
+        self.labels = labels
+        if ax is None:
+            fig = plt.figure(figsize=figsize, dpi=dpi)
+            ax = fig.add_subplot(projection="3d") if self.spatial else fig.add_subplot()
+        elif self.spatial and getattr(ax, "name", "") != "3d":
+            raise InputError("a spatial model needs 3-D axes (projection='3d')")
+        self.ax = ax
+        self.scale = self._scale()
+        self.lines = []
+        for sh in self._shapes(k):
+            style = STYLE.get(sh.kind, dict(color="k"))
+            (line,) = ax.plot(*sh.points.T, **style)
+            line.set_gid(f"element-{sh.element}" if sh.element is not None else f"node-{sh.node}")
+            line.spacar_kind = sh.kind
+            self.lines.append(line)
+        self._static_decorations(trace)
+        self.node_texts = {}
+        if labels:
+            coords = self._coords(k)
+            for n in self.geometry.position_nodes:
+                if n in coords:
+                    self.node_texts[n] = ax.text(*self._pos(coords[n]), f" {n}", fontsize=8, color="0.2", zorder=7)
+        self.title = ax.set_title("") if title else None
+        self._limits()
+        self.update(k)
+
+    # --- geometry of frames ------------------------------------------------------------------
+
+    def _coords(self, k):
+        return frame_coordinates(self.node_columns, self.res.x[k])
+
+    def _shapes(self, k):
+        return shapes(self.geometry, self._coords(k), self.scale, self.beam_points)
+
+    def _pos(self, c):
+        p = np.zeros(self.dim)
+        c = np.asarray(c)[: self.dim]
+        p[: len(c)] = c
+        return p
+
+    def _frames_sample(self, limit=200):
+        nt = len(self.res.t)
+        return np.unique(np.linspace(0, nt - 1, min(nt, limit)).astype(int))
+
+    def _positions(self):
+        """Positions of all position nodes at the sampled frames: (frames, nodes, dim)."""
+        cols = [self.node_columns[n] for n in self.geometry.position_nodes if n in self.node_columns]
+        if not cols:
+            return np.zeros((1, 1, self.dim))
+        frames = self._frames_sample()
+        out = np.zeros((len(frames), len(cols), self.dim))
+        for j, c in enumerate(cols):
+            v = self.res.x[np.ix_(frames, c)][:, : self.dim]
+            out[:, j, : v.shape[1]] = v
+        return out
+
+    def _scale(self):
+        p = self._positions().reshape(-1, self.dim)
+        span = float((p.max(axis=0) - p.min(axis=0)).max()) if len(p) else 0.0
+        return span if span > 0 else 1.0
+
+    def _limits(self):
+        pts = []
+        for k in self._frames_sample(100):
+            pts.extend(sh.points for sh in self._shapes(k))
+        pts = np.vstack(pts) if pts else np.zeros((1, self.dim))
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        centre, half = (lo + hi) / 2, (hi - lo) / 2
+        pad = 0.08 * max(float(half.max()), 1e-9) + 0.02 * self.scale
+        half = half + pad
+        ax = self.ax
+        if self.spatial:
+            r = float(half.max())
+            ax.set_xlim(centre[0] - r, centre[0] + r)
+            ax.set_ylim(centre[1] - r, centre[1] + r)
+            ax.set_zlim(centre[2] - r, centre[2] + r)
+            ax.set_box_aspect((1, 1, 1))
+            ax.set_xlabel("x")
+            ax.set_ylabel("y")
+            ax.set_zlabel("z")
+        else:
+            ax.set_xlim(centre[0] - half[0], centre[0] + half[0])
+            ax.set_ylim(centre[1] - half[1], centre[1] + half[1])
+            ax.set_aspect("equal", adjustable="box")
+            ax.set_xlabel("x")
+            ax.set_ylabel("y")
+            ax.grid(True, alpha=0.25)
+
+    def _static_decorations(self, trace):
+        """Slider guides along the free direction of partly fixed position nodes, and node paths."""
+        res, ax = self.res, self.ax
+        for n in self.geometry.position_nodes:
+            cls = self.geometry.classes(n)
+            if n not in self.node_columns or "fixed" not in cls or all(c == "fixed" for c in cls):
+                continue
+            p = res.x[:, self.node_columns[n]][:, : self.dim]
+            lo, hi = p.min(axis=0), p.max(axis=0)
+            ext = 0.1 * self.scale
+            pts = np.array([lo - ext * (hi > lo), hi + ext * (hi > lo)])
+            for i, c in enumerate(cls[: self.dim]):
+                if c == "fixed":
+                    pts[:, i] = p[0, i]
+            ax.plot(*pts.T, color="0.5", lw=1.0, ls=(0, (4, 3)), zorder=1)
+        for n in trace or ():
+            if n not in self.node_columns:
+                raise InputError(f"trace: there is no node {n} in the results")
+            p = res.x[:, self.node_columns[n]][:, : self.dim]
+            ax.plot(*p.T, color="C3", lw=1.0, alpha=0.6, zorder=2)
+
+    # --- update ----------------------------------------------------------------------------
+
+    def update(self, k: int):
+        """Move every artist to output index k; returns the artists."""
+        for line, sh in zip(self.lines, self._shapes(k)):
+            if self.spatial:
+                line.set_data_3d(*sh.points.T)
+            else:
+                line.set_data(*sh.points.T)
+        if self.node_texts:
+            coords = self._coords(k)
+            for n, text in self.node_texts.items():
+                p = self._pos(coords[n])
+                if self.spatial:
+                    text.set_position(p[:2])
+                    text.set_3d_properties(p[2], None)
+                else:
+                    text.set_position(p)
+        if self.title is not None:
+            self.title.set_text(f"t = {self.res.t[k]:.4g} s")
+        return self.lines
+
+    def element_lines(self, element: int) -> list:
+        """The artists of one element (for inspection and styling)."""
+        return [ln for ln in self.lines if ln.get_gid() == f"element-{element}"]
+
+
+def draw(res: Results, k: int = -1, *, time: float | None = None, ax=None, labels: bool = False,
+         trace=(), beam_points: int = 21, figsize=None):
+    """Draw the mechanism at output index ``k`` (default the last) or at the output time nearest
+    to ``time``. ``labels`` writes the node numbers; ``trace`` lists position nodes whose paths
+    over the whole run are drawn (e.g. a coupler curve). Returns the :class:`Scene` (its ``ax``
+    is the axes)."""
+    if time is not None:
+        k = res.time_index(time)
+    k = range(len(res.t))[k]
+    return Scene(res, ax, k, labels=labels, trace=trace, beam_points=beam_points, figsize=figsize)
