@@ -8,6 +8,7 @@
 #include "spacar/catalogue.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/integrator.hpp"
+#include "spacar/dynamics.hpp"
 #include "spacar/kinematics.hpp"
 #include "spacar/model.hpp"
 #include "spacar/simulate.hpp"
@@ -299,6 +300,23 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", &Simulation::assemble)
       .def("forces", &Simulation::forces)
+      .def("reduced_accelerations",
+           [](Simulation& s) {
+             // q̈ of the reduced equations (3.1) with transfer functions at the last evaluated
+             // state: an independent check of the integration path's sparse solve.
+             Data& d = s.data();
+             const System& sys = s.system();
+             const Eigen::VectorXd qdd = d.qdd, xdd = d.xdd, edd = d.edd, qhat_dd = d.qhat_dd;
+             solve_transfer(sys, d);
+             solve_velocities(sys, d);
+             solve_dynamics(sys, d);
+             const Eigen::VectorXd reduced = d.qdd;
+             d.qdd = qdd;
+             d.xdd = xdd;
+             d.edd = edd;
+             d.qhat_dd = qhat_dd;
+             return reduced;
+           })
       .def("linearize", [](Simulation& s) { return linearization_to_dict(s.linearize()); })
       .def("diagnose",
            [](Simulation& s) {

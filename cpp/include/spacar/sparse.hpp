@@ -48,7 +48,7 @@ class BlockMatrix {
 // computed once (analyze) above.
 class LinearSolver {
  public:
-  static constexpr int kDenseLimit = 80;
+  static constexpr int kDenseLimit = 30;
 
   void analyze(const Eigen::SparseMatrix<double>& A);
   // False if the matrix is (numerically) singular.
