@@ -34,7 +34,9 @@ void solve_velocities(const System& sys, Data& data);
 // ẍ = DF q̂̈ + acc0 and ë = B ẍ + c, for the current q̂̈.
 void solve_accelerations(const System& sys, Data& data);
 
-// Diagnosis of the position constraint block at the current positions (formulation.md §2.3).
+// Diagnosis of the position constraint block A_P (or, velocity = true, of the velocity block A_V,
+// whose rows hold the nonholonomic deformations instead of their kinematic coordinates) at the
+// current positions (formulation.md §2.3, §5).
 struct ConstraintDiagnosis {
   int n_constraints = 0, n_calculable = 0, rank = 0;
   std::vector<int> redundant;     // deformations whose release removes the redundancy
@@ -43,8 +45,8 @@ struct ConstraintDiagnosis {
   std::vector<std::vector<std::pair<int, double>>> redundant_groups, undetermined_groups;
   std::string text;               // readable report naming elements and nodes
 };
-ConstraintDiagnosis diagnose(const System& sys, Data& data);
-std::string diagnose_constraints(const System& sys, Data& data);
+ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity = false);
+std::string diagnose_constraints(const System& sys, Data& data, bool velocity = false);
 
 // Check that the constraint block is square; throws KinematicsError with the diagnosis.
 void check_constraint_counts(const System& sys, Data& data);
