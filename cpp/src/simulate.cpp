@@ -246,7 +246,11 @@ void Simulation::store_state() {
       if (!target) el.e[i] = data_.e[k];  // a given target stays exact for the next block
       el.ed[i] = data_.ed[k];
       el.edd[i] = data_.edd[k];
-      if (c == DefClass::Input || c == DefClass::Dynamic || c == DefClass::Kinematic) el.e_given[i] = true;
+      // Values that are states continue in the next block: inputs, DOFs, kinematic coordinates
+      // and the integrated values of released velocity-level deformations (slips).
+      if (c == DefClass::Input || c == DefClass::Dynamic || c == DefClass::Kinematic ||
+          (c == DefClass::Released && sys.def_velocity_level[k]))
+        el.e_given[i] = true;
     }
   model_.time = data_.t;
 }
