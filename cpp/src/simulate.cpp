@@ -26,9 +26,32 @@ Simulation::Simulation(Model& model)
   int g = 0;
   for (const auto& [id, n] : model_.nodes)
     for (double v : n.x) data_.x[g++] = v;
-  x_base_ = data_.x;
-  qhat_base_ = data_.qhat;
+  forget_solutions();
+}
+
+void Simulation::forget_solutions() {
+  recent_.clear();
+  recent_next_ = 0;
+  have_last_ = have_anchor_ = false;
   predictor_ = Eigen::VectorXd::Zero(sys_->nx);
+}
+
+Simulation::Solution Simulation::solution(double t, bool with_DF) const {
+  return Solution{t, Eigen::VectorXd(), data_.x, data_.qhat, data_.angle_ref,
+                  with_DF ? data_.DF : Eigen::MatrixXd()};
+}
+
+void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
+  if (t > kinematic_failure_t_) kinematic_failure_.clear();  // passed: the failure is history
+  for (size_t i = 0; i < recent_.size(); ++i) {  // newest first
+    const Solution& s = recent_[(recent_next_ + kRecent - 1 - i) % kRecent];
+    if (s.t == t && s.Y.size() == Y.size() && s.Y == Y) {
+      anchor_ = s;
+      have_anchor_ = true;
+      return;
+    }
+  }
+  have_anchor_ = false;  // not found (should not happen): predict from the last solution
 }
 
 void Simulation::assemble() {
@@ -37,30 +60,83 @@ void Simulation::assemble() {
   set_dofs(sys, data_, sys.q0.data(), sys.qd0.data());
   check_constraint_counts(sys, data_);
   solve_positions(sys, data_, sys.settings.maxiterat, sys.settings.epskin, true);
-  x_base_ = data_.x;
-  qhat_base_ = data_.qhat;
-  have_base_ = false;  // DF not yet available for the predictor
+  forget_solutions();
+  last_ = solution(sys.t0, false);  // DF not yet available for the predictor
+  have_last_ = true;
 }
 
 void Simulation::evaluate(double t, const double* q, const double* qd) {
   const System& sys = *sys_;
   set_inputs(sys, data_, t);
   set_dofs(sys, data_, q, qd);
-  // Predictor: the last solved positions advanced with the first-order transfer function.
-  data_.x = x_base_;
-  for (size_t i = 0; i < sys.x_input.size(); ++i) data_.x[sys.x_input[i]] = data_.qhat[sys.qhat_col_x[sys.x_input[i]]];
-  for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_.x[sys.x_dyn[j]] = q[j];
-  if (have_base_) {
-    predictor_.noalias() = data_.DF * (data_.qhat - qhat_base_);
-    for (int c : sys.x_calc) data_.x[c] += predictor_[c];
+  // Newton starts from the last solution advanced with its first-order transfer function (the
+  // predictor). The last solution may be a stage up to a full step ahead, solved before the step
+  // failed elsewhere: predicting from it can fail, or converge to another branch of the
+  // constraints (a disc turned over, a linkage through its dead point). In a right-hand side,
+  // the result must therefore also be continuous with the start of the integration step; if it
+  // is not, or Newton failed, Newton starts again from that step start, and if the result is
+  // still not continuous, the step is rejected (KinematicsError → smaller step).
+  const auto solve_from = [&](const Solution* base) {
+    if (base) {
+      data_.x = base->x;
+      data_.angle_ref = base->angles;
+      if (base->DF.size() > 0) {
+        predictor_.noalias() = base->DF * (data_.qhat - base->qhat);
+        for (int c : sys.x_calc) data_.x[c] += predictor_[c];
+      }
+    }
+    for (size_t i = 0; i < sys.x_input.size(); ++i) data_.x[sys.x_input[i]] = data_.qhat[sys.qhat_col_x[sys.x_input[i]]];
+    for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_.x[sys.x_dyn[j]] = q[j];
+    solve_positions(sys, data_, sys.settings.maxiterat, sys.settings.epskin, false);
+  };
+  const bool check = in_rhs_ && have_anchor_;
+  std::string why;
+  bool ok = false;
+  try {
+    solve_from(have_last_ ? &last_ : nullptr);
+    ok = !check || continuous_with_step_start(why);
+  } catch (const KinematicsError& err) {
+    if (!have_anchor_) throw;
+    why = err.what();
   }
-  solve_positions(sys, data_, sys.settings.maxiterat, sys.settings.epskin, false);
+  if (!ok) {
+    solve_from(&anchor_);
+    if (check && !continuous_with_step_start(why)) throw KinematicsError(why);
+  }
   solve_transfer(sys, data_);
   solve_velocities(sys, data_);
   solve_dynamics(sys, data_);
-  x_base_ = data_.x;
-  qhat_base_ = data_.qhat;
-  have_base_ = true;
+  last_ = solution(t, true);
+  have_last_ = true;
+}
+
+// The calculable coordinates just solved against the first-order prediction from the step start
+// (anchor_): the nonlinear part of the motion must not exceed the linear part (plus a small
+// floor), in units of the element lengths for positions and of 1 for angles and Euler
+// parameters. For a rigid link turning by Δ the ratio is about Δ/2: this rejects only steps
+// that turn parts by radians, or jumps to another solution branch.
+bool Simulation::continuous_with_step_start(std::string& why) const {
+  const System& sys = *sys_;
+  predictor_anchor_.noalias() = anchor_.DF * (data_.qhat - anchor_.qhat);
+  double dev = 0.0, inc = 0.0;
+  int worst = -1;
+  for (int c : sys.x_calc) {
+    const double w = sys.coord_is_length[c] ? 1.0 / sys.length_scale : 1.0;
+    const double d = std::abs(data_.x[c] - anchor_.x[c] - predictor_anchor_[c]) * w;
+    inc = std::max(inc, std::abs(predictor_anchor_[c]) * w);
+    if (d > dev || worst < 0) {
+      dev = d;
+      worst = c;
+    }
+  }
+  if (dev <= inc + 1e-6) return true;
+  std::ostringstream os;
+  os << "the positions at t = " << data_.t << " are not continuous with the start of the integration step at t = "
+     << anchor_.t << ": " << sys.coord_name(worst) << " differs by " << dev
+     << " (scaled) from its first-order prediction, while the predicted motion is " << inc
+     << "; the step is too large for the kinematics here (or the mechanism is at a singular configuration)";
+  why = os.str();
+  return false;
 }
 
 void Simulation::forces() { solve_reactions(*sys_, data_); }
@@ -79,13 +155,25 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
 
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side
+    bool& flag;
+    explicit InRhs(bool& f) : flag(f) { flag = true; }
+    ~InRhs() { flag = false; }
+  };
   try {
+    const InRhs in_rhs(in_rhs_);
     evaluate_state(t, Y);
   } catch (const KinematicsError& err) {
     kinematic_failure_ = err.what();
+    kinematic_failure_t_ = t;
     throw StepRejected(err.what());
   }
-  kinematic_failure_.clear();
+  // Remember the solutions of the right-hand sides: one of them is the next step's start.
+  Solution s = last_;
+  s.Y = Y;
+  if (recent_.size() < kRecent) recent_.push_back(std::move(s));
+  else recent_[recent_next_] = std::move(s);
+  recent_next_ = (recent_next_ + 1) % kRecent;
   dY.head(nd) = Y.tail(nd);
   for (int i = 0; i < ny; ++i) dY[nd + i] = data_.ed[sys_->y_defs[i]];
   dY.tail(nd) = data_.qdd;
@@ -152,6 +240,7 @@ BlockResults Simulation::run(const RunOptions& options) {
       if (h > 0.0) integ.set_initial_step(h);
       if (!sys_->free_rotations.empty())
         integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+      integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
       const std::vector<double> remaining(times.begin() + k_out, times.end());
       auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
       double t_reached = t;
@@ -213,8 +302,7 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   data_.angle_ref = angles;
   data_.e_integrated = integrated;
   data_.total_newton_iterations = newton;
-  x_base_ = x;
-  have_base_ = false;
+  forget_solutions();  // the next evaluation starts from x (the new q̂ has another meaning)
   // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;
   const int n = sys.n_dof(), ny = static_cast<int>(sys.y_defs.size());

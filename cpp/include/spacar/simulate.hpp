@@ -74,14 +74,40 @@ class Simulation {
   // Make the largest Euler parameter of that node the dependent one: recompile the system and
   // map the state (t, Y) to the new degrees of freedom.
   void repartition(int which, double t, Eigen::VectorXd& Y);
+  // A solved state, kept as the starting point of the Newton iteration of later evaluations.
+  struct Solution {
+    double t = 0.0;
+    Eigen::VectorXd Y;                // integrator state of a right-hand side (else empty)
+    Eigen::VectorXd x, qhat, angles;  // positions, q̂, branches of the angle-type deformations
+    Eigen::MatrixXd DF;               // first-order transfer function there (empty: not computed)
+  };
+  Solution solution(double t, bool with_DF) const;
+  // The integrator starts a step at (t, Y): that accepted state becomes the base of the Newton
+  // iterations until the next step.
+  void step_start(double t, const Eigen::VectorXd& Y);
+  void forget_solutions();
+  bool continuous_with_step_start(std::string& why) const;
   Model& model_;
   std::map<int, int> dependent_;  // dependent Euler parameter of free rotations, by node
   std::unique_ptr<System> sys_;
   Data data_;
-  Eigen::VectorXd x_base_, qhat_base_, predictor_;
+  // Newton starts from the last solution advanced with its DF (the predictor); in a right-hand
+  // side, if that fails or leaves the branch of the step start, again from the step start
+  // (anchor_), see evaluate().
+  Solution last_, anchor_;
+  bool have_last_ = false, have_anchor_ = false;
+  static constexpr size_t kRecent = 32;  // recent right-hand sides, to find the step start
+  std::vector<Solution> recent_;
+  size_t recent_next_ = 0;
+  Eigen::VectorXd predictor_;
+  mutable Eigen::VectorXd predictor_anchor_;
+  bool in_rhs_ = false;            // evaluating a right-hand side of the integrator
   std::unique_ptr<Linearizer> linearizer_;
-  bool have_base_ = false;
-  std::string kinematic_failure_;  // message of the last right-hand side that failed in Newton
+  // Message and time of the last right-hand side that failed in Newton, kept while the
+  // integration has not passed that time: at a step-size collapse it says that the kinematics
+  // has no solution ahead (formulation.md §2.2), whatever rejected the very last attempt.
+  std::string kinematic_failure_;
+  double kinematic_failure_t_ = 0.0;
 };
 
 }  // namespace spacar
