@@ -80,14 +80,14 @@ def incline_wheel(alpha, gdir, heading, m=2.0, r=0.4, I=0.11, T=2.0, n=20, epski
 @pytest.mark.parametrize("alpha, gdir, heading", [(0.3, 0.0, 0.0), (0.5, 0.4, -0.7), (0.2, 2.0, 2.5)])
 def test_planar_wheel_rolling_down_an_incline(alpha, gdir, heading):
     """Centre acceleration (g sin α) cos(gdir − h) / (1 + I/(m r²)) along the rolling direction
-    t, none across it, to 1e-9 (relative to g); position ½ a t² t; spin rate v/r."""
+    t, none across it, to 1e-9 relative; position ½ a t² t; spin rate v/r."""
     m, r, I = 2.0, 0.4, 0.11
     res = incline_wheel(alpha, gdir, heading, m, r, I).run()
     t = t_of(heading)
     g_along = 9.81 * math.sin(alpha) * math.cos(gdir - heading)
     a = g_along / (1 + I / (m * r * r))
     acc = res.node(3).xdd
-    assert np.max(np.abs(acc - a * t)) < 1e-9 * 9.81
+    assert np.max(np.abs(acc - a * t)) < 1e-9 * abs(a)
     x0 = np.array([0.2, -0.1])
     assert np.max(np.abs(res.node(3).x - x0 - 0.5 * a * res.t[:, None] ** 2 * t)) < 1e-9
     np.testing.assert_allclose(res.node(5).xd[:, 0], a * res.t / r, rtol=0, atol=1e-9)
