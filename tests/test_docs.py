@@ -36,7 +36,8 @@ README_COMMANDS = [
     'python3 -m venv .venv && . .venv/bin/activate && pip install . && spacar run examples/slidercrank.dat',
     'python3 -m venv .venv && . .venv/bin/activate && pip install ".[test]" && pytest',
 ]
-NOTEBOOKS = ["01_slidercrank.ipynb", "02_fourbar.ipynb", "03_cantilever.ipynb", "04_rigid_body.ipynb"]
+NOTEBOOKS = ["01_slidercrank.ipynb", "02_fourbar.ipynb", "03_cantilever.ipynb", "04_rigid_body.ipynb",
+             "05_rolling_wheel_and_bicycle.ipynb"]
 
 
 def read(name):

@@ -43,6 +43,16 @@ void bind_kernels(py::module_& m) {
              h.k->first_derivatives(x.data(), e.data(), B.data());
              return B;
            })
+      .def("rates",
+           [](const KernelHandle& h, const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
+             h.check(x, h.nc(), "x");
+             h.check(v, h.nc(), "v");
+             Eigen::VectorXd r(h.nd());
+             h.k->rates(x.data(), v.data(), r.data());
+             return r;
+           })
+      .def("velocity_level", [](const KernelHandle& h, int i) { return h.k->velocity_level(i); })
+      .def("period", [](const KernelHandle& h, int i) { return h.k->period(i); })
       .def("convective",
            [](const KernelHandle& h, const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
              h.check(x, h.nc(), "x");

@@ -86,6 +86,13 @@ void bind_catalogue(py::module_& m) {
       .def_readonly("n_lgeomy", &ElementType::n_lgeomy)
       .def_readonly("has_direction", &ElementType::has_direction)
       .def_readonly("extension", &ElementType::extension)
+      .def_property_readonly("velocity_level",
+                             [](const ElementType& t) {
+                               std::vector<bool> v(t.deformations.size(), false);
+                               for (size_t i = 0; i < t.velocity_level.size() && i < v.size(); ++i)
+                                 v[i] = t.velocity_level[i];
+                               return v;
+                             })
       .def_readonly("description", &ElementType::description)
       .def_property_readonly("implemented", [](const ElementType& t) { return t.make != nullptr; })
       .def_property_readonly("n_deformations", &ElementType::n_deformations);

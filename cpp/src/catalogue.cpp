@@ -186,6 +186,7 @@ std::vector<ElementType> build_catalogue() {
     set_params(e, 3, 3, "r x y: radius and initial axis of rotation");
     e.edampp = "d1 d2: linear creep damping of the released slips (extension)";
     e.n_estiff = 2;
+    e.velocity_level = {true, true};
     e.make = make_plwheel;
   }
   {
@@ -194,6 +195,7 @@ std::vector<ElementType> build_catalogue() {
                          "knife-edge wheel rolling on a plane (extension)");
     set_params(e, 4, 7, "ax ay az r [nx ny nz]: initial axle direction, radius, ground-plane normal");
     e.extension = true;
+    e.velocity_level = {false, true, true};
     e.make = make_wheel;
   }
   return t;

@@ -381,6 +381,8 @@ size_t Integrator::emit_outputs(const std::vector<double>& touts, size_t next, d
 
 void Integrator::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
 
+void Integrator::set_step_start(StepStart start) { step_start_ = std::move(start); }
+
 double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
                              const std::vector<double>& touts, const Output& out) {
   if (y.size() != n_) throw std::invalid_argument("Integrator: the state has the wrong size");
@@ -427,6 +429,7 @@ double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::Vecto
 
     ++stats_.nsteps;
     Attempt result = Attempt::Failed;
+    if (step_start_) step_start_(t, y);
     try {
       result = attempt_step(f, t, h_try, t_new, y, dense);
     } catch (const StepRejected& e) {

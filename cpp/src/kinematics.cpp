@@ -91,7 +91,7 @@ void factorize(const System& sys, Data& data, const BlockMatrix& A, LinearSolver
   if (!lu.factorize(A.matrix())) {
     std::ostringstream os;
     os << "the " << what << " constraint block is singular at t = " << data.t << ".\n"
-       << diagnose_constraints(sys, data);
+       << diagnose_constraints(sys, data, &A == &data.AV);
     throw KinematicsError(os.str());
   }
 }
@@ -129,7 +129,7 @@ void check_constraint_counts(const System& sys, Data& data) {
   if (sys.rows_P.size() != nc || sys.rows_V.size() != nc) {
     std::ostringstream os;
     os << "the kinematic constraints do not determine the calculable coordinates:\n"
-       << diagnose_constraints(sys, data);
+       << diagnose_constraints(sys, data, sys.rows_P.size() == nc);
     throw KinematicsError(os.str());
   }
 }
@@ -325,16 +325,18 @@ std::vector<int> dependent_columns(const Eigen::MatrixXd& V, const std::vector<i
 
 }  // namespace
 
-ConstraintDiagnosis diagnose(const System& sys, Data& data) {
+ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
   ConstraintDiagnosis d;
-  const int nP = static_cast<int>(sys.rows_P.size());
+  const std::vector<int>& rows = velocity ? sys.rows_V : sys.rows_P;
+  BlockMatrix& block = velocity ? data.AV : data.AP;
+  const int nP = static_cast<int>(rows.size());
   const int nc = static_cast<int>(sys.x_calc.size());
   d.n_constraints = nP;
   d.n_calculable = nc;
   if (nP > 0 && nc > 0) {
     evaluate_elements(sys, data);
-    assemble_block(sys, data, data.AP, data.AP_block);
-    const Eigen::MatrixXd A = Eigen::MatrixXd(data.AP.matrix());
+    assemble_block(sys, data, block, velocity ? data.AV_block : data.AP_block);
+    const Eigen::MatrixXd A = Eigen::MatrixXd(block.matrix());
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const Eigen::VectorXd& s = svd.singularValues();
     const double tol = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(s[0], 1e-300);
@@ -343,7 +345,7 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data) {
       const Eigen::VectorXd u = svd.matrixU().col(i);
       std::vector<std::pair<int, double>> group;
       for (int r = 0; r < nP; ++r)
-        if (std::abs(u[r]) > 0.1 * u.cwiseAbs().maxCoeff()) group.push_back({sys.rows_P[r], u[r] / u.cwiseAbs().maxCoeff()});
+        if (std::abs(u[r]) > 0.1 * u.cwiseAbs().maxCoeff()) group.push_back({rows[r], u[r] / u.cwiseAbs().maxCoeff()});
       d.redundant_groups.push_back(group);
     }
     for (int i = d.rank; i < nc; ++i) {  // right null vectors: undetermined motions
@@ -358,10 +360,11 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data) {
     std::vector<int> order;
     for (int pass = 0; pass < 2; ++pass)
       for (int r = 0; r < nP; ++r) {
-        const bool fixed = sys.def_class[sys.rows_P[r]] == DefClass::Fixed;
+        const DefClass c = sys.def_class[rows[r]];
+        const bool fixed = c == DefClass::Fixed || c == DefClass::Nonholonomic;
         if ((pass == 1) == fixed) order.push_back(r);
       }
-    for (int r : dependent_columns(A.transpose(), order)) d.redundant.push_back(sys.rows_P[r]);
+    for (int r : dependent_columns(A.transpose(), order)) d.redundant.push_back(rows[r]);
     std::sort(d.redundant.begin(), d.redundant.end());
     std::vector<int> cols(nc);
     for (int j = 0; j < nc; ++j) cols[j] = j;
@@ -369,15 +372,22 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data) {
   } else if (nc > 0) {
     d.undetermined = sys.x_calc;
   } else {
-    d.redundant = sys.rows_P;
+    d.redundant = rows;
   }
 
   std::ostringstream os;
-  os << "  " << nP << " constraint equations (fixed, input, dynamic deformations) for " << nc
-     << " calculable coordinates";
+  if (velocity)
+    os << "  " << nP << " velocity constraint equations (fixed, input, dynamic, nonholonomic deformations) for " << nc
+       << " calculable coordinate rates";
+  else
+    os << "  " << nP << " constraint equations (fixed, input, dynamic deformations) for " << nc
+       << " calculable coordinates";
   if (nP > nc) os << ": over-constrained by " << nP - nc;
   if (nP < nc) os << ": under-constrained by " << nc - nP;
   os << "; rank " << d.rank << ".";
+  if (velocity && (!d.redundant.empty() || !d.undetermined.empty()))
+    os << "\n  the nonholonomic constraints (ENHC) do not determine these rates: pair each nonholonomic"
+          "\n  deformation with a kinematic coordinate whose rate it determines (formulation.md §5).";
   if (!d.redundant.empty()) {
     os << "\n  redundant constraints; release these (RLSE) to remove the redundancy:";
     for (int k : d.redundant) os << "\n   - RLSE " << sys.def_label[k][0] << " " << sys.def_label[k][1] << "   (" << sys.def_name(k) << ")";
@@ -398,7 +408,9 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data) {
   return d;
 }
 
-std::string diagnose_constraints(const System& sys, Data& data) { return diagnose(sys, data).text; }
+std::string diagnose_constraints(const System& sys, Data& data, bool velocity) {
+  return diagnose(sys, data, velocity).text;
+}
 
 std::string weakest_constraint(const System& sys, Data& data) {
   const int nV = static_cast<int>(sys.rows_V.size()), nc = static_cast<int>(sys.x_calc.size());

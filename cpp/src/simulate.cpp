@@ -22,12 +22,70 @@ std::unique_ptr<System> prepare_and_compile(Model& model) {
 
 Simulation::Simulation(Model& model)
     : model_(model), sys_(prepare_and_compile(model)), data_(std::make_unique<Data>(*sys_)) {
-  xd_base_ = xdd_base_ = predicted_ = Eigen::VectorXd::Zero(sys_->nx);
+  predicted_ = Eigen::VectorXd::Zero(sys_->nx);
   for (const FreeRotation& fr : sys_->free_rotations) dependent_[fr.node] = fr.dependent;
   int g = 0;
   for (const auto& [id, n] : model_.nodes)
     for (double v : n.x) data_->x[g++] = v;
-  x_base_ = data_->x;
+}
+
+void Simulation::remember(Solved& s) const {
+  s.valid = true;
+  s.t = data_->t;
+  s.x = data_->x;
+  s.xd = data_->xd;
+  s.xdd = data_->xdd;
+  s.qhat = data_->qhat;
+  s.angle_ref = data_->angle_ref;
+}
+
+void Simulation::predict_from(const Solved& s, double t, const double* q) {
+  const System& sys = *sys_;
+  data_->x = s.x;
+  data_->angle_ref = s.angle_ref;
+  for (int g : sys.x_input) data_->x[g] = data_->qhat[sys.qhat_col_x[g]];
+  for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_->x[sys.x_dyn[j]] = q[j];
+  const double dt = t - s.t;
+  for (int c : sys.x_calc) data_->x[c] += dt * (s.xd[c] + 0.5 * dt * s.xdd[c]);
+}
+
+// The nonlinear part of the motion since the step start must not exceed the predicted motion
+// (plus a small floor), in units of the element lengths for positions and of 1 for angles and
+// Euler parameters: this rejects only steps that turn parts by radians, or jumps to another
+// solution branch (a disc turned over, a linkage through its dead point).
+bool Simulation::continuous_with_step_start(std::string& why) const {
+  const System& sys = *sys_;
+  const Solved& a = anchor_;
+  const double dt = data_->t - a.t;
+  double dev = 0.0, inc = 0.0;
+  int worst = -1;
+  for (int c : sys.x_calc) {
+    const double w = sys.coord_is_length[c] ? 1.0 / sys.length_scale : 1.0;
+    const double motion = dt * (a.xd[c] + 0.5 * dt * a.xdd[c]);
+    const double d = std::abs(data_->x[c] - a.x[c] - motion) * w;
+    inc = std::max(inc, std::abs(motion) * w);
+    if (d > dev || worst < 0) {
+      dev = d;
+      worst = c;
+    }
+  }
+  if (dev <= inc + 1e-6) return true;
+  std::ostringstream os;
+  os << "the positions at t = " << data_->t << " are not continuous with the start of the integration step at t = "
+     << a.t << ": " << sys.coord_name(worst) << " differs by " << dev
+     << " (scaled) from its prediction, while the predicted motion is " << inc
+     << "; the step is too large for the kinematics here (or the mechanism is at a singular configuration)";
+  why = os.str();
+  return false;
+}
+
+void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
+  if (t > kinematic_failure_t_) kinematic_failure_.clear();  // passed: the failure is history
+  if (anchor_.valid && anchor_.t == t) return;                // the same step again, smaller
+  // The integrator has just evaluated the right-hand side at the accepted state, unless an
+  // output time was evaluated since: then solve it again.
+  if (!(base_.valid && base_.t == t)) evaluate_state(t, Y);
+  anchor_ = base_;
 }
 
 void Simulation::assemble() {
@@ -36,48 +94,54 @@ void Simulation::assemble() {
   set_dofs(sys, *data_, sys.q0.data(), sys.qd0.data());
   check_constraint_counts(sys, *data_);
   solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, true);
-  x_base_ = data_->x;
-  have_base_ = false;  // no velocities yet for the predictor
+  base_ = anchor_ = Solved();
+  base_.x = data_->x;  // positions only: no velocities yet for the predictor
+  base_.angle_ref = data_->angle_ref;
+  have_transfer_ = false;
 }
 
 void Simulation::solve_state(double t, const double* q, const double* qd, bool transfer_predictor) {
   const System& sys = *sys_;
   set_inputs(sys, *data_, t);
   set_dofs(sys, *data_, q, qd);
-  // Predictor of the positions: from the last solved state, a second-order Taylor step in time
-  // (integration stages), or the first-order transfer function applied to the change of the
-  // independent coordinates (states given by the user, when DF of the last state is known).
-  data_->x = x_base_;
-  for (int g : sys.x_input) data_->x[g] = data_->qhat[sys.qhat_col_x[g]];
-  for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_->x[sys.x_dyn[j]] = q[j];
-  bool predicted = true;
+  // Predictor of the positions: the first-order transfer function applied to the change of the
+  // independent coordinates (states given by the user, when DF of the last state is known), or
+  // the last solved state advanced by a second-order Taylor step in time (integration stages).
   predicted_.setZero();
   if (transfer_predictor && have_transfer_) {
-    predicted_.noalias() = data_->DF * (data_->qhat - qhat_base_);
+    predict_from(base_, base_.t, q);
+    predicted_.noalias() = data_->DF * (data_->qhat - qhat_transfer_);
     for (int c : sys.x_calc) data_->x[c] += predicted_[c];
-  } else if (have_base_ && t != t_base_) {
-    const double dt = t - t_base_;
-    for (int c : sys.x_calc) data_->x[c] += dt * (xd_base_[c] + 0.5 * dt * xdd_base_[c]);
+  } else if (base_.valid) {
+    predict_from(base_, t, q);
   } else {
-    predicted = false;
+    Solved positions = base_;  // after assembly: positions only
+    positions.t = t;
+    positions.xd = positions.xdd = Eigen::VectorXd::Zero(sys.nx);
+    predict_from(positions, t, q);
   }
+  const bool check = in_rhs_ && anchor_.valid;
+  std::string why;
+  bool ok = false;
   try {
     solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
-  } catch (const KinematicsError&) {
-    if (!predicted) throw;
-    // A long extrapolation (e.g. the integrator's trial of its first step) may overshoot: start
-    // again from the last solved positions.
-    for (int c : sys.x_calc) data_->x[c] = x_base_[c];
+    ok = !check || continuous_with_step_start(why);
+  } catch (const KinematicsError& err) {
+    if (!check && !base_.valid) throw;
+    why = err.what();
+  }
+  if (!ok) {
+    // The last solved state may be a stage up to a full step ahead, solved before the step
+    // failed elsewhere: start again from the step start (or, outside the integrator, from the
+    // last solution itself); if the result is still not continuous, reject the step.
+    if (check) predict_from(anchor_, t, q);
+    else predict_from(base_, base_.t, q);
     solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
+    if (check && !continuous_with_step_start(why)) throw KinematicsError(why);
   }
   solve_velocities_direct(sys, *data_);
   solve_dynamics_direct(sys, *data_);
-  x_base_ = data_->x;
-  xd_base_ = data_->xd;
-  xdd_base_ = data_->xdd;
-  qhat_base_ = data_->qhat;
-  t_base_ = t;
-  have_base_ = true;
+  remember(base_);
   have_transfer_ = false;
 }
 
@@ -90,6 +154,7 @@ void Simulation::evaluate(double t, const double* q, const double* qd) {
   assemble_mass_matrix(sys, *data_);
   for (int j = 0; j < sys.n_dof(); ++j) data_->DFq.col(j) = data_->DF.col(sys.dof_cols[j]);
   data_->Mbar.noalias() = data_->DFq.transpose() * data_->M * data_->DFq;
+  qhat_transfer_ = data_->qhat;
   have_transfer_ = true;
 }
 
@@ -103,7 +168,7 @@ void Simulation::move_to(double t, const double* q, const double* qd) {
     qd0[j] = data_->qhat_d[sys.dof_cols[j]];
   }
   const double t0 = data_->t;
-  if (!have_base_) evaluate(t0, q0.data(), qd0.data());
+  if (!have_transfer_) evaluate(t0, q0.data(), qd0.data());
   // A step is accepted when Newton only corrected the predicted positions by a small fraction
   // of the predicted change (the correction of a smooth path shrinks with the step squared; a
   // jump to another branch does not) or by a negligible amount.
@@ -117,14 +182,14 @@ void Simulation::move_to(double t, const double* q, const double* qd) {
   };
   while (s < 1.0) {
     const double s1 = ds >= 1.0 - s ? 1.0 : s + ds;
-    const Eigen::VectorXd x_from = x_base_, angles_from = data_->angle_ref;
+    const Solved from = base_;
     bool ok = true;
     try {
       evaluate(at(s1), qs.data(), qds.data());
       double predicted = 0.0, corrected = 0.0;
       for (int c : sys.x_calc) {
         predicted = std::max(predicted, std::abs(predicted_[c]));
-        corrected = std::max(corrected, std::abs(data_->x[c] - x_from[c] - predicted_[c]));
+        corrected = std::max(corrected, std::abs(data_->x[c] - from.x[c] - predicted_[c]));
       }
       ok = corrected <= 0.1 * predicted || corrected <= tiny;
     } catch (const KinematicsError&) {
@@ -142,9 +207,8 @@ void Simulation::move_to(double t, const double* q, const double* qd) {
       throw KinematicsError(os.str());
     }
     // Back to the last accepted state (exact positions, its DF for the predictor).
-    x_base_ = x_from;
-    data_->angle_ref = angles_from;
-    have_base_ = have_transfer_ = false;
+    base_ = from;
+    have_transfer_ = false;
     evaluate(at(s), qs.data(), qds.data());
     ds *= 0.5;
   }
@@ -166,10 +230,17 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
 
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side
+    bool& flag;
+    explicit InRhs(bool& f) : flag(f) { flag = true; }
+    ~InRhs() { flag = false; }
+  };
   try {
+    const InRhs in_rhs(in_rhs_);
     evaluate_state(t, Y);
   } catch (const KinematicsError& err) {
     kinematic_failure_ = err.what();
+    kinematic_failure_t_ = t;
     throw StepRejected(err.what());
   }
   dY.head(nd) = Y.tail(nd);
@@ -237,12 +308,11 @@ BlockResults Simulation::run(const RunOptions& options) {
       integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
       integ.set_max_step(st.hmax);
       if (h > 0.0) integ.set_initial_step(h);
-      // After every accepted step: forget kinematic failures of rejected trials; stop to
-      // repartition a free rotation whose dependent Euler parameter became small.
-      integ.set_stop_condition([this](double, const Eigen::VectorXd& y) {
-        kinematic_failure_.clear();
-        return !sys_->free_rotations.empty() && rotation_to_repartition(y) >= 0;
-      });
+      // Stop to repartition a free rotation whose dependent Euler parameter became small.
+      if (!sys_->free_rotations.empty())
+        integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+      integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
+      anchor_.valid = false;
       const std::vector<double> remaining(times.begin() + k_out, times.end());
       auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
       double t_reached = t;
@@ -273,25 +343,26 @@ void Simulation::explain_collapse(const IntegrationError& err, const Eigen::Vect
   std::string integrator = err.what();
   const size_t cut = integrator.find(" (last rejection");
   if (cut != std::string::npos) integrator.resize(cut);
-  // The step collapsed because the kinematics has no solution (a right-hand side since the last
-  // accepted step failed in the Newton iteration): a KinematicsError (formulation.md §2.2).
+  // At the last accepted state: is the velocity constraint block nearly singular (a dead point,
+  // where the accelerations grow without bound)?
+  std::string weak;
+  if (!sys_->x_calc.empty() && sys_->x_calc.size() <= 2000) {
+    try {
+      evaluate_state(data_->t, Y);
+      weak = weakest_constraint(*sys_, *data_);
+      if (!weak.empty())
+        weak = "\n  at t = " + std::to_string(data_->t) + " (max Newton residual " +
+               std::to_string(data_->residual.size() ? data_->residual.cwiseAbs().maxCoeff() : 0.0) + "):\n" + weak;
+    } catch (const Error&) {
+    }
+  }
+  // The step collapsed because the kinematics has no (continuous) solution ahead: a right-hand
+  // side failed in the Newton iteration since the last accepted step (formulation.md §2.2).
   if (!kinematic_failure_.empty())
     throw KinematicsError(kinematic_failure_ + "\nNo kinematic solution down to the minimum step (" + integrator +
-                          ").");
-  // Or the mechanism runs into a singular configuration (a dead point): the accelerations grow
-  // without bound as the velocity constraint block loses rank.
-  if (sys_->x_calc.empty() || sys_->x_calc.size() > 2000) return;
-  try {
-    solve_state(data_->t, Y.data(), Y.data() + sys_->n_dof() + sys_->y_defs.size());
-  } catch (const Error&) {
-    return;
-  }
-  const std::string weak = weakest_constraint(*sys_, *data_);
+                          ")." + weak);
   if (!weak.empty())
-    throw KinematicsError("the mechanism reaches a singular configuration at t = " + std::to_string(data_->t) +
-                          " (" + integrator + "); max Newton residual " +
-                          std::to_string(data_->residual.size() ? data_->residual.cwiseAbs().maxCoeff() : 0.0) +
-                          ".\n" + weak);
+    throw KinematicsError("the mechanism reaches a singular configuration (" + integrator + ")." + weak);
 }
 
 int Simulation::rotation_to_repartition(const Eigen::VectorXd& Y) const {
@@ -323,8 +394,10 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   data_->angle_ref = angles;
   data_->e_integrated = integrated;
   data_->total_newton_iterations = newton;
-  x_base_ = x;
-  have_base_ = have_transfer_ = false;
+  base_ = anchor_ = Solved();  // the next evaluation starts from x (q̂ has another meaning)
+  base_.x = x;
+  base_.angle_ref = angles;
+  have_transfer_ = false;
   // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;
   const int n = sys.n_dof(), ny = static_cast<int>(sys.y_defs.size());
@@ -356,7 +429,11 @@ void Simulation::store_state() {
       if (!target) el.e[i] = data_->e[k];  // a given target stays exact for the next block
       el.ed[i] = data_->ed[k];
       el.edd[i] = data_->edd[k];
-      if (c == DefClass::Input || c == DefClass::Dynamic || c == DefClass::Kinematic) el.e_given[i] = true;
+      // Values that are states continue in the next block: inputs, DOFs, kinematic coordinates
+      // and the integrated values of released velocity-level deformations (slips).
+      if (c == DefClass::Input || c == DefClass::Dynamic || c == DefClass::Kinematic ||
+          (c == DefClass::Released && sys.def_velocity_level[k]))
+        el.e_given[i] = true;
     }
   model_.time = data_->t;
 }

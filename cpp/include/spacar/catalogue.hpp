@@ -39,6 +39,8 @@ struct ElementType {
   int n_lgeomy = 0;                       // number of LGEOMY values
   bool has_direction = false;             // DIR replaces the vector of the definition line
   bool extension = false;                 // not in the SPACAR95 manual
+  std::vector<bool> velocity_level;       // per deformation: only its rate is defined (wheel slips);
+                                          // empty: all holonomic
   std::string description;
   ReferenceFn reference = nullptr;
   MakeFn make = nullptr;                  // nullptr: physics not implemented yet

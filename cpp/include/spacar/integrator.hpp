@@ -59,6 +59,11 @@ class Integrator {
   using StopCondition = std::function<bool(double t, const Eigen::VectorXd& y)>;
   void set_stop_condition(StopCondition stop);
 
+  // Called before every attempted step with its start (t, y), the last accepted state, at which
+  // the right-hand side has just been evaluated (also again after a rejection).
+  using StepStart = std::function<void(double t, const Eigen::VectorXd& y)>;
+  void set_step_start(StepStart start);
+
   const IntegratorStats& stats() const;   // cumulative over all integrate calls
 
  private:
@@ -85,6 +90,7 @@ class Integrator {
   double err_ = 0.0;                 // error norm of the last attempted step
   std::string failure_;              // why the last step was rejected, for error messages
   StopCondition stop_;
+  StepStart step_start_;
   IntegratorStats stats_;
   // Work space, allocated once so that the step loop never touches the heap.
   std::vector<Eigen::VectorXd> k_;       // stages; k_[0] = f(t, y)

@@ -38,7 +38,9 @@ void solve_velocities_direct(const System& sys, Data& data);
 // ẍ = DF q̂̈ + acc0 and ë = B ẍ + c, for the current q̂̈.
 void solve_accelerations(const System& sys, Data& data);
 
-// Diagnosis of the position constraint block at the current positions (formulation.md §2.3).
+// Diagnosis of the position constraint block A_P (or, velocity = true, of the velocity block A_V,
+// whose rows hold the nonholonomic deformations instead of their kinematic coordinates) at the
+// current positions (formulation.md §2.3, §5).
 struct ConstraintDiagnosis {
   int n_constraints = 0, n_calculable = 0, rank = 0;
   std::vector<int> redundant;     // deformations whose release removes the redundancy
@@ -47,8 +49,9 @@ struct ConstraintDiagnosis {
   std::vector<std::vector<std::pair<int, double>>> redundant_groups, undetermined_groups;
   std::string text;               // readable report naming elements and nodes
 };
-ConstraintDiagnosis diagnose(const System& sys, Data& data);
-std::string diagnose_constraints(const System& sys, Data& data);
+// velocity: the velocity block (rows V) instead of the position block (rows P).
+ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity = false);
+std::string diagnose_constraints(const System& sys, Data& data, bool velocity = false);
 // If the velocity constraint block is nearly singular (a dead point): which constraints lose
 // their independence and which coordinates move; "" otherwise.
 std::string weakest_constraint(const System& sys, Data& data);

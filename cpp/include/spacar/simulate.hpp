@@ -85,18 +85,37 @@ class Simulation {
   // Make the largest Euler parameter of that node the dependent one: recompile the system and
   // map the state (t, Y) to the new degrees of freedom.
   void repartition(int which, double t, Eigen::VectorXd& Y);
+  // A solved state: the starting point of the Newton iterations of later evaluations.
+  struct Solved {
+    bool valid = false;
+    double t = 0.0;
+    Eigen::VectorXd x, xd, xdd, qhat, angle_ref;
+  };
+  void remember(Solved& s) const;
+  // Start the positions from s: its solution advanced by a second-order Taylor step in time.
+  void predict_from(const Solved& s, double t, const double* q);
+  // The positions just solved against the prediction from the step start (anchor_): false if
+  // they deviate by more than the predicted motion (another branch of the constraints).
+  bool continuous_with_step_start(std::string& why) const;
+  // The integrator starts a step at (t, Y): that accepted state becomes the anchor.
+  void step_start(double t, const Eigen::VectorXd& Y);
   Model& model_;
   std::map<int, int> dependent_;  // dependent Euler parameter of free rotations, by node
   std::unique_ptr<System> sys_;
   std::unique_ptr<Data> data_;  // replaced when the system is recompiled (repartition)
-  // Last solved state: the predictor of the next position solve.
-  Eigen::VectorXd x_base_, xd_base_, xdd_base_, qhat_base_;
-  Eigen::VectorXd predicted_;   // change of the positions predicted by the transfer function
-  double t_base_ = 0.0;
-  bool have_transfer_ = false;  // data holds DF of the last state (set by evaluate)
+  // Newton starts from the last solved state (base_); in a right-hand side, if that fails or
+  // leaves the branch of the step start, again from the step start (anchor_).
+  Solved base_, anchor_;
+  bool in_rhs_ = false;          // evaluating a right-hand side of the integrator
+  Eigen::VectorXd qhat_transfer_;  // q̂ at which data holds DF (set by evaluate)
+  Eigen::VectorXd predicted_;    // change of the positions predicted by the transfer function
+  bool have_transfer_ = false;
   std::unique_ptr<Linearizer> linearizer_;
-  bool have_base_ = false;
-  std::string kinematic_failure_;  // message of the last right-hand side that failed in Newton
+  // Message and time of the last right-hand side that failed in Newton, kept while the
+  // integration has not passed that time: at a step-size collapse it says that the kinematics
+  // has no solution ahead (formulation.md §2.2), whatever rejected the very last attempt.
+  std::string kinematic_failure_;
+  double kinematic_failure_t_ = 0.0;
 };
 
 }  // namespace spacar

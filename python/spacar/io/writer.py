@@ -87,9 +87,14 @@ def dump(model, digits: int = 4) -> str:
                 out.add("E", [eid, i], [el.e[i - 1]])
                 out.add("ED", [eid, i], [el.ed[i - 1]])
                 out.add("EDD", [eid, i], [el.edd[i - 1]])
+    velocity_level = {t.name: t.velocity_level for t in _core.element_catalogue()}
     for eid, el in sorted(elements.items()):
         for i, c in enumerate(el.cls, start=1):
             if c in (_core.DefClass.fixed, _core.DefClass.linearization) and el.e_given[i - 1] and el.e[i - 1] != 0:
+                out.add("E", [eid, i], [el.e[i - 1]])
+            elif velocity_level[el.type_name][i - 1] and el.e_given[i - 1] and (
+                    c == _core.DefClass.released or (c == _core.DefClass.nonholonomic and el.e[i - 1] != 0)):
+                # integrated value of a slip (released) or the constant value of a nonholonomic one
                 out.add("E", [eid, i], [el.e[i - 1]])
     # 7. reference geometry
     for eid, el in sorted(elements.items()):

@@ -51,6 +51,9 @@ class ElementKernel {
   virtual double period(int i) const { return 0.0; }
   // Velocity-level deformation (only its rate is defined): its value is integrated, not computed.
   virtual bool velocity_level(int i) const { return false; }
+  // The rates ė at (x, v) evaluated directly (for tests): holonomic rows as the directional
+  // derivative of D along v, velocity-level rows from the element's slip-rate function.
+  virtual void rates(const double* x, const double* v, double* edot) const = 0;
 
   // Constitutive matrix from ESTIFF (or, in the same form, EDAMPP) values: σ = S e (+ D ė).
   // Zero for elements without stiffness data.
@@ -125,6 +128,20 @@ class AutoDiffElement : public ElementKernel {
         e[i] = 0.0;
         for (int k = 0; k < NC; ++k) B[i + ND * k] = rj[i].d[k];
       }
+    }
+  }
+
+  void rates(const double* x, const double* v, double* edot) const override {
+    using J1 = Jet<double, 1>;
+    J1 xj[NC], ej[ND];
+    for (int k = 0; k < NC; ++k) xj[k] = J1(x[k], {v[k]});
+    self().deform(xj, ej);
+    for (int i = 0; i < ND; ++i) edot[i] = ej[i].d[0];
+    if constexpr (kVelocity != 0) {
+      double r[ND];
+      self().slip_rates(x, v, r);
+      for (int i = 0; i < ND; ++i)
+        if (velocity_level(i)) edot[i] = r[i];
     }
   }
 
