@@ -1,6 +1,7 @@
 #include "spacar/kinematics.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -100,6 +101,9 @@ void factorize(const System& sys, Data& data, const BlockMatrix& A, LinearSolver
 void factorize_velocity_block(const System& sys, Data& data) {
   assemble_block(sys, data, data.AV, data.AV_block);
   factorize(sys, data, data.AV, data.luV, "velocity");
+  // Without nonholonomic rows the velocity block is the position block: a Jacobian for the
+  // next position solve.
+  data.jacobian_reusable = sys.rows_P == sys.rows_V;
 }
 
 }  // namespace
@@ -140,23 +144,40 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
   evaluate_elements(sys, data);
   compute_residual(sys, data);
   const int limit = assembly ? std::max(max_iter, 50) : max_iter;
-  std::ostringstream history;
+  // Largest residual per iteration, for the message of a failure (no formatting in the loop).
+  std::array<double, 64> history;
+  int n_history = 0;
+  auto note = [&](double r) {
+    if (n_history < static_cast<int>(history.size())) history[n_history++] = r;
+  };
   data.newton_iterations = 0;
+  // Large (sparse) systems reuse the factorization of the velocity block of the last solved
+  // state, the same matrix at nearby positions: the iteration converges linearly but saves a
+  // factorization, which dominates there; the iterates then go to 1e-3 EPSKIN (a polish of the
+  // same effect as the quadratic step) and a fresh factorization is made as soon as the
+  // contraction is poor. Small systems use full Newton with one polish step after convergence.
+  const bool chord = !assembly && data.jacobian_reusable && !data.luV.dense();
+  LinearSolver* J = chord ? &data.luV : nullptr;
   bool converged = false;
+  double previous = std::numeric_limits<double>::infinity();
   for (int it = 0; it <= limit && nc > 0; ++it) {
     const double rmax = max_abs(data.residual);
     if (!std::isfinite(rmax)) {
       converged = false;
-      history << (it ? ", " : "") << number(rmax);
+      note(rmax);
       break;
     }
-    if (converged) break;  // the polish iteration after convergence has been done
-    converged = rmax <= tol;
+    if (converged && (!chord || rmax <= 1e-3 * tol)) break;  // polished
+    converged = converged || rmax <= tol;
     if (it == limit && !converged) break;
-    history << (it ? ", " : "") << rmax;
-    assemble_block(sys, data, data.AP, data.AP_block);
-    factorize(sys, data, data.AP, data.luP, "position");
-    data.luP.solve(data.residual, data.sol_V);
+    note(rmax);
+    if (!chord || rmax > 0.25 * previous) {
+      assemble_block(sys, data, data.AP, data.AP_block);
+      factorize(sys, data, data.AP, data.luP, "position");
+      J = &data.luP;
+    }
+    previous = rmax;
+    J->solve(data.residual, data.sol_V);
     data.step.head(nc) = data.sol_V;
     double lambda = 1.0;
     const double norm0 = data.residual.norm();
@@ -172,11 +193,14 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
     }
     ++data.newton_iterations;
   }
+  data.jacobian_reusable = false;  // the positions moved: the velocity block must be refactorized
   data.total_newton_iterations += data.newton_iterations;
   if (!converged && nc > 0) {
     std::ostringstream os;
     os << "Newton iteration on the positions did not converge in " << limit << " iterations at t = " << data.t
-       << " (EPSKIN " << tol << "); max residual per iteration: " << history.str() << ".\nLargest residuals: "
+       << " (EPSKIN " << tol << "); max residual per iteration:";
+    for (int i = 0; i < n_history; ++i) os << (i ? ", " : " ") << number(history[i]);
+    os << ".\nLargest residuals: "
        << worst_rows(sys, data, 3);
     throw KinematicsError(os.str());
   }

@@ -44,6 +44,7 @@ struct Data {
   BlockMatrix AP, AV;           // constraint blocks ∂D^P/∂x^c and ∂D^V/∂x^c (sparse, fixed pattern)
   std::vector<int> AP_block, AV_block;  // block id of each element in AP / AV
   LinearSolver luP, luV;        // their factorizations
+  bool jacobian_reusable = false;  // luV holds the position block at the last solved positions
   Eigen::VectorXd rhs_V, sol_V; // right-hand side and solution of a velocity-level solve (|V|, n_c)
   // Dense transfer functions, allocated on first use (linearization, Simulation::evaluate).
   Eigen::MatrixXd rhs_DF;       // right-hand sides of the transfer functions (|V| x n_qhat)

@@ -57,6 +57,7 @@ class LinearSolver {
   void solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const;
   void solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   int size() const { return n_; }
+  bool dense() const { return dense_; }
 
  private:
   int n_ = 0;
