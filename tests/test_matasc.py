@@ -276,3 +276,30 @@ def test_linearization_files(tmp_path, monkeypatch):
     assert buck.shape == (5, 1 + nz)
     assert buck[0, 1] == pytest.approx(res.linearizations[0].buckling_factors()[0], rel=1e-14)
     assert 2.46 < buck[0, 1] < 2.47      # π²/4 = 2.4674 (formulation.md §10.4, 3 elements)
+
+
+def test_linearization_files_of_a_nonholonomic_model_are_written_as_the_run_proceeds(tmp_path):
+    """The bicycle (4 kinematic coordinates): each _lin line holds nz, nk and the matrices with
+    K_k, AK0, BK0; the lines are on disk at each output time, not only at the end."""
+    import spacar
+    model = spacar.read("examples/bicycle.dat")
+    model.matasc(1)
+    model.timestep(2, 0.01)
+    stem = tmp_path / "bike"
+    seen = []
+
+    def probe(k, state):
+        seen.append(sum(1 for line in open(f"{stem}_lin.asc") if not line.startswith("%")))
+
+    res = spacar.simulate(model, output_stem=stem, on_output=probe)
+    assert seen == [1, 2, 3]
+    rows = np.loadtxt(f"{stem}_lin.asc", comments="%")
+    nz, nk = int(rows[0, 1]), int(rows[0, 2])
+    assert (nz, nk) == (3, 4)
+    lin = res.linearizations[-1]
+    expected = np.concatenate([[lin.t, nz, nk]] + [np.asarray(getattr(lin, n)).ravel(order="F") for n in
+                                                    ("M0", "C0", "D0", "K0", "N0", "G0", "Kk", "AK0", "BK0")]
+                              + [lin.r0])
+    assert np.allclose(rows[-1], expected, rtol=1e-14, atol=0)
+    eig = np.loadtxt(f"{stem}_eig.asc", comments="%")
+    assert eig.shape[1] == 1 + 2 * (2 * nz + nk)

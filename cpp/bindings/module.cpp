@@ -362,7 +362,7 @@ void bind_simulation(py::module_& m) {
             else if (method == "dopri5") opt.method = Method::DOPRI5;
             else throw InputError("unknown integration method '" + method + "' (dop853, dopri5)");
             if (!on_output.is_none()) {
-              opt.on_output = [on_output](int k, const Data& d) {
+              opt.on_output = [on_output](int k, const Data& d, const Linearization* lin) {
                 py::gil_scoped_acquire gil;
                 py::dict state;
                 state["t"] = d.t;
@@ -374,6 +374,7 @@ void bind_simulation(py::module_& m) {
                 state["edd"] = d.edd;
                 state["sigma"] = d.sigma;
                 state["reaction"] = d.reaction;
+                if (lin) state["linearization"] = linearization_to_dict(*lin);
                 on_output(k, state);
               };
             }

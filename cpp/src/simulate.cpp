@@ -287,7 +287,7 @@ BlockResults Simulation::run(const RunOptions& options) {
     else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
     if (linear) res.linearizations.push_back(linearize());
     record(res, k_out);
-    if (options.on_output) options.on_output(k_out, *data_);
+    if (options.on_output) options.on_output(k_out, *data_, linear ? &res.linearizations.back() : nullptr);
     ++k_out;
   };
   // State Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.

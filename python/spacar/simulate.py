@@ -43,7 +43,12 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
                               coordinate_labels=system.coord_label, deformation_labels=system.def_label,
                               coordinate_classes=[c.name for c in system.coord_class],
                               forcemode=settings.forcemode, created=model._matasc_files)
-        callbacks.append(writer.write)
+        def write(k, state, writer=writer, mode=settings.linear):
+            writer.write(k, state)
+            if "linearization" in state:
+                writer.write_linearization(Linearization(state["linearization"], system.coord_label,
+                                                         system.def_label), mode)
+        callbacks.append(write)
     bar = _progress.make(progress, model.current_time, settings.timestep_tp)
     if bar is not None:
         callbacks.append(bar)
@@ -75,6 +80,4 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
     res = Results(arrays, system.coord_label, system.def_label, stats, Geometry.from_model(model), lins,
                   model.settings.linear)
-    if writer is not None and lins:
-        writer.write_linearizations(lins, model.settings.linear)
     return res

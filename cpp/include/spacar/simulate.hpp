@@ -24,9 +24,9 @@ using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::R
 struct RunOptions {
   Method method = Method::DOP853;
   double initial_step = 0.0;  // > 0: continue with this step (RESTART 0 across blocks)
-  // Called after every output time is recorded (index k, data of that state): progress bars,
-  // files written as the run proceeds.
-  std::function<void(int, const Data&)> on_output;
+  // Called after every output time is recorded (index k, data of that state, its linearization
+  // or nullptr): progress bars, files written as the run proceeds.
+  std::function<void(int, const Data&, const Linearization*)> on_output;
 };
 
 struct BlockResults {

@@ -82,6 +82,7 @@ class MatascWriter:
         self.created = created
         supported = [i for i, c in enumerate(coordinate_classes) if c in ("fixed", "input")]
         self._files = {}
+        self._lin_files = {}  # _lin, _eig, _buck: opened at the first linearization
         self._columns = {}
         for suffix, (key, prefix, over, text) in STATE_FILES.items():
             if suffix == "rx" and forcemode < 1 or suffix == "sig" and forcemode < 2:
@@ -122,7 +123,8 @@ class MatascWriter:
         return fh
 
     def write(self, k: int, state: dict) -> None:
-        """One output time: a line in every file, flushed."""
+        """One output time: a line in every state file, flushed (the linearization files are
+        written by write_linearization)."""
         t = float(state["t"])
         for suffix, fh in self._files.items():
             key, cols = self._columns[suffix]
@@ -130,47 +132,45 @@ class MatascWriter:
             fh.write(format_line(np.concatenate(([t], values))))
             fh.flush()
 
-    def write_linearizations(self, linearizations, linear_mode) -> None:
-        """``_lin``, ``_eig`` (and ``_buck`` for LINEAR 2): one line per output time."""
-        if not linearizations:
-            return
-        lin0 = linearizations[0]
-        z = " ".join(f"{k}({a},{b})" for k, a, b in lin0.z_labels)
-        nz = len(lin0.z_labels)
-        files = {
-            "lin": self._open("lin", "linearized equations", ["t", "nz", "nk", "M0", "C0", "D0", "K0", "N0", "G0",
-                                                                "K_k", "AK0", "BK0", "r0"],
-                              extra=[f"z: {z}", "matrices nz x nz, column-major; nk = 0 kinematic coordinates "
-                                                "(K_k, AK0, BK0 empty)"]),
-            "eig": self._open("eig", "eigenvalues of the linearized equations",
-                              ["t"] + [f"{p}{i}" for i in range(1, 2 * nz + 1) for p in ("re", "im")],
-                              extra=[f"z: {z}", "eigenvalues of the first-order system, sorted by |Im|, then Re"]),
-        }
-        if linear_mode == 2:
-            files["buck"] = self._open("buck", "buckling multipliers", ["t"] + [f"mu{i}" for i in range(1, nz + 1)],
-                                       extra=[f"z: {z}", "real parts, sorted by absolute value; NaN pads "
-                                                         "missing (infinite) multipliers"])
-        try:
-            for lin in linearizations:
-                row = [lin.t, len(lin.z_labels), 0]
-                for name in ("M0", "C0", "D0", "K0", "N0", "G0"):
-                    row.extend(np.asarray(getattr(lin, name)).ravel(order="F"))
-                row.extend(np.asarray(lin.r0).ravel())
-                files["lin"].write(format_line(row))
-                lam = lin.eigenvalues()
-                files["eig"].write(format_line([lin.t] + [v for z_ in lam for v in (z_.real, z_.imag)]))
-                if "buck" in files:
-                    mu = np.real(lin.buckling_factors())
-                    pad = np.full(nz, np.nan)
-                    pad[: min(len(mu), nz)] = mu[:nz]
-                    files["buck"].write(format_line([lin.t, *pad]))
-                for fh in files.values():
-                    fh.flush()
-        finally:
-            for fh in files.values():
-                fh.close()
+    def write_linearization(self, lin, linear_mode) -> None:
+        """``_lin``, ``_eig`` (and ``_buck`` for LINEAR 2): a line for one output time, flushed;
+        the files are opened at the first linearization."""
+        nz, nk = len(lin.z_labels), len(lin.y_labels)
+        if "lin" not in self._lin_files:
+            z = " ".join(f"{k}({a},{b})" for k, a, b in lin.z_labels)
+            y = " ".join(f"{k}({a},{b})" for k, a, b in lin.y_labels)
+            n_eig = 2 * nz + nk
+            self._lin_files["lin"] = self._open(
+                "lin", "linearized equations",
+                ["t", "nz", "nk", "M0", "C0", "D0", "K0", "N0", "G0", "K_k", "AK0", "BK0", "r0"],
+                extra=[f"z: {z}", f"kinematic coordinates: {y or 'none'}",
+                       "M0..G0 nz x nz, K_k nz x nk, AK0 nk x nz, BK0 nk x (nz + nk), column-major"])
+            self._lin_files["eig"] = self._open(
+                "eig", "eigenvalues of the linearized equations",
+                ["t"] + [f"{p}{i}" for i in range(1, n_eig + 1) for p in ("re", "im")],
+                extra=[f"z: {z}", "eigenvalues of the first-order system, sorted by |Im|, then Re"])
+            if linear_mode == 2:
+                self._lin_files["buck"] = self._open(
+                    "buck", "buckling multipliers", ["t"] + [f"mu{i}" for i in range(1, nz + 1)],
+                    extra=[f"z: {z}", "real parts, sorted by absolute value; NaN pads missing (infinite) multipliers"])
+        files = self._lin_files
+        row = [lin.t, nz, nk]
+        for name in ("M0", "C0", "D0", "K0", "N0", "G0", "Kk", "AK0", "BK0"):
+            row.extend(np.asarray(getattr(lin, name)).ravel(order="F"))
+        row.extend(np.asarray(lin.r0).ravel())
+        files["lin"].write(format_line(row))
+        lam = lin.eigenvalues()
+        files["eig"].write(format_line([lin.t] + [v for z_ in lam for v in (z_.real, z_.imag)]))
+        if "buck" in files:
+            mu = np.real(lin.buckling_factors())
+            pad = np.full(nz, np.nan)
+            pad[: min(len(mu), nz)] = mu[:nz]
+            files["buck"].write(format_line([lin.t, *pad]))
+        for fh in files.values():
+            fh.flush()
 
     def close(self) -> None:
-        for fh in self._files.values():
+        for fh in (*self._files.values(), *self._lin_files.values()):
             fh.close()
         self._files = {}
+        self._lin_files = {}
