@@ -31,13 +31,7 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) C0_(i, j) = s.lgeomy[3 * j + i];
     const double rhoA = s.emass.empty() ? 0.0 : s.emass[0];
-    mass_.W << 13.0 / 35, 11.0 / 210, 9.0 / 70, -13.0 / 420,  //
-        11.0 / 210, 1.0 / 105, 13.0 / 420, -1.0 / 140,          //
-        9.0 / 70, 13.0 / 420, 13.0 / 35, -11.0 / 210,           //
-        -13.0 / 420, -1.0 / 140, -11.0 / 210, 1.0 / 105;
-    mass_.W *= rhoA * l0_;
-    mass_.w << 0.5, 1.0 / 12, 0.5, -1.0 / 12;
-    mass_.w *= rhoA * l0_;
+    mass_ = hermite_mass<3>(rhoA, l0_);
     // Rotary inertia: T = (l0/6)(Ω_pᵀJΩ_p + Ω_pᵀJΩ_q + Ω_qᵀJΩ_q), Ω the section angular velocity.
     const Eigen::Vector3d Js(s.emass.size() > 1 ? s.emass[1] : 0.0, s.emass.size() > 2 ? s.emass[2] : 0.0,
                              s.emass.size() > 3 ? s.emass[3] : 0.0);

@@ -19,14 +19,7 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
  public:
   explicit PlBeam(const ElementSetup& s) : l0_(s.l0), alpha0_(s.lgeomy.empty() ? 0.0 : s.lgeomy[0]) {
     const double rhoA = s.emass.empty() ? 0.0 : s.emass[0];
-    // ∫ H_i H_j dξ of the cubic Hermite functions (H1, H2, H3, H4).
-    mass_.W << 13.0 / 35, 11.0 / 210, 9.0 / 70, -13.0 / 420,  //
-        11.0 / 210, 1.0 / 105, 13.0 / 420, -1.0 / 140,          //
-        9.0 / 70, 13.0 / 420, 13.0 / 35, -11.0 / 210,           //
-        -13.0 / 420, -1.0 / 140, -11.0 / 210, 1.0 / 105;
-    mass_.W *= rhoA * l0_;
-    mass_.w << 0.5, 1.0 / 12, 0.5, -1.0 / 12;
-    mass_.w *= rhoA * l0_;
+    mass_ = hermite_mass<2>(rhoA, l0_);
   }
 
   template <class S>

@@ -32,18 +32,21 @@ from pathlib import Path
 
 import numpy as np
 
+from ..results import QUANTITIES
+
 FMT = "%.15E"
 
-# file suffix: (state key, label prefix, over, description)
+# file suffix: the quantity it holds (spacar.results.QUANTITIES: attribute, coordinates or
+# deformations, column label prefix) and the description in its header
 STATE_FILES = {
-    "x": ("x", "x", "coordinate", "nodal coordinates"),
-    "xd": ("xd", "xd", "coordinate", "velocities of the nodal coordinates"),
-    "xdd": ("xdd", "xdd", "coordinate", "accelerations of the nodal coordinates"),
-    "e": ("e", "e", "deformation", "deformations"),
-    "ed": ("ed", "ed", "deformation", "deformation rates"),
-    "edd": ("edd", "edd", "deformation", "deformation second rates"),
-    "rx": ("reaction", "r", "coordinate", "reactions on the fixed and input coordinates (FORCEMODE >= 1)"),
-    "sig": ("sigma", "s", "deformation", "generalized stresses of all deformations (FORCEMODE 2)"),
+    "x": ("x", "nodal coordinates"),
+    "xd": ("xd", "velocities of the nodal coordinates"),
+    "xdd": ("xdd", "accelerations of the nodal coordinates"),
+    "e": ("e", "deformations"),
+    "ed": ("ed", "deformation rates"),
+    "edd": ("edd", "deformation second rates"),
+    "rx": ("reaction", "reactions on the fixed and input coordinates (FORCEMODE >= 1)"),
+    "sig": ("sigma", "generalized stresses of all deformations (FORCEMODE 2)"),
 }
 
 
@@ -84,7 +87,8 @@ class MatascWriter:
         self._files = {}
         self._lin_files = {}  # _lin, _eig, _buck: opened at the first linearization
         self._columns = {}
-        for suffix, (key, prefix, over, text) in STATE_FILES.items():
+        for suffix, (quantity, text) in STATE_FILES.items():
+            key, over, prefix, _ = QUANTITIES[quantity]
             if suffix == "rx" and forcemode < 1 or suffix == "sig" and forcemode < 2:
                 continue
             labels = self.coordinate_labels if over == "coordinate" else self.deformation_labels

@@ -79,6 +79,33 @@ struct MassPoints {
   Eigen::Matrix<double, NG, 1> w = Eigen::Matrix<double, NG, 1>::Zero();
 };
 
+// Consistent mass of linear interpolation between two points: W = (ρA l0/6)[[2, 1], [1, 2]],
+// gravity weights ρA l0 (½, ½) (trusses).
+template <int DIM>
+MassPoints<2, DIM> linear_mass(double rhoA, double l0) {
+  MassPoints<2, DIM> m;
+  m.W << 2.0, 1.0, 1.0, 2.0;
+  m.W *= rhoA * l0 / 6.0;
+  m.w << 0.5, 0.5;
+  m.w *= rhoA * l0;
+  return m;
+}
+
+// Consistent mass of the cubic Hermite interpolation r = H1 x_p + H2 l0 t_p + H3 x_q + H4 l0 t_q
+// (beams): W = ρA l0 ∫ H_i H_j dξ, gravity weights ρA l0 ∫ H_i dξ = ρA l0 (½, 1/12, ½, −1/12).
+template <int DIM>
+MassPoints<4, DIM> hermite_mass(double rhoA, double l0) {
+  MassPoints<4, DIM> m;
+  m.W << 13.0 / 35, 11.0 / 210, 9.0 / 70, -13.0 / 420,  //
+      11.0 / 210, 1.0 / 105, 13.0 / 420, -1.0 / 140,      //
+      9.0 / 70, 13.0 / 420, 13.0 / 35, -11.0 / 210,       //
+      -13.0 / 420, -1.0 / 140, -11.0 / 210, 1.0 / 105;
+  m.W *= rhoA * l0;
+  m.w << 0.5, 1.0 / 12, 0.5, -1.0 / 12;
+  m.w *= rhoA * l0;
+  return m;
+}
+
 namespace detail {
 template <class T, class = void>
 struct velocity_rows : std::integral_constant<unsigned, 0> {};
