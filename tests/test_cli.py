@@ -211,3 +211,15 @@ def test_dump_digits_out_of_range_is_a_usage_error(capsys, digits):
     out = capsys.readouterr()
     assert "--dump-digits" in out.err and "Traceback" not in out.err
     assert out.out == ""  # rejected before any analysis
+
+
+def test_run_blocks_from_python_continues_like_the_command_line():
+    """Model.run_blocks analyses the blocks in order: the second block starts where the first
+    ended (t = 5) and runs its own TIMESTEP."""
+    import numpy as np
+    text = EXAMPLE.read_text() + "TIMESTEP 10 1.0\nEND\n"
+    model = spacar.read_string(text, "two_blocks.dat")
+    first, second = list(model.run_blocks())
+    assert first.t[-1] == 5.0 and second.t[0] == 5.0 and second.t[-1] == 6.0
+    assert len(second.t) == 11
+    assert np.allclose(second.x[0], first.x[-1], atol=1e-9)

@@ -22,11 +22,10 @@ import numpy as np
 
 from . import __version__
 from .errors import SpacarError
-from .io.reader import apply_block, read
+from .io.reader import read
 from .io.matasc import default_stem
 from .io.writer import dump
 from .results import Results
-from .simulate import simulate
 
 
 def _comment(text: str, stream=None):
@@ -64,15 +63,13 @@ def _run(args) -> int:
     if args.output_stem:
         model.output_stem = args.output_stem
     animated = []
-    for k, block in enumerate(model.blocks):
-        if k > 0:
-            apply_block(model, block)
-        n_warn = len(model.warnings)
-        res = simulate(model, method=args.method, progress=args.progress)
+    n_warn = len(model.warnings)
+    for k, res in enumerate(model.run_blocks(method=args.method, progress=args.progress)):
         if model.settings.animate == 1:
             animated.append(res)
         for w in model.warnings[n_warn:]:
             _comment(f"warning: {w}")
+        n_warn = len(model.warnings)
         s = res.stats
         _comment(f"block {k + 1}: t = {res.t[0]:g} .. {res.t[-1]:g}, {len(res.t)} output times, "
                  f"{s['rhs_evaluations']} right-hand sides, {s['accepted']} steps "

@@ -364,6 +364,18 @@ class Model:
 
         return check(self)
 
+    def run_blocks(self, **kwargs):
+        """Analyse the blocks of the input in order, as ``spacar run`` does: the current block
+        first, then each later block applied to the state reached. Yields one
+        :class:`spacar.Results` per block (``kwargs`` go to :func:`spacar.simulate`)."""
+        from .io.reader import apply_block
+        from .simulate import simulate
+
+        for k, block in enumerate(self.blocks or [None]):
+            if k > 0:
+                apply_block(self, block)
+            yield simulate(self, **kwargs)
+
     def run(self, **kwargs):
         """Run the analysis of the current block; see :func:`spacar.simulate`."""
         from .simulate import simulate
