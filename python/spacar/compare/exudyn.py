@@ -545,7 +545,7 @@ class ExudynModel:
                 raise ValueError(f"solver {solver!r} needs a fixed step")
             ti.automaticStepSize = False
             ti.numberOfSteps = max(1, int(round((t_end - t_start) / step)))
-        if solver not in EXPLICIT and len(self.mbs.systemData.GetODE2Coordinates()) > 200:
+        if len(self.mbs.systemData.GetODE2Coordinates()) > 200:
             s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
         return s
 

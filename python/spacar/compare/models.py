@@ -13,6 +13,11 @@ from ..model import Model
 
 G = 9.81
 
+# Numbering of the chains: links (beams) 1..n from position node i to i+1; BETA/LAMBDA nodes
+# START + i (start of link i) and END + i (end of link i; END + 0 is the ground's); hinges
+# HINGE + i. The offsets leave room for n < 100000 links.
+START, END, HINGE = 100000, 200000, 300000
+
 
 def _tolerances(m: Model, eps, epskin):
     m.epsint(eps)
@@ -28,26 +33,26 @@ def planar_chain(n: int, length: float = 1.0, rho_a: float = 1.0, tip_mass: floa
     """An n-link planar pendulum chain of total ``length``, released from rest at ``angle``
     (rad, from the +x axis) under gravity.
 
-    Link i is a rigid PLBEAM i from position node i to i+1 with the BETA nodes 100+i (start) and
-    200+i (end) — both rotate with the link — and EMASS ``rho_a``; ``tip_mass`` is a MASS on
-    every position node 2..n+1, ``joint_inertia`` a MASS (Izz) on every BETA node 100+i. The
-    joints are PLHINGE 1000+i from node 200+i−1 to 100+i (node 200 is the fixed ground BETA
+    Link i is a rigid PLBEAM i from position node i to i+1 with the BETA nodes START+i (start)
+    and END+i (end) — both rotate with the link — and EMASS ``rho_a``; ``tip_mass`` is a MASS on
+    every position node 2..n+1, ``joint_inertia`` a MASS (Izz) on every BETA node START+i. The
+    joints are PLHINGE HINGE+i from node END+i−1 to START+i (node END is the fixed ground BETA
     node, at ``ground_angle``); ``dof="relative"`` makes their e1 the DOFs (DYNE: Pinocchio's q,
-    relative joint angles), ``dof="absolute"`` the link rotations (DYNX on 100+i).
+    relative joint angles), ``dof="absolute"`` the link rotations (DYNX on START+i).
     ``stiffness``/``damping``: ESTIFF/EDAMPP of the hinges."""
     m = Model()
     step = length / n
     c, s = math.cos(angle), math.sin(angle)
     m.x(1, 0.0, 0.0)
     for i in range(1, n + 1):
-        m.plbeam(i, i, 100 + i, i + 1, 200 + i)
+        m.plbeam(i, i, START + i, i + 1, END + i)
         m.x(i + 1, i * step * c, i * step * s)
-        m.plhinge(1000 + i, 200 + i - 1, 100 + i)
+        m.plhinge(HINGE + i, END + i - 1, START + i)
         if dof == "relative":
-            m.dyne(1000 + i, 1)
+            m.dyne(HINGE + i, 1)
         elif dof == "absolute":
-            m.rlse(1000 + i, 1)
-            m.dynx(100 + i, 1)
+            m.rlse(HINGE + i, 1)
+            m.dynx(START + i, 1)
         else:
             raise ValueError("dof must be 'relative' or 'absolute'")
         if rho_a:
@@ -55,14 +60,14 @@ def planar_chain(n: int, length: float = 1.0, rho_a: float = 1.0, tip_mass: floa
         if tip_mass:
             m.mass(i + 1, tip_mass)
         if joint_inertia:
-            m.mass(100 + i, joint_inertia)
+            m.mass(START + i, joint_inertia)
         if stiffness or damping:
-            m.estiff(1000 + i, stiffness)
-            m.edampp(1000 + i, damping)
+            m.estiff(HINGE + i, stiffness)
+            m.edampp(HINGE + i, damping)
     m.fix(1)
-    m.fix(200)
+    m.fix(END)
     if ground_angle:
-        m.beta(200, ground_angle)
+        m.beta(END, ground_angle)
     if gravity is not None and any(gravity):
         m.gravity(*gravity)
     _tolerances(m, eps, epskin)
@@ -77,13 +82,14 @@ def _box_inertia(mass, a, b, c):
 def spatial_chain(n: int, seed: int = 0, joints: str = "hinge", t_end: float = 0.5, n_out: int = 5,
                   eps: float = 1e-9, epskin: float = 1e-11, ground_rotation: bool = True,
                   stiffness: float = 0.0) -> Model:
-    """An n-link spatial chain with random (seeded) geometry: rigid BEAM i from node i to i+1
-    with LAMBDA nodes 100+i and 200+i, EMASS ρA with rotary inertia, a point MASS at every
-    node 2..n+1 and a full inertia tensor (MASS on LAMBDA 100+i, a rotated box). Joints:
-    ``"hinge"`` — HINGE 1000+i from LAMBDA 200+i−1 to 100+i about a random axis, e1 DYNE
-    (relative angles; node 200 is the fixed ground LAMBDA node, rotated by 0.4 rad about a
-    random axis if ``ground_rotation``); ``"spherical"`` — shared position nodes only, DYNX on the LAMBDA nodes
-    100+i (Euler parameters as DOFs). Gravity along a random direction."""
+    """An n-link spatial chain with random (seeded) geometry, numbered as the planar chain: rigid
+    BEAM i from node i to i+1 with LAMBDA nodes START+i and END+i, EMASS ρA with rotary inertia,
+    a point MASS at every node 2..n+1 and a full inertia tensor (MASS on LAMBDA START+i, a
+    rotated box). Joints: ``"hinge"`` — HINGE HINGE+i from LAMBDA END+i−1 to START+i about a
+    random axis, e1 DYNE (relative angles; node END is the fixed ground LAMBDA node, rotated by
+    0.4 rad about a random axis if ``ground_rotation``); ``"spherical"`` — shared position nodes
+    only, DYNX on the LAMBDA nodes START+i (Euler parameters as DOFs). Gravity along a random
+    direction."""
     rng = np.random.default_rng(seed)
     m = Model()
     p = np.array([0.1, -0.2, 0.3])
@@ -92,32 +98,32 @@ def spatial_chain(n: int, seed: int = 0, joints: str = "hinge", t_end: float = 0
         d = rng.normal(size=3)
         d *= (0.4 + 0.4 * rng.random()) / np.linalg.norm(d)
         v = np.cross(d, rng.normal(size=3))
-        m.beam(i, i, 100 + i, i + 1, 200 + i, *v)
+        m.beam(i, i, START + i, i + 1, END + i, *v)
         p = p + d
         m.xyz(i + 1, *p)
         if joints == "hinge":
-            m.hinge(1000 + i, 200 + i - 1, 100 + i, *rng.normal(size=3))
-            m.dyne(1000 + i, 1)
+            m.hinge(HINGE + i, END + i - 1, START + i, *rng.normal(size=3))
+            m.dyne(HINGE + i, 1)
             if stiffness:
-                m.estiff(1000 + i, stiffness)
+                m.estiff(HINGE + i, stiffness)
         elif joints == "spherical":
-            m.dynx(100 + i)
+            m.dynx(START + i)
         else:
             raise ValueError("joints must be 'hinge' or 'spherical'")
         m.emass(i, 1.0 + rng.random(), 1e-3, 2e-3, 3e-3)
         m.mass(i + 1, 0.2 + 0.3 * rng.random())
         Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
         J = Q @ _box_inertia(0.5, *(0.1 + 0.2 * rng.random(3))) @ Q.T
-        m.mass(100 + i, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
+        m.mass(START + i, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
     m.fix(1)
     if joints == "hinge":
-        m.fix(200)
+        m.fix(END)
         if ground_rotation:
             # a moderate rotation (0.4 rad about a random axis): the assembly starts from the
             # given positions with the links' LAMBDA nodes at the reference and must converge
             u = rng.normal(size=3)
             u /= np.linalg.norm(u)
-            m.lambda_(200, math.cos(0.2), *(math.sin(0.2) * u))
+            m.lambda_(END, math.cos(0.2), *(math.sin(0.2) * u))
     g = rng.normal(size=3)
     m.gravity(*(G * g / np.linalg.norm(g)))
     _tolerances(m, eps, epskin)
