@@ -74,6 +74,11 @@ def machine(peers: bool = False) -> dict:
         "NumPy": np.__version__,
         "spacar": spacar.__version__,
     }
+    try:
+        info["load average at start (1/5/15 min)"] = " / ".join(f"{v:.2f}" for v in os.getloadavg()) + \
+            " (other processes share the machine; timings are best-of-repeats)"
+    except OSError:  # pragma: no cover
+        pass
     if peers:
         import exudyn
         import pinocchio
@@ -157,6 +162,75 @@ def fmt_err(e) -> str:
 
 
 # --- output ---------------------------------------------------------------------------------
+
+RESULTS = ROOT / "benchmarks" / "results"
+
+
+def _restore_keys(obj):
+    if isinstance(obj, dict):
+        out = {}
+        for k, v in obj.items():
+            key = k
+            if isinstance(k, str):
+                for conv in (int, float):
+                    try:
+                        key = conv(k)
+                        break
+                    except ValueError:
+                        pass
+            out[key] = _restore_keys(v)
+        return out
+    if isinstance(obj, list):
+        return [_restore_keys(v) for v in obj]
+    return obj
+
+
+def save_results(name: str, result: dict) -> Path:
+    """Raw figures of a full run (benchmarks/results/<name>.json), so that the section and the
+    plots can be regenerated without measuring again (``--from-results``)."""
+    import json
+
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    path = RESULTS / f"{name}.json"
+    path.write_text(json.dumps(result, indent=1, default=float) + "\n")
+    return path
+
+
+def load_results(name: str) -> dict:
+    import json
+
+    return _restore_keys(json.loads((RESULTS / f"{name}.json").read_text()))
+
+
+def standard_main(module_name, doc, run, section, plot, argv=None, extra_args=None):
+    """The command line shared by the benchmark scripts: --quick, --no-write, --no-plot,
+    --from-results (regenerate the section and plots from benchmarks/results/<name>.json)."""
+    import argparse
+
+    p = argparse.ArgumentParser(description=doc.splitlines()[0])
+    p.add_argument("--quick", action="store_true", help="tiny sizes, few settings (smoke test); writes nothing")
+    p.add_argument("--no-write", action="store_true", help="do not update docs/performance.md")
+    p.add_argument("--no-plot", action="store_true", help="do not write docs/img/*.png")
+    p.add_argument("--from-results", action="store_true", help="do not measure: use benchmarks/results/<case>.json")
+    if extra_args:
+        extra_args(p)
+    a = p.parse_args(argv)
+    if a.from_results:
+        r = load_results(module_name)
+    else:
+        r = run(a)
+        if not a.quick:
+            save_results(module_name, r)
+    plots = None if (a.no_plot or r.get("quick")) else plot(r)
+    text = section(r, plots)
+    print(text)
+    if not a.no_write and not r.get("quick"):
+        write_section(section_title(text), text)
+    return 0
+
+
+def section_title(text: str) -> str:
+    return text.splitlines()[0][3:].strip()
 
 def write_section(title: str, text: str, path: Path = DOC) -> None:
     """Replace (or append) the section ``## title`` of docs/performance.md."""

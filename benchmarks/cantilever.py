@@ -19,11 +19,10 @@ A full simulation is not timed at large n: the beam's highest eigenfrequency gro
 explicit integrator (spacar's DOP853 included) needs O(n²) steps; the issue's target is about the
 cost per evaluation, which this script measures.
 
-    python benchmarks/cantilever.py [--quick] [--no-write] [--no-plot] [--sizes 10 20 ...]
+    python benchmarks/cantilever.py [--quick] [--no-write] [--no-plot] [--from-results] [--sizes 10 20 ...]
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 
@@ -136,19 +135,10 @@ def plot(r: dict) -> dict:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true")
-    p.add_argument("--no-write", action="store_true")
-    p.add_argument("--no-plot", action="store_true")
-    p.add_argument("--sizes", type=int, nargs="*", help="element counts (default 10 … 1000)")
-    a = p.parse_args(argv)
-    r = run(a.quick, a.sizes)
-    plots = None if (a.no_plot or a.quick) else plot(r)
-    text = section(r, plots)
-    print(text)
-    if not a.no_write:
-        C.write_section(TITLE, text)
-    return 0
+    def extra(p):
+        p.add_argument("--sizes", type=int, nargs="*", help="element counts (default 10 … 1000)")
+
+    return C.standard_main("cantilever", __doc__, lambda a: run(a.quick, a.sizes), section, plot, argv, extra)
 
 
 if __name__ == "__main__":

@@ -8,11 +8,10 @@ EPSIND = 1e-12, exudyn's generalized-α at h = 1e-5. Error = largest position er
 middle node 6 and the slider node 8 at t = 5 s (m). The difference between the two references is
 reported as the model difference.
 
-    python benchmarks/slidercrank_exudyn.py [--quick] [--no-write] [--no-plot]
+    python benchmarks/slidercrank_exudyn.py [--quick] [--no-write] [--no-plot] [--from-results]
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 
@@ -129,18 +128,7 @@ def plot(r: dict) -> dict:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true")
-    p.add_argument("--no-write", action="store_true")
-    p.add_argument("--no-plot", action="store_true")
-    a = p.parse_args(argv)
-    r = run(a.quick)
-    plots = None if (a.no_plot or a.quick) else plot(r)
-    text = section(r, plots)
-    print(text)
-    if not a.no_write:
-        C.write_section(TITLE, text)
-    return 0
+    return C.standard_main("slidercrank_exudyn", __doc__, lambda a: run(a.quick), section, plot, argv)
 
 
 if __name__ == "__main__":
