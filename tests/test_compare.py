@@ -61,11 +61,8 @@ def test_planar_chain_springs_dampers_ground_rotation():
     """Hinge ESTIFF/EDAMPP are joint springs and dampers (τ = −St θ − d θ̇); a rotated fixed
     ground BETA node rotates the first joint frame; gravity off the axes."""
     model = models.planar_chain(4, rho_a=1.0, tip_mass=0.5, stiffness=3.0, damping=0.2, ground_angle=0.3,
-                                gravity=(1.0, -G_), epskin=1e-12)
+                                gravity=(1.0, -models.G), epskin=1e-12)
     assert_matches_pinocchio(model)
-
-
-G_ = 9.81
 
 
 def test_planar_chain_absolute_angles():

@@ -76,7 +76,6 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
 
 from .. import _core
 from ._topology import (
-    NK,
     UnsupportedModelError,
     analyse,
     lambda_of_rotation,

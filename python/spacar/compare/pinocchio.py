@@ -36,11 +36,7 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
     raise ImportError("spacar.compare.pinocchio needs Pinocchio: pip install 'spacar[compare]' (package pin)") from exc
 
 from .. import _core
-from ._topology import E_matrix, UnsupportedModelError, analyse
-
-
-def _skew(w):
-    return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+from ._topology import UnsupportedModelError, analyse
 
 
 def _quat_xyzw(R: np.ndarray) -> np.ndarray:
