@@ -1,0 +1,17 @@
+"""Cross-checks against exudyn and Pinocchio: converters that build the equivalent peer model of
+a spacar model, run it, and return side-by-side arrays.
+
+* :mod:`spacar.compare.pinocchio` — kinematic trees of rigid links (CRBA mass matrix, ABA
+  accelerations, trajectories by integrating ABA).
+* :mod:`spacar.compare.exudyn` — rigid bodies with revolute/spherical joints, joint springs,
+  closed loops, sliders, prescribed crank rotation, and flexible planar beams as ANCF cable
+  elements; trajectories mapped back onto spacar's nodal coordinates.
+
+Both need the optional extra ``compare`` (``pip install "spacar[compare]"``: exudyn and pin);
+the submodules import their peer on first use, so ``import spacar.compare`` always works.
+What each converter supports is listed in its module docstring and in docs/comparison.md; a
+model outside that raises :class:`UnsupportedModelError` naming the node or element concerned.
+"""
+from ._topology import Topology, UnsupportedModelError, analyse
+
+__all__ = ["UnsupportedModelError", "Topology", "analyse"]

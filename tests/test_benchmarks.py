@@ -1,0 +1,27 @@
+"""Smoke test of the benchmark scripts (benchmarks/*.py): they run on tiny sizes
+(``run_all.py --quick``, a few seconds) and print every section; nothing is written to docs/."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("pinocchio")
+pytest.importorskip("exudyn")
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_run_all_quick(tmp_path):
+    doc = ROOT / "docs" / "performance.md"
+    before = doc.read_text() if doc.exists() else None
+    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "run_all.py"), "--quick"],
+                         capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr[-3000:]
+    for title in ("## Manual slider-crank", "## Rigid N-link chains", "## Four-bar linkage",
+                  "## Flexible cantilever", "## Manual slider-crank: spacar, exudyn"):
+        assert title in out.stdout
+    assert "Time per right-hand side" in out.stdout and "Growth from n" in out.stdout
+    assert (doc.read_text() if doc.exists() else None) == before
