@@ -347,6 +347,13 @@ void bind_simulation(py::module_& m) {
                throw InputError("evaluate(): q and qd must have one value per degree of freedom");
              s.evaluate(t, q.data(), qd.data());
            })
+      .def("solve_state",
+           [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+             // The integration path: positions, velocities, q̈ and stresses without DF.
+             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
+               throw InputError("solve_state(): q and qd must have one value per degree of freedom");
+             s.solve_state(t, q.data(), qd.data());
+           })
       .def("move_to",
            [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
              if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
