@@ -9,6 +9,7 @@
 #include "spacar/errors.hpp"
 #include "spacar/integrator.hpp"
 #include "spacar/kinematics.hpp"
+#include "spacar/limits.hpp"
 #include "spacar/model.hpp"
 #include "spacar/simulate.hpp"
 
@@ -22,12 +23,47 @@ namespace {
 
 // The Python exception types, created once; the C++ exception of the same name maps to each.
 struct PyErrors {
-  py::handle base, input, kinematics, mass, integration, not_implemented;
+  py::handle base, input, kinematics, mass, integration, time_limit, not_implemented;
 };
 
 PyErrors& py_errors() {
   static PyErrors e;
   return e;
+}
+
+// The Python exception type of a C++ exception of the core and its message; a null handle for
+// any other exception (left to pybind11's own translation).
+py::handle python_type(const std::exception_ptr& p, std::string& message) {
+  const PyErrors& e = py_errors();
+  try {
+    std::rethrow_exception(p);
+  } catch (const InputError& x) {
+    message = x.what();
+    return e.input;
+  } catch (const KinematicsError& x) {
+    message = x.what();
+    return e.kinematics;
+  } catch (const SingularMassError& x) {
+    message = x.what();
+    return e.mass;
+  } catch (const NotImplementedError& x) {
+    message = x.what();
+    return e.not_implemented;
+  } catch (const TimeLimitError& x) {
+    message = x.what();
+    return e.time_limit;
+  } catch (const IntegrationError& x) {
+    message = x.what();
+    return e.integration;
+  } catch (const StepRejected& x) {
+    message = x.what();
+    return e.integration;
+  } catch (const Error& x) {
+    message = x.what();
+    return e.base;
+  } catch (...) {
+  }
+  return py::handle();
 }
 
 void bind_errors(py::module_& m) {
@@ -37,27 +73,28 @@ void bind_errors(py::module_& m) {
   e.kinematics = py::exception<KinematicsError>(m, "KinematicsError", e.base).release();
   e.mass = py::exception<SingularMassError>(m, "SingularMassError", e.base).release();
   e.integration = py::exception<IntegrationError>(m, "IntegrationError", e.base).release();
+  e.time_limit = py::exception<TimeLimitError>(m, "TimeLimitError", e.base).release();
   e.not_implemented = py::exception<NotImplementedError>(m, "NotImplementedError", e.base).release();
   py::register_exception_translator([](std::exception_ptr p) {
-    const PyErrors& e = py_errors();
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const InputError& x) {
-      py::set_error(e.input, x.what());
-    } catch (const KinematicsError& x) {
-      py::set_error(e.kinematics, x.what());
-    } catch (const SingularMassError& x) {
-      py::set_error(e.mass, x.what());
-    } catch (const NotImplementedError& x) {
-      py::set_error(e.not_implemented, x.what());
-    } catch (const IntegrationError& x) {
-      py::set_error(e.integration, x.what());
-    } catch (const StepRejected& x) {
-      py::set_error(e.integration, x.what());
-    } catch (const Error& x) {
-      py::set_error(e.base, x.what());
-    }
+    if (!p) return;
+    std::string message;
+    const py::handle type = python_type(p, message);
+    if (type) py::set_error(type, message.c_str());
+    else std::rethrow_exception(p);
   });
+}
+
+// Raise the Python exception of a failed run with the results computed before the failure as
+// its attribute `results`. Exceptions of Python code called by the run (the on_output callback)
+// and foreign C++ exceptions propagate unchanged.
+[[noreturn]] void raise_with_results(const std::exception_ptr& p, py::object results) {
+  std::string message;
+  const py::handle type = python_type(p, message);
+  if (!type) std::rethrow_exception(p);
+  py::object exc = py::reinterpret_borrow<py::object>(type)(message);
+  exc.attr("results") = std::move(results);
+  PyErr_SetObject(type.ptr(), exc.ptr());
+  throw py::error_already_set();
 }
 
 void bind_catalogue(py::module_& m) {
@@ -318,7 +355,8 @@ void bind_simulation(py::module_& m) {
            })
       .def(
           "run",
-          [](Simulation& s, py::object on_output, double initial_step, const std::string& method) {
+          [](Simulation& s, py::object on_output, double initial_step, const std::string& method,
+             double time_limit) {
             RunOptions opt;
             opt.initial_step = initial_step;
             if (method == "dop853") opt.method = Method::DOP853;
@@ -340,14 +378,23 @@ void bind_simulation(py::module_& m) {
                 on_output(k, state);
               };
             }
+            opt.time_limit = time_limit;
             BlockResults r;
+            std::exception_ptr failure;
             {
               py::gil_scoped_release release;
-              r = s.run(opt);
+              try {
+                s.run(r, opt);
+              } catch (...) {
+                failure = std::current_exception();
+              }
             }
+            if (failure) raise_with_results(failure, block_results_to_dict(std::move(r)));
             return block_results_to_dict(std::move(r));
           },
-          py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853");
+          py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
+          py::arg("time_limit") = 0.0,
+          "Run the block; on failure the exception has the results up to the failure as `results`.");
 }
 
 }  // namespace
@@ -355,6 +402,8 @@ void bind_simulation(py::module_& m) {
 PYBIND11_MODULE(_core, m) {
   m.doc() = "spacar C++ core";
   bind_errors(m);
+  m.def("memory_limit", &memory_limit, "Bytes one analysis may allocate for its work and result arrays.");
+  m.def("set_memory_limit", &set_memory_limit, py::arg("bytes"));
   bind_catalogue(m);
   bind_model(m);
   bind_simulation(m);

@@ -1,5 +1,6 @@
 #include "spacar/data.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace spacar {
@@ -33,6 +34,24 @@ Data::Data(const System& sys) {
   DFq = Eigen::MatrixXd::Zero(nx, nd);
   Mbar = Eigen::MatrixXd::Zero(nd, nd);
   rhs = qdd = Eigen::VectorXd::Zero(nd);
+}
+
+double Data::estimate_bytes(const System& sys) {
+  const double nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
+  const double nP = static_cast<double>(sys.rows_P.size()), nV = static_cast<double>(sys.rows_V.size());
+  const double nc = static_cast<double>(sys.x_calc.size()), nA = std::max(nP, nV);
+  double doubles = nx * nx                 // M
+                   + ne * ne               // global constitutive matrices of the linearization
+                   + 2.0 * nA * nc         // A and its LU factors
+                   + nV * nq + nc * nq     // rhs_DF and the solution of the transfer functions
+                   + 2.0 * nx * nq + ne * nq  // DF (and the linearization's copy), DFe
+                   + nx * nd + 2.0 * nd * nd  // DFq, Mbar and its factor
+                   + 20.0 * (nx + ne + nq);   // vectors
+  for (const SystemElement& se : sys.elements) {
+    const double n = static_cast<double>(se.coords.size()), m = se.nd;
+    doubles += 2.0 * m * n + n * n + 6.0 * n + 2.0 * m * m + 64.0;  // work arrays, S, D, kernel
+  }
+  return 8.0 * doubles;
 }
 
 }  // namespace spacar

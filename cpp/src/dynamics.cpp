@@ -91,6 +91,15 @@ void solve_dynamics(const System& sys, Data& data) {
   reduced_residual(sys, data, data.rhs);
   data.rhs = -data.rhs;
   data.Mbar.noalias() = data.DFq.transpose() * data.M * data.DFq;
+  if (!data.Mbar.allFinite()) {
+    // Overflow (e.g. an enormous MASS or a state far out of range in a trial step): not a
+    // singular matrix. Non-finite accelerations make the integrator reject the step and report
+    // the non-finite values if no smaller step helps.
+    data.qdd.setConstant(std::numeric_limits<double>::quiet_NaN());
+    for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
+    solve_accelerations(sys, data);
+    return;
+  }
   data.llt.compute(data.Mbar);
   if (data.llt.info() != Eigen::Success || nd == 0) {
     if (nd == 0) return;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "spacar/errors.hpp"
+#include "spacar/limits.hpp"
 
 namespace spacar {
 
@@ -302,6 +303,11 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data) {
   d.n_constraints = nP;
   d.n_calculable = nc;
   if (nP > 0 && nc > 0) {
+    // Full SVD: U (nP x nP), V (nc x nc), the block and its work copy.
+    require_memory(8.0 * (static_cast<double>(nP) * nP + static_cast<double>(nc) * nc + 3.0 * nP * nc),
+                   "the constraint diagnosis of " + std::to_string(nP) + " constraints on " + std::to_string(nc) +
+                       " calculable coordinates",
+                   "");
     evaluate_elements(sys, data);
     assemble_block(sys, data, sys.row_P, nP);
     const Eigen::MatrixXd A = data.A.topRows(nP);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "spacar/errors.hpp"
@@ -517,12 +518,20 @@ void Model::add_automatic_constraints() {
   const int l2 = find_element_type("L2MIN1");
   for (const auto& [id, el] : elements)
     if (el.type == l2) has_constraint[el.nodes[0]] = true;
-  int next = elements.empty() ? 1 : elements.rbegin()->first + 1;
+  // Numbers after the largest element number; once that is the largest int (an input may use
+  // it), the smallest free numbers.
+  int next = elements.empty() ? 0 : elements.rbegin()->first;
+  auto free_number = [&]() {
+    if (next < std::numeric_limits<int>::max()) return ++next;
+    int k = 1;
+    while (elements.count(k)) ++k;
+    return k;
+  };
   for (const auto& [node_id, has] : has_constraint) {
     if (has) continue;
-    add_element("L2MIN1", next, {node_id}, {});
-    elements.at(next).automatic = true;
-    ++next;
+    const int id = free_number();
+    add_element("L2MIN1", id, {node_id}, {});
+    elements.at(id).automatic = true;
   }
 }
 
@@ -545,12 +554,21 @@ void Model::compute_reference_geometry() {
       fail(located(el.origin), t.name, " ", id, ": ", err.what());
     }
     if (t.has_length && !el.l0) {
+      if (!std::isfinite(l0))
+        fail(located(el.origin), t.name, " ", id,
+             " has a length that is not a finite number (the coordinates of its nodes are too large)");
       if (!(l0 > 0.0))
         fail(located(el.origin), t.name, " ", id,
              " has zero length: its nodes coincide in the initial positions");
       el.l0 = l0;
     }
-    if (t.n_lgeomy > 0 && el.lgeomy.empty()) el.lgeomy = lgeomy;
+    if (t.n_lgeomy > 0 && el.lgeomy.empty()) {
+      for (double v : lgeomy)
+        if (!std::isfinite(v))
+          fail(located(el.origin), t.name, " ", id,
+               ": its reference geometry (LGEOMY) is not finite (the coordinates of its nodes are too large)");
+      el.lgeomy = lgeomy;
+    }
   }
 }
 

@@ -18,6 +18,7 @@ from .errors import (
     NotImplementedError,
     SingularMassError,
     SpacarError,
+    TimeLimitError,
 )
 from .io.reader import parse, read, read_string
 from .io.writer import dump
@@ -28,6 +29,20 @@ from .results import Results
 from .simulate import simulate
 
 __version__ = "0.1.0"
+
+
+def memory_limit() -> int:
+    """Bytes one analysis may allocate for its work and result arrays (default 4 GiB). Inputs
+    that would need more (e.g. ``TIMESTEP 10000000 1`` on a large model) are refused with an
+    :class:`InputError` before anything is allocated."""
+    return _core.memory_limit()
+
+
+def set_memory_limit(nbytes: int) -> None:
+    """Set the limit of :func:`memory_limit` for this process."""
+    if isinstance(nbytes, bool) or not isinstance(nbytes, int) or not 0 < nbytes < 2**63:
+        raise InputError(f"the memory limit must be a positive number of bytes, got {nbytes!r}")
+    _core.set_memory_limit(nbytes)
 
 
 def element_catalogue():
@@ -54,5 +69,8 @@ __all__ = [
     "KinematicsError",
     "SingularMassError",
     "IntegrationError",
+    "TimeLimitError",
     "NotImplementedError",
+    "memory_limit",
+    "set_memory_limit",
 ]

@@ -48,7 +48,13 @@ def _run(args) -> int:
         if k > 0:
             apply_block(model, block)
         n_warn = len(model.warnings)
-        res = simulate(model, method=args.method)
+        try:
+            res = simulate(model, method=args.method, time_limit=args.time_limit)
+        except SpacarError as err:
+            partial = getattr(err, "results", None)
+            if partial is not None:  # say how far the block got
+                err.args = (f"{err} ({len(partial)} of {model.settings.timestep_n + 1} output times computed)",)
+            raise
         for w in model.warnings[n_warn:]:
             _comment(f"warning: {w}")
         s = res.stats
@@ -77,6 +83,16 @@ def _digits(text: str) -> int:
     return value
 
 
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds, got {text!r}") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, got {text!r}")
+    return value
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="spacar", description="Kinematic and dynamic analysis of multibody systems (SPACAR95 input format).")
     parser.add_argument("--version", action="version", version=f"spacar {__version__}")
@@ -86,6 +102,8 @@ def main(argv=None) -> int:
     run.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                      help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
     run.add_argument("--method", choices=["dop853", "dopri5"], default="dop853", help="integration method")
+    run.add_argument("--time-limit", type=_seconds, default=None, metavar="SECONDS",
+                     help="wall-clock limit per block (default: none); beyond it the run stops with an error")
     run.set_defaults(func=_run)
     check = sub.add_parser("check", help="summarise the model: nodes, elements, classes, degrees of freedom")
     check.add_argument("file")

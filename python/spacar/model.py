@@ -15,22 +15,39 @@ from .keywords import INT, KEYWORDS, Keyword
 _INT_LIMIT = 2**31 - 1
 
 
+def _show(value) -> str:
+    """A short text of a value for messages (huge integers cannot even be converted to text)."""
+    if isinstance(value, numbers.Integral) and not -10**30 < value < 10**30:
+        return f"an integer of {int(value).bit_length()} bits"
+    try:
+        text = repr(value)
+    except Exception:  # noqa: BLE001 - any object may be passed; the message must not fail
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _check_value(kw: Keyword, pname: str, kind: str, value):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise InputError(f"{kw.name}: {pname} must be a number, got {value!r}")
+        raise InputError(f"{kw.name}: {pname} must be a number, got {_show(value)}")
+    try:
+        real, overflow = float(value), False
+    except (OverflowError, ValueError, TypeError):  # huge Python ints and fractions
+        real, overflow = math.inf, True
     if kind == INT:
         if isinstance(value, numbers.Integral):
             value = int(value)
-        elif math.isfinite(value) and float(value).is_integer():
-            value = int(value)
+        elif math.isfinite(real) and real.is_integer():
+            value = int(real)
         else:
-            raise InputError(f"{kw.name}: {pname} must be an integer, got {value!r}")
+            raise InputError(f"{kw.name}: {pname} must be an integer, got {_show(value)}")
         if abs(value) > _INT_LIMIT:
-            raise InputError(f"{kw.name}: {pname} = {value} is out of range")
+            raise InputError(f"{kw.name}: {pname} = {_show(value)} is out of range")
         return value
-    value = float(value)
+    if overflow:
+        raise InputError(f"{kw.name}: {pname} must be a finite number, got a value too large for a double")
+    value = real
     if not math.isfinite(value):
-        raise InputError(f"{kw.name}: {pname} must be a finite number, got {value!r}")
+        raise InputError(f"{kw.name}: {pname} must be a finite number, got {_show(value)}")
     return value
 
 

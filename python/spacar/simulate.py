@@ -1,12 +1,25 @@
 """Running an analysis block from Python."""
 from __future__ import annotations
 
+import math
+import numbers
+
 from . import _core
+from .errors import InputError, SpacarError
 from .linearize import Linearization
 from .results import Results
 
 
-def simulate(model, *, method: str = "dop853", on_output=None) -> Results:
+def _results(arrays: dict, system, settings_linear) -> Results:
+    stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
+                                    "newton_iterations", "wall_time")}
+    res = Results(arrays, system.coord_label, system.def_label, stats)
+    res.linearizations = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
+    res.settings_linear = settings_linear
+    return res
+
+
+def simulate(model, *, method: str = "dop853", on_output=None, time_limit=None) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
     The mechanism is assembled at the current time; with degrees of freedom the reduced
@@ -17,19 +30,34 @@ def simulate(model, *, method: str = "dop853", on_output=None) -> Results:
     ``on_output(k, state)`` is called after output time k is recorded, with ``state`` a dict of
     NumPy arrays ``t, x, xd, xdd, e, ed, edd, sigma, reaction`` (progress, files written as the
     run proceeds). It runs at output times only, never inside the integration.
-    Returns :class:`spacar.Results`.
+
+    ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
+    :class:`spacar.TimeLimitError`.
+
+    Returns :class:`spacar.Results`. If the analysis fails midway, the :class:`spacar.SpacarError`
+    raised carries the results up to the failure as ``err.results`` (a :class:`spacar.Results`
+    with the output times recorded before the failure, possibly none); the model's state is
+    then left as it was before the block.
     """
+    if time_limit is None:
+        limit = 0.0
+    elif (isinstance(time_limit, numbers.Real) and not isinstance(time_limit, bool)
+          and math.isfinite(time_limit) and time_limit > 0):
+        limit = float(time_limit)
+    else:
+        raise InputError(f"time_limit must be a positive number of seconds or None, got {time_limit!r}")
     model.prepare()
     sim = _core.Simulation(model._core)
     restart = model._core.settings.restart == 1
     step = 0.0 if restart else model._continue_step
-    arrays = sim.run(on_output=on_output, initial_step=step, method=method)
+    try:
+        arrays = sim.run(on_output=on_output, initial_step=step, method=method, time_limit=limit)
+    except SpacarError as err:
+        partial = getattr(err, "results", None)
+        if isinstance(partial, dict):
+            model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
+            err.results = _results(partial, sim.system, model.settings.linear)
+        raise
     model._continue_step = arrays["last_step"]
-    system = sim.system
-    stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
-                                    "newton_iterations", "wall_time")}
     model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    res = Results(arrays, system.coord_label, system.def_label, stats)
-    res.linearizations = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
-    res.settings_linear = model.settings.linear
-    return res
+    return _results(arrays, sim.system, model.settings.linear)

@@ -19,6 +19,10 @@ struct ElementWork {
 
 struct Data {
   explicit Data(const System& sys);
+  // Bytes the analysis of `sys` allocates (these arrays, the factorizations and the temporaries
+  // of the transfer functions and the linearization): checked against the memory limit before
+  // anything is allocated, since the matrices are dense in the number of coordinates.
+  static double estimate_bytes(const System& sys);
 
   double t = 0.0;
   Eigen::VectorXd x, xd, xdd;   // nodal coordinates and their derivatives (nx)

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,7 +28,16 @@ struct RunOptions {
   // Called after every output time is recorded (index k, data of that state): progress bars,
   // files written as the run proceeds.
   std::function<void(int, const Data&)> on_output;
+  // Wall-clock seconds the block may take (0: no limit); beyond it TimeLimitError.
+  double time_limit = 0.0;
+  // Integration steps (accepted and rejected) over the whole block.
+  long max_steps = Integrator::kMaxSteps;
 };
+
+// Tolerances below this (100 machine epsilons) cannot be met in double precision: EPSINT and
+// EPSIND are raised to it with a warning, so that a tiny tolerance cannot make the integrator
+// crawl through millions of round-off-limited steps.
+constexpr double kMinTolerance = 100.0 * 2.220446049250313e-16;
 
 struct BlockResults {
   Eigen::VectorXd t;
@@ -62,6 +72,10 @@ class Simulation {
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
 
   BlockResults run(const RunOptions& options = {});
+  // The same, into `res`. If the run fails (an exception), `res` holds what was computed up to
+  // the failure: the output times recorded so far (the arrays cut to those rows), the counters
+  // and the warnings; the model is not changed.
+  void run(BlockResults& res, const RunOptions& options);
   // Write the state reached into the model (coordinates, rates, deformation values, time).
   void store_state();
 
@@ -80,6 +94,10 @@ class Simulation {
   std::unique_ptr<Linearizer> linearizer_;
   bool have_base_ = false;
   std::string kinematic_failure_;  // message of the last right-hand side that failed in Newton
+  void check_time(double t);       // TimeLimitError past the deadline of the running block
+  bool has_deadline_ = false;
+  std::chrono::steady_clock::time_point deadline_;
+  double time_limit_ = 0.0;
 };
 
 }  // namespace spacar

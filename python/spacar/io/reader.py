@@ -54,6 +54,9 @@ def _error(file, line, keyword, reason):
 
 def _number(token: str, kind: str):
     if kind == INT:
+        if len(token) > 40 and _INT_RE.match(token):
+            # Far out of range (and Python refuses to convert very long digit strings).
+            raise ValueError(f"{token[:20]}... ({len(token)} digits) is out of range")
         if _INT_RE.match(token):
             return int(token)
         if _REAL_RE.match(token):
