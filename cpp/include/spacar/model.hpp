@@ -123,6 +123,9 @@ class Model {
   // every node is used by an element, freeze the topology. Later calls only validate.
   void prepare();
   bool frozen() const { return frozen_; }
+  // Deserialisation only (pickle): the model was prepared when it was saved; its reference
+  // geometry and automatic elements are part of the saved state, so nothing is recomputed.
+  void restore_prepared() { frozen_ = true; }
 
   // Lookups that raise InputError naming the missing item.
   Node& node(int id);
