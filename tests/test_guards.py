@@ -293,3 +293,28 @@ def test_cli_time_limit(tmp_path, capsys):
     err = capsys.readouterr().err
     assert re.search(r"spacar: TimeLimitError: the time limit of 0\.002 s was exceeded at t = \S+ "
                      r"\(\d+ of 101 output times computed\)", err), err
+
+
+# --- the constraint diagnosis stays fast and short for large models -----------------------------
+
+def test_the_diagnosis_of_a_large_model_is_bounded():
+    start = time.perf_counter()
+    model = spacar.read_string(chain(1000))  # 1000 constraints, 2000 calculable coordinates
+    check = model.check()
+    assert not check.diagnosis.ok and not check.diagnosis.detailed and check.diagnosis.rank == -1
+    assert "constraints: not diagnosed:" in str(check)
+    assert "too large for a detailed diagnosis (at most 1500 constraints and calculable coordinates)" in str(check)
+    model.timestep(1, 0.1)
+    with pytest.raises(KinematicsError, match="too large for a detailed diagnosis"):
+        spacar.simulate(model)
+    assert time.perf_counter() - start < 5.0  # was minutes: cubic SVD and selections of every column
+
+
+def test_the_diagnosis_text_lists_a_bounded_number_of_items():
+    check = spacar.read_string(chain(100)).check()
+    d = check.diagnosis
+    assert len(d.undetermined) == 100 and d.rank == 100  # the structured fields keep everything
+    text = str(check)
+    assert text.count("\n   - node") == 20 and "   ... and 80 more undetermined coordinates" in text
+    assert text.count("free motion:") == 5 and "   ... and 95 more free motions" in text
+    assert len(text) < 2000
