@@ -27,6 +27,7 @@ from .linearize import Linearization, linearize
 from .model import Model
 from .results import Results
 from .simulate import simulate
+from .sweep import SweepError, SweepResult, sweep
 
 __version__ = "0.1.0"
 
@@ -60,6 +61,9 @@ __all__ = [
     "parse",
     "dump",
     "simulate",
+    "sweep",
+    "SweepResult",
+    "SweepError",
     "linearize",
     "Linearization",
     "summary",
