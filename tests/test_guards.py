@@ -318,3 +318,37 @@ def test_the_diagnosis_text_lists_a_bounded_number_of_items():
     assert text.count("\n   - node") == 20 and "   ... and 80 more undetermined coordinates" in text
     assert text.count("free motion:") == 5 and "   ... and 95 more free motions" in text
     assert len(text) < 2000
+
+
+# --- wrong types in the Python API are InputErrors (found by the fuzzing harness) ---------------
+
+def test_wrong_types_in_the_python_api_are_input_errors():
+    model = spacar.read(EXAMPLE)
+    for digits in (None, 0, 18, 2.5, True, "4", 10**5000):
+        with pytest.raises(InputError, match="digits must be an integer between 1 and 17"):
+            model.dump(digits)
+    with pytest.raises(InputError, match="on_output must be a function"):
+        spacar.simulate(model.copy(), on_output=5)
+    with pytest.raises(InputError, match="method must be 'dop853' or 'dopri5'"):
+        spacar.simulate(model.copy(), method=None)
+    with pytest.raises(InputError, match="time_limit must be a positive number of seconds"):
+        spacar.simulate(model.copy(), time_limit=10**400)
+    with pytest.raises(InputError, match=r"the input must be a text \(str\), got bytes: decode bytes first"):
+        spacar.read_string(TEXT.encode())
+    with pytest.raises(InputError, match=r"the input must be a text \(str\), got int"):
+        spacar.read_string(5)
+    with pytest.raises(InputError, match=r"the file name must be a str"):
+        spacar.read_string(TEXT, 5)
+    with pytest.raises(InputError, match=r"read: a file name or path, got 5"):
+        spacar.read(5)
+    with pytest.raises(InputError, match=r"cannot read the input file \(embedded null byte\)"):
+        spacar.read("a\x00b")
+    with pytest.raises(InputError, match=r"unknown keyword 5"):
+        model.apply(5, 1)
+
+
+def test_non_finite_linearized_equations_are_refused():
+    model = spacar.read_string(with_lines("GRAVITY 0 -1e308"))
+    with pytest.raises(SpacarError, match=r"the linearized equations at t = 0 are not finite \(\w+ has infinite or "
+                                          r"NaN entries\): the model's values exceed double precision"):
+        spacar.linearize(model)

@@ -10,6 +10,7 @@ Quick start::
     print(model.dump())                               # the restartable state dump
 """
 from . import _core
+from ._util import show as _show
 from .check import Check, Diagnosis, Summary, check, summary
 from .errors import (
     InputError,
@@ -42,7 +43,7 @@ def memory_limit() -> int:
 def set_memory_limit(nbytes: int) -> None:
     """Set the limit of :func:`memory_limit` for this process."""
     if isinstance(nbytes, bool) or not isinstance(nbytes, int) or not 0 < nbytes < 2**63:
-        raise InputError(f"the memory limit must be a positive number of bytes, got {nbytes!r}")
+        raise InputError(f"the memory limit must be a positive number of bytes, got {_show(nbytes)}")
     _core.set_memory_limit(nbytes)
 
 

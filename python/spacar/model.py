@@ -9,26 +9,16 @@ import math
 import numbers
 
 from . import _core
+from ._util import show
 from .errors import InputError
 from .keywords import INT, KEYWORDS, Keyword
 
 _INT_LIMIT = 2**31 - 1
 
 
-def _show(value) -> str:
-    """A short text of a value for messages (huge integers cannot even be converted to text)."""
-    if isinstance(value, numbers.Integral) and not -10**30 < value < 10**30:
-        return f"an integer of {int(value).bit_length()} bits"
-    try:
-        text = repr(value)
-    except Exception:  # noqa: BLE001 - any object may be passed; the message must not fail
-        text = f"<{type(value).__name__}>"
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _check_value(kw: Keyword, pname: str, kind: str, value):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise InputError(f"{kw.name}: {pname} must be a number, got {_show(value)}")
+        raise InputError(f"{kw.name}: {pname} must be a number, got {show(value)}")
     try:
         real, overflow = float(value), False
     except (OverflowError, ValueError, TypeError):  # huge Python ints and fractions
@@ -39,15 +29,15 @@ def _check_value(kw: Keyword, pname: str, kind: str, value):
         elif math.isfinite(real) and real.is_integer():
             value = int(real)
         else:
-            raise InputError(f"{kw.name}: {pname} must be an integer, got {_show(value)}")
+            raise InputError(f"{kw.name}: {pname} must be an integer, got {show(value)}")
         if abs(value) > _INT_LIMIT:
-            raise InputError(f"{kw.name}: {pname} = {_show(value)} is out of range")
+            raise InputError(f"{kw.name}: {pname} = {show(value)} is out of range")
         return value
     if overflow:
         raise InputError(f"{kw.name}: {pname} must be a finite number, got a value too large for a double")
     value = real
     if not math.isfinite(value):
-        raise InputError(f"{kw.name}: {pname} must be a finite number, got {_show(value)}")
+        raise InputError(f"{kw.name}: {pname} must be a finite number, got {show(value)}")
     return value
 
 
@@ -109,9 +99,9 @@ class Model:
         """Apply one keyword line: ``model.apply("FIX", 8, 2)``. ``origin`` (file, line, keyword)
         is remembered with the elements and nodes the line defines, for errors found at the
         first END (e.g. an element of zero length)."""
-        kw = KEYWORDS.get(keyword.upper())
+        kw = KEYWORDS.get(keyword.upper()) if isinstance(keyword, str) else None
         if kw is None or kw.name in ("END", "EOF"):
-            raise InputError(f"unknown keyword {keyword!r}")
+            raise InputError(f"unknown keyword {show(keyword)}")
         self._origin = origin
         try:
             return getattr(self, kw.builder)(*args)

@@ -1,10 +1,8 @@
 """Running an analysis block from Python."""
 from __future__ import annotations
 
-import math
-import numbers
-
 from . import _core
+from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
 from .linearize import Linearization
 from .results import Results
@@ -39,13 +37,11 @@ def simulate(model, *, method: str = "dop853", on_output=None, time_limit=None) 
     with the output times recorded before the failure, possibly none); the model's state is
     then left as it was before the block.
     """
-    if time_limit is None:
-        limit = 0.0
-    elif (isinstance(time_limit, numbers.Real) and not isinstance(time_limit, bool)
-          and math.isfinite(time_limit) and time_limit > 0):
-        limit = float(time_limit)
-    else:
-        raise InputError(f"time_limit must be a positive number of seconds or None, got {time_limit!r}")
+    limit = seconds_or_none(time_limit, "time_limit") or 0.0
+    if on_output is not None and not callable(on_output):
+        raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
+    if not isinstance(method, str):
+        raise InputError(f"method must be 'dop853' or 'dopri5', got {show(method)}")
     model.prepare()
     sim = _core.Simulation(model._core)
     restart = model._core.settings.restart == 1

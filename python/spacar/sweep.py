@@ -32,6 +32,7 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
+from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
 from .keywords import INT, LOOKUP, SETTINGS, Keyword
 from .model import Model, check_args
@@ -86,23 +87,23 @@ def _identifiers(kw: Keyword) -> int:
 def _parse_line_key(key: str) -> _Line:
     words = key.split()
     if not words:
-        raise InputError(f"sweep parameter {key!r}: empty")
+        raise InputError(f"sweep parameter {show(key)}: empty")
     kw = LOOKUP.get(words[0].upper()[:8])
     if kw is None:
-        raise InputError(f"sweep parameter {key!r}: unknown keyword {words[0]!r}")
+        raise InputError(f"sweep parameter {show(key)}: unknown keyword {show(words[0])}")
     if kw.group not in _SWEEPABLE_GROUPS:
-        raise InputError(f"sweep parameter {key!r}: {kw.name} lines define the model's structure and cannot "
+        raise InputError(f"sweep parameter {show(key)}: {kw.name} lines define the model's structure and cannot "
                          "be replaced by value; use a factory function (sweep(make_model, ...))")
     n_ids = _identifiers(kw)
     names = " ".join(p.name for p in kw.params[:n_ids])
     if len(words) - 1 != n_ids:
         what = f"{kw.name} {names}" if n_ids else kw.name
-        raise InputError(f"sweep parameter {key!r}: a {kw.name} line is named by {what!r} "
+        raise InputError(f"sweep parameter {show(key)}: a {kw.name} line is named by {show(what)} "
                          f"({n_ids} number{'s' if n_ids != 1 else ''} after the keyword)")
     try:
         ids = tuple(int(w) for w in words[1:])
     except ValueError:
-        raise InputError(f"sweep parameter {key!r}: {names} must be integers") from None
+        raise InputError(f"sweep parameter {show(key)}: {names} must be integers") from None
     return _Line(key, kw, ids)
 
 
@@ -111,7 +112,7 @@ def _lines_of(key) -> tuple:
         return (_parse_line_key(key),)
     if isinstance(key, tuple) and key and all(isinstance(k, str) for k in key):
         return tuple(_parse_line_key(k) for k in key)
-    raise InputError(f"sweep parameter {key!r}: a keyword line such as 'ESTIFF 2' or a tuple of them")
+    raise InputError(f"sweep parameter {show(key)}: a keyword line such as 'ESTIFF 2' or a tuple of them")
 
 
 def _name(key) -> str:
@@ -119,7 +120,7 @@ def _name(key) -> str:
         return key
     if isinstance(key, tuple) and key and all(isinstance(k, str) for k in key):
         return " & ".join(key)
-    raise InputError(f"sweep parameter {key!r}: name it by a string (an input line such as 'ESTIFF 2', or any "
+    raise InputError(f"sweep parameter {show(key)}: name it by a string (an input line such as 'ESTIFF 2', or any "
                      "name for a factory) or a tuple of input lines")
 
 
@@ -129,7 +130,7 @@ def _check_value(key, lines, value):
         try:
             check_args(line.keyword, line.arguments(value))
         except InputError as err:
-            raise InputError(f"sweep parameter {_name(key)!r} = {value!r}: {err}") from None
+            raise InputError(f"sweep parameter {show(_name(key))} = {show(value)}: {err}") from None
 
 
 def _cases(parameters, by_lines: bool):
@@ -140,10 +141,10 @@ def _cases(parameters, by_lines: bool):
         names, axes = [], []
         for key, values in parameters.items():
             if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
-                raise InputError(f"sweep parameter {_name(key)!r}: give a sequence of values, got {values!r}")
+                raise InputError(f"sweep parameter {show(_name(key))}: give a sequence of values, got {show(values)}")
             values = list(values)
             if not values:
-                raise InputError(f"sweep parameter {_name(key)!r}: no values")
+                raise InputError(f"sweep parameter {show(_name(key))}: no values")
             names.append(_name(key))
             axes.append(values)
         keys = list(parameters)
@@ -207,22 +208,22 @@ class _Outputs:
                     self._check_name(item)
                     self.items[str(name)] = item
                 else:
-                    raise InputError(f"sweep outputs[{name!r}]: a function or an output name, got {item!r}")
+                    raise InputError(f"sweep outputs[{show(name)}]: a function or an output name, got {show(item)}")
         elif isinstance(spec, (list, tuple)):
             for name in spec:
                 if not isinstance(name, str):
-                    raise InputError(f"sweep outputs: names, got {name!r}")
+                    raise InputError(f"sweep outputs: names, got {show(name)}")
                 self._add_name(name)
         else:
-            raise InputError(f"sweep outputs: a name, a list of names, a dict or a function, got {spec!r}")
+            raise InputError(f"sweep outputs: a name, a list of names, a dict or a function, got {show(spec)}")
 
     def _check_name(self, name):
         allowed = RESULT_ARRAYS if self.analysis == "simulate" else LINEARIZATION_OUTPUTS
         base = name[:-len("_final")] if name.endswith("_final") else name
         if callable(self.analysis) or base not in allowed:
             if callable(self.analysis):
-                raise InputError(f"sweep outputs: with an analysis function, give functions of its result, not {name!r}")
-            raise InputError(f"sweep outputs: unknown output {name!r} for analysis={self.analysis!r}; "
+                raise InputError(f"sweep outputs: with an analysis function, give functions of its result, not {show(name)}")
+            raise InputError(f"sweep outputs: unknown output {show(name)} for analysis={show(self.analysis)}; "
                              f"one of {', '.join(allowed)}" + (", 'final', 'history'" if self.analysis == "simulate" else ""))
 
     def _add_name(self, name):
@@ -276,7 +277,7 @@ def _run_case(task: _Task, params: dict):
                 try:
                     model.apply(line.keyword.name, *line.arguments(value))
                 except SpacarError as err:
-                    raise type(err)(f"sweep parameter {name!r} = {value!r}: {err}") from None
+                    raise type(err)(f"sweep parameter {show(name)} = {show(value)}: {err}") from None
     else:
         model = task.model(dict(params))
         if not isinstance(model, Model):
@@ -591,14 +592,12 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
 
         model = read(model)
     if not isinstance(model, Model) and not callable(model):
-        raise InputError(f"sweep: model must be a spacar.Model, an input file or a factory function, got {model!r}")
+        raise InputError(f"sweep: model must be a spacar.Model, an input file or a factory function, got {show(model)}")
     if not (analysis in ("simulate", "linearize") or callable(analysis)):
-        raise InputError(f"sweep: analysis must be 'simulate', 'linearize' or a function, got {analysis!r}")
-    if time_limit is not None and not (isinstance(time_limit, numbers.Real) and not isinstance(time_limit, bool)
-                                       and math.isfinite(time_limit) and time_limit > 0):
-        raise InputError(f"sweep: time_limit must be a positive number of seconds or None, got {time_limit!r}")
-    if method not in ("dop853", "dopri5"):
-        raise InputError(f"sweep: unknown integration method {method!r} (dop853, dopri5)")
+        raise InputError(f"sweep: analysis must be 'simulate', 'linearize' or a function, got {show(analysis)}")
+    time_limit = seconds_or_none(time_limit, "sweep: time_limit")
+    if not isinstance(method, str) or method not in ("dop853", "dopri5"):
+        raise InputError(f"sweep: unknown integration method {show(method)} (dop853, dopri5)")
     names, cases, grid, lines = _cases(parameters, by_lines=isinstance(model, Model))
     task = _Task(model, lines, analysis, _Outputs(outputs, analysis), method, time_limit)
     n = len(cases)
@@ -610,7 +609,7 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
         n_workers = max(1, min(workers or os.cpu_count() or 1, n))
     for name, value in (("workers", workers), ("chunksize", chunksize)):
         if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1):
-            raise InputError(f"sweep: {name} must be a positive integer, got {value!r}")
+            raise InputError(f"sweep: {name} must be a positive integer, got {show(value)}")
     size = chunksize or max(1, math.ceil(n / (4 * n_workers)))
     chunks = [indexed[i:i + size] for i in range(0, n, size)]
 
