@@ -352,3 +352,12 @@ def test_non_finite_linearized_equations_are_refused():
     with pytest.raises(SpacarError, match=r"the linearized equations at t = 0 are not finite \(\w+ has infinite or "
                                           r"NaN entries\): the model's values exceed double precision"):
         spacar.linearize(model)
+
+
+def test_a_singular_velocity_block_with_an_exact_zero_pivot_is_an_error():
+    """Found by fuzzing: at the identity the L2MIN1 row of a LAMBDA node with a given first
+    Euler parameter is exactly zero; Eigen's condition estimate of that LU is 1, not 0, and the
+    run 'succeeded' with NaN velocities."""
+    text = "HINGE 1 1 2 0.1 0 0\nFIX 1\nINPUTX 1 1\nINPUTX 2 1\nRLSE 1 3\nEND\n"
+    with pytest.raises(KinematicsError, match=r"constraint block is singular at t = 0 .*\n.*rank 2"):
+        spacar.simulate(spacar.read_string(text))

@@ -173,6 +173,8 @@ def test_progress_callback_and_chunks():
     ({"XD a b": [1]}, r"n i must be integers"),
     ({"XD 2 1": [1.5, float("nan")]}, r"'XD 2 1' = nan: XD: x must be a finite number"),
     ({"XD 2 1": [float("inf")]}, r"must be a finite number"),
+    ({"XD 2 1": [np.array(np.nan)]}, r"must be a finite number"),  # a 0-d array is a number
+    ({"ESTIFF 2": [np.array([0.0, np.inf])]}, r"must be a finite number"),
     ({"ESTIFF 2": [(0.0, float("-inf"))]}, r"'ESTIFF 2' = \(0\.0, -inf\): ESTIFF: x must be a finite number"),
     ({"TIMESTEP": [(10.5, 1.0)]}, r"TIMESTEP: n must be an integer"),
     ({"XD 2 1": 1.5}, r"give a sequence of values"),
@@ -193,7 +195,10 @@ def test_bad_options_are_refused_at_once():
                            ({"workers": 0}, "workers must be a positive integer"), ({"chunksize": 1.5}, "chunksize"),
                            ({"method": "euler"}, "unknown integration method"),
                            ({"outputs": "nope"}, "unknown output 'nope'"), ({"outputs": 3}, "sweep outputs"),
-                           ({"analysis": "linearize", "outputs": "x"}, "unknown output 'x'")]:
+                           ({"analysis": "linearize", "outputs": "x"}, "unknown output 'x'"),
+                           ({"workers": "2"}, "workers must be a positive integer"),
+                           ({"executor": 5}, "executor must be a dask.distributed.Client or a concurrent.futures"),
+                           ({"client": "tcp://x"}, "client must be")]:
         with pytest.raises(InputError, match=reason):
             spacar.sweep(base, grid, **{"workers": 1, **kwargs})
     with pytest.raises(InputError, match="must be a spacar.Model"):

@@ -101,9 +101,12 @@ void factorize(const System& sys, Data& data, int n_rows, const char* what) {
   const int nc = static_cast<int>(sys.x_calc.size());
   if (nc == 0) return;
   data.lu.compute(data.A.topRows(n_rows));
-  // An exactly zero pivot makes Eigen's estimate NaN (0/0): report it as 0, never as "nan".
+  // An exactly zero pivot makes Eigen's estimate NaN (0/0), or even 1 when the zero pivot is the
+  // last one (diag(1, 1, 0)): a zero or non-finite pivot is singular whatever the estimate says.
   const double rc_estimate = data.lu.rcond();
-  const double rc = std::isfinite(rc_estimate) ? rc_estimate : 0.0;
+  const auto pivots = data.lu.matrixLU().diagonal();
+  const bool zero_pivot = !pivots.allFinite() || (pivots.array() == 0.0).any();
+  const double rc = std::isfinite(rc_estimate) && !zero_pivot ? rc_estimate : 0.0;
   if (!(rc > 1e-13)) {
     std::ostringstream os;
     os << "the " << what << " constraint block is singular at t = " << data.t << " (reciprocal condition "

@@ -226,6 +226,10 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
       kinematic_failure_.clear();
       for (;;) {
         // One segment: integrate until the end, or until a free rotation must be repartitioned.
+        // The step limit holds for the block, whatever the number of segments.
+        if (res.steps >= options.max_steps)
+          throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
+                                 " steps in the block at t = " + num(t));
         Integrator integ(static_cast<int>(Y.size()), options.method);
         const int n = sys_->n_dof();
         Eigen::VectorXd rtol(2 * n);
@@ -233,7 +237,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
         rtol.tail(n).setConstant(st.epsind);
         integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
         integ.set_max_step(st.hmax);
-        integ.set_max_steps(std::max(1L, options.max_steps - res.steps));
+        integ.set_max_steps(options.max_steps - res.steps);
         if (h > 0.0) integ.set_initial_step(h);
         if (!sys_->free_rotations.empty())
           integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });

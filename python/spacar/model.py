@@ -8,6 +8,8 @@ from __future__ import annotations
 import math
 import numbers
 
+import numpy as np
+
 from . import _core
 from ._util import show
 from .errors import InputError
@@ -17,7 +19,9 @@ _INT_LIMIT = 2**31 - 1
 
 
 def _check_value(kw: Keyword, pname: str, kind: str, value):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]  # a 0-d array is its number
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise InputError(f"{kw.name}: {pname} must be a number, got {show(value)}")
     try:
         real, overflow = float(value), False

@@ -68,7 +68,8 @@ class _Line:
     ids: tuple
 
     def arguments(self, value) -> tuple:
-        values = tuple(value) if isinstance(value, (tuple, list, np.ndarray)) else (value,)
+        several = isinstance(value, (tuple, list)) or (isinstance(value, np.ndarray) and value.ndim > 0)
+        values = tuple(value) if several else (value,)
         return (*self.ids, *values)
 
 
@@ -603,13 +604,17 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     n = len(cases)
     indexed = list(enumerate(cases))
 
+    for name, value in (("workers", workers), ("chunksize", chunksize)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1):
+            raise InputError(f"sweep: {name} must be a positive integer, got {show(value)}")
+    for name, value in (("client", client), ("executor", executor)):
+        if value is not None and not callable(getattr(value, "submit", None)):
+            raise InputError(f"sweep: {name} must be a dask.distributed.Client or a concurrent.futures.Executor, "
+                             f"got {show(value)}")
     if client is not None or executor is not None:
         n_workers = _client_workers(client) if client is not None else (workers or os.cpu_count() or 1)
     else:
         n_workers = max(1, min(workers or os.cpu_count() or 1, n))
-    for name, value in (("workers", workers), ("chunksize", chunksize)):
-        if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1):
-            raise InputError(f"sweep: {name} must be a positive integer, got {show(value)}")
     size = chunksize or max(1, math.ceil(n / (4 * n_workers)))
     chunks = [indexed[i:i + size] for i in range(0, n, size)]
 
