@@ -361,3 +361,18 @@ def test_a_singular_velocity_block_with_an_exact_zero_pivot_is_an_error():
     text = "HINGE 1 1 2 0.1 0 0\nFIX 1\nINPUTX 1 1\nINPUTX 2 1\nRLSE 1 3\nEND\n"
     with pytest.raises(KinematicsError, match=r"constraint block is singular at t = 0 .*\n.*rank 2"):
         spacar.simulate(spacar.read_string(text))
+
+
+def test_a_second_enhc_of_a_deformation_releases_its_old_kinematic_coordinate():
+    """Found by fuzzing: after ENHC 2 1 3 1 and ENHC 2 1 4 1, element 3 deformation 1 stayed a
+    kinematic coordinate of nothing, and the state dump did not read back to the same model."""
+    text = ("PLBEAMNL 1 1 2 3 4\nPLHINGE 2 2 4\nPLHINGE 3 4 5\nPLHINGE 4 4 5\nX 1 3.5 -3.7\nX 3 0.1 -3.5\n"
+            "FIX 1\nENHC 2 1 3 1\nE 3 1 1e-3\nENHC 2 1 4 1\nEND\n")
+    model = spacar.read_string(text)
+    classes = {eid: [c.name for c in el.cls] for eid, el in model.elements.items()}
+    assert classes[2] == ["nonholonomic"] and classes[3] == ["fixed"] and classes[4] == ["kinematic"]
+    dump = model.dump(digits=17)
+    assert spacar.read_string(dump).dump(digits=17) == dump
+    with pytest.raises(InputError, match=r"element 4 deformation 1 is the kinematic coordinate of a nonholonomic "
+                                         r"deformation \(ENHC\); change that ENHC first"):
+        model.enhc(4, 1, 3, 1)

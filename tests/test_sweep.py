@@ -196,6 +196,7 @@ def test_bad_options_are_refused_at_once():
                            ({"method": "euler"}, "unknown integration method"),
                            ({"outputs": "nope"}, "unknown output 'nope'"), ({"outputs": 3}, "sweep outputs"),
                            ({"analysis": "linearize", "outputs": "x"}, "unknown output 'x'"),
+                           ({"analysis": "linearize", "outputs": "M0_final"}, "unknown output 'M0_final'"),
                            ({"workers": "2"}, "workers must be a positive integer"),
                            ({"executor": 5}, "executor must be a dask.distributed.Client or a concurrent.futures"),
                            ({"client": "tcp://x"}, "client must be")]:

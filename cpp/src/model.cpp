@@ -286,6 +286,9 @@ void Model::set_nonholonomic(int e1, int i1, int e2, int i2) {
   const int k1 = deformation_index(a, i1);
   const int k2 = deformation_index(b, i2);
   if (e1 == e2 && i1 == i2) fail("a nonholonomic deformation cannot be its own kinematic coordinate");
+  if (a.cls[k1] == DefClass::Kinematic)
+    fail("element ", e1, " deformation ", i1,
+         " is the kinematic coordinate of a nonholonomic deformation (ENHC); change that ENHC first");
   if (b.cls[k2] != DefClass::Fixed && b.cls[k2] != DefClass::Kinematic)
     fail("the kinematic coordinate element ", e2, " deformation ", i2, " must be a fixed deformation, it is ",
          def_class_name(b.cls[k2]), " (manual §5.3 note 2)");
@@ -294,6 +297,15 @@ void Model::set_nonholonomic(int e1, int i1, int e2, int i2) {
       if (el.kinematic_of[k][0] == e2 && el.kinematic_of[k][1] == i2 && !(id == e1 && int(k) == k1))
         fail("element ", e2, " deformation ", i2, " is already the kinematic coordinate of element ", id,
              " deformation ", k + 1);
+  // A second ENHC of the same deformation replaces its pairing: the old kinematic coordinate
+  // becomes a fixed deformation again (as when the nonholonomic deformation changes class).
+  if (a.cls[k1] == DefClass::Nonholonomic) {
+    const auto [old_e, old_i] = a.kinematic_of[k1];
+    if (!(old_e == e2 && old_i == i2)) {
+      Element& old = element(old_e);
+      if (old.cls[old_i - 1] == DefClass::Kinematic) old.cls[old_i - 1] = DefClass::Fixed;
+    }
+  }
   a.cls[k1] = DefClass::Nonholonomic;
   a.kinematic_of[k1] = {e2, i2};
   b.cls[k2] = DefClass::Kinematic;

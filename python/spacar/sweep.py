@@ -28,7 +28,7 @@ import pickle
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -220,7 +220,7 @@ class _Outputs:
 
     def _check_name(self, name):
         allowed = RESULT_ARRAYS if self.analysis == "simulate" else LINEARIZATION_OUTPUTS
-        base = name[:-len("_final")] if name.endswith("_final") else name
+        base = name[:-len("_final")] if self.analysis == "simulate" and name.endswith("_final") else name
         if callable(self.analysis) or base not in allowed:
             if callable(self.analysis):
                 raise InputError(f"sweep outputs: with an analysis function, give functions of its result, not {show(name)}")
