@@ -212,7 +212,8 @@ def test_huge_hmax_is_harmless():
 
 def test_overflowing_stiffness_stops_with_a_clear_error():
     model = spacar.read_string(TEXT.replace("ESTIFF 2 0. 0.0012723", "ESTIFF 2 0. 1e308"))
-    with pytest.raises(spacar.IntegrationError, match=r"non-finite rhs value"):
+    with pytest.raises(SpacarError, match=r"the accelerations at t = 0 are not finite: the model's values exceed "
+                                          r"double precision"):
         spacar.simulate(model)
 
 
@@ -376,3 +377,14 @@ def test_a_second_enhc_of_a_deformation_releases_its_old_kinematic_coordinate():
     with pytest.raises(InputError, match=r"element 4 deformation 1 is the kinematic coordinate of a nonholonomic "
                                          r"deformation \(ENHC\); change that ENHC first"):
         model.enhc(4, 1, 3, 1)
+
+
+def test_non_finite_results_stop_the_run():
+    """Found by fuzzing: an enormous load on a support gave infinite reactions in a run that
+    'succeeded'. Now the run stops at the first such output time with a clear error."""
+    text = "PLBEAMNL 1 1 2 3 4\nX 1 -1.0 2.6\nX 3 0.6 0.6\nBETA 4 100\nFIX 1\nFORCE 3 1e308 1e-300\nFIX 2 1\n"
+    model = spacar.read_string(text + "TIMESTEP 2 1\nEND\n")  # the case the fuzzer found
+    with pytest.raises(SpacarError, match=r"the reactions at t = 0 are not finite: the model's values exceed double "
+                                          r"precision") as info:
+        spacar.simulate(model)
+    assert len(info.value.results) == 0

@@ -109,6 +109,23 @@ BlockResults Simulation::run(const RunOptions& options) {
   return res;
 }
 
+void Simulation::require_finite_state(double t) const {
+  // Values beyond double precision (e.g. FORCE 8 1e308 on a support) must not reach the results
+  // as infinities or NaNs: the run stops here and keeps the output times before.
+  const std::pair<const char*, const Eigen::VectorXd*> parts[] = {
+      {"coordinates", &data_.x}, {"velocities", &data_.xd}, {"accelerations", &data_.xdd},
+      {"deformations", &data_.e}, {"deformation rates", &data_.ed}, {"deformation accelerations", &data_.edd},
+      {"stresses", &data_.sigma}, {"reactions", &data_.reaction}};
+  for (const auto& [name, v] : parts)
+    if (!v->allFinite()) {
+      std::ostringstream os;
+      os << "the " << name << " at t = " << t
+         << " are not finite: the model's values exceed double precision (check the magnitudes of loads, "
+            "masses, stiffnesses and rates)";
+      throw Error(os.str());
+    }
+}
+
 void Simulation::check_time(double t) {
   if (has_deadline_ && std::chrono::steady_clock::now() > deadline_) {
     std::ostringstream os;
@@ -211,6 +228,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
       check_time(t);
       evaluate(t, Y.data(), Y.data() + nd);
       if (st.forcemode >= 1 || linear) forces();
+      require_finite_state(t);
       if (linear) res.linearizations.push_back(linearize());
       record(res, k_out);
       if (options.on_output) options.on_output(k_out, data_);

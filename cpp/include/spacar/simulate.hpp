@@ -95,6 +95,7 @@ class Simulation {
   bool have_base_ = false;
   std::string kinematic_failure_;  // message of the last right-hand side that failed in Newton
   void check_time(double t);       // TimeLimitError past the deadline of the running block
+  void require_finite_state(double t) const;  // SpacarError if an output would hold inf or NaN
   bool has_deadline_ = false;
   std::chrono::steady_clock::time_point deadline_;
   double time_limit_ = 0.0;
