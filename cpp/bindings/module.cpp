@@ -10,6 +10,7 @@
 #include "spacar/integrator.hpp"
 #include "spacar/dynamics.hpp"
 #include "spacar/kinematics.hpp"
+#include "spacar/limits.hpp"
 #include "spacar/model.hpp"
 #include "spacar/simulate.hpp"
 
@@ -23,12 +24,47 @@ namespace {
 
 // The Python exception types, created once; the C++ exception of the same name maps to each.
 struct PyErrors {
-  py::handle base, input, kinematics, mass, integration, not_implemented;
+  py::handle base, input, kinematics, mass, integration, time_limit, not_implemented;
 };
 
 PyErrors& py_errors() {
   static PyErrors e;
   return e;
+}
+
+// The Python exception type of a C++ exception of the core and its message; a null handle for
+// any other exception (left to pybind11's own translation).
+py::handle python_type(const std::exception_ptr& p, std::string& message) {
+  const PyErrors& e = py_errors();
+  try {
+    std::rethrow_exception(p);
+  } catch (const InputError& x) {
+    message = x.what();
+    return e.input;
+  } catch (const KinematicsError& x) {
+    message = x.what();
+    return e.kinematics;
+  } catch (const SingularMassError& x) {
+    message = x.what();
+    return e.mass;
+  } catch (const NotImplementedError& x) {
+    message = x.what();
+    return e.not_implemented;
+  } catch (const TimeLimitError& x) {
+    message = x.what();
+    return e.time_limit;
+  } catch (const IntegrationError& x) {
+    message = x.what();
+    return e.integration;
+  } catch (const StepRejected& x) {
+    message = x.what();
+    return e.integration;
+  } catch (const Error& x) {
+    message = x.what();
+    return e.base;
+  } catch (...) {
+  }
+  return py::handle();
 }
 
 void bind_errors(py::module_& m) {
@@ -38,27 +74,28 @@ void bind_errors(py::module_& m) {
   e.kinematics = py::exception<KinematicsError>(m, "KinematicsError", e.base).release();
   e.mass = py::exception<SingularMassError>(m, "SingularMassError", e.base).release();
   e.integration = py::exception<IntegrationError>(m, "IntegrationError", e.base).release();
+  e.time_limit = py::exception<TimeLimitError>(m, "TimeLimitError", e.base).release();
   e.not_implemented = py::exception<NotImplementedError>(m, "NotImplementedError", e.base).release();
   py::register_exception_translator([](std::exception_ptr p) {
-    const PyErrors& e = py_errors();
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const InputError& x) {
-      py::set_error(e.input, x.what());
-    } catch (const KinematicsError& x) {
-      py::set_error(e.kinematics, x.what());
-    } catch (const SingularMassError& x) {
-      py::set_error(e.mass, x.what());
-    } catch (const NotImplementedError& x) {
-      py::set_error(e.not_implemented, x.what());
-    } catch (const IntegrationError& x) {
-      py::set_error(e.integration, x.what());
-    } catch (const StepRejected& x) {
-      py::set_error(e.integration, x.what());
-    } catch (const Error& x) {
-      py::set_error(e.base, x.what());
-    }
+    if (!p) return;
+    std::string message;
+    const py::handle type = python_type(p, message);
+    if (type) py::set_error(type, message.c_str());
+    else std::rethrow_exception(p);
   });
+}
+
+// Raise the Python exception of a failed run with the results computed before the failure as
+// its attribute `results`. Exceptions of Python code called by the run (the on_output callback)
+// and foreign C++ exceptions propagate unchanged.
+[[noreturn]] void raise_with_results(const std::exception_ptr& p, py::object results) {
+  std::string message;
+  const py::handle type = python_type(p, message);
+  if (!type) std::rethrow_exception(p);
+  py::object exc = py::reinterpret_borrow<py::object>(type)(message);
+  exc.attr("results") = std::move(results);
+  PyErr_SetObject(type.ptr(), exc.ptr());
+  throw py::error_already_set();
 }
 
 void bind_catalogue(py::module_& m) {
@@ -97,6 +134,145 @@ void bind_catalogue(py::module_& m) {
       .def_property_readonly("implemented", [](const ElementType& t) { return t.make != nullptr; })
       .def_property_readonly("n_deformations", &ElementType::n_deformations);
   m.def("element_catalogue", &element_catalogue, py::return_value_policy::reference);
+}
+
+// --- pickling of the model: every field, exactly (floats are Python floats), so that a model
+// sent to another process (spacar.sweep, dask) is the same model, state included.
+
+constexpr int kModelStateVersion = 1;
+
+template <class T>
+std::vector<int> enum_ints(const std::vector<T>& v) {
+  std::vector<int> out;
+  for (T c : v) out.push_back(static_cast<int>(c));
+  return out;
+}
+
+[[noreturn]] void bad_state(const std::string& why) {
+  throw InputError("invalid pickled spacar model: " + why);
+}
+
+template <class T>
+std::vector<T> to_enums(const std::vector<int>& v, int max_value, const char* what) {
+  std::vector<T> out;
+  for (int c : v) {
+    if (c < 0 || c > max_value) bad_state(std::string(what) + " out of range");
+    out.push_back(static_cast<T>(c));
+  }
+  return out;
+}
+
+py::tuple model_state(const Model& m) {
+  py::list nodes, elements;
+  for (const auto& [id, n] : m.nodes)
+    nodes.append(py::make_tuple(n.id, static_cast<int>(n.kind), n.x, enum_ints(n.cls), n.xd, n.xdd, n.force,
+                                n.mass, n.torquel, n.used, n.x_given, n.origin));
+  for (const auto& [id, el] : m.elements) {
+    std::vector<bool> given(el.e_given.begin(), el.e_given.end());
+    elements.append(py::make_tuple(el.id, element_catalogue()[el.type].name, el.nodes, el.params, el.l0, el.lgeomy,
+                                   el.estiff, el.edampp, el.emass, enum_ints(el.cls), el.e, el.ed, el.edd, given,
+                                   el.kinematic_of, el.automatic, el.origin));
+  }
+  const Settings& st = m.settings;
+  py::tuple settings = py::make_tuple(st.timestep_n, st.timestep_tp, st.hmax, st.maxiterat, st.epskin, st.epsint,
+                                      st.epsind, st.forcemode, st.animate, st.matasc, st.jobid, st.restart, st.linear);
+  return py::make_tuple(kModelStateVersion, nodes, elements, settings, m.time, m.gravity, m.gravity_given,
+                        m.frozen());
+}
+
+Model model_from_state(const py::tuple& state) {
+  if (state.size() != 8 || state[0].cast<int>() != kModelStateVersion)
+    bad_state("unknown format (saved by another version of spacar?)");
+  Model m;
+  for (const py::handle& h : state[1].cast<py::list>()) {
+    const py::tuple t = h.cast<py::tuple>();
+    if (t.size() != 12) bad_state("node record");
+    Node n;
+    n.id = t[0].cast<int>();
+    const int kind = t[1].cast<int>();
+    if (kind < static_cast<int>(NodeKind::Any) || kind > static_cast<int>(NodeKind::Lambda)) bad_state("node kind");
+    n.kind = static_cast<NodeKind>(kind);
+    n.x = t[2].cast<std::vector<double>>();
+    n.cls = to_enums<CoordClass>(t[3].cast<std::vector<int>>(), 3, "coordinate class");
+    n.xd = t[4].cast<std::vector<double>>();
+    n.xdd = t[5].cast<std::vector<double>>();
+    n.force = t[6].cast<std::vector<double>>();
+    n.mass = t[7].cast<std::vector<double>>();
+    n.torquel = t[8].cast<std::vector<double>>();
+    n.used = t[9].cast<bool>();
+    n.x_given = t[10].cast<int>();
+    n.origin = t[11].cast<std::string>();
+    const size_t size = n.kind == NodeKind::Any ? 4 : static_cast<size_t>(node_size(n.kind));
+    if (n.id <= 0 || n.x.size() != size || n.cls.size() != size || n.xd.size() != size || n.xdd.size() != size ||
+        m.nodes.count(n.id))
+      bad_state("node " + std::to_string(n.id));
+    m.nodes.emplace(n.id, std::move(n));
+  }
+  for (const py::handle& h : state[2].cast<py::list>()) {
+    const py::tuple t = h.cast<py::tuple>();
+    if (t.size() != 17) bad_state("element record");
+    Element el;
+    el.id = t[0].cast<int>();
+    el.type = find_element_type(t[1].cast<std::string>());
+    if (el.type < 0) bad_state("element type " + t[1].cast<std::string>());
+    const ElementType& et = element_catalogue()[el.type];
+    el.nodes = t[2].cast<std::vector<int>>();
+    el.params = t[3].cast<std::vector<double>>();
+    el.l0 = t[4].cast<std::optional<double>>();
+    el.lgeomy = t[5].cast<std::vector<double>>();
+    el.estiff = t[6].cast<std::vector<double>>();
+    el.edampp = t[7].cast<std::vector<double>>();
+    el.emass = t[8].cast<std::vector<double>>();
+    el.cls = to_enums<DefClass>(t[9].cast<std::vector<int>>(), 6, "deformation class");
+    el.e = t[10].cast<std::vector<double>>();
+    el.ed = t[11].cast<std::vector<double>>();
+    el.edd = t[12].cast<std::vector<double>>();
+    const auto given = t[13].cast<std::vector<bool>>();
+    el.e_given.assign(given.begin(), given.end());
+    el.kinematic_of = t[14].cast<std::vector<std::array<int, 2>>>();
+    el.automatic = t[15].cast<bool>();
+    el.origin = t[16].cast<std::string>();
+    const size_t nd = static_cast<size_t>(et.n_deformations());
+    bool ok = el.id > 0 && !m.elements.count(el.id) && el.nodes.size() == et.nodes.size() && el.cls.size() == nd &&
+              el.e.size() == nd && el.ed.size() == nd && el.edd.size() == nd && el.e_given.size() == nd &&
+              el.kinematic_of.size() == nd && el.params.size() >= static_cast<size_t>(et.n_params_min) &&
+              el.params.size() <= static_cast<size_t>(et.n_params_max);
+    for (size_t i = 0; ok && i < el.nodes.size(); ++i) {
+      auto it = m.nodes.find(el.nodes[i]);
+      ok = it != m.nodes.end() && it->second.kind == et.nodes[i];
+    }
+    if (!ok) bad_state("element " + std::to_string(el.id));
+    m.elements.emplace(el.id, std::move(el));
+  }
+  for (const auto& [id, el] : m.elements)  // references of nonholonomic deformations
+    for (size_t k = 0; k < el.cls.size(); ++k)
+      if (el.cls[k] == DefClass::Nonholonomic) {
+        auto it = m.elements.find(el.kinematic_of[k][0]);
+        const int i = el.kinematic_of[k][1];
+        if (it == m.elements.end() || i < 1 || i > static_cast<int>(it->second.cls.size()))
+          bad_state("nonholonomic deformation of element " + std::to_string(id));
+      }
+  const py::tuple st = state[3].cast<py::tuple>();
+  if (st.size() != 13) bad_state("settings record");
+  Settings& s = m.settings;
+  s.timestep_n = st[0].cast<int>();
+  s.timestep_tp = st[1].cast<double>();
+  s.hmax = st[2].cast<double>();
+  s.maxiterat = st[3].cast<int>();
+  s.epskin = st[4].cast<double>();
+  s.epsint = st[5].cast<double>();
+  s.epsind = st[6].cast<double>();
+  s.forcemode = st[7].cast<int>();
+  s.animate = st[8].cast<int>();
+  s.matasc = st[9].cast<int>();
+  s.jobid = st[10].cast<std::optional<int>>();
+  s.restart = st[11].cast<int>();
+  s.linear = st[12].cast<std::optional<int>>();
+  m.time = state[4].cast<double>();
+  m.gravity = state[5].cast<std::array<double, 3>>();
+  m.gravity_given = state[6].cast<bool>();
+  if (state[7].cast<bool>()) m.restore_prepared();
+  return m;
 }
 
 void bind_model(py::module_& m) {
@@ -163,6 +339,8 @@ void bind_model(py::module_& m) {
   py::class_<Model>(m, "Model")
       .def(py::init<>())
       .def("copy", [](const Model& self) { return Model(self); })
+      .def(py::pickle([](const Model& self) { return model_state(self); },
+                      [](const py::tuple& state) { return model_from_state(state); }))
       .def("add_element", &Model::add_element, py::arg("type"), py::arg("id"), py::arg("nodes"),
            py::arg("params"), py::arg("origin") = "")
       .def("set_coordinates", &Model::set_coordinates, py::arg("node"), py::arg("kind"), py::arg("values"),
@@ -362,7 +540,8 @@ void bind_simulation(py::module_& m) {
            })
       .def(
           "run",
-          [](Simulation& s, py::object on_output, double initial_step, const std::string& method) {
+          [](Simulation& s, py::object on_output, double initial_step, const std::string& method,
+             double time_limit) {
             RunOptions opt;
             opt.initial_step = initial_step;
             if (method == "dop853") opt.method = Method::DOP853;
@@ -385,14 +564,23 @@ void bind_simulation(py::module_& m) {
                 on_output(k, state);
               };
             }
+            opt.time_limit = time_limit;
             BlockResults r;
+            std::exception_ptr failure;
             {
               py::gil_scoped_release release;
-              r = s.run(opt);
+              try {
+                s.run(r, opt);
+              } catch (...) {
+                failure = std::current_exception();
+              }
             }
+            if (failure) raise_with_results(failure, block_results_to_dict(std::move(r)));
             return block_results_to_dict(std::move(r));
           },
-          py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853");
+          py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
+          py::arg("time_limit") = 0.0,
+          "Run the block; on failure the exception has the results up to the failure as `results`.");
 }
 
 }  // namespace
@@ -400,6 +588,8 @@ void bind_simulation(py::module_& m) {
 PYBIND11_MODULE(_core, m) {
   m.doc() = "spacar C++ core";
   bind_errors(m);
+  m.def("memory_limit", &memory_limit, "Bytes one analysis may allocate for its work and result arrays.");
+  m.def("set_memory_limit", &set_memory_limit, py::arg("bytes"));
   bind_catalogue(m);
   bind_model(m);
   bind_simulation(m);

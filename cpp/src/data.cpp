@@ -1,6 +1,10 @@
 #include "spacar/data.hpp"
 
+#include <algorithm>
 #include <limits>
+#include <string>
+
+#include "spacar/limits.hpp"
 
 namespace spacar {
 
@@ -92,6 +96,10 @@ void Data::build_equations_of_motion(const System& sys) {
 
 void Data::ensure_dense(const System& sys) {
   if (dense_ready) return;
+  require_memory(estimate_dense_bytes(sys),
+                 "the dense transfer functions and mass matrices of " + std::to_string(sys.nx) +
+                     " nodal coordinates and " + std::to_string(sys.ne) + " deformations",
+                 "the linearization uses dense matrices, spacar.simulate does not");
   const int nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
   rhs_DF = Eigen::MatrixXd::Zero(static_cast<int>(sys.rows_V.size()), nq);
   DF = Eigen::MatrixXd::Zero(nx, nq);
@@ -100,6 +108,29 @@ void Data::ensure_dense(const System& sys) {
   DFq = Eigen::MatrixXd::Zero(nx, nd);
   Mbar = Eigen::MatrixXd::Zero(nd, nd);
   dense_ready = true;
+}
+
+double Data::estimate_bytes(const System& sys) {
+  const double nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
+  double doubles = 30.0 * (nx + ne + nq + nd);  // vectors
+  for (const SystemElement& se : sys.elements) {
+    const double n = static_cast<double>(se.coords.size()), m = se.nd;
+    // Work arrays, S, D and kernel; entries of A_P, A_V and the equations of motion, with ten
+    // times the entries again for the fill of their sparse factors.
+    doubles += 2.0 * m * n + n * n + 6.0 * n + 2.0 * m * m + 64.0 + 11.0 * (2.0 * m * n + 2.0 * m * n + n * n);
+  }
+  return 8.0 * doubles;
+}
+
+double Data::estimate_dense_bytes(const System& sys) {
+  const double nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
+  const double nV = static_cast<double>(sys.rows_V.size()), nc = static_cast<double>(sys.x_calc.size());
+  const double doubles = nx * nx                  // M
+                         + ne * ne                // global constitutive matrices of the linearization
+                         + nV * nq + nc * nq      // rhs_DF and the solution of the transfer functions
+                         + 2.0 * nx * nq + ne * nq  // DF (and the linearization's copy), DFe
+                         + nx * nd + 2.0 * nd * nd;  // DFq, Mbar and its factor
+  return 8.0 * doubles;
 }
 
 }  // namespace spacar

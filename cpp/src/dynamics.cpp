@@ -153,6 +153,15 @@ void solve_dynamics(const System& sys, Data& data) {
   data.rhs = -data.rhs;
   assemble_mass_matrix(sys, data);
   data.Mbar.noalias() = data.DFq.transpose() * data.M * data.DFq;
+  if (!data.Mbar.allFinite()) {
+    // Overflow (e.g. an enormous MASS or a state far out of range in a trial step): not a
+    // singular matrix. Non-finite accelerations make the integrator reject the step and report
+    // the non-finite values if no smaller step helps.
+    data.qdd.setConstant(std::numeric_limits<double>::quiet_NaN());
+    for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
+    solve_accelerations(sys, data);
+    return;
+  }
   data.llt.compute(data.Mbar);
   if (nd == 0) return;
   if (data.llt.info() != Eigen::Success) throw_singular_mass(sys, data, data.Mbar);
@@ -199,7 +208,19 @@ void solve_dynamics_direct(const System& sys, Data& data) {
   for (size_t b = 0; b < sys.bodies.size(); ++b) data.KKT.add(data.KKT_body[b], data.body_M[b]);
   for (int g = 0; g < sys.nx; ++g)
     if (data.free_index[g] >= 0) data.kkt_rhs[data.free_index[g]] = -data.g[g];
-  if (!data.luK.factorize(data.KKT.matrix())) {
+  // Values beyond double precision (an enormous stiffness, load or mass) overflow here or in the
+  // solution: that is not a singular mass matrix, and no smaller step can help.
+  const Eigen::SparseMatrix<double>& K = data.KKT.matrix();
+  const Eigen::Map<const Eigen::VectorXd> K_values(K.valuePtr(), K.nonZeros());
+  auto overflow = [&]() {
+    std::ostringstream os;
+    os << "the accelerations at t = " << data.t
+       << " are not finite: the model's values exceed double precision (check the magnitudes of loads, masses, "
+          "stiffnesses and rates)";
+    return Error(os.str());
+  };
+  if (!data.kkt_rhs.allFinite() || !K_values.allFinite()) throw overflow();
+  if (!data.luK.factorize(K)) {
     // Name the degrees of freedom without inertia through the reduced equations.
     solve_transfer(sys, data);
     solve_velocities(sys, data);
@@ -223,8 +244,11 @@ void solve_dynamics_direct(const System& sys, Data& data) {
   for (int g : sys.x_dyn) data.qdd[j++] = data.xdd[g];
   for (int k : sys.e_dyn) data.qdd[j++] = data.edd[k];
   for (j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
-  if (!data.qdd.allFinite() || !data.xdd.allFinite())
+  if (!data.qdd.allFinite() || !data.xdd.allFinite()) {
+    constexpr double kHuge = 1e150;  // entries whose products overflow
+    if (data.kkt_rhs.cwiseAbs().maxCoeff() > kHuge || K_values.cwiseAbs().maxCoeff() > kHuge) throw overflow();
     throw SingularMassError("the equations of motion have no finite solution at t = " + std::to_string(data.t));
+  }
 }
 
 namespace {

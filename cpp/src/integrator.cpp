@@ -166,7 +166,6 @@ constexpr Scheme kDopri5{6, 7, 1, 5.0, 0.2, 10.0, true, kC5, kA5, kD5};
 const Scheme& scheme(Method m) { return m == Method::DOP853 ? kDop853 : kDopri5; }
 
 constexpr double kSafety = 0.9;
-constexpr long kMaxSteps = 10000000;
 
 // out = y + h * sum_j row[j] * k[j] over the first `count` stages (zero weights skipped: the
 // tableaux are sparse).
@@ -234,6 +233,13 @@ void Integrator::set_initial_step(double h) {
     throw std::invalid_argument("Integrator: the initial step must be finite and >= 0");
   h_initial_ = h;
 }
+
+void Integrator::set_max_steps(long n) {
+  if (n < 1) throw std::invalid_argument("Integrator: the step limit must be positive");
+  max_steps_ = n;
+}
+
+double Integrator::min_step(double t) { return 1e-12 * std::max(1.0, std::abs(t)); }
 
 double Integrator::last_step() const { return h_last_; }
 
@@ -413,11 +419,11 @@ double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::Vecto
   bool rejected = false;   // the previous attempt failed: do not grow the step right after
   double t = t0;
   for (long steps = 0; t < t_end; ++steps) {
-    if (steps >= kMaxSteps)
-      throw IntegrationError("Integrator: more than " + std::to_string(kMaxSteps) +
+    if (steps >= max_steps_)
+      throw IntegrationError("Integrator: more than " + std::to_string(max_steps_) +
                              " steps at " + describe(t, h));
-    const double h_min = 1e-12 * std::max(1.0, std::abs(t));
-    if (h < h_min)
+    const double h_min = min_step(t);
+    if (!(h >= h_min))  // also a NaN step (from a non-finite error estimate)
       throw IntegrationError("Integrator: step size underflow at " + describe(t, h) +
                              " (last rejection: " + failure_ + ")");
 

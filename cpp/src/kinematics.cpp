@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "spacar/errors.hpp"
+#include "spacar/limits.hpp"
 
 namespace spacar {
 
@@ -329,19 +330,26 @@ void solve_accelerations(const System& sys, Data& data) {
 namespace {
 
 // Greedy selection in the given order: vectors (columns of V) that add rank are kept, the others
-// are dependent on those before them. Returns the dependent ones.
+// are dependent on those before them. Returns the dependent ones. Gram-Schmidt with
+// reorthogonalisation against the kept vectors, held as the columns of one matrix so that each
+// projection is a matrix-vector product (large models: thousands of columns).
 std::vector<int> dependent_columns(const Eigen::MatrixXd& V, const std::vector<int>& order) {
-  std::vector<Eigen::VectorXd> basis;
+  const Eigen::Index m = V.rows();
+  Eigen::MatrixXd basis(m, std::min<Eigen::Index>(m, static_cast<Eigen::Index>(order.size())));
+  Eigen::Index k = 0;
+  Eigen::VectorXd v(m), c;
   std::vector<int> dependent;
   for (int j : order) {
-    Eigen::VectorXd v = V.col(j);
+    v = V.col(j);
     const double norm0 = v.norm();
-    for (int pass = 0; pass < 2; ++pass)  // twice: Gram-Schmidt with reorthogonalisation
-      for (const Eigen::VectorXd& b : basis) v -= b.dot(v) * b;
-    if (norm0 == 0.0 || v.norm() <= 1e-8 * norm0) {
+    for (int pass = 0; pass < 2 && k > 0; ++pass) {  // twice: Gram-Schmidt with reorthogonalisation
+      c.noalias() = basis.leftCols(k).transpose() * v;
+      v.noalias() -= basis.leftCols(k) * c;
+    }
+    if (norm0 == 0.0 || k == basis.cols() || v.norm() <= 1e-8 * norm0) {
       dependent.push_back(j);
     } else {
-      basis.push_back(v / v.norm());
+      basis.col(k++) = v / v.norm();
     }
   }
   return dependent;
@@ -357,26 +365,36 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
   const int nc = static_cast<int>(sys.x_calc.size());
   d.n_constraints = nP;
   d.n_calculable = nc;
-  if (nP > 0 && nc > 0) {
+  const bool too_large = nP > kMaxDiagnosisSize || nc > kMaxDiagnosisSize;
+  if (too_large) {
+    d.rank = -1;
+  } else if (nP > 0 && nc > 0) {
+    // Full SVD: U (nP x nP), V (nc x nc), the block and its work copy.
+    require_memory(8.0 * (static_cast<double>(nP) * nP + static_cast<double>(nc) * nc + 3.0 * nP * nc),
+                   "the constraint diagnosis of " + std::to_string(nP) + " constraints on " + std::to_string(nc) +
+                       " calculable coordinates",
+                   "");
     evaluate_elements(sys, data);
     assemble_block(sys, data, block, velocity ? data.AV_block : data.AP_block);
     const Eigen::MatrixXd A = Eigen::MatrixXd(block.matrix());
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::BDCSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const Eigen::VectorXd& s = svd.singularValues();
     const double tol = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(s[0], 1e-300);
     for (int i = 0; i < s.size(); ++i) d.rank += s[i] > tol;
     for (int i = d.rank; i < nP; ++i) {  // left null vectors: combinations of redundant rows
       const Eigen::VectorXd u = svd.matrixU().col(i);
+      const double umax = u.cwiseAbs().maxCoeff();
       std::vector<std::pair<int, double>> group;
       for (int r = 0; r < nP; ++r)
-        if (std::abs(u[r]) > 0.1 * u.cwiseAbs().maxCoeff()) group.push_back({rows[r], u[r] / u.cwiseAbs().maxCoeff()});
+        if (std::abs(u[r]) > 0.1 * umax) group.push_back({rows[r], u[r] / umax});
       d.redundant_groups.push_back(group);
     }
     for (int i = d.rank; i < nc; ++i) {  // right null vectors: undetermined motions
       const Eigen::VectorXd v = svd.matrixV().col(i);
+      const double vmax = v.cwiseAbs().maxCoeff();
       std::vector<std::pair<int, double>> group;
       for (int j = 0; j < nc; ++j)
-        if (std::abs(v[j]) > 0.1 * v.cwiseAbs().maxCoeff()) group.push_back({sys.x_calc[j], v[j] / v.cwiseAbs().maxCoeff()});
+        if (std::abs(v[j]) > 0.1 * vmax) group.push_back({sys.x_calc[j], v[j] / vmax});
       d.undetermined_groups.push_back(group);
     }
     // A concrete set to release: keep prescribed rows (inputs, DOFs) first, then fixed ones in
@@ -388,11 +406,14 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
         const bool fixed = c == DefClass::Fixed || c == DefClass::Nonholonomic;
         if ((pass == 1) == fixed) order.push_back(r);
       }
-    for (int r : dependent_columns(A.transpose(), order)) d.redundant.push_back(rows[r]);
+    // (The selections cost O(n^3): skipped when the SVD shows full rank.)
+    if (d.rank < nP)
+      for (int r : dependent_columns(A.transpose(), order)) d.redundant.push_back(rows[r]);
     std::sort(d.redundant.begin(), d.redundant.end());
     std::vector<int> cols(nc);
     for (int j = 0; j < nc; ++j) cols[j] = j;
-    for (int j : dependent_columns(A, cols)) d.undetermined.push_back(sys.x_calc[j]);
+    if (d.rank < nc)
+      for (int j : dependent_columns(A, cols)) d.undetermined.push_back(sys.x_calc[j]);
   } else if (nc > 0) {
     d.undetermined = sys.x_calc;
   } else {
@@ -408,25 +429,49 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
        << " calculable coordinates";
   if (nP > nc) os << ": over-constrained by " << nP - nc;
   if (nP < nc) os << ": under-constrained by " << nc - nP;
+  if (too_large) {
+    os << "; the block is too large for a detailed diagnosis (at most " << kMaxDiagnosisSize
+       << " constraints and calculable coordinates).";
+    d.text = os.str();
+    return d;
+  }
   os << "; rank " << d.rank << ".";
   if (velocity && (!d.redundant.empty() || !d.undetermined.empty()))
     os << "\n  the nonholonomic constraints (ENHC) do not determine these rates: pair each nonholonomic"
           "\n  deformation with a kinematic coordinate whose rate it determines (formulation.md §5).";
+  // Long lists are cut (the structured fields keep everything): an error message stays readable.
+  constexpr size_t kItems = 20, kGroups = 5, kTerms = 12;
+  auto more = [&os](size_t shown, size_t total, const char* what) {
+    if (total > shown) os << "\n   ... and " << total - shown << " more " << what;
+  };
   if (!d.redundant.empty()) {
     os << "\n  redundant constraints; release these (RLSE) to remove the redundancy:";
-    for (int k : d.redundant) os << "\n   - RLSE " << sys.def_label[k][0] << " " << sys.def_label[k][1] << "   (" << sys.def_name(k) << ")";
-    for (const auto& group : d.redundant_groups) {
-      os << "\n  dependent combination:";
-      for (const auto& [k, w] : group) os << " " << sys.def_name(k) << " (weight " << w << ")";
+    for (size_t i = 0; i < d.redundant.size() && i < kItems; ++i) {
+      const int k = d.redundant[i];
+      os << "\n   - RLSE " << sys.def_label[k][0] << " " << sys.def_label[k][1] << "   (" << sys.def_name(k) << ")";
     }
+    more(kItems, d.redundant.size(), "redundant constraints");
+    for (size_t i = 0; i < d.redundant_groups.size() && i < kGroups; ++i) {
+      const auto& group = d.redundant_groups[i];
+      os << "\n  dependent combination:";
+      for (size_t t = 0; t < group.size() && t < kTerms; ++t)
+        os << " " << sys.def_name(group[t].first) << " (weight " << group[t].second << ")";
+      if (group.size() > kTerms) os << " ... (" << group.size() - kTerms << " more terms)";
+    }
+    more(kGroups, d.redundant_groups.size(), "dependent combinations");
   }
   if (!d.undetermined.empty()) {
     os << "\n  undetermined coordinates; fix them (FIX), make them degrees of freedom (DYNX) or add elements:";
-    for (int g : d.undetermined) os << "\n   - " << sys.coord_name(g);
-    for (const auto& group : d.undetermined_groups) {
+    for (size_t i = 0; i < d.undetermined.size() && i < kItems; ++i) os << "\n   - " << sys.coord_name(d.undetermined[i]);
+    more(kItems, d.undetermined.size(), "undetermined coordinates");
+    for (size_t i = 0; i < d.undetermined_groups.size() && i < kGroups; ++i) {
+      const auto& group = d.undetermined_groups[i];
       os << "\n  free motion:";
-      for (const auto& [g, w] : group) os << " " << sys.coord_name(g) << " (weight " << w << ")";
+      for (size_t t = 0; t < group.size() && t < kTerms; ++t)
+        os << " " << sys.coord_name(group[t].first) << " (weight " << group[t].second << ")";
+      if (group.size() > kTerms) os << " ... (" << group.size() - kTerms << " more terms)";
     }
+    more(kGroups, d.undetermined_groups.size(), "free motions");
   }
   d.text = os.str();
   return d;
@@ -438,9 +483,9 @@ std::string diagnose_constraints(const System& sys, Data& data, bool velocity) {
 
 std::string weakest_constraint(const System& sys, Data& data) {
   const int nV = static_cast<int>(sys.rows_V.size()), nc = static_cast<int>(sys.x_calc.size());
-  if (nV != nc || nc == 0) return "";
+  if (nV != nc || nc == 0 || nc > kMaxDiagnosisSize) return "";
   assemble_block(sys, data, data.AV, data.AV_block);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(data.AV.matrix()), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(data.AV.matrix()), Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd& s = svd.singularValues();
   const double ratio = s[nc - 1] / s[0];
   if (!(ratio < 1e-6)) return "";

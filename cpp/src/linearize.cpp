@@ -3,6 +3,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <sstream>
+#include <utility>
 
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
@@ -175,6 +177,20 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
   lin.Kk = dy.topRows(nz);
   lin.BK0.resize(nk, nz + nk);
   lin.BK0 << dz.bottomRows(nk), dy.bottomRows(nk);
+  // Values beyond double precision (e.g. GRAVITY 1e308) give infinities and NaNs here: refuse them
+  // rather than hand non-finite matrices to the eigen-analyses.
+  auto refuse = [&](const char* name) {
+    std::ostringstream os;
+    os << "the linearized equations at t = " << data.t << " are not finite (" << name
+       << " has infinite or NaN entries): the model's values exceed double precision";
+    throw Error(os.str());
+  };
+  for (const auto& [name, m] : {std::pair<const char*, const Eigen::MatrixXd*>{"M0", &lin.M0}, {"C0", &lin.C0},
+                                {"D0", &lin.D0}, {"K0", &lin.K0}, {"N0", &lin.N0}, {"G0", &lin.G0},
+                                {"Kk", &lin.Kk}, {"AK0", &lin.AK0}, {"BK0", &lin.BK0},
+                                {"DF", &lin.DFz}, {"DFe", &lin.DFez}})
+    if (!m->allFinite()) refuse(name);
+  if (!lin.r0.allFinite()) refuse("r0");
   return lin;
 }
 

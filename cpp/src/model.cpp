@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <Eigen/Dense>
@@ -287,6 +288,9 @@ void Model::set_nonholonomic(int e1, int i1, int e2, int i2) {
   const int k1 = deformation_index(a, i1);
   const int k2 = deformation_index(b, i2);
   if (e1 == e2 && i1 == i2) fail("a nonholonomic deformation cannot be its own kinematic coordinate");
+  if (a.cls[k1] == DefClass::Kinematic)
+    fail("element ", e1, " deformation ", i1,
+         " is the kinematic coordinate of a nonholonomic deformation (ENHC); change that ENHC first");
   if (b.cls[k2] != DefClass::Fixed && b.cls[k2] != DefClass::Kinematic)
     fail("the kinematic coordinate element ", e2, " deformation ", i2, " must be a fixed deformation, it is ",
          def_class_name(b.cls[k2]), " (manual §5.3 note 2)");
@@ -295,6 +299,15 @@ void Model::set_nonholonomic(int e1, int i1, int e2, int i2) {
       if (el.kinematic_of[k][0] == e2 && el.kinematic_of[k][1] == i2 && !(id == e1 && int(k) == k1))
         fail("element ", e2, " deformation ", i2, " is already the kinematic coordinate of element ", id,
              " deformation ", k + 1);
+  // A second ENHC of the same deformation replaces its pairing: the old kinematic coordinate
+  // becomes a fixed deformation again (as when the nonholonomic deformation changes class).
+  if (a.cls[k1] == DefClass::Nonholonomic) {
+    const auto [old_e, old_i] = a.kinematic_of[k1];
+    if (!(old_e == e2 && old_i == i2)) {
+      Element& old = element(old_e);
+      if (old.cls[old_i - 1] == DefClass::Kinematic) old.cls[old_i - 1] = DefClass::Fixed;
+    }
+  }
   a.cls[k1] = DefClass::Nonholonomic;
   a.kinematic_of[k1] = {e2, i2};
   b.cls[k2] = DefClass::Kinematic;
@@ -530,12 +543,20 @@ void Model::add_automatic_constraints() {
   const int l2 = find_element_type("L2MIN1");
   for (const auto& [id, el] : elements)
     if (el.type == l2) has_constraint[el.nodes[0]] = true;
-  int next = elements.empty() ? 1 : elements.rbegin()->first + 1;
+  // Numbers after the largest element number; once that is the largest int (an input may use
+  // it), the smallest free numbers.
+  int next = elements.empty() ? 0 : elements.rbegin()->first;
+  auto free_number = [&]() {
+    if (next < std::numeric_limits<int>::max()) return ++next;
+    int k = 1;
+    while (elements.count(k)) ++k;
+    return k;
+  };
   for (const auto& [node_id, has] : has_constraint) {
     if (has) continue;
-    add_element("L2MIN1", next, {node_id}, {});
-    elements.at(next).automatic = true;
-    ++next;
+    const int id = free_number();
+    add_element("L2MIN1", id, {node_id}, {});
+    elements.at(id).automatic = true;
   }
 }
 
@@ -558,12 +579,21 @@ void Model::compute_reference_geometry() {
       fail(located(el.origin), t.name, " ", id, ": ", err.what());
     }
     if (t.has_length && !el.l0) {
+      if (!std::isfinite(l0))
+        fail(located(el.origin), t.name, " ", id,
+             " has a length that is not a finite number (the coordinates of its nodes are too large)");
       if (!(l0 > 0.0))
         fail(located(el.origin), t.name, " ", id,
              " has zero length: its nodes coincide in the initial positions");
       el.l0 = l0;
     }
-    if (t.n_lgeomy > 0 && el.lgeomy.empty()) el.lgeomy = lgeomy;
+    if (t.n_lgeomy > 0 && el.lgeomy.empty()) {
+      for (double v : lgeomy)
+        if (!std::isfinite(v))
+          fail(located(el.origin), t.name, " ", id,
+               ": its reference geometry (LGEOMY) is not finite (the coordinates of its nodes are too large)");
+      el.lgeomy = lgeomy;
+    }
   }
 }
 

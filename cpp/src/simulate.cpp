@@ -8,6 +8,7 @@
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
+#include "spacar/limits.hpp"
 
 namespace spacar {
 
@@ -15,7 +16,12 @@ namespace {
 
 std::unique_ptr<System> prepare_and_compile(Model& model) {
   model.prepare();
-  return compile(model);
+  std::unique_ptr<System> sys = compile(model);
+  require_memory(Data::estimate_bytes(*sys),
+                 "the analysis of " + std::to_string(sys->nx) + " nodal coordinates and " + std::to_string(sys->ne) +
+                     " deformations",
+                 "");
+  return sys;
 }
 
 }  // namespace
@@ -230,6 +236,7 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
 
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  check_time(t);
   struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side
     bool& flag;
     explicit InRhs(bool& f) : flag(f) { flag = true; }
@@ -261,82 +268,201 @@ void Simulation::record(BlockResults& res, int k) {
 }
 
 BlockResults Simulation::run(const RunOptions& options) {
+  BlockResults res;
+  run(res, options);
+  return res;
+}
+
+void Simulation::require_finite_state(double t) const {
+  // Values beyond double precision (e.g. FORCE 8 1e308 on a support) must not reach the results
+  // as infinities or NaNs: the run stops here and keeps the output times before.
+  const std::pair<const char*, const Eigen::VectorXd*> parts[] = {
+      {"coordinates", &data_->x}, {"velocities", &data_->xd}, {"accelerations", &data_->xdd},
+      {"deformations", &data_->e}, {"deformation rates", &data_->ed}, {"deformation accelerations", &data_->edd},
+      {"stresses", &data_->sigma}, {"reactions", &data_->reaction}};
+  for (const auto& [name, v] : parts)
+    if (!v->allFinite()) {
+      std::ostringstream os;
+      os << "the " << name << " at t = " << t
+         << " are not finite: the model's values exceed double precision (check the magnitudes of loads, "
+            "masses, stiffnesses and rates)";
+      throw Error(os.str());
+    }
+}
+
+void Simulation::check_time(double t) {
+  if (has_deadline_ && std::chrono::steady_clock::now() > deadline_) {
+    std::ostringstream os;
+    os << "the time limit of " << time_limit_ << " s was exceeded at t = " << t;
+    throw TimeLimitError(os.str());
+  }
+}
+
+namespace {
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+
+// Keep the first `rows` rows of every time-indexed array (a run that failed midway).
+void cut_rows(BlockResults& res, int rows) {
+  res.t.conservativeResize(rows);
+  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd, &res.reaction, &res.e, &res.ed, &res.edd, &res.sigma})
+    m->conservativeResize(rows, m->cols());
+}
+
+}  // namespace
+
+void Simulation::run(BlockResults& res, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  if (!(options.time_limit >= 0.0)) throw InputError("the time limit must not be negative");
+  if (options.max_steps < 1) throw InputError("the step limit must be positive");
+  has_deadline_ = options.time_limit > 0.0 && std::isfinite(options.time_limit);
+  time_limit_ = options.time_limit;
+  if (has_deadline_)
+    deadline_ = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(options.time_limit));
   // The system may be recompiled during the run (repartition): keep copies, not references.
-  const Settings st = sys_->settings;
+  Settings st = sys_->settings;
   const int n_out = st.timestep_n;
   const double t0 = sys_->t0, t_end = t0 + st.timestep_tp;
-  BlockResults res;
+  res = BlockResults();
   res.warnings = sys_->warnings;
+  const int nd0 = sys_->n_dof(), ny0 = static_cast<int>(sys_->y_defs.size());
+  const bool linear = !sys_->e_line.empty() || st.linear.value_or(0) >= 1;
+
+  // Requests that cannot be carried out are refused before any work (formulation.md §8.1).
+  if (!std::isfinite(t_end))
+    throw InputError("TIMESTEP: the end time TIME + Tp = " + num(t0) + " + " + num(st.timestep_tp) +
+                     " is not a finite number");
+  if (n_out > 0 && st.timestep_tp > 0.0 && !(t0 + st.timestep_tp / n_out > t0))
+    throw InputError("TIMESTEP: the output interval Tp/n = " + num(st.timestep_tp / n_out) +
+                     " is lost in the rounding of the time t = " + num(t0) + " (TIME)");
+  const bool integrate = (nd0 > 0 || ny0 > 0) && n_out > 0 && t_end > t0;
+  if (integrate) {
+    const double h_min = Integrator::min_step(t_end);
+    if (st.timestep_tp < h_min)
+      throw InputError("TIMESTEP: the period Tp = " + num(st.timestep_tp) +
+                       " is shorter than the smallest integration step " + num(h_min) + " at t = " + num(t_end));
+    if (st.hmax < Integrator::min_step(t0))
+      throw InputError("HMAX " + num(st.hmax) + " is below the smallest integration step " +
+                       num(Integrator::min_step(t0)) + " at t = " + num(t0));
+    if (st.timestep_tp / st.hmax > static_cast<double>(options.max_steps))
+      throw InputError("HMAX " + num(st.hmax) + " needs at least Tp/HMAX = " + num(st.timestep_tp / st.hmax) +
+                       " steps, more than the limit of " + std::to_string(options.max_steps) + " steps per block");
+    for (auto [eps, name] : {std::pair<double*, const char*>{&st.epsint, "EPSINT"}, {&st.epsind, "EPSIND"}})
+      if (*eps < kMinTolerance) {
+        res.warnings.push_back(std::string(name) + " " + num(*eps) +
+                               " is below the attainable accuracy in double precision: " + num(kMinTolerance) +
+                               " (100 machine epsilons) is used");
+        *eps = kMinTolerance;
+      }
+  }
   const int nt = n_out + 1;
+  {
+    const double nx = sys_->nx, ne = sys_->ne, nz = nd0 + static_cast<double>(sys_->e_line.size());
+    double per_time = 8.0 * (1.0 + 4.0 * nx + 4.0 * ne);
+    if (linear) per_time += 8.0 * (6.0 * nz * nz + nz + (nx + ne) * nz);
+    require_memory(per_time * nt,
+                   "the results of " + std::to_string(nt) + " output times (" + std::to_string(sys_->nx) +
+                       " coordinates, " + std::to_string(sys_->ne) + " deformations" +
+                       (linear ? ", linearized equations" : "") + ")",
+                   "use fewer output intervals (TIMESTEP n) or split the period into blocks");
+  }
   res.t.resize(nt);
   for (RowMatrix* m : {&res.x, &res.xd, &res.xdd, &res.reaction}) m->resize(nt, sys_->nx);
   res.reaction.setZero();
-  const bool linear = !sys_->e_line.empty() || st.linear.value_or(0) >= 1;
   for (RowMatrix* m : {&res.e, &res.ed, &res.edd, &res.sigma}) m->resize(nt, sys_->ne);
   std::vector<double> times(nt);
   for (int k = 0; k < nt; ++k) times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
   times.back() = t_end;  // exactly the end of the block, whatever the rounding
 
-  assemble();
-  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   int k_out = 0;
-  auto output = [&](double t, const Eigen::VectorXd& Y) {
-    evaluate_state(t, Y);
-    if (st.forcemode >= 1 || linear) forces();
-    else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
-    if (linear) res.linearizations.push_back(linearize());
-    record(res, k_out);
-    if (options.on_output) options.on_output(k_out, *data_, linear ? &res.linearizations.back() : nullptr);
-    ++k_out;
+  auto finish = [&]() {
+    res.newton_iterations = data_->total_newton_iterations;
+    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  // State Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
-  Eigen::VectorXd Y(2 * nd + ny);
-  Y << sys_->q0, sys_->y0, sys_->qd0;
-  if ((nd == 0 && ny == 0) || n_out == 0 || !(t_end > t0)) {
-    // Kinematic analysis (or a single analysis at the current time).
-    for (double t : times) output(t, Y);
-  } else {
-    double t = t0, h = options.initial_step;
-    kinematic_failure_.clear();
-    for (;;) {
-      // One segment: integrate until the end, or until a free rotation must be repartitioned.
-      Integrator integ(static_cast<int>(Y.size()), options.method);
-      Eigen::VectorXd rtol(Y.size());
-      rtol.head(nd + ny).setConstant(st.epsint);
-      rtol.tail(nd).setConstant(st.epsind);
-      integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
-      integ.set_max_step(st.hmax);
-      if (h > 0.0) integ.set_initial_step(h);
-      // Stop to repartition a free rotation whose dependent Euler parameter became small.
-      if (!sys_->free_rotations.empty())
-        integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
-      integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
-      anchor_.valid = false;
-      const std::vector<double> remaining(times.begin() + k_out, times.end());
-      auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
-      double t_reached = t;
-      try {
-        t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
-      } catch (const IntegrationError& err) {
-        explain_collapse(err, Y);
-        throw;
+  try {
+    assemble();
+    const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+    auto output = [&](double t, const Eigen::VectorXd& Y) {
+      check_time(t);
+      evaluate_state(t, Y);
+      if (st.forcemode >= 1 || linear) forces();
+      else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
+      require_finite_state(t);
+      if (linear) res.linearizations.push_back(linearize());
+      record(res, k_out);
+      if (options.on_output) options.on_output(k_out, *data_, linear ? &res.linearizations.back() : nullptr);
+      ++k_out;
+    };
+    // State Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
+    Eigen::VectorXd Y(2 * nd + ny);
+    Y << sys_->q0, sys_->y0, sys_->qd0;
+    if (!integrate) {
+      // Kinematic analysis (or a single analysis at the current time).
+      for (double t : times) output(t, Y);
+    } else {
+      double t = t0, h = options.initial_step;
+      kinematic_failure_.clear();
+      for (;;) {
+        // One segment: integrate until the end, or until a free rotation must be repartitioned.
+        // The step limit holds for the block, whatever the number of segments.
+        if (res.steps >= options.max_steps)
+          throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
+                                 " steps in the block at t = " + num(t));
+        Integrator integ(static_cast<int>(Y.size()), options.method);
+        Eigen::VectorXd rtol(Y.size());
+        rtol.head(nd + ny).setConstant(st.epsint);
+        rtol.tail(nd).setConstant(st.epsind);
+        integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
+        integ.set_max_step(st.hmax);
+        integ.set_max_steps(options.max_steps - res.steps);
+        if (h > 0.0) integ.set_initial_step(h);
+        // Stop to repartition a free rotation whose dependent Euler parameter became small.
+        if (!sys_->free_rotations.empty())
+          integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+        integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
+        anchor_.valid = false;
+        const std::vector<double> remaining(times.begin() + k_out, times.end());
+        auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
+        auto add_stats = [&]() {
+          const IntegratorStats& s = integ.stats();
+          res.rhs_evaluations += s.nfev;
+          res.steps += s.nsteps;
+          res.accepted += s.naccept;
+          res.rejected += s.nreject;
+        };
+        double t_reached = t;
+        try {
+          t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
+        } catch (const IntegrationError& err) {
+          add_stats();
+          explain_collapse(err, Y);
+          throw;
+        } catch (...) {
+          add_stats();
+          throw;
+        }
+        add_stats();
+        h = res.last_step = integ.last_step();
+        if (t_reached >= t_end) break;
+        t = t_reached;
+        repartition(rotation_to_repartition(Y), t, Y);
       }
-      const IntegratorStats& s = integ.stats();
-      res.rhs_evaluations += s.nfev;
-      res.steps += s.nsteps;
-      res.accepted += s.naccept;
-      res.rejected += s.nreject;
-      h = res.last_step = integ.last_step();
-      if (t_reached >= t_end) break;
-      t = t_reached;
-      repartition(rotation_to_repartition(Y), t, Y);
     }
+  } catch (...) {
+    cut_rows(res, k_out);
+    finish();
+    has_deadline_ = false;
+    throw;
   }
-  res.newton_iterations = data_->total_newton_iterations;
-  res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  has_deadline_ = false;
+  finish();
   store_state();
-  return res;
 }
 
 void Simulation::explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y) {

@@ -88,6 +88,8 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double>& A) {
     const double pmin = dense_lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
     return std::isfinite(pmin) && amax > 0.0 && pmin > 1e-13 * amax;
   }
+  // Overflowed entries (a trial state far out of range) would pass as a "successful" factorization.
+  if (!Eigen::Map<const Eigen::VectorXd>(A.valuePtr(), A.nonZeros()).allFinite()) return false;
   sparse_lu_.factorize(A);
   return sparse_lu_.info() == Eigen::Success;
 }

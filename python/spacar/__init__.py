@@ -16,6 +16,7 @@ that use them (``plot``, ``draw``, ``animate``, ``save_animation``; ``Results.to
 progress bar).
 """
 from . import _core
+from ._util import show as _show
 from .check import Check, Diagnosis, Summary, check, summary
 from .errors import (
     InputError,
@@ -24,6 +25,7 @@ from .errors import (
     NotImplementedError,
     SingularMassError,
     SpacarError,
+    TimeLimitError,
 )
 from .io.reader import parse, read, read_string
 from .io.writer import dump
@@ -33,8 +35,23 @@ from .model import Model
 from .geometry import Geometry
 from .results import Results
 from .simulate import simulate
+from .sweep import SweepError, SweepResult, sweep
 
 __version__ = "0.1.0"
+
+
+def memory_limit() -> int:
+    """Bytes one analysis may allocate for its work and result arrays (default 4 GiB). Inputs
+    that would need more (e.g. ``TIMESTEP 10000000 1`` on a large model) are refused with an
+    :class:`InputError` before anything is allocated."""
+    return _core.memory_limit()
+
+
+def set_memory_limit(nbytes: int) -> None:
+    """Set the limit of :func:`memory_limit` for this process."""
+    if isinstance(nbytes, bool) or not isinstance(nbytes, int) or not 0 < nbytes < 2**63:
+        raise InputError(f"the memory limit must be a positive number of bytes, got {_show(nbytes)}")
+    _core.set_memory_limit(nbytes)
 
 
 def element_catalogue():
@@ -81,6 +98,9 @@ __all__ = [
     "parse",
     "dump",
     "simulate",
+    "sweep",
+    "SweepResult",
+    "SweepError",
     "linearize",
     "Linearization",
     "summary",
@@ -93,5 +113,8 @@ __all__ = [
     "KinematicsError",
     "SingularMassError",
     "IntegrationError",
+    "TimeLimitError",
     "NotImplementedError",
+    "memory_limit",
+    "set_memory_limit",
 ]

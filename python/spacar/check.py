@@ -60,8 +60,14 @@ class Diagnosis:
     text: str
 
     @property
+    def detailed(self) -> bool:
+        """False for a constraint block too large to diagnose (rank -1: counts only)."""
+        return self.rank >= 0
+
+    @property
     def ok(self) -> bool:
-        return not self.redundant and not self.undetermined and self.n_constraints == self.n_calculable
+        return (self.detailed and not self.redundant and not self.undetermined
+                and self.n_constraints == self.n_calculable)
 
 
 @dataclass
@@ -70,7 +76,10 @@ class Check:
     diagnosis: Diagnosis
 
     def __str__(self):
-        verdict = "the constraints determine the calculable coordinates" if self.diagnosis.ok else "problems:"
+        if self.diagnosis.ok:
+            verdict = "the constraints determine the calculable coordinates"
+        else:
+            verdict = "problems:" if self.diagnosis.detailed else "not diagnosed:"
         return f"{self.summary}\nconstraints: {verdict}\n{self.diagnosis.text}"
 
 

@@ -14,6 +14,7 @@ Everything that is not the dump is printed as ``*`` comment lines, so the output
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import sys
 from pathlib import Path
@@ -64,7 +65,17 @@ def _run(args) -> int:
         model.output_stem = args.output_stem
     animated = []
     n_warn = len(model.warnings)
-    for k, res in enumerate(model.run_blocks(method=args.method, progress=args.progress)):
+    blocks = model.run_blocks(method=args.method, progress=args.progress, time_limit=args.time_limit)
+    for k in itertools.count():
+        try:
+            res = next(blocks)
+        except StopIteration:
+            break
+        except SpacarError as err:
+            partial = getattr(err, "results", None)
+            if partial is not None:  # say how far the block got
+                err.args = (f"{err} ({len(partial)} of {model.settings.timestep_n + 1} output times computed)",)
+            raise
         if model.settings.animate == 1:
             animated.append(res)
         for w in model.warnings[n_warn:]:
@@ -118,6 +129,16 @@ def _digits(text: str) -> int:
     return value
 
 
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds, got {text!r}") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, got {text!r}")
+    return value
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="spacar", description="Kinematic and dynamic analysis of multibody systems (SPACAR95 input format).")
     parser.add_argument("--version", action="version", version=f"spacar {__version__}")
@@ -134,6 +155,8 @@ def main(argv=None) -> int:
                      help="stem of the MATASC and animation files (default: the input file without extension)")
     run.add_argument("--animation", metavar="FILE",
                      help="file of the ANIMATE 1 animation: .gif (default <stem>.gif), .mp4 (ffmpeg) or .html")
+    run.add_argument("--time-limit", type=_seconds, default=None, metavar="SECONDS",
+                     help="wall-clock limit per block (default: none); beyond it the run stops with an error")
     run.set_defaults(func=_run)
     check = sub.add_parser("check", help="summarise the model: nodes, elements, classes, degrees of freedom")
     check.add_argument("file")

@@ -147,6 +147,14 @@ def linearize(model, state=None) -> Linearization:
     if state is None:
         t, q, qd = model.current_time, system.q0, system.qd0
     else:
-        t, q, qd = state
+        try:
+            t, q, qd = state
+            t = float(t)
+            q = np.asarray(q, dtype=float).reshape(-1)
+            qd = np.asarray(qd, dtype=float).reshape(-1)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError("state must be (t, q, qd): a time and two arrays of numbers") from None
+        if not (np.isfinite(t) and np.isfinite(q).all() and np.isfinite(qd).all()):
+            raise InputError("state (t, q, qd) must hold finite numbers only (no NaN or infinity)")
     sim.move_to(float(t), np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
     return Linearization(sim.linearize(), system.coord_label, system.def_label)

@@ -8,7 +8,10 @@ from __future__ import annotations
 import math
 import numbers
 
+import numpy as np
+
 from . import _core
+from ._util import show
 from .errors import InputError
 from .keywords import INT, KEYWORDS, Keyword
 
@@ -16,21 +19,29 @@ _INT_LIMIT = 2**31 - 1
 
 
 def _check_value(kw: Keyword, pname: str, kind: str, value):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise InputError(f"{kw.name}: {pname} must be a number, got {value!r}")
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]  # a 0-d array is its number
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise InputError(f"{kw.name}: {pname} must be a number, got {show(value)}")
+    try:
+        real, overflow = float(value), False
+    except (OverflowError, ValueError, TypeError):  # huge Python ints and fractions
+        real, overflow = math.inf, True
     if kind == INT:
         if isinstance(value, numbers.Integral):
             value = int(value)
-        elif math.isfinite(value) and float(value).is_integer():
-            value = int(value)
+        elif math.isfinite(real) and real.is_integer():
+            value = int(real)
         else:
-            raise InputError(f"{kw.name}: {pname} must be an integer, got {value!r}")
+            raise InputError(f"{kw.name}: {pname} must be an integer, got {show(value)}")
         if abs(value) > _INT_LIMIT:
-            raise InputError(f"{kw.name}: {pname} = {value} is out of range")
+            raise InputError(f"{kw.name}: {pname} = {show(value)} is out of range")
         return value
-    value = float(value)
+    if overflow:
+        raise InputError(f"{kw.name}: {pname} must be a finite number, got a value too large for a double")
+    value = real
     if not math.isfinite(value):
-        raise InputError(f"{kw.name}: {pname} must be a finite number, got {value!r}")
+        raise InputError(f"{kw.name}: {pname} must be a finite number, got {show(value)}")
     return value
 
 
@@ -94,9 +105,9 @@ class Model:
         """Apply one keyword line: ``model.apply("FIX", 8, 2)``. ``origin`` (file, line, keyword)
         is remembered with the elements and nodes the line defines, for errors found at the
         first END (e.g. an element of zero length)."""
-        kw = KEYWORDS.get(keyword.upper())
+        kw = KEYWORDS.get(keyword.upper()) if isinstance(keyword, str) else None
         if kw is None or kw.name in ("END", "EOF"):
-            raise InputError(f"unknown keyword {keyword!r}")
+            raise InputError(f"unknown keyword {show(keyword)}")
         self._origin = origin
         try:
             return getattr(self, kw.builder)(*args)

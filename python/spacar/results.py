@@ -367,6 +367,7 @@ class Results:
 
     def __repr__(self):
         if len(self.t) == 0:
-            return "<spacar.Results: no output times>"
+            return (f"<spacar.Results: no output times, {self.x.shape[1]} coordinates, "
+                    f"{self.e.shape[1]} deformations>")
         return (f"<spacar.Results: {len(self.t)} output times from t = {self.t[0]:g} to {self.t[-1]:g}, "
                 f"{self.x.shape[1]} coordinates, {self.e.shape[1]} deformations>")

@@ -2,13 +2,24 @@
 from __future__ import annotations
 
 from . import _core
+from ._util import seconds_or_none, show
+from .errors import InputError, SpacarError
 from .geometry import Geometry
 from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
 from .results import Results
 
 
-def simulate(model, *, method: str = "dop853", on_output=None, progress=None, output_stem=None) -> Results:
+def _results(arrays: dict, system, model) -> Results:
+    stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
+                                    "newton_iterations", "wall_time")}
+    lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
+    return Results(arrays, system.coord_label, system.def_label, stats, Geometry.from_model(model), lins,
+                   model.settings.linear)
+
+
+def simulate(model, *, method: str = "dop853", on_output=None, progress=None, output_stem=None,
+             time_limit=None) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
     The mechanism is assembled at the current time; with degrees of freedom the reduced
@@ -27,10 +38,22 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     (docs/matasc.md), line by line as the run proceeds; the stem is ``output_stem``, else
     ``model.output_stem``, else the input file name without extension, else ``spacar``.
 
-    Returns :class:`spacar.Results` (with ``res.geometry`` for drawing).
+    ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
+    :class:`spacar.TimeLimitError`.
+
+    Returns :class:`spacar.Results` (with ``res.geometry`` for drawing). If the analysis fails
+    midway, the :class:`spacar.SpacarError` raised carries the results up to the failure as
+    ``err.results`` (a :class:`spacar.Results` with the output times recorded before the failure,
+    possibly none; the MATASC files hold the same times); the model's state is then left as it
+    was before the block.
     """
     from . import __version__, progress as _progress
 
+    limit = seconds_or_none(time_limit, "time_limit") or 0.0
+    if on_output is not None and not callable(on_output):
+        raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
+    if not isinstance(method, str):
+        raise InputError(f"method must be 'dop853' or 'dopri5', got {show(method)}")
     model.prepare()
     sim = _core.Simulation(model._core)
     system = sim.system
@@ -66,18 +89,18 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     restart = settings.restart == 1
     step = 0.0 if restart else model._continue_step
     try:
-        arrays = sim.run(on_output=callback, initial_step=step, method=method)
+        arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit)
+    except SpacarError as err:
+        partial = getattr(err, "results", None)
+        if isinstance(partial, dict):
+            model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
+            err.results = _results(partial, sim.system, model)
+        raise
     finally:
         if writer is not None:
             writer.close()
         if bar is not None:
             bar.close()
     model._continue_step = arrays["last_step"]
-    system = sim.system
-    stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
-                                    "newton_iterations", "wall_time")}
     model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
-    res = Results(arrays, system.coord_label, system.def_label, stats, Geometry.from_model(model), lins,
-                  model.settings.linear)
-    return res
+    return _results(arrays, sim.system, model)

@@ -23,6 +23,12 @@ struct Data {
   // Allocate the dense matrices of the full path (transfer functions, reduced mass matrix).
   void ensure_dense(const System& sys);
   bool dense_ready = false;
+  // Bytes an analysis of `sys` allocates on the sparse path (vectors, element work arrays, the
+  // constraint blocks and the equations of motion with room for the fill of their factors), and
+  // in addition for the dense matrices of ensure_dense (transfer functions, mass matrices, the
+  // linearization's constitutive matrices). Checked against the memory limit before allocating.
+  static double estimate_bytes(const System& sys);
+  static double estimate_dense_bytes(const System& sys);
 
  private:
   void build_constraint_blocks(const System& sys);

@@ -27,6 +27,12 @@ struct SingularMassError : Error {
   using Error::Error;
 };
 
+// The analysis did not finish within the wall-clock time limit it was given
+// (spacar.simulate(..., time_limit=...)); the results up to that moment are kept.
+struct TimeLimitError : Error {
+  using Error::Error;
+};
+
 // A feature that is specified but whose physics has not been implemented yet.
 struct NotImplementedError : Error {
   using Error::Error;

@@ -41,6 +41,12 @@ class Integrator {
   // Per component; both >= 0 and not both zero (defaults: rtol = atol = 1e-6).
   void set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol);
   void set_max_step(double hmax);   // default +inf
+  // Steps (accepted and rejected) one integrate() call may take before IntegrationError
+  // (default kMaxSteps).
+  void set_max_steps(long n);
+  static constexpr long kMaxSteps = 10000000;
+  // Smallest step size the integrator takes at time t (below it: step size underflow).
+  static double min_step(double t);
   // 0 = automatic estimate (Hairer's hinit); used to continue across blocks (RESTART 0).
   void set_initial_step(double h);
   // Step proposed after the last accepted step, to continue later with set_initial_step.
@@ -85,6 +91,7 @@ class Integrator {
   Method method_;
   Eigen::VectorXd rtol_, atol_;
   double hmax_;
+  long max_steps_ = kMaxSteps;
   double h_initial_ = 0.0;
   double h_last_ = 0.0;
   double err_ = 0.0;                 // error norm of the last attempted step

@@ -41,8 +41,12 @@ void solve_accelerations(const System& sys, Data& data);
 // Diagnosis of the position constraint block A_P (or, velocity = true, of the velocity block A_V,
 // whose rows hold the nonholonomic deformations instead of their kinematic coordinates) at the
 // current positions (formulation.md §2.3, §5).
+// Above this many constraints or calculable coordinates the diagnosis gives the counts only
+// (rank = -1): the SVD and the selections are cubic in the size and would take minutes.
+constexpr int kMaxDiagnosisSize = 1500;
+
 struct ConstraintDiagnosis {
-  int n_constraints = 0, n_calculable = 0, rank = 0;
+  int n_constraints = 0, n_calculable = 0, rank = 0;  // rank -1: not computed (too large)
   std::vector<int> redundant;     // deformations whose release removes the redundancy
   std::vector<int> undetermined;  // calculable coordinates left undetermined
   // From the SVD: dependent combinations of rows and free motions, (index, weight).

@@ -124,6 +124,9 @@ class Model {
   // Euler parameters of the LAMBDA nodes (accepted within 1e-3 of unit length).
   void prepare();
   bool frozen() const { return frozen_; }
+  // Deserialisation only (pickle): the model was prepared when it was saved; its reference
+  // geometry and automatic elements are part of the saved state, so nothing is recomputed.
+  void restore_prepared() { frozen_ = true; }
 
   // Lookups that raise InputError naming the missing item.
   Node& node(int id);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,7 +28,16 @@ struct RunOptions {
   // Called after every output time is recorded (index k, data of that state, its linearization
   // or nullptr): progress bars, files written as the run proceeds.
   std::function<void(int, const Data&, const Linearization*)> on_output;
+  // Wall-clock seconds the block may take (0: no limit); beyond it TimeLimitError.
+  double time_limit = 0.0;
+  // Integration steps (accepted and rejected) over the whole block.
+  long max_steps = Integrator::kMaxSteps;
 };
+
+// Tolerances below this (100 machine epsilons) cannot be met in double precision: EPSINT and
+// EPSIND are raised to it with a warning, so that a tiny tolerance cannot make the integrator
+// crawl through millions of round-off-limited steps.
+constexpr double kMinTolerance = 100.0 * 2.220446049250313e-16;
 
 struct BlockResults {
   Eigen::VectorXd t;
@@ -73,6 +83,10 @@ class Simulation {
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
 
   BlockResults run(const RunOptions& options = {});
+  // The same, into `res`. If the run fails (an exception), `res` holds what was computed up to
+  // the failure: the output times recorded so far (the arrays cut to those rows), the counters
+  // and the warnings; the model is not changed.
+  void run(BlockResults& res, const RunOptions& options);
   // Write the state reached into the model (coordinates, rates, deformation values, time).
   void store_state();
 
@@ -116,6 +130,11 @@ class Simulation {
   // has no solution ahead (formulation.md §2.2), whatever rejected the very last attempt.
   std::string kinematic_failure_;
   double kinematic_failure_t_ = 0.0;
+  void check_time(double t);       // TimeLimitError past the deadline of the running block
+  void require_finite_state(double t) const;  // SpacarError if an output would hold inf or NaN
+  bool has_deadline_ = false;
+  std::chrono::steady_clock::time_point deadline_;
+  double time_limit_ = 0.0;
 };
 
 }  // namespace spacar

@@ -15,6 +15,7 @@ import os
 import re
 from dataclasses import dataclass, field
 
+from .._util import show
 from ..errors import InputError, SpacarError
 from ..keywords import INT, LOOKUP, Keyword
 from ..model import Model, check_args
@@ -54,18 +55,21 @@ def _error(file, line, keyword, reason):
 
 def _number(token: str, kind: str):
     if kind == INT:
+        if len(token) > 40 and _INT_RE.match(token):
+            # Far out of range (and Python refuses to convert very long digit strings).
+            raise ValueError(f"{token[:20]}... ({len(token)} digits) is out of range")
         if _INT_RE.match(token):
             return int(token)
         if _REAL_RE.match(token):
             value = float(token.replace("d", "e").replace("D", "e"))
             if value.is_integer():
                 return int(value)
-        raise ValueError(f"{token!r} is not an integer")
+        raise ValueError(f"{show(token)} is not an integer")
     if _REAL_RE.match(token) or _INT_RE.match(token):
         return float(token.replace("d", "e").replace("D", "e"))
     if token.lower().lstrip("+-") in ("nan", "inf", "infinity"):
-        raise ValueError(f"{token!r} is not a number (NaN and infinity are not accepted)")
-    raise ValueError(f"{token!r} is not a number")
+        raise ValueError(f"{show(token)} is not a number (NaN and infinity are not accepted)")
+    raise ValueError(f"{show(token)} is not a number")
 
 
 def _parse_line(kw: Keyword, tokens):
@@ -85,8 +89,17 @@ def _parse_line(kw: Keyword, tokens):
     return values
 
 
+def _check_text(text, file):
+    if not isinstance(text, str):
+        raise InputError(f"the input must be a text (str), got {type(text).__name__}"
+                         + (": decode bytes first, e.g. data.decode('utf-8')" if isinstance(text, bytes) else ""))
+    if not isinstance(file, str):
+        raise InputError(f"the file name must be a str, got {type(file).__name__}")
+
+
 def parse(text: str, file: str = "<string>") -> list[Block]:
     """Split an input text into blocks of commands; checks syntax, counts and types."""
+    _check_text(text, file)
     blocks = [Block()]
     ended_by_eof = False
     for lineno, raw in enumerate(_NEWLINE_RE.split(text), start=1):
@@ -100,10 +113,10 @@ def parse(text: str, file: str = "<string>") -> list[Block]:
         head = tokens[0]
         if not head[0].isalpha():
             raise _error(file, lineno, head.upper(),
-                         f"a line must start with a keyword (a letter first), not {head!r}")
+                         f"a line must start with a keyword (a letter first), not {show(head)}")
         kw = LOOKUP.get(head.upper()[:8])
         if kw is None:
-            raise _error(file, lineno, head.upper(), f"unknown keyword {head!r}")
+            raise _error(file, lineno, head.upper(), f"unknown keyword {show(head)}")
         try:
             values = _parse_line(kw, tokens[1:])
             check_args(kw, values)
@@ -152,10 +165,15 @@ def read_string(text: str, file: str = "<string>") -> Model:
 
 def read(path) -> Model:
     """Read a SPACAR95 input file (see :func:`read_string`)."""
-    path = os.fspath(path)
+    try:
+        path = os.fspath(path)
+    except TypeError:
+        raise InputError(f"read: a file name or path, got {show(path)}") from None
+    if isinstance(path, bytes):
+        path = os.fsdecode(path)
     try:
         with open(path, encoding="utf-8", errors="replace") as fh:
             text = fh.read()
-    except OSError as err:
-        raise InputError(f"{path}: cannot read the input file ({err.strerror})") from None
+    except (OSError, ValueError) as err:  # ValueError: a NUL in the name
+        raise InputError(f"{path}: cannot read the input file ({getattr(err, 'strerror', None) or err})") from None
     return read_string(text, path)

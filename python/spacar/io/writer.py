@@ -5,7 +5,11 @@ integers are written as `` %3d`` and reals as `` %10.3E`` (4 significant digits,
 """
 from __future__ import annotations
 
+import numbers
+
 from .. import _core
+from .._util import show
+from ..errors import InputError
 
 _CLASS_KEYWORD_X = {
     _core.CoordClass.fixed: "FIX",
@@ -29,8 +33,9 @@ _NODE_KEYWORD = {
 
 class _Lines:
     def __init__(self, digits: int):
-        if not 1 <= digits <= 17:
-            raise ValueError("digits must be between 1 and 17")
+        if isinstance(digits, bool) or not isinstance(digits, numbers.Integral) or not 1 <= digits <= 17:
+            raise InputError(f"dump: digits must be an integer between 1 and 17, got {show(digits)}")
+        digits = int(digits)
         self.real = f" {{:{digits + 6}.{digits - 1}E}}"
         self.out = []
 

@@ -1,0 +1,36 @@
+"""Small helpers shared by the modules: safe texts of user values for messages, argument checks."""
+from __future__ import annotations
+
+import math
+import numbers
+
+from .errors import InputError
+
+
+def show(value) -> str:
+    """A short text of any value for an error message: huge integers cannot even be converted to
+    text (Python refuses beyond 4300 digits), long values are cut, a failing repr is replaced."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        try:
+            if not -10**30 < value < 10**30:
+                return f"an integer of {int(value).bit_length()} bits"
+        except Exception:  # noqa: BLE001 - an Integral whose comparison fails
+            pass
+    try:
+        text = repr(value)
+    except Exception:  # noqa: BLE001 - any object may be passed; the message must not fail
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def seconds_or_none(value, what: str):
+    """A positive finite number of seconds (as float), or None."""
+    if value is None:
+        return None
+    try:
+        ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value) and value > 0
+    except (OverflowError, TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise InputError(f"{what} must be a positive number of seconds or None, got {show(value)}")
+    return float(value)

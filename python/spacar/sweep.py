@@ -1,0 +1,714 @@
+"""Parameter studies: many analyses of one model over a grid or a sample of parameter values, in
+parallel processes (default), on a Dask cluster, or serially, gathered into NumPy arrays.
+
+A parameter is named like the input line it replaces, keyword and identifying numbers::
+
+    spacar.sweep("examples/slidercrank.dat", {
+        "XD 2 1": [1.0, 1.5, 2.0],                       # crank speed: XD n i x
+        ("ESTIFF 2", "ESTIFF 3"): [(0.0, k) for k in (1e-3, 2e-3)],   # both rod elements
+    })
+
+Each case is a copy of the model with those lines applied after its own input lines (before
+its END), as if the input file had said so; then the analysis runs (``"simulate"``: the current
+block, ``"linearize"``: the linearized equations at the current state) and the requested
+outputs are kept. Anything a keyword cannot express is a factory: ``sweep(make_model, {...})``
+calls ``make_model(params)`` with the case's parameters and analyses the model it returns.
+
+See docs/sweep.md.
+"""
+from __future__ import annotations
+
+import concurrent.futures
+import itertools
+import math
+import multiprocessing
+import numbers
+import os
+import pickle
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ._util import seconds_or_none, show
+from .errors import InputError, SpacarError
+from .keywords import INT, LOOKUP, SETTINGS, Keyword
+from .model import Model, check_args
+
+__all__ = ["sweep", "SweepResult", "SweepError"]
+
+# Keyword groups whose lines are values that a later line replaces. Element, boundary-condition
+# and control lines change the model's structure or accumulate: use a factory for those.
+_SWEEPABLE_GROUPS = ("Nodes (§5.2)", "Initial values (§5.4)", "Dynamic properties (§5.5)", SETTINGS)
+
+RESULT_ARRAYS = ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")
+LINEARIZATION_OUTPUTS = ("eigenfrequencies", "eigenvalues", "buckling_factors", "M0", "C0", "D0", "K0", "N0",
+                         "G0", "r0", "stiffness", "damping")
+
+
+class SweepError(NamedTuple):
+    """A failed case: its index, its parameters, the exception's type name and message."""
+
+    index: int
+    parameters: dict
+    type: str
+    message: str
+
+
+# --- parameters ---------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class _Line:
+    """A parameter that replaces the values of a keyword line: ``keyword ids... values...``."""
+
+    key: str
+    keyword: Keyword
+    ids: tuple
+
+    def arguments(self, value) -> tuple:
+        several = isinstance(value, (tuple, list)) or (isinstance(value, np.ndarray) and value.ndim > 0)
+        values = tuple(value) if several else (value,)
+        return (*self.ids, *values)
+
+
+def _identifiers(kw: Keyword) -> int:
+    """How many leading numbers identify a line of this keyword (node, element, component)."""
+    if kw.group == SETTINGS:
+        return 0
+    n = 0
+    for p in kw.params:
+        if p.kind != INT or p.count_min != 1 or p.count_max != 1:
+            break
+        n += 1
+    return n
+
+
+def _parse_line_key(key: str) -> _Line:
+    words = key.split()
+    if not words:
+        raise InputError(f"sweep parameter {show(key)}: empty")
+    kw = LOOKUP.get(words[0].upper()[:8])
+    if kw is None:
+        raise InputError(f"sweep parameter {show(key)}: unknown keyword {show(words[0])}")
+    if kw.group not in _SWEEPABLE_GROUPS:
+        raise InputError(f"sweep parameter {show(key)}: {kw.name} lines define the model's structure and cannot "
+                         "be replaced by value; use a factory function (sweep(make_model, ...))")
+    n_ids = _identifiers(kw)
+    names = " ".join(p.name for p in kw.params[:n_ids])
+    if len(words) - 1 != n_ids:
+        what = f"{kw.name} {names}" if n_ids else kw.name
+        raise InputError(f"sweep parameter {show(key)}: a {kw.name} line is named by {show(what)} "
+                         f"({n_ids} number{'s' if n_ids != 1 else ''} after the keyword)")
+    try:
+        ids = tuple(int(w) for w in words[1:])
+    except ValueError:
+        raise InputError(f"sweep parameter {show(key)}: {names} must be integers") from None
+    return _Line(key, kw, ids)
+
+
+def _lines_of(key) -> tuple:
+    if isinstance(key, str):
+        return (_parse_line_key(key),)
+    if isinstance(key, tuple) and key and all(isinstance(k, str) for k in key):
+        return tuple(_parse_line_key(k) for k in key)
+    raise InputError(f"sweep parameter {show(key)}: a keyword line such as 'ESTIFF 2' or a tuple of them")
+
+
+def _name(key) -> str:
+    if isinstance(key, str):
+        return key
+    if isinstance(key, tuple) and key and all(isinstance(k, str) for k in key):
+        return " & ".join(key)
+    raise InputError(f"sweep parameter {show(key)}: name it by a string (an input line such as 'ESTIFF 2', or any "
+                     "name for a factory) or a tuple of input lines")
+
+
+def _check_value(key, lines, value):
+    """Refuse a value that no model could take (wrong type or count, NaN, infinity) at once."""
+    for line in lines:
+        try:
+            check_args(line.keyword, line.arguments(value))
+        except InputError as err:
+            raise InputError(f"sweep parameter {show(_name(key))} = {show(value)}: {err}") from None
+
+
+def _cases(parameters, by_lines: bool):
+    """(names, cases as dicts name → value, grid axes or None)."""
+    if isinstance(parameters, dict):
+        if not parameters:
+            raise InputError("sweep: no parameters")
+        names, axes = [], []
+        for key, values in parameters.items():
+            if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+                raise InputError(f"sweep parameter {show(_name(key))}: give a sequence of values, got {show(values)}")
+            values = list(values)
+            if not values:
+                raise InputError(f"sweep parameter {show(_name(key))}: no values")
+            names.append(_name(key))
+            axes.append(values)
+        keys = list(parameters)
+        cases = [dict(zip(names, combo)) for combo in itertools.product(*axes)]
+        grid = dict(zip(names, axes))
+    elif isinstance(parameters, (list, tuple)):
+        if not parameters or not all(isinstance(c, dict) for c in parameters):
+            raise InputError("sweep: parameters must be a dict of value lists (a grid) or a list of dicts (a sample)")
+        keys = list(parameters[0])
+        for i, c in enumerate(parameters):
+            if list(c) != keys:
+                raise InputError(f"sweep: case {i} has the parameters {list(c)}, case 0 has {keys}")
+        names = [_name(k) for k in keys]
+        cases = [{_name(k): v for k, v in c.items()} for c in parameters]
+        grid = None
+    else:
+        raise InputError("sweep: parameters must be a dict of value lists (a grid) or a list of dicts (a sample)")
+    if len(set(names)) != len(names):
+        raise InputError(f"sweep: parameter names repeat: {names}")
+    lines = {}
+    if by_lines:
+        for key, name in zip(keys, names):
+            lines[name] = _lines_of(key)
+        for case in cases:
+            for name, value in case.items():
+                _check_value(name, lines[name], value)
+    return names, cases, grid, lines
+
+
+# --- outputs ----------------------------------------------------------------------------------------
+
+def _linearization_output(name):
+    def get(lin):
+        value = getattr(lin, name)
+        return value() if callable(value) else value
+    return get
+
+
+class _Outputs:
+    """What to keep of a case's result: name → extractor. Picklable (names, or the user's
+    functions)."""
+
+    def __init__(self, spec, analysis):
+        self.spec = spec
+        self.analysis = analysis
+        self.single = None  # a function whose return value names the outputs itself
+        self.items = {}
+        if spec is None:
+            spec = "final" if analysis == "simulate" else "eigenfrequencies" if analysis == "linearize" else None
+        if spec is None:
+            self.single = _identity
+        elif callable(spec):
+            self.single = spec
+        elif isinstance(spec, str):
+            self._add_name(spec)
+        elif isinstance(spec, dict):
+            for name, item in spec.items():
+                if callable(item):
+                    self.items[str(name)] = item
+                elif isinstance(item, str):
+                    self._check_name(item)
+                    self.items[str(name)] = item
+                else:
+                    raise InputError(f"sweep outputs[{show(name)}]: a function or an output name, got {show(item)}")
+        elif isinstance(spec, (list, tuple)):
+            for name in spec:
+                if not isinstance(name, str):
+                    raise InputError(f"sweep outputs: names, got {show(name)}")
+                self._add_name(name)
+        else:
+            raise InputError(f"sweep outputs: a name, a list of names, a dict or a function, got {show(spec)}")
+
+    def _check_name(self, name):
+        allowed = RESULT_ARRAYS if self.analysis == "simulate" else LINEARIZATION_OUTPUTS
+        base = name[:-len("_final")] if self.analysis == "simulate" and name.endswith("_final") else name
+        if callable(self.analysis) or base not in allowed:
+            if callable(self.analysis):
+                raise InputError(f"sweep outputs: with an analysis function, give functions of its result, not {show(name)}")
+            raise InputError(f"sweep outputs: unknown output {show(name)} for analysis={show(self.analysis)}; "
+                             f"one of {', '.join(allowed)}" + (", 'final', 'history'" if self.analysis == "simulate" else ""))
+
+    def _add_name(self, name):
+        if self.analysis == "simulate" and name in ("final", "history"):
+            for a in RESULT_ARRAYS:
+                self.items[a] = a + ("_final" if name == "final" else "")
+            return
+        self._check_name(name)
+        self.items[name] = name
+
+    def extract(self, result) -> dict:
+        if self.single is not None:
+            value = self.single(result)
+            return dict(value) if isinstance(value, dict) else {"value": value}
+        out = {}
+        for name, item in self.items.items():
+            if callable(item):
+                out[name] = item(result)
+            elif self.analysis == "simulate":
+                final = item.endswith("_final")
+                array = getattr(result, item[:-len("_final")] if final else item)
+                out[name] = array[-1] if final else array
+            else:
+                out[name] = _linearization_output(item)(result)
+        return out
+
+
+def _identity(result):
+    return result
+
+
+# --- running cases ------------------------------------------------------------------------------
+
+@dataclass
+class _Task:
+    """Everything a worker needs besides the cases (sent once per chunk, pickled)."""
+
+    model: Any                # a spacar.Model or a factory(params) -> Model
+    lines: dict               # parameter name -> tuple of _Line (keyword-line parameters)
+    analysis: Any             # "simulate", "linearize" or a function(model) -> result
+    outputs: _Outputs
+    method: str = "dop853"
+    time_limit: float | None = None
+
+
+def _run_case(task: _Task, params: dict):
+    if isinstance(task.model, Model):
+        model = task.model.copy()
+        for name, value in params.items():
+            for line in task.lines[name]:
+                try:
+                    model.apply(line.keyword.name, *line.arguments(value))
+                except SpacarError as err:
+                    raise type(err)(f"sweep parameter {show(name)} = {show(value)}: {err}") from None
+    else:
+        model = task.model(dict(params))
+        if not isinstance(model, Model):
+            raise InputError(f"the factory returned {type(model).__name__}, not a spacar.Model")
+    n_warnings = len(model.warnings)
+    if task.analysis == "simulate":
+        from .simulate import simulate
+
+        result = simulate(model, method=task.method, time_limit=task.time_limit)
+    elif task.analysis == "linearize":
+        from .linearize import linearize
+
+        result = linearize(model)
+    else:
+        result = task.analysis(model)
+    values = {name: np.asarray(v) for name, v in task.outputs.extract(result).items()}
+    labels = None
+    if task.analysis == "simulate":
+        labels = (result.coordinate_labels, result.deformation_labels)
+    return values, labels, model.warnings[n_warnings:]
+
+
+def _run_cases(task: _Task, cases: list) -> list:
+    """Run the cases [(index, params)]; returns [(index, ok, payload, seconds)] with payload
+    (values, labels, warnings) or, for a failed case, (exception type name, message)."""
+    out = []
+    for index, params in cases:
+        start = time.perf_counter()
+        try:
+            payload = _run_case(task, params)
+            ok = True
+        except Exception as err:  # noqa: BLE001 - every failure is reported with its case
+            ok = False
+            payload = (_type_name(err), str(err))
+        out.append((index, ok, payload, time.perf_counter() - start))
+    return out
+
+
+def _run_chunk(task_bytes: bytes, cases: list) -> list:
+    """Worker entry point (module level, so that spawned processes and dask workers import it)."""
+    return _run_cases(pickle.loads(task_bytes), cases)
+
+
+def _type_name(err: BaseException) -> str:
+    t = type(err)
+    module = t.__module__
+    if module.startswith("spacar"):
+        module = "spacar"
+    return t.__name__ if module == "builtins" else f"{module}.{t.__name__}"
+
+
+def _dumps(obj) -> bytes:
+    """Pickle with cloudpickle when it is installed (lambdas and notebook functions travel),
+    otherwise the standard pickle."""
+    try:
+        import cloudpickle
+    except ImportError:  # pragma: no cover - cloudpickle comes with the dask extra
+        cloudpickle = None
+    try:
+        return cloudpickle.dumps(obj) if cloudpickle else pickle.dumps(obj)
+    except Exception as err:  # noqa: BLE001
+        raise InputError(f"sweep: the model, factory or output functions cannot be sent to worker processes "
+                         f"({type(err).__name__}: {err}); define functions at module level, install "
+                         "cloudpickle, or use workers=1") from None
+
+
+# --- progress ----------------------------------------------------------------------------------
+
+class _Progress:
+    def __init__(self, progress, total):
+        self.total = total
+        self.done = 0
+        self.bar = None
+        self.callback = None
+        if callable(progress):
+            self.callback = progress
+            return
+        if progress is None:
+            progress = _tqdm_available() and hasattr(sys.stderr, "isatty") and sys.stderr.isatty()
+        if progress:
+            if _tqdm_available():
+                from tqdm.auto import tqdm
+
+                self.bar = tqdm(total=total, desc="spacar.sweep", unit="case")
+            else:
+                self.callback = self._print
+
+    def _print(self, done, total):
+        print(f"spacar.sweep: {done}/{total} cases", file=sys.stderr, flush=True)
+
+    def update(self, n, failed=0):
+        self.done += n
+        if self.bar is not None:
+            self.bar.update(n)
+            if failed:
+                self.bar.set_postfix(failed=failed)
+        elif self.callback is not None:
+            self.callback(self.done, self.total)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _tqdm_available() -> bool:
+    try:
+        import tqdm  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+# --- the result -------------------------------------------------------------------------------------
+
+@dataclass
+class SweepResult:
+    """The outcome of :func:`spacar.sweep`.
+
+    ``parameters``: name → array over the cases (shape (n,) for numbers, (n, k) for tuples of k
+    values). ``values``: output name → array of shape (n, *output shape), NaN for failed cases
+    (an object array if the cases' outputs differ in shape or are not numbers). ``errors``: one
+    :class:`SweepError` per failed case. ``ok``: which cases succeeded. For a grid, ``grid``
+    holds the axes and :meth:`reshaped` gives the values in the grid's shape.
+    """
+
+    parameters: dict
+    values: dict
+    errors: list
+    ok: np.ndarray
+    cases: list
+    grid: dict | None = None
+    seconds: np.ndarray | None = None      # wall time of each case in its worker
+    wall_time: float = 0.0                 # of the whole sweep
+    warnings: list = field(default_factory=list)   # (index, message) of new warnings per case
+    coordinate_labels: list | None = None  # columns of x, xd, xdd, reaction: (node, component)
+    deformation_labels: list | None = None  # columns of e, ed, edd, sigma: (element, deformation)
+    analysis: Any = "simulate"
+
+    def __len__(self):
+        return len(self.cases)
+
+    def __getitem__(self, name):
+        return self.values[name]
+
+    @property
+    def shape(self) -> tuple:
+        return tuple(len(v) for v in self.grid.values()) if self.grid else (len(self.cases),)
+
+    def reshaped(self, name) -> np.ndarray:
+        """``values[name]`` with the case axis split into the grid's axes (in parameter order)."""
+        v = self.values[name]
+        return v.reshape(self.shape + v.shape[1:])
+
+    def raise_errors(self):
+        """Raise a SpacarError listing the failed cases, if any."""
+        if self.errors:
+            lines = [f"case {e.index} {e.parameters}: {e.type}: {e.message.splitlines()[0]}" for e in self.errors[:10]]
+            more = f"\n... and {len(self.errors) - 10} more" if len(self.errors) > 10 else ""
+            raise SpacarError(f"{len(self.errors)} of {len(self)} cases failed:\n" + "\n".join(lines) + more)
+
+    def to_xarray(self):
+        """An ``xarray.Dataset``: for a grid of numbers the dimensions are the parameters with
+        their values as coordinates; otherwise one dimension ``case`` with the parameters as
+        coordinates. Outputs of the result arrays get the dimensions ``coordinate`` (with ``node``
+        and ``component``), ``deformation`` (``element``, ``index``) and ``time``."""
+        try:
+            import xarray as xr
+        except ImportError:  # pragma: no cover
+            raise ImportError("to_xarray() needs xarray: pip install 'spacar[dask]' or pip install xarray") from None
+        if self.grid is not None:
+            # One dimension per parameter; numbers are its coordinate, tuples of numbers are
+            # numbered along it and given as a coordinate "<name> values".
+            case_dims = list(self.grid)
+            coords = {}
+            for name, axis in self.grid.items():
+                values = self.parameters[name].reshape(self.shape + self.parameters[name].shape[1:])
+                axis_values = np.asarray(values[tuple(slice(None) if d == name else 0 for d in case_dims)])
+                if axis_values.ndim == 1 and axis_values.dtype.kind in "biuf":
+                    coords[name] = axis_values
+                else:
+                    coords[name] = np.arange(len(axis))
+                    if axis_values.dtype != object:
+                        coords[f"{name} values"] = ((name,) + tuple(f"{name}_dim{i}" for i in range(1, axis_values.ndim)),
+                                                    axis_values)
+        else:
+            case_dims = ["case"]
+            coords = {"case": np.arange(len(self.cases))}
+            for name, v in self.parameters.items():
+                if v.dtype != object:
+                    coords[name] = (("case",) + tuple(f"{name}_dim{i}" for i in range(1, v.ndim)), v)
+        scalar_grid = self.grid is not None
+        shape = self.shape if scalar_grid else (len(self.cases),)
+        data = {}
+        for name, v in self.values.items():
+            if v.dtype == object:
+                continue  # ragged outputs do not fit a Dataset
+            v = v.reshape(shape + v.shape[1:])
+            data[name] = (case_dims + self._output_dims(name, v.ndim - len(shape)), v)
+        data["ok"] = (case_dims, self.ok.reshape(shape))
+        if self.seconds is not None:
+            data["seconds"] = (case_dims, self.seconds.reshape(shape))
+        if self.coordinate_labels is not None and any("coordinate" in d[0] for d in data.values()):
+            coords["node"] = ("coordinate", np.array([c[0] for c in self.coordinate_labels]))
+            coords["component"] = ("coordinate", np.array([c[1] for c in self.coordinate_labels]))
+        if self.deformation_labels is not None and any("deformation" in d[0] for d in data.values()):
+            coords["element"] = ("deformation", np.array([c[0] for c in self.deformation_labels]))
+            coords["index"] = ("deformation", np.array([c[1] for c in self.deformation_labels]))
+        return xr.Dataset(data, coords=coords, attrs={"analysis": str(self.analysis), "failed": len(self.errors)})
+
+    def _output_dims(self, name, ndim):
+        base = name[:-len("_final")] if name.endswith("_final") else name
+        if self.analysis == "simulate" and base in RESULT_ARRAYS:
+            column = "coordinate" if base in ("x", "xd", "xdd", "reaction") else "deformation"
+            dims = [] if base == "t" else [column]
+            if ndim > len(dims):
+                dims = ["time"] + dims
+            if len(dims) == ndim:
+                return dims
+        if self.analysis == "linearize" and base in ("eigenfrequencies", "eigenvalues", "buckling_factors") and ndim == 1:
+            return ["mode"]
+        return [f"{name}_dim{i}" for i in range(ndim)]
+
+    def __repr__(self):
+        shape = "x".join(str(n) for n in self.shape)
+        outs = ", ".join(f"{k} {v.shape[1:] if v.dtype != object else '(ragged)'}" for k, v in self.values.items())
+        return (f"<spacar.SweepResult: {len(self.cases)} cases ({shape}{' grid' if self.grid else ''}), "
+                f"{len(self.errors)} failed, outputs: {outs or 'none'}; {self.wall_time:.3g} s>")
+
+
+def _stack(per_case: list, n: int):
+    """Stack the cases' arrays of one output; NaN (or None) where a case failed."""
+    present = [v for v in per_case if v is not None]
+    shapes = {v.shape for v in present}
+    numeric = all(v.dtype.kind in "biufc" for v in present)
+    if len(shapes) == 1 and numeric:
+        (shape,) = shapes
+        dtype = np.result_type(*[v.dtype for v in present])
+        if len(present) < n:
+            dtype = np.result_type(dtype, np.float64)
+        out = np.full((n, *shape), np.nan, dtype=dtype) if dtype.kind in "fc" else np.empty((n, *shape), dtype)
+        for i, v in enumerate(per_case):
+            if v is not None:
+                out[i] = v
+        return out
+    out = np.empty(n, dtype=object)
+    for i, v in enumerate(per_case):
+        out[i] = v
+    return out
+
+
+def _parameter_arrays(names, cases):
+    out = {}
+    for name in names:
+        column = [c[name] for c in cases]
+        try:
+            arr = np.asarray(column)
+            if arr.dtype == object or arr.dtype.kind not in "biuf":
+                raise ValueError
+        except (ValueError, TypeError):
+            arr = np.empty(len(column), dtype=object)
+            arr[:] = column
+        out[name] = arr
+    return out
+
+
+# --- the entry point -------------------------------------------------------------------------------
+
+def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str = "dop853",
+          time_limit: float | None = None, workers: int | None = None, client=None, executor=None,
+          chunksize: int | None = None, progress=None) -> SweepResult:
+    """Run an analysis of ``model`` for every case of ``parameters`` and gather the outputs.
+
+    ``model``: a :class:`spacar.Model` (or an input file name), copied for every case; or a
+    factory ``make_model(params) -> Model`` called with the case's parameters (a dict).
+
+    ``parameters``: a dict ``{name: [values]}`` for the grid of all combinations
+    (``itertools.product``, in the dict's order), or a list of dicts (an explicit sample). With a
+    model, a name is an input line: the keyword and the numbers that identify the line, e.g.
+    ``"ESTIFF 2"``, ``"XD 2 1"``, ``"X 3"``, ``"MASS 8"``, ``"TIMESTEP"``, ``"EPSINT"``; a value
+    is the rest of that line (a number, or a tuple for several numbers: ``(0.0, 1.2e-3)``). A
+    tuple of names sets the same values on several lines (``("ESTIFF 2", "ESTIFF 3")``).
+
+    ``analysis``: ``"simulate"`` (:func:`spacar.simulate` of the current block), ``"linearize"``
+    (:func:`spacar.linearize` at the current state) or a function ``f(model) -> result``.
+
+    ``outputs``: for ``"simulate"``, ``"final"`` (default: the arrays t, x, xd, xdd, e, ed, edd,
+    sigma, reaction of :class:`spacar.Results` at the last output time, under those names),
+    ``"history"`` (the whole arrays) or a list of array names (``"x"``: the whole array,
+    ``"x_final"``: its last row); for ``"linearize"``, ``"eigenfrequencies"``
+    (default) or names of :class:`spacar.Linearization` attributes (M0, K0, ...). A function of
+    the result returns a number, an array or a dict of them; a dict ``{name: function or name}``
+    names each output.
+
+    ``time_limit``: seconds per simulation (:class:`spacar.TimeLimitError` beyond).
+
+    Where the cases run: ``client`` (a ``dask.distributed.Client``) runs them on that cluster;
+    ``executor`` (any ``concurrent.futures.Executor``) on it; otherwise ``workers`` local
+    processes (default: the number of CPUs; started with "spawn", so scripts need the ``if
+    __name__ == "__main__":`` guard), or in this process with ``workers=1``. Cases go in chunks
+    of ``chunksize`` (default: about four chunks per worker).
+
+    ``progress``: True for a progress bar (tqdm when installed), False for none, None (default)
+    for a bar on an interactive terminal, or a function ``progress(done, total)``.
+
+    Failed cases do not stop the sweep: they are listed in ``result.errors`` with their
+    parameters, exception type and message, and their values are NaN. Returns a
+    :class:`SweepResult`.
+    """
+    start = time.perf_counter()
+    if isinstance(model, (str, os.PathLike)):
+        from .io.reader import read
+
+        model = read(model)
+    if not isinstance(model, Model) and not callable(model):
+        raise InputError(f"sweep: model must be a spacar.Model, an input file or a factory function, got {show(model)}")
+    if not (analysis in ("simulate", "linearize") or callable(analysis)):
+        raise InputError(f"sweep: analysis must be 'simulate', 'linearize' or a function, got {show(analysis)}")
+    time_limit = seconds_or_none(time_limit, "sweep: time_limit")
+    if not isinstance(method, str) or method not in ("dop853", "dopri5"):
+        raise InputError(f"sweep: unknown integration method {show(method)} (dop853, dopri5)")
+    names, cases, grid, lines = _cases(parameters, by_lines=isinstance(model, Model))
+    task = _Task(model, lines, analysis, _Outputs(outputs, analysis), method, time_limit)
+    n = len(cases)
+    indexed = list(enumerate(cases))
+
+    for name, value in (("workers", workers), ("chunksize", chunksize)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1):
+            raise InputError(f"sweep: {name} must be a positive integer, got {show(value)}")
+    for name, value in (("client", client), ("executor", executor)):
+        if value is not None and not callable(getattr(value, "submit", None)):
+            raise InputError(f"sweep: {name} must be a dask.distributed.Client or a concurrent.futures.Executor, "
+                             f"got {show(value)}")
+    if client is not None or executor is not None:
+        n_workers = _client_workers(client) if client is not None else (workers or os.cpu_count() or 1)
+    else:
+        n_workers = max(1, min(workers or os.cpu_count() or 1, n))
+    size = chunksize or max(1, math.ceil(n / (4 * n_workers)))
+    chunks = [indexed[i:i + size] for i in range(0, n, size)]
+
+    outcomes = {}
+    bar = _Progress(progress, n)
+    failed = 0
+
+    def collect(chunk, results):
+        nonlocal failed
+        for index, ok, payload, seconds in results:
+            outcomes[index] = (ok, payload, seconds)
+            failed += not ok
+        bar.update(len(chunk), failed)
+
+    def lost(chunk, err):
+        collect(chunk, [(i, False, (_type_name(err), f"the worker failed: {err}"), math.nan) for i, _ in chunk])
+
+    try:
+        if client is None and executor is None and n_workers == 1:
+            for chunk in chunks:
+                collect(chunk, _run_cases(task, chunk))
+        else:
+            payload = _dumps(task)
+            if client is not None:
+                _run_dask(client, payload, chunks, collect, lost)
+            else:
+                own = executor is None
+                pool = executor or concurrent.futures.ProcessPoolExecutor(
+                    max_workers=n_workers, mp_context=multiprocessing.get_context("spawn"))
+                try:
+                    futures = {pool.submit(_run_chunk, payload, chunk): chunk for chunk in chunks}
+                    for future in concurrent.futures.as_completed(futures):
+                        chunk = futures[future]
+                        try:
+                            collect(chunk, future.result())
+                        except Exception as err:  # noqa: BLE001 - a worker that died
+                            lost(chunk, err)
+                finally:
+                    if own:
+                        pool.shutdown(wait=True, cancel_futures=True)
+    finally:
+        bar.close()
+
+    return _gather(task, names, cases, grid, outcomes, time.perf_counter() - start)
+
+
+def _client_workers(client) -> int:
+    try:
+        return max(1, sum(client.nthreads().values()))
+    except Exception:  # noqa: BLE001 - any client-like object
+        return os.cpu_count() or 1
+
+
+def _run_dask(client, payload, chunks, collect, lost):
+    from distributed import as_completed
+
+    data = client.scatter(payload, broadcast=True)
+    futures = [client.submit(_run_chunk, data, chunk, pure=False) for chunk in chunks]
+    owner = {f.key: chunk for f, chunk in zip(futures, chunks)}
+    for future in as_completed(futures):
+        chunk = owner[future.key]
+        try:
+            collect(chunk, future.result())
+        except Exception as err:  # noqa: BLE001 - a worker that died, a lost connection
+            lost(chunk, err)
+
+
+def _gather(task, names, cases, grid, outcomes, wall_time) -> SweepResult:
+    n = len(cases)
+    ok = np.zeros(n, dtype=bool)
+    seconds = np.full(n, np.nan)
+    errors, warnings = [], []
+    per_output: dict[str, list] = {}
+    order: list[str] = []
+    labels = None
+    for i in range(n):
+        success, payload, secs = outcomes[i]
+        seconds[i] = secs
+        if not success:
+            errors.append(SweepError(i, dict(cases[i]), payload[0], payload[1]))
+            continue
+        ok[i] = True
+        values, case_labels, case_warnings = payload
+        labels = labels or case_labels
+        warnings.extend((i, w) for w in case_warnings)
+        for name, v in values.items():
+            if name not in per_output:
+                per_output[name] = [None] * n
+                order.append(name)
+            per_output[name][i] = v
+    values = {name: _stack(per_output[name], n) for name in order}
+    return SweepResult(
+        parameters=_parameter_arrays(names, cases), values=values, errors=errors, ok=ok, cases=cases,
+        grid=grid, seconds=seconds, wall_time=wall_time, warnings=warnings,
+        coordinate_labels=[tuple(c) for c in labels[0]] if labels else None,
+        deformation_labels=[tuple(c) for c in labels[1]] if labels else None,
+        analysis=task.analysis if isinstance(task.analysis, str) else getattr(task.analysis, "__name__", "function"))
