@@ -145,6 +145,28 @@ void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R) {
   for (int j = 0; j < nd; ++j) R[j] += data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
 }
 
+void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R) {
+  solve_accelerations_direct(sys, data);
+  compute_inertia_and_loads(sys, data);
+  constitutive_stresses(sys, data);
+  inertia_force(sys, data);
+  // DFe = B DF element by element, so DF_qᵀ g + DFe_qᵀ σ = DF_qᵀ (g + Σ Bᵀ σ).
+  Eigen::VectorXd w = data.g, all;
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const Eigen::MatrixXd& B = data.work[i].B;
+    for (int a = 0; a < se.nd; ++a) {
+      const double s = data.sigma[se.def_offset + a];
+      if (s != 0.0)
+        for (size_t j = 0; j < se.coords.size(); ++j) w[se.coords[j]] += B(a, j) * s;
+    }
+  }
+  transfer_transposed(sys, data, w, all);
+  const int nd = sys.n_dof();
+  R.resize(nd);
+  for (int j = 0; j < nd; ++j) R[j] = all[sys.dof_cols[j]];
+}
+
 void solve_dynamics(const System& sys, Data& data) {
   const int nd = sys.n_dof();
   // The residual at q̈ = 0 holds the inputs' accelerations, convective, applied and elastic forces.

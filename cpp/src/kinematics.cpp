@@ -327,6 +327,66 @@ void solve_accelerations(const System& sys, Data& data) {
   }
 }
 
+void solve_accelerations_direct(const System& sys, Data& data) {
+  // Known accelerations: inputs and DOF coordinates; fixed coordinates rest.
+  data.xdd.setZero();
+  for (int g : sys.x_input) data.xdd[g] = data.qhat_dd[sys.qhat_col_x[g]];
+  for (int g : sys.x_dyn) data.xdd[g] = data.qhat_dd[sys.qhat_col_x[g]];
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc > 0) {
+    // A_V ẍ^c = ë^V − c^V − B_{V,x̄} ẍ_x̄ with the velocity block of solve_velocities_direct.
+    for (size_t r = 0; r < sys.rows_V.size(); ++r) {
+      const int k = sys.rows_V[r];
+      const int col = sys.qhat_col_e[k];
+      data.rhs_V[r] = (col >= 0 ? data.qhat_dd[col] : 0.0) - data.conv[k];
+    }
+    for (size_t i = 0; i < sys.elements.size(); ++i) {
+      const SystemElement& se = sys.elements[i];
+      const Eigen::MatrixXd& B = data.work[i].B;
+      for (int a = 0; a < se.nd; ++a) {
+        const int r = sys.row_V[se.def_offset + a];
+        if (r < 0) continue;
+        for (size_t j = 0; j < se.coords.size(); ++j) data.rhs_V[r] -= B(a, j) * data.xdd[se.coords[j]];
+      }
+    }
+    data.luV.solve(data.rhs_V, data.sol_V);
+    for (int j = 0; j < nc; ++j) data.xdd[sys.x_calc[j]] = data.sol_V[j];
+  }
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    ElementWork& w = data.work[i];
+    for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.xdd[se.coords[j]];
+    data.edd.segment(se.def_offset, se.nd).noalias() = w.B * w.a + w.c;
+  }
+}
+
+void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out) {
+  // DF = [unit rows of the coordinates in q̂; A_V⁻¹ rhs_DF on the calculable ones], so
+  // DFᵀ w = (unit part)ᵀ w + rhs_DFᵀ μ with A_Vᵀ μ = w^c: one transposed solve.
+  out = Eigen::VectorXd::Zero(sys.n_qhat());
+  for (int g = 0; g < sys.nx; ++g)
+    if (sys.qhat_col_x[g] >= 0) out[sys.qhat_col_x[g]] += w[g];
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc == 0) return;
+  for (int j = 0; j < nc; ++j) data.rhs_V[j] = w[sys.x_calc[j]];
+  data.luV.solve_transposed(data.rhs_V, data.sol_V);
+  for (size_t i = 0; i < sys.elements.size(); ++i) {  // rhs_DFᵀ μ, as solve_transfer builds rhs_DF
+    const SystemElement& se = sys.elements[i];
+    const Eigen::MatrixXd& B = data.work[i].B;
+    for (int a = 0; a < se.nd; ++a) {
+      const int r = sys.row_V[se.def_offset + a];
+      if (r < 0) continue;
+      const double mu = data.sol_V[r];
+      for (size_t j = 0; j < se.coords.size(); ++j) {
+        const int col = sys.qhat_col_x[se.coords[j]];
+        if (col >= 0) out[col] -= B(a, j) * mu;
+      }
+      const int ecol = sys.qhat_col_e[se.def_offset + a];
+      if (ecol >= 0) out[ecol] += mu;
+    }
+  }
+}
+
 namespace {
 
 // Greedy selection in the given order: vectors (columns of V) that add rank are kept, the others

@@ -37,7 +37,7 @@ Eigen::MatrixXd global_constitutive(const System& sys, bool damping) {
 Linearizer::Linearizer(const Model& model, const std::map<int, int>& dependent)
     : lin_(compile(model, dependent, true)), ld_(std::make_unique<Data>(*lin_)) {}
 
-void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd) {
+void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd, bool transfer) {
   const System& L = *lin_;
   const int nz = L.n_dof();
   Eigen::VectorXd q(nz), qd(nz);
@@ -49,8 +49,8 @@ void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd) {
   set_dofs(L, *ld_, q.data(), qd.data());
   const double tol = std::min(L.settings.epskin, 1e-10);
   solve_positions(L, *ld_, std::max(L.settings.maxiterat, 50), tol, false);
-  solve_transfer(L, *ld_);
-  solve_velocities(L, *ld_);
+  if (transfer) solve_transfer(L, *ld_);
+  solve_velocities_direct(L, *ld_);
 }
 
 void Linearizer::residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R) {
@@ -58,7 +58,7 @@ void Linearizer::residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R) {
   const int nz = L.n_dof();
   for (int i = 0; i < nz; ++i) ld_->qhat_dd[L.dof_cols[order_[i]]] = zdd[i];
   Eigen::VectorXd RL(nz);
-  reduced_residual(L, *ld_, RL);
+  reduced_residual_direct(L, *ld_, RL);
   R.resize(nz);
   for (int i = 0; i < nz; ++i) R[i] = RL[order_[i]];
 }
@@ -114,7 +114,7 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
   ld_->x = data.x;
   ld_->angle_ref = data.angle_ref;
   ld_->e_integrated = data.e_integrated;
-  set_z(z, zd);
+  set_z(z, zd, true);
   const Eigen::VectorXd x_nominal = ld_->x, angles_nominal = ld_->angle_ref;
   residual(zdd, lin.r0);
   lin.r0 = -lin.r0;
@@ -137,7 +137,7 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
     ld_->x = x_nominal;
     ld_->angle_ref = angles_nominal;
     for (int j = 0; j < nk; ++j) ld_->e_integrated[sys.e_kinematic[j]] = yy[j];
-    set_z(zz, zzd);
+    set_z(zz, zzd, false);
     Eigen::VectorXd R;
     residual(zdd, R);
     Eigen::VectorXd out(nz + nk);

@@ -22,6 +22,9 @@ void assemble_mass_matrix(const System& sys, Data& data);
 // Residual of the reduced equations of motion at the current q̂̈ (formulation.md §7.2):
 // R = DF_qᵀ [M ẍ + h − f] + DFe_qᵀ σ. Requires positions, DF and velocities.
 void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R);
+// The same residual without transfer functions (cost linear in the model size): accelerations
+// and DF_qᵀ from solves with the velocity block. Requires positions and solve_velocities_direct.
+void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R);
 
 // Σ σ_k H_k − ∂f/∂x (nx x nx) at the current positions for the stress vector sigma: the
 // geometric stiffness of the stresses and the stiffness of position-dependent loads.

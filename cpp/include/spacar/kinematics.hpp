@@ -38,6 +38,14 @@ void solve_velocities_direct(const System& sys, Data& data);
 // ẍ = DF q̂̈ + acc0 and ë = B ẍ + c, for the current q̂̈.
 void solve_accelerations(const System& sys, Data& data);
 
+// The same without transfer functions: ẍ^c from one solve with the velocity block (after
+// solve_velocities_direct), ë = B ẍ + c.
+void solve_accelerations_direct(const System& sys, Data& data);
+
+// out = DFᵀ w (one entry per column of q̂) without forming DF: one solve with the transposed
+// velocity block (after solve_velocities_direct). Uses the rhs_V/sol_V work vectors.
+void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out);
+
 // Diagnosis of the position constraint block A_P (or, velocity = true, of the velocity block A_V,
 // whose rows hold the nonholonomic deformations instead of their kinematic coordinates) at the
 // current positions (formulation.md §2.3, §5).

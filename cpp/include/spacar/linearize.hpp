@@ -43,7 +43,9 @@ class Linearizer {
 
  private:
   void residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R);
-  void set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd);
+  // Kinematics at z, ż; the dense transfer functions only if asked (the nominal state: the
+  // perturbed states of the finite differences need the residual only).
+  void set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd, bool transfer);
   std::unique_ptr<System> lin_;
   std::unique_ptr<Data> ld_;
   std::vector<int> order_;      // z index → DOF index of the linearization system
