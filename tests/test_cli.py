@@ -223,3 +223,33 @@ def test_run_blocks_from_python_continues_like_the_command_line():
     assert first.t[-1] == 5.0 and second.t[0] == 5.0 and second.t[-1] == 6.0
     assert len(second.t) == 11
     assert np.allclose(second.x[0], first.x[-1], atol=1e-9)
+
+
+@pytest.mark.parametrize("forcemode", [0, 1, 2])
+def test_run_prints_reactions_and_stresses_as_comments(tmp_path, capsys, forcemode):
+    """FORCEMODE 1: the reactions on the fixed and input coordinates at the dump's time as
+    ``* REACTION n i value``; 2: also ``* SIGMA e i value``; the output still reads as input."""
+    text = EXAMPLE.read_text()
+    end = text.upper().index("\nEND")
+    path = tmp_path / "forces.dat"
+    path.write_text(text[:end] + f"\nFORCEMODE {forcemode}" + text[end:])
+    code, stdout, stderr = run_main(capsys, "run", "--dump-digits", "17", str(path))
+    assert code == 0, stderr
+    res = spacar.simulate(spacar.read(path))
+    reactions = {(int(n), int(i)): float(v)
+                 for n, i, v in re.findall(r"^\* REACTION\s+(\d+)\s+(\d+)\s+(\S+)$", stdout, re.M)}
+    stresses = {(int(e), int(i)): float(v)
+                for e, i, v in re.findall(r"^\* SIGMA\s+(\d+)\s+(\d+)\s+(\S+)$", stdout, re.M)}
+    if forcemode == 0:
+        assert not reactions and not stresses
+        return
+    # Fixed: node 1 (x, y), node 8 (y); input: the crank angle, node 2.
+    assert sorted(reactions) == [(1, 1), (1, 2), (2, 1), (8, 2)]
+    for (n, i), v in reactions.items():
+        assert v == pytest.approx(res.reaction[-1, res.coordinate_index(n, i)], rel=1e-12, abs=1e-15)
+    assert bool(stresses) == (forcemode == 2)
+    if stresses:
+        assert sorted(stresses) == sorted(res.deformation_labels)
+        for (e, i), v in stresses.items():
+            assert v == pytest.approx(res.sigma[-1, res.deformation_index(e, i)], rel=1e-12, abs=1e-15)
+    assert spacar.read_string(stdout).current_time == 5.0

@@ -39,7 +39,7 @@ NOTES = {
     "HMAX": "9.999E+03 (SPACAR95's 'undefined') means no limit.",
     "EPSINT": "Error control per component: rtol = EPSINT, atol = 1e-3 EPSINT (docs/formulation.md).",
     "EPSIND": "Error control per component: rtol = EPSIND, atol = 1e-3 EPSIND (docs/formulation.md).",
-    "FORCEMODE": "Reactions and stresses go to the Results arrays and the MATASC files, not to the dump.",
+    "FORCEMODE": "Reactions and stresses go to the Results arrays, the MATASC files and, as `*` comment lines after the dump, to the output of `spacar run`.",
     "ANIMATE": "`spacar run` writes the animation of the blocks with ANIMATE 1 to `<stem>.gif` next to the "
                "input file (`--animation` for .mp4 or .html). In Python: `spacar.animate(res)`.",
     "MATASC": "Files `<stem>_x.asc`, `_xd`, `_xdd`, `_e`, `_ed`, `_edd`, `_rx`, `_sig`, `_lin`, `_eig`, "
