@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import scipy.optimize
 import pytest
 
 import spacar
@@ -136,6 +137,51 @@ def wheel_ref(normal):
     return reference
 
 
+def quadric_params(Q, b, c):
+    """SURFACE/WHEEL coefficients c1..c10 of f(x) = xᵀQx + bᵀx + c."""
+    return (Q[0, 0], Q[1, 1], Q[2, 2], 2 * Q[0, 1], 2 * Q[1, 2], 2 * Q[0, 2], *b, c)
+
+
+def quadric_of(params):
+    c = params
+    Q = np.array([[c[0], c[3] / 2, c[5] / 2], [c[3] / 2, c[1], c[4] / 2], [c[5] / 2, c[4] / 2, c[2]]])
+    return Q, np.array(c[6:9]), c[9]
+
+
+def wheel_quadric_ref(kind):
+    """A WHEEL on a quadratic surface (params ax ay az r c1..c10), its centre about r from the
+    surface on the positive side: outside a ball ("ball"), inside a spherical bowl ("bowl"), or
+    outside a randomly rotated and shifted ellipsoid with semi-axes 2.5..4 ("ellipsoid"), r ≤ 0.6
+    so that the surface is curved less than the rim."""
+    def reference(case, rng):
+        r = rng.uniform(0.2, 0.6)
+        axis = rng.normal(size=3) * rng.uniform(0.3, 3)
+        c0 = rng.uniform(-1, 1, 3)
+        d = unit(rng.normal(size=3))
+        if kind == "ellipsoid":
+            Rq = rotation_matrix(unit(rng.normal(size=4)))
+            Q = Rq @ np.diag(1 / rng.uniform(2.5, 4.0, 3) ** 2) @ Rq.T
+            p = c0 + d * (1 / math.sqrt(d @ Q @ d) + r * rng.uniform(0.5, 1.5))
+            sign = 1.0
+        else:
+            Rs = rng.uniform(2.0, 4.0)
+            Q = np.eye(3) / Rs ** 2
+            sign = 1.0 if kind == "ball" else -1.0
+            p = c0 + d * (Rs + sign * r * rng.uniform(0.5, 1.5))
+        # f = sign ((x − c0)ᵀQ(x − c0) − 1), positive on the wheel's side
+        params = quadric_params(sign * Q, sign * (-2 * Q @ c0), sign * (c0 @ Q @ c0 - 1))
+        return Reference(x=assemble(case.kinds, [p]), params=(*axis, r, *params), scale=r)
+    return reference
+
+
+def wheel_normal(params, p):
+    """The unit normal the contact is taken against: the plane's, or ∇f at the centre."""
+    if len(params) == 14:
+        Q, b, _ = quadric_of(params[4:])
+        return unit(2 * Q @ p + b)
+    return unit(params[4:7]) if len(params) == 7 else np.array([0.0, 0.0, 1.0])
+
+
 def plbelt_ref(equal_radii=False):
     """Pulley centres L0 ∈ [0.5, 2] apart (LENGTHO, LGEOMY α0), radii r_i ∈ [0.05, 0.3] L0, ρA and
     wound angles a1⁰, a2⁰ ∈ [4, 6] rad (so that the arcs stay positive for β ∈ [−π, π])."""
@@ -169,7 +215,7 @@ class WheelCase(ElementCase):
             ref = self.reference(self, rng)
             x = random_configuration(rng, self.kinds, ref, lambda_norms=(0.9, 1.1) if off_sphere else None)
             a = rotation_matrix(x[3:7]) @ unit(ref.params[0:3])
-            nrm = unit(ref.params[4:7]) if len(ref.params) == 7 else np.array([0.0, 0.0, 1.0])
+            nrm = wheel_normal(ref.params, x[0:3])
             if 1.0 - (nrm @ a) ** 2 < 0.09:
                 continue
             count += 1
@@ -188,6 +234,9 @@ GROUND_CASES = [
     WheelCase("WHEEL", wheel_ref(None)),
     WheelCase("WHEEL", wheel_ref((0.0, 0.0, -1.0)), label="WHEEL-n=-z"),
     WheelCase("WHEEL", wheel_ref("random"), label="WHEEL-n=random"),
+    WheelCase("WHEEL", wheel_quadric_ref("ball"), label="WHEEL-ball"),
+    WheelCase("WHEEL", wheel_quadric_ref("bowl"), label="WHEEL-bowl"),
+    WheelCase("WHEEL", wheel_quadric_ref("ellipsoid"), label="WHEEL-ellipsoid"),
 ]
 CASES = {str(c): c for c in INVARIANT_CASES + GROUND_CASES}
 
@@ -504,6 +553,89 @@ def test_wheel_contact_height_and_slips(label):
         t2 = np.cross(n, t1)
         np.testing.assert_allclose(k.rates(x, v), [n @ vc, t1 @ vc, t2 @ vc], rtol=0,
                                    atol=1e-10 * max(1, np.abs(v).max()))
+
+
+def least_rim_point(f, grad, xp, a, r):
+    """The rim point where f is least, found without the element's Newton iteration: f sampled
+    at 3600 points of the rim, then the root of df/dθ = ∇f·y'(θ) bracketed around the best
+    sample (Brent's method)."""
+    b1 = unit(np.cross(a, [1.0, 0.3, -0.2]))
+    b2 = np.cross(unit(a), b1)
+    rho = r * np.linalg.norm(a)
+    point = lambda th: xp + rho * (math.cos(th) * b1 + math.sin(th) * b2)
+    slope = lambda th: grad(point(th)) @ (rho * (-math.sin(th) * b1 + math.cos(th) * b2))
+    grid = np.linspace(0, 2 * math.pi, 3600, endpoint=False)
+    best = grid[int(np.argmin([f(point(t)) for t in grid]))]
+    h = 2 * math.pi / 3600
+    return point(scipy.optimize.brentq(slope, best - h, best + h, xtol=1e-15, rtol=1e-15))
+
+
+@pytest.mark.parametrize("label", ["WHEEL-ball", "WHEEL-bowl", "WHEEL-ellipsoid"])
+def test_wheel_on_a_quadric_contact_height_and_slips(label):
+    """§4.14 on a quadratic surface against an independent construction: the contact point y is
+    the rim point of least f (sampled and minimised over the rim), e1 = f(y)/|∇f(y)|; the slips
+    are t1·v_c and t2·v_c with N = ∇f(y)/|∇f(y)|, t1 = (a × N)/|a × N|, t2 = N × t1 and the
+    rigid-body velocity v_c = ẋ_p + ω × (y − x_p) of that rim point."""
+    c = CASES[label]
+    for rng, ref, k, x in c.samples("contact"):
+        Q, b, c0 = quadric_of(ref.params[4:])
+        f = lambda y: y @ Q @ y + b @ y + c0
+        lam = x[3:7]
+        a = rotation_matrix(lam) @ unit(ref.params[0:3])
+        y = least_rim_point(f, lambda y: 2 * Q @ y + b, x[0:3], a, ref.params[3])
+        g = 2 * Q @ y + b
+        e = k.deformations(x)
+        np.testing.assert_allclose(e[0], f(y) / np.linalg.norm(g), rtol=0, atol=1e-10 * ref.scale)
+        assert e[1] == 0.0 and e[2] == 0.0
+        lamd = rng.normal(size=4)
+        lamd -= (lamd @ lam) * lam
+        v = np.concatenate([rng.normal(size=3), lamd])
+        vc = v[0:3] + np.cross(2 * E_of(lam) @ lamd, y - x[0:3])
+        n = unit(g)
+        t1 = unit(np.cross(a, n))
+        t2 = np.cross(n, t1)
+        np.testing.assert_allclose(k.rates(x, v)[1:], [t1 @ vc, t2 @ vc], rtol=0,
+                                   atol=1e-10 * max(1, np.abs(v).max()))
+
+
+def test_wheel_on_a_plane_given_as_a_quadric_is_the_plane_wheel():
+    """The quadric path with f = n·x (c7..c9 = n) equals the closed-form plane path on the unit
+    sphere of λ, where the two formulas describe the same disc (off it they extend it
+    differently: the plane formula keeps the radius, the rim R(λ)u0 scales with |λ|²): e, the
+    rates B v and the accelerations ë = B ẍ + c along motions that keep |λ| = 1 (λ̇ ⟂ λ,
+    λ̈ = −|λ̇|² λ)."""
+    rng = np.random.default_rng(11)
+    count = 0
+    while count < 20:
+        axis, r, n = rng.normal(size=3), rng.uniform(0.2, 1.0), unit(rng.normal(size=3))
+        plane = _core.element_kernel("WHEEL", params=[*axis, r, *n])
+        quadric = _core.element_kernel("WHEEL", params=[*axis, r, 0, 0, 0, 0, 0, 0, *n, 0])
+        lam = unit(rng.normal(size=4))
+        if 1 - (n @ rotation_matrix(lam) @ unit(axis)) ** 2 < 0.09:
+            continue
+        count += 1
+        x = np.concatenate([rng.uniform(-2, 2, 3), lam])
+        w = rng.normal(size=4)
+        w -= (w @ lam) * lam
+        v = np.concatenate([rng.normal(size=3), w])
+        acc = np.concatenate([rng.normal(size=3), -(w @ w) * lam])
+        for k in (plane, quadric):
+            assert np.isfinite(k.deformations(x)).all()
+        np.testing.assert_allclose(quadric.deformations(x), plane.deformations(x), rtol=0, atol=1e-13)
+        np.testing.assert_allclose(quadric.first_derivatives(x) @ v, plane.first_derivatives(x) @ v,
+                                   rtol=0, atol=1e-12 * np.abs(v).max())
+        edd = [k.first_derivatives(x) @ acc + k.convective(x, v) for k in (plane, quadric)]
+        np.testing.assert_allclose(edd[1], edd[0], rtol=0, atol=1e-11 * max(1.0, np.abs(edd[0]).max()))
+
+
+def test_wheel_surface_input_errors():
+    with pytest.raises(spacar.InputError, match="c1 .. c9 are all zero"):
+        _core.element_kernel("WHEEL", params=[0, 1, 0, 0.3] + [0.0] * 9 + [1.0])
+    with pytest.raises(spacar.InputError, match="quadratic surface"):
+        _core.element_kernel("WHEEL", params=[0, 1, 0, 0.3, 1, 1])
+    with pytest.raises(spacar.InputError, match=r"^wheel.dat, line 2, keyword WHEEL: WHEEL 1 takes 4, 7 or 14 "
+                                                r"numbers after its nodes .* got 10$"):
+        spacar.read_string("* a wheel\nWHEEL 1 1 2 0 1 0 0.3 1 1 1 1 1 1\nEND\n", file="wheel.dat")
 
 
 def test_wheel_rolling_direction():

@@ -7,6 +7,9 @@
   mass between the driving reaction and d/dt of the kinetic and strain energy of the whole drive;
 * a rolling disc (WHEEL) in steady circular motion: the steady-motion condition between lean
   angle, spin and radius, derived below, kept over several revolutions;
+* a disc rolling in a spherical bowl (WHEEL on a quadratic surface): in its vertical plane
+  through the bowl's centre, the pendulum equation (R − r)(1 + I_a/(m r²)) θ̈ = −g sin θ solved
+  independently; in a general 3-D motion, energy conserved and the contact point at rest;
 * the Whipple bicycle of Meijaard et al. (2007), examples/bicycle.dat: M, C1, K0, K2, the
   eigenvalues at 0–10 m/s, the weave and capsize speeds;
 * a planar cart (two PLWHEELs on a rigid body): turning radius at constant steer; released
@@ -25,11 +28,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.integrate import cumulative_simpson
+from scipy.integrate import cumulative_simpson, solve_ivp
 from scipy.optimize import brentq
 
 import spacar
 from spacar import _core
+from spatial_models import R_, body_angular_velocity
 
 ROOT = Path(__file__).resolve().parents[1]
 BICYCLE = ROOT / "examples" / "bicycle.dat"
@@ -315,6 +319,79 @@ def test_rolling_disc_drifts_when_the_condition_is_violated():
     Om, ws = disc_steady_state(phi, rho)
     d_lean, d_radius, _, _ = disc_drift(phi, rho, Om * (1 + 1e-6), ws)
     assert d_lean > 1e-8 and d_radius > 1e-8
+
+
+# ---------------------------------------------------------------------------------------------
+# Disc rolling in a spherical bowl (WHEEL on a quadratic surface)
+# ---------------------------------------------------------------------------------------------
+
+def bowl_disc(theta0, lean=0.0, yaw_rate=0.0, spin=0.0, Rb=1.0, r=0.1, m=1.0, g=9.81, T=3.0, n=60):
+    """The rolling disc model above in a spherical bowl of radius Rb, f = Rb² − |y − c|² with
+    c = (0, 0, Rb) (c1..c3 = −1, c9 = 2 Rb), the centre started on the circle of radius Rb − r
+    at angle θ0 from the bottom in the xz-plane, axle along y."""
+    M = spacar.Model()
+    M.bearing(1, 10, 11, 1, 3, 0.0, 0.0, 1.0)
+    M.hinge(2, 3, 2, 0.0, 1.0, 0.0)
+    M.wheel(3, 1, 2, 0.0, 1.0, 0.0, r, -1, -1, -1, 0, 0, 0, 0, 0, 2 * Rb, 0)
+    M.xyz(10, 0.0, 0.0, 0.0)
+    M.xyz(1, (Rb - r) * math.sin(theta0), 0.0, Rb - (Rb - r) * math.cos(theta0))
+    M.fix(10)
+    M.fix(11)
+    M.rlse(1, 1)
+    M.dyne(1, 4, 5)
+    M.dyne(2, 1)
+    M.enhc(3, 2, 1, 2)
+    M.enhc(3, 3, 1, 3)
+    M.e(1, 5, math.sin(lean))
+    M.ed(1, 4, yaw_rate)
+    M.ed(2, 1, spin)
+    M.mass(1, m)
+    M.mass(2, 0.25 * m * r * r, 0, 0, 0.5 * m * r * r, 0, 0.25 * m * r * r)
+    M.gravity(0.0, 0.0, -g)
+    M.timestep(n, T)
+    return tight(M)
+
+
+def test_disc_rolling_in_a_bowl_is_a_pendulum():
+    """Released from rest at θ0 = 0.5 rad in the vertical plane through the bowl's centre, the
+    centre moves on the circle of radius Rb − r and θ(t) follows (Rb − r)(3/2) θ̈ = −g sin θ
+    (I_a = m r²/2), integrated here by SciPy at rtol 1e-13."""
+    Rb, r, g, theta0 = 1.0, 0.1, 9.81, 0.5
+    res = bowl_disc(theta0).run()
+    x, y, z = res.node(1).x.T
+    theta = np.arctan2(x, Rb - z)
+    ref = solve_ivp(lambda t, s: [s[1], -g * math.sin(s[0]) / (1.5 * (Rb - r))], (0.0, res.t[-1]),
+                    [theta0, 0.0], method="DOP853", rtol=1e-13, atol=1e-14, t_eval=res.t)
+    assert np.abs(theta - ref.y[0]).max() < 1e-9
+    assert np.abs(np.hypot(x, Rb - z) - (Rb - r)).max() < 1e-12
+    assert np.abs(y).max() < 1e-12 and np.abs(res.deformation(1, 5)).max() < 1e-12
+    assert theta.min() < -0.49  # it swung through to the other side
+
+
+def test_disc_rolling_in_a_bowl_in_3d_conserves_energy_without_slip():
+    """Leaning, turning and spinning: T + V constant (the rolling constraints do no work) and the
+    material point of the rim at the contact at rest, to the integration tolerance."""
+    m, r, g, Rb = 1.0, 0.1, 9.81, 1.0
+    J = np.diag([0.25 * m * r * r, 0.5 * m * r * r, 0.25 * m * r * r])
+    res = bowl_disc(0.4, lean=0.2, yaw_rate=1.5, spin=-25.0, T=2.0, n=100).run()
+    lam, lamd = res.node(2).x, res.node(2).xd
+    w_body = body_angular_velocity(lam, lamd)
+    T = 0.5 * m * (res.node(1).xd ** 2).sum(axis=1) + 0.5 * np.einsum("ti,ij,tj->t", w_body, J, w_body)
+    E = T + m * g * res.node(1).x[:, 2]
+    assert np.abs(E - E[0]).max() < 1e-9 * E[0]
+    assert np.ptp(res.deformation(1, 4)) > 0.5 and np.ptp(res.deformation(1, 5)) > 0.05  # a 3-D motion
+    # contact point: the rim point farthest from the bowl's centre c; its velocity ẋ + ω × (y − x)
+    c = np.array([0.0, 0.0, Rb])
+    for k in range(0, len(res.t), 10):
+        R = R_(lam[k])
+        a = R @ np.array([0.0, 1.0, 0.0])
+        p = res.node(1).x[k]
+        d = (p - c) - ((p - c) @ a) * a
+        y = p + r * d / np.linalg.norm(d)
+        assert abs(np.linalg.norm(y - c) - Rb) < 1e-10
+        omega = R @ w_body[k]
+        vc = res.node(1).xd[k] + np.cross(omega, y - p)
+        assert np.linalg.norm(vc) < 1e-9
 
 
 # ---------------------------------------------------------------------------------------------

@@ -191,9 +191,13 @@ std::vector<ElementType> build_catalogue() {
   }
   {
     ElementType& e = add(t, "WHEEL", {K::XYZ, K::Lambda}, {"p1", "o1"},
-                         {"height of the lowest rim point", "longitudinal slip", "lateral slip"},
-                         "knife-edge wheel rolling on a plane (extension)");
-    set_params(e, 4, 7, "ax ay az r [nx ny nz]: initial axle direction, radius, ground-plane normal");
+                         {"height of the contact point", "longitudinal slip", "lateral slip"},
+                         "knife-edge wheel rolling on a plane or a quadratic surface (extension)");
+    set_params(e, 4, 14,
+               "ax ay az r [nx ny nz | c1 .. c10]: initial axle direction, radius; ground-plane normal "
+               "(default 0 0 1) or the coefficients of a quadratic surface as for SURFACE, positive on the "
+               "wheel's side");
+    e.n_params_allowed = {4, 7, 14};
     e.extension = true;
     e.velocity_level = {false, true, true};
     e.make = make_wheel;

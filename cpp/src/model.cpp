@@ -155,6 +155,15 @@ void Model::add_element(const std::string& type_name, int id, const std::vector<
   if (node_ids.size() != et.nodes.size())
     fail(et.name, " takes ", et.nodes.size(), " nodes, got ", node_ids.size());
   require_count(params, et.n_params_min, et.n_params_max, (et.name + " parameters").c_str());
+  if (!et.n_params_allowed.empty() &&
+      std::find(et.n_params_allowed.begin(), et.n_params_allowed.end(), static_cast<int>(params.size())) ==
+          et.n_params_allowed.end()) {
+    std::string counts;
+    for (size_t i = 0; i < et.n_params_allowed.size(); ++i)
+      counts += (i == 0 ? "" : i + 1 == et.n_params_allowed.size() ? " or " : ", ") +
+                std::to_string(et.n_params_allowed[i]);
+    fail(et.name, " ", id, " takes ", counts, " numbers after its nodes (", et.params, "), got ", params.size());
+  }
   require_finite(params, et.name.c_str());
   if (et.has_direction && params[0] == 0.0 && params[1] == 0.0 && params[2] == 0.0)
     fail(et.name, " ", id, ": the direction vector has zero length");

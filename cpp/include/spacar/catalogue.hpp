@@ -32,6 +32,7 @@ struct ElementType {
   std::vector<std::string> node_roles;    // e.g. {"p1", "o1", "p2", "o2"}
   std::vector<std::string> deformations;  // meaning of e1, e2, ...
   int n_params_min = 0, n_params_max = 0; // numbers after the node list on the definition line
+  std::vector<int> n_params_allowed;       // the counts in [min, max] that are valid (empty: all)
   std::string params;                     // their meaning ("" if none)
   std::string estiff, edampp, emass;      // meaning of ESTIFF / EDAMPP / EMASS values ("" = not used)
   int n_estiff = 0, n_emass = 0;          // maximum number of ESTIFF/EDAMPP and EMASS values
