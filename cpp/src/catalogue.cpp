@@ -194,7 +194,7 @@ std::vector<ElementType> build_catalogue() {
                          {"height of the contact point", "longitudinal slip", "lateral slip"},
                          "knife-edge wheel rolling on a plane or a quadratic surface (extension)");
     set_params(e, 4, 14,
-               "ax ay az r [nx ny nz | c1 .. c10]: initial axle direction, radius; ground-plane normal "
+               "ax ay az r [nx ny nz or c1 .. c10]: initial axle direction, radius; ground-plane normal "
                "(default 0 0 1) or the coefficients of a quadratic surface as for SURFACE, positive on the "
                "wheel's side");
     e.n_params_allowed = {4, 7, 14};
