@@ -6,6 +6,8 @@
 #include <sstream>
 #include <utility>
 
+#include <Eigen/Sparse>
+
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
@@ -125,10 +127,17 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
     lin.DFez.col(i) = ld_->DFe.col(L.dof_cols[order_[i]]);
   }
   assemble_mass_matrix(L, *ld_);
-  lin.M0 = lin.DFz.transpose() * ld_->M * lin.DFz;
-  lin.K0 = lin.DFez.transpose() * global_constitutive(L, false) * lin.DFez;
-  lin.D0 = lin.DFez.transpose() * global_constitutive(L, true) * lin.DFez;
-  lin.G0 = lin.DFz.transpose() * geometric_stiffness(L, *ld_, data.sigma) * lin.DFz;
+  // The mass, constitutive and geometric matrices are block sparse (element by element): as
+  // sparse factors the products cost half the dense ones (one dense product each).
+  auto reduce = [](const Eigen::MatrixXd& T, const Eigen::MatrixXd& A) -> Eigen::MatrixXd {
+    const Eigen::SparseMatrix<double> As = A.sparseView();
+    const Eigen::MatrixXd AT = As * T;
+    return T.transpose() * AT;
+  };
+  lin.M0 = reduce(lin.DFz, ld_->M);
+  lin.K0 = reduce(lin.DFez, global_constitutive(L, false));
+  lin.D0 = reduce(lin.DFez, global_constitutive(L, true));
+  lin.G0 = reduce(lin.DFz, geometric_stiffness(L, *ld_, data.sigma));
   lin.AK0.resize(nk, nz);
   for (int j = 0; j < nk; ++j) lin.AK0.row(j) = lin.DFez.row(sys.e_kinematic[j]);
 
