@@ -256,17 +256,18 @@ def disc_steady_state(phi, rho, m=1.0, r=0.1, g=9.81):
     return Om, wa - Om * math.sin(phi)
 
 
-def rolling_disc(phi, Om, ws, m=1.0, r=0.1, g=9.81, T=1.0, n=10):
+def rolling_disc(phi, Om, ws, m=1.0, r=0.1, g=9.81, T=1.0, n=10, surface=(), centre=None):
     """BEARING 1 from the ground (10, 11) to the disc centre 1 and a turning frame 3 (vertical
     axis: e1 height RLSE, e2 = x and e3 = y kinematic coordinates of the slips, e4 = yaw and
     e5 = sin(lean) DOFs, e6 = pitch of the frame fixed at 0); HINGE 2 from the frame to the disc
-    2 about the axle (e1 = spin DOF); WHEEL 3 (e1 fixed: contact, e2 and e3 ENHC)."""
+    2 about the axle (e1 = spin DOF); WHEEL 3 (e1 fixed: contact, e2 and e3 ENHC) on the plane
+    z = 0 or on the quadratic `surface` c1..c10, the centre starting at (0, 0, r) or `centre`."""
     M = spacar.Model()
     M.bearing(1, 10, 11, 1, 3, 0.0, 0.0, 1.0)
     M.hinge(2, 3, 2, 0.0, 1.0, 0.0)
-    M.wheel(3, 1, 2, 0.0, 1.0, 0.0, r)
+    M.wheel(3, 1, 2, 0.0, 1.0, 0.0, r, *surface)
     M.xyz(10, 0.0, 0.0, 0.0)
-    M.xyz(1, 0.0, 0.0, r)
+    M.xyz(1, *(centre if centre is not None else (0.0, 0.0, r)))
     M.fix(10)
     M.fix(11)
     M.rlse(1, 1)
@@ -325,31 +326,13 @@ def test_rolling_disc_drifts_when_the_condition_is_violated():
 # Disc rolling in a spherical bowl (WHEEL on a quadratic surface)
 # ---------------------------------------------------------------------------------------------
 
-def bowl_disc(theta0, lean=0.0, yaw_rate=0.0, spin=0.0, Rb=1.0, r=0.1, m=1.0, g=9.81, T=3.0, n=60):
-    """The rolling disc model above in a spherical bowl of radius Rb, f = Rb² − |y − c|² with
+def bowl_disc(theta0, lean=0.0, yaw_rate=0.0, spin=0.0, Rb=1.0, r=0.1, T=3.0, n=60):
+    """The rolling disc above in a spherical bowl of radius Rb, f = Rb² − |y − c|² with
     c = (0, 0, Rb) (c1..c3 = −1, c9 = 2 Rb), the centre started on the circle of radius Rb − r
     at angle θ0 from the bottom in the xz-plane, axle along y."""
-    M = spacar.Model()
-    M.bearing(1, 10, 11, 1, 3, 0.0, 0.0, 1.0)
-    M.hinge(2, 3, 2, 0.0, 1.0, 0.0)
-    M.wheel(3, 1, 2, 0.0, 1.0, 0.0, r, -1, -1, -1, 0, 0, 0, 0, 0, 2 * Rb, 0)
-    M.xyz(10, 0.0, 0.0, 0.0)
-    M.xyz(1, (Rb - r) * math.sin(theta0), 0.0, Rb - (Rb - r) * math.cos(theta0))
-    M.fix(10)
-    M.fix(11)
-    M.rlse(1, 1)
-    M.dyne(1, 4, 5)
-    M.dyne(2, 1)
-    M.enhc(3, 2, 1, 2)
-    M.enhc(3, 3, 1, 3)
-    M.e(1, 5, math.sin(lean))
-    M.ed(1, 4, yaw_rate)
-    M.ed(2, 1, spin)
-    M.mass(1, m)
-    M.mass(2, 0.25 * m * r * r, 0, 0, 0.5 * m * r * r, 0, 0.25 * m * r * r)
-    M.gravity(0.0, 0.0, -g)
-    M.timestep(n, T)
-    return tight(M)
+    centre = ((Rb - r) * math.sin(theta0), 0.0, Rb - (Rb - r) * math.cos(theta0))
+    return rolling_disc(lean, yaw_rate, spin, r=r, T=T, n=n, surface=(-1, -1, -1, 0, 0, 0, 0, 0, 2 * Rb, 0),
+                        centre=centre)
 
 
 def test_disc_rolling_in_a_bowl_is_a_pendulum():

@@ -282,31 +282,49 @@ void solve_velocities(const System& sys, Data& data) {
   }
 }
 
-void solve_velocities_direct(const System& sys, Data& data) {
-  // Known rates: inputs and DOF coordinates; fixed coordinates rest.
-  data.xd.setZero();
-  for (int g : sys.x_input) data.xd[g] = data.qhat_d[sys.qhat_col_x[g]];
-  for (int g : sys.x_dyn) data.xd[g] = data.qhat_d[sys.qhat_col_x[g]];
-  const int nc = static_cast<int>(sys.x_calc.size());
-  if (nc > 0) {
-    factorize_velocity_block(sys, data);
-    // A_V ẋ^c = ė^V − B_{V,x̄} ẋ_x̄, ė^V the known rates (inputs, DOFs; 0 for the rest).
-    for (size_t r = 0; r < sys.rows_V.size(); ++r) {
-      const int col = sys.qhat_col_e[sys.rows_V[r]];
-      data.rhs_V[r] = col >= 0 ? data.qhat_d[col] : 0.0;
-    }
-    for (size_t i = 0; i < sys.elements.size(); ++i) {
-      const SystemElement& se = sys.elements[i];
-      const Eigen::MatrixXd& B = data.work[i].B;
-      for (int a = 0; a < se.nd; ++a) {
-        const int r = sys.row_V[se.def_offset + a];
-        if (r < 0) continue;
-        for (size_t j = 0; j < se.coords.size(); ++j) data.rhs_V[r] -= B(a, j) * data.xd[se.coords[j]];
-      }
-    }
-    data.luV.solve(data.rhs_V, data.sol_V);
-    for (int j = 0; j < nc; ++j) data.xd[sys.x_calc[j]] = data.sol_V[j];
+namespace {
+// ë = B ẍ + c, element by element, for the current ẍ.
+void deformation_accelerations(const System& sys, Data& data) {
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    ElementWork& w = data.work[i];
+    for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.xdd[se.coords[j]];
+    data.edd.segment(se.def_offset, se.nd).noalias() = w.B * w.a + w.c;
   }
+}
+
+// Rates y of all coordinates from the rates of q̂ (inputs and DOF coordinates; fixed ones rest)
+// with the factorized velocity block: A_V y^c = ė^V − s^V − B_{V,x̄} y_x̄, ė^V the q̂ rates of
+// the rows (0 for the rest); s = 0 for velocities, the convective terms c for accelerations.
+void calculable_rates(const System& sys, Data& data, const Eigen::VectorXd& qhat_rate, bool convective,
+                      Eigen::VectorXd& y) {
+  y.setZero();
+  for (int g : sys.x_input) y[g] = qhat_rate[sys.qhat_col_x[g]];
+  for (int g : sys.x_dyn) y[g] = qhat_rate[sys.qhat_col_x[g]];
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc == 0) return;
+  for (size_t r = 0; r < sys.rows_V.size(); ++r) {
+    const int k = sys.rows_V[r];
+    const int col = sys.qhat_col_e[k];
+    data.rhs_V[r] = (col >= 0 ? qhat_rate[col] : 0.0) - (convective ? data.conv[k] : 0.0);
+  }
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const Eigen::MatrixXd& B = data.work[i].B;
+    for (int a = 0; a < se.nd; ++a) {
+      const int r = sys.row_V[se.def_offset + a];
+      if (r < 0) continue;
+      for (size_t j = 0; j < se.coords.size(); ++j) data.rhs_V[r] -= B(a, j) * y[se.coords[j]];
+    }
+  }
+  data.luV.solve(data.rhs_V, data.sol_V);
+  for (int j = 0; j < nc; ++j) y[sys.x_calc[j]] = data.sol_V[j];
+}
+}  // namespace
+
+void solve_velocities_direct(const System& sys, Data& data) {
+  if (!sys.x_calc.empty()) factorize_velocity_block(sys, data);
+  calculable_rates(sys, data, data.qhat_d, false, data.xd);
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
     ElementWork& w = data.work[i];
@@ -319,45 +337,12 @@ void solve_velocities_direct(const System& sys, Data& data) {
 void solve_accelerations(const System& sys, Data& data) {
   data.xdd = data.acc0;
   data.xdd.noalias() += data.DF * data.qhat_dd;
-  for (size_t i = 0; i < sys.elements.size(); ++i) {
-    const SystemElement& se = sys.elements[i];
-    ElementWork& w = data.work[i];
-    for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.xdd[se.coords[j]];
-    data.edd.segment(se.def_offset, se.nd).noalias() = w.B * w.a + w.c;
-  }
+  deformation_accelerations(sys, data);
 }
 
 void solve_accelerations_direct(const System& sys, Data& data) {
-  // Known accelerations: inputs and DOF coordinates; fixed coordinates rest.
-  data.xdd.setZero();
-  for (int g : sys.x_input) data.xdd[g] = data.qhat_dd[sys.qhat_col_x[g]];
-  for (int g : sys.x_dyn) data.xdd[g] = data.qhat_dd[sys.qhat_col_x[g]];
-  const int nc = static_cast<int>(sys.x_calc.size());
-  if (nc > 0) {
-    // A_V ẍ^c = ë^V − c^V − B_{V,x̄} ẍ_x̄ with the velocity block of solve_velocities_direct.
-    for (size_t r = 0; r < sys.rows_V.size(); ++r) {
-      const int k = sys.rows_V[r];
-      const int col = sys.qhat_col_e[k];
-      data.rhs_V[r] = (col >= 0 ? data.qhat_dd[col] : 0.0) - data.conv[k];
-    }
-    for (size_t i = 0; i < sys.elements.size(); ++i) {
-      const SystemElement& se = sys.elements[i];
-      const Eigen::MatrixXd& B = data.work[i].B;
-      for (int a = 0; a < se.nd; ++a) {
-        const int r = sys.row_V[se.def_offset + a];
-        if (r < 0) continue;
-        for (size_t j = 0; j < se.coords.size(); ++j) data.rhs_V[r] -= B(a, j) * data.xdd[se.coords[j]];
-      }
-    }
-    data.luV.solve(data.rhs_V, data.sol_V);
-    for (int j = 0; j < nc; ++j) data.xdd[sys.x_calc[j]] = data.sol_V[j];
-  }
-  for (size_t i = 0; i < sys.elements.size(); ++i) {
-    const SystemElement& se = sys.elements[i];
-    ElementWork& w = data.work[i];
-    for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.xdd[se.coords[j]];
-    data.edd.segment(se.def_offset, se.nd).noalias() = w.B * w.a + w.c;
-  }
+  calculable_rates(sys, data, data.qhat_dd, true, data.xdd);
+  deformation_accelerations(sys, data);
 }
 
 void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out) {
