@@ -13,17 +13,13 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import os
-import platform
-import re
 import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
+import _common as C
 import spacar
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -31,59 +27,6 @@ EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 DOC = ROOT / "docs" / "performance.md"
 SECTION = "## Manual slider-crank"
 AIM_MS = 50.0
-
-
-def cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.lower().startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine()
-
-
-def compiler() -> str:
-    """Compiler of the extension module: from the CMake build directory next to it (editable or
-    build-tree installs), else the system's c++."""
-    here = Path(spacar._core.__file__).resolve()
-    for parent in list(here.parents)[:5]:
-        cache = parent / "CMakeCache.txt"
-        if not cache.is_file():
-            continue
-        text = cache.read_text(errors="replace")
-        build_type = re.search(r"^CMAKE_BUILD_TYPE:\w+=(.*)$", text, re.M)
-        flags = None
-        if build_type:
-            flags = re.search(rf"^CMAKE_CXX_FLAGS_{build_type.group(1).upper()}:\w+=(.*)$", text, re.M)
-        for info in sorted(parent.glob("CMakeFiles/*/CMakeCXXCompiler.cmake")):
-            ctext = info.read_text(errors="replace")
-            cid = re.search(r'set\(CMAKE_CXX_COMPILER_ID "([^"]*)"\)', ctext)
-            ver = re.search(r'set\(CMAKE_CXX_COMPILER_VERSION "([^"]*)"\)', ctext)
-            if cid and ver:
-                desc = f"{cid.group(1)} {ver.group(1)}"
-                if build_type:
-                    desc += f", {build_type.group(1)}"
-                if flags and flags.group(1).strip():
-                    desc += f" ({flags.group(1).strip()})"
-                return desc
-    try:
-        out = subprocess.run(["c++", "--version"], capture_output=True, text=True, timeout=10).stdout
-        return out.splitlines()[0].strip() + " (system c++; build directory not found)"
-    except (OSError, IndexError, subprocess.SubprocessError):
-        return "unknown"
-
-
-def machine() -> dict:
-    return {
-        "CPU": cpu_model(),
-        "cores": f"{os.cpu_count()} logical",
-        "OS": f"{platform.system()} {platform.release()}",
-        "compiler": compiler(),
-        "Python": platform.python_version(),
-        "NumPy": np.__version__,
-        "spacar": spacar.__version__,
-    }
 
 
 def run_once():
@@ -139,9 +82,7 @@ def section(m: dict, f: dict) -> str:
         "input `examples/slidercrank.dat` unchanged (manual §5.7: DOP853, EPSINT = EPSIND = 1e-3,",
         f"EPSKIN = 1e-5), one block of 5 s with {f['outputs']} output times, {f['n']} runs after one warm-up run.",
         "",
-        "| machine | |",
-        "|---|---|",
-        *[f"| {k} | {v} |" for k, v in m.items()],
+        *C.machine_table(m),
         "",
         "| figure | best | median |",
         "|---|---|---|",
@@ -163,32 +104,18 @@ def section(m: dict, f: dict) -> str:
     return "\n".join(lines)
 
 
-def write_section(text: str, path: Path = DOC) -> None:
-    if path.exists():
-        doc = path.read_text()
-    else:
-        doc = "# Performance\n\nMeasured figures of spacar; each section is written by the script named in it.\n\n"
-    pattern = re.compile(rf"^{re.escape(SECTION)}\n.*?(?=^## |\Z)", re.M | re.S)
-    if pattern.search(doc):
-        doc = pattern.sub(lambda _: text + "\n", doc, count=1)
-    else:
-        doc = doc.rstrip("\n") + "\n\n" + text + "\n"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(doc.rstrip("\n") + "\n")
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("-n", type=int, default=20, help="number of timed runs (default 20)")
     parser.add_argument("--cli-repeats", type=int, default=3, help="end-to-end CLI runs (0: skip)")
     parser.add_argument("--no-write", action="store_true", help=f"do not update {DOC.relative_to(ROOT)}")
     args = parser.parse_args(argv)
-    m = machine()
+    m = C.machine()
     f = measure(args.n, args.cli_repeats)
     text = section(m, f)
     print(text)
     if not args.no_write:
-        write_section(text)
+        C.write_section(SECTION[3:], text, DOC)
         print(f"updated {DOC}")
     return 0
 
