@@ -21,12 +21,10 @@ gravity, simulated over T = 0.3 s.
 from __future__ import annotations
 
 import sys
-import time
 
 import numpy as np
 
 import _common as C
-import spacar
 from spacar.compare import models
 
 TITLE = "Rigid N-link chains: spacar, exudyn, Pinocchio"
@@ -59,17 +57,7 @@ def hinge_columns(labels, n):
 def run_spacar(n, t_end, eps, repeat=3):
     """Best wall time of ``spacar.simulate`` over up to ``repeat`` runs (each on a fresh copy of
     the model, built outside the timing); joint angles at T and the run's statistics."""
-    model = chain(n, t_end, eps)
-    best, res = float("inf"), None
-    spent = 0.0
-    for k in range(repeat):
-        m = model.copy()
-        start = time.perf_counter()
-        res = spacar.simulate(m)
-        wall = time.perf_counter() - start
-        best, spent = min(best, wall), spent + wall
-        if spent > 2.0:
-            break
+    res, best = C.simulate_best(chain(n, t_end, eps), repeat)
     q = res.e[-1, hinge_columns(res.deformation_labels, n)]
     return q, best, res.stats
 
