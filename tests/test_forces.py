@@ -25,6 +25,7 @@ import pytest
 
 import spacar
 from spacar import _core
+from equilibrium import static_equilibrium
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
 G = 9.81
@@ -63,37 +64,6 @@ def planar_cantilever(n, force, torque, flexible, L=1.0, slope=0.0):
     return m
 
 
-def static_equilibrium(model, tol=1e-13):
-    """The DOF values at rest in equilibrium: Newton on the reduced force R(q) = −M̄ q̈ (at
-    q̇ = 0) with a central-difference Jacobian (R, unlike q̈, is well conditioned)."""
-    model = model.copy()
-    model.prepare()
-    sim = _core.Simulation(model._core)
-    sim.assemble()
-    nd = sim.system.n_dof
-    q, zero = np.zeros(nd), np.zeros(nd)
-
-    def force(q):
-        sim.move_to(0.0, q, zero)
-        return -np.array(sim.data.Mbar) @ np.array(sim.data.qdd)
-
-    for _ in range(30):
-        R = force(q)
-        if np.abs(R).max() < tol:
-            break
-        J = np.empty((nd, nd))
-        for j in range(nd):
-            dq = np.zeros(nd)
-            dq[j] = 1e-6
-            J[:, j] = (force(q + dq) - force(q - dq)) / 2e-6
-        q = q - np.linalg.solve(J, R)
-    else:
-        raise AssertionError(f"no static equilibrium: |R| = {np.abs(R).max()}")
-    sim.move_to(0.0, q, zero)
-    sim.forces()
-    return sim, q
-
-
 @pytest.mark.parametrize("slope", [0.0, 0.4])
 def test_rigid_planar_cantilever_reaction_balances_tip_load(slope):
     """All deformations rigid: the kinematic analysis alone gives the reaction at the clamp,
@@ -119,6 +89,7 @@ def test_flexible_planar_cantilever_reaction_in_deflected_equilibrium():
     the deflected tip, to 1e-10 of the load."""
     F, T = np.array([0.3, -2.0]), 0.5
     sim, q = static_equilibrium(planar_cantilever(4, F, T, flexible=True))
+    sim.forces()
     r, x = np.array(sim.data.reaction), np.array(sim.data.x)
     labels = [tuple(lbl) for lbl in sim.system.coord_label]
     idx = {lbl: i for i, lbl in enumerate(labels)}
