@@ -253,3 +253,19 @@ def test_run_prints_reactions_and_stresses_as_comments(tmp_path, capsys, forcemo
         for (e, i), v in stresses.items():
             assert v == pytest.approx(res.sigma[-1, res.deformation_index(e, i)], rel=1e-12, abs=1e-15)
     assert spacar.read_string(stdout).current_time == 5.0
+
+
+def test_forcemode_1_prints_the_driving_force_of_an_input_deformation(tmp_path, capsys):
+    """A crank driven through its hinge angle (INPUTE): FORCEMODE 1 prints the hinge's stress,
+    the driving torque, next to the reactions; no other stresses."""
+    path = tmp_path / "crank.dat"
+    path.write_text("PLHINGE 1 1 2\nPLBEAM 2 3 2 4 5\nX 4 0.2 0\nFIX 1\nFIX 3\nINPUTE 1 1\nED 1 1 2.0\n"
+                    "EMASS 2 1.5\nGRAVITY 0 -9.81\nFORCEMODE 1\nTIMESTEP 4 0.5\nEND\n")
+    code, stdout, stderr = run_main(capsys, "run", "--dump-digits", "17", str(path))
+    assert code == 0, stderr
+    res = spacar.simulate(spacar.read(path))
+    stresses = re.findall(r"^\* SIGMA\s+(\d+)\s+(\d+)\s+(\S+)$", stdout, re.M)
+    assert [(int(e), int(i)) for e, i, _ in stresses] == [(1, 1)]
+    assert float(stresses[0][2]) == pytest.approx(res.sigma[-1, res.deformation_index(1, 1)], rel=1e-12)
+    assert abs(float(stresses[0][2])) > 0.1  # it lifts the crank against gravity
+    assert re.search(r"^\* REACTION\s+3\s+2\s", stdout, re.M)

@@ -53,20 +53,22 @@ def _print_linearization(res) -> None:
         _comment("buckling factors: " + " ".join(f"{m:.6g}" for m in lin.buckling_factors()))
 
 
-def _print_forces(res, forcemode: int, digits: int) -> None:
-    """FORCEMODE 1: the reactions on the fixed and input coordinates at the dump's time, as
-    comment lines keyed like the dump (``* REACTION n i value``); FORCEMODE 2 also the stresses
-    of all elements (``* SIGMA e i value``). The dump format has no place for them."""
+def _print_forces(res, model, digits: int) -> None:
+    """FORCEMODE 1: the reactions on the fixed and input coordinates and the driving forces of
+    the input deformations at the dump's time, as comment lines keyed like the dump
+    (``* REACTION n i value``, ``* SIGMA e i value``); FORCEMODE 2: the stresses of all
+    deformations. The dump format has no place for them."""
+    forcemode = model.settings.forcemode
     if forcemode < 1 or len(res.t) == 0:
         return
     real = f" {{:{digits + 6}.{digits - 1}E}}"
-    _comment(f"FORCEMODE {forcemode} at t = {res.t[-1]:g}: reactions on the fixed and input coordinates"
-             + (", stresses of the elements" if forcemode >= 2 else ""))
+    _comment(f"FORCEMODE {forcemode} at t = {res.t[-1]:g}: reactions on the fixed and input coordinates, "
+             + ("stresses of the elements" if forcemode >= 2 else "driving forces of the input deformations"))
     for i in res.supported_columns():
         n, c = res.coordinate_labels[i]
         _comment(f"{'REACTION':<8s} {n:3d} {c:3d}" + real.format(res.reaction[-1, i]))
-    if forcemode >= 2:
-        for k, (e, i) in enumerate(res.deformation_labels):
+    for k, (e, i) in enumerate(res.deformation_labels):
+        if forcemode >= 2 or model.elements[e].cls[i - 1].name == "input":
             _comment(f"{'SIGMA':<8s} {e:3d} {i:3d}" + real.format(res.sigma[-1, k]))
 
 
@@ -103,7 +105,7 @@ def _run(args) -> int:
                  f"{s['rhs_evaluations']} right-hand sides, {s['accepted']} steps "
                  f"({s['rejected']} rejected), {s['wall_time'] * 1e3:.1f} ms")
         _print_linearization(res)
-        _print_forces(res, model.settings.forcemode, args.dump_digits)
+        _print_forces(res, model, args.dump_digits)
         if model.settings.matasc == 1:
             _comment(f"MATASC files: {default_stem(model)}_*.asc")
         sys.stdout.write(dump(model, digits=args.dump_digits))
