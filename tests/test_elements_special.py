@@ -628,6 +628,34 @@ def test_wheel_on_a_plane_given_as_a_quadric_is_the_plane_wheel():
         np.testing.assert_allclose(edd[1], edd[0], rtol=0, atol=1e-11 * max(1.0, np.abs(edd[0]).max()))
 
 
+def test_wheel_on_a_large_sphere_steeply_tilted():
+    """Round-off in the contact search grows like eps/|a × N| for a steeply tilted disc: the
+    Newton iteration must accept its round-off floor instead of failing (NaN). A disc of radius 1
+    touching spheres of radius 100 and 1e4 at tilts up to 1.54 rad (|a × N| ≈ 0.03), random
+    contact directions and spins: e1 ≈ 0 and all derivatives finite."""
+    rng = np.random.default_rng(3)
+    for R in (100.0, 1e4):
+        k = _core.element_kernel("WHEEL", params=[1, 0, 0, 1.0, 1, 1, 1, 0, 0, 0, 0, 0, 0, -R * R])
+        for _ in range(300):
+            n = unit(rng.normal(size=3))
+            tilt = rng.uniform(1.3, 1.54)
+            # axle â0 = x rotated so that its angle with n is π/2 − tilt (tilt 0: upright disc)
+            b = unit(np.cross(n, rng.normal(size=3)))
+            a = math.cos(tilt) * b + math.sin(tilt) * n
+            # λ rotating x onto a, then a random spin about a
+            axis = np.cross([1.0, 0, 0], a)
+            ang = math.atan2(np.linalg.norm(axis), a[0])
+            l1 = np.r_[math.cos(ang / 2), math.sin(ang / 2) * unit(axis)]
+            spin = rng.uniform(-math.pi, math.pi)
+            l2 = np.r_[math.cos(spin / 2), math.sin(spin / 2) * np.array([1.0, 0, 0])]
+            lam = np.r_[l1[0] * l2[0] - l1[1:] @ l2[1:], l1[0] * l2[1:] + l2[0] * l1[1:] + np.cross(l1[1:], l2[1:])]
+            d = unit(n - (n @ a) * a)  # from the contact point to the centre, in the disc plane
+            x = np.r_[R * n + d, lam]
+            e = k.deformations(x)
+            assert abs(e[0]) < 1e-9 * R, (R, tilt)
+            assert np.isfinite(k.first_derivatives(x)).all() and np.isfinite(k.convective(x, rng.normal(size=7))).all()
+
+
 def test_wheel_surface_input_errors():
     with pytest.raises(spacar.InputError, match="c1 .. c9 are all zero"):
         _core.element_kernel("WHEEL", params=[0, 1, 0, 0.3] + [0.0] * 9 + [1.0])

@@ -67,8 +67,9 @@ def _print_forces(res, model, digits: int) -> None:
     for i in res.supported_columns():
         n, c = res.coordinate_labels[i]
         _comment(f"{'REACTION':<8s} {n:3d} {c:3d}" + real.format(res.reaction[-1, i]))
+    elements = model.elements  # a new dict on every access
     for k, (e, i) in enumerate(res.deformation_labels):
-        if forcemode >= 2 or model.elements[e].cls[i - 1].name == "input":
+        if forcemode >= 2 or elements[e].cls[i - 1].name == "input":
             _comment(f"{'SIGMA':<8s} {e:3d} {i:3d}" + real.format(res.sigma[-1, k]))
 
 
