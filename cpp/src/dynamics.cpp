@@ -145,6 +145,22 @@ void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R) {
   for (int j = 0; j < nd; ++j) R[j] += data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
 }
 
+namespace {
+// Σ_k B_kᵀ σ_k added to out, over the deformations selected by `take`.
+template <class Take>
+void add_element_loads(const System& sys, const Data& data, Take take, Eigen::VectorXd& out) {
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const ElementWork& w = data.work[i];
+    for (int a = 0; a < se.nd; ++a) {
+      const int k = se.def_offset + a;
+      if (data.sigma[k] == 0.0 || !take(k)) continue;
+      for (size_t j = 0; j < se.coords.size(); ++j) out[se.coords[j]] += w.B(a, j) * data.sigma[k];
+    }
+  }
+}
+}  // namespace
+
 void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R) {
   solve_accelerations_direct(sys, data);
   compute_inertia_and_loads(sys, data);
@@ -152,15 +168,7 @@ void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R) 
   inertia_force(sys, data);
   // DFe = B DF element by element, so DF_qᵀ g + DFe_qᵀ σ = DF_qᵀ (g + Σ Bᵀ σ).
   Eigen::VectorXd w = data.g, all;
-  for (size_t i = 0; i < sys.elements.size(); ++i) {
-    const SystemElement& se = sys.elements[i];
-    const Eigen::MatrixXd& B = data.work[i].B;
-    for (int a = 0; a < se.nd; ++a) {
-      const double s = data.sigma[se.def_offset + a];
-      if (s != 0.0)
-        for (size_t j = 0; j < se.coords.size(); ++j) w[se.coords[j]] += B(a, j) * s;
-    }
-  }
+  add_element_loads(sys, data, [](int) { return true; }, w);
   transfer_transposed(sys, data, w, all);
   const int nd = sys.n_dof();
   R.resize(nd);
@@ -272,22 +280,6 @@ void solve_dynamics_direct(const System& sys, Data& data) {
     throw SingularMassError("the equations of motion have no finite solution at t = " + std::to_string(data.t));
   }
 }
-
-namespace {
-// Σ_k B_kᵀ σ_k added to out, over the deformations selected by `take`.
-template <class Take>
-void add_element_loads(const System& sys, const Data& data, Take take, Eigen::VectorXd& out) {
-  for (size_t i = 0; i < sys.elements.size(); ++i) {
-    const SystemElement& se = sys.elements[i];
-    const ElementWork& w = data.work[i];
-    for (int a = 0; a < se.nd; ++a) {
-      const int k = se.def_offset + a;
-      if (data.sigma[k] == 0.0 || !take(k)) continue;
-      for (size_t j = 0; j < se.coords.size(); ++j) out[se.coords[j]] += w.B(a, j) * data.sigma[k];
-    }
-  }
-}
-}  // namespace
 
 void nodal_reactions(const System& sys, Data& data) {
   // r = M ẍ + h − f + Bᵀσ on fixed and input coordinates (6.2), σ complete.

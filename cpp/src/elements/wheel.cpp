@@ -89,8 +89,8 @@ class Wheel : public AutoDiffElement<Wheel, 7, 3> {
   void deform(const S* x, S* e) const {
     e[1] = S(0.0);
     e[2] = S(0.0);
-    const Vec3<S> a = rotate(x + 3, a0_);
     if (!quadric_) {
+      const Vec3<S> a = rotate(x + 3, a0_);
       const S na = n_[0] * a[0] + n_[1] * a[1] + n_[2] * a[2];
       e[0] = n_[0] * x[0] + n_[1] * x[1] + n_[2] * x[2] - r_ * sqrt(1.0 - na * na);
       return;
