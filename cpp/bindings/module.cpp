@@ -19,6 +19,7 @@ using namespace spacar;
 
 void bind_kernels(py::module_& m);
 void bind_integrator(py::module_& m);
+void bind_sparse(py::module_& m);
 
 namespace {
 
@@ -595,4 +596,5 @@ PYBIND11_MODULE(_core, m) {
   bind_simulation(m);
   bind_kernels(m);
   bind_integrator(m);
+  bind_sparse(m);
 }

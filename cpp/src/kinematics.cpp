@@ -152,12 +152,15 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
     if (n_history < static_cast<int>(history.size())) history[n_history++] = r;
   };
   data.newton_iterations = 0;
-  // Large (sparse) systems reuse the factorization of the velocity block of the last solved
-  // state, the same matrix at nearby positions: the iteration converges linearly but saves a
-  // factorization, which dominates there; the iterates then go to 1e-3 EPSKIN (a polish of the
-  // same effect as the quadratic step) and a fresh factorization is made as soon as the
-  // contraction is poor. Small systems use full Newton with one polish step after convergence.
-  const bool chord = !assembly && data.jacobian_reusable && !data.luV.dense();
+  // Large systems reuse the factorization of the velocity block of the last solved state, the
+  // same matrix at nearby positions: the iteration converges linearly but saves factorizations;
+  // the iterates then go to 1e-3 EPSKIN (a polish of the same effect as the quadratic step) and
+  // a fresh factorization is made as soon as the contraction is poor. Small systems use full
+  // Newton with one polish step after convergence: near a singular configuration it fails with
+  // the residual that names the constraints. (With the replayed sparse LU both cost the same
+  // on benchmarks/chains.py from 10 to 100 links, within the noise of the measurement.)
+  constexpr int kChordMinimum = 31;  // calculable coordinates
+  const bool chord = !assembly && data.jacobian_reusable && nc >= kChordMinimum;
   LinearSolver* J = chord ? &data.luV : nullptr;
   bool converged = false;
   double previous = std::numeric_limits<double>::infinity();

@@ -67,49 +67,30 @@ void BlockMatrix::add_transposed(int id, const Eigen::MatrixXd& local) {
 
 void LinearSolver::analyze(const Eigen::SparseMatrix<double>& A) {
   n_ = static_cast<int>(A.rows());
-  dense_ = n_ <= kDenseLimit;
-  if (dense_) {
-    dense_matrix_.setZero(n_, n_);
-  } else {
-    sparse_lu_.analyzePattern(A);
-  }
+  lu_.analyze(A);
+  in_.setZero(n_);
+  out_.setZero(n_);
 }
 
-bool LinearSolver::factorize(const Eigen::SparseMatrix<double>& A) {
-  if (n_ == 0) return true;
-  if (dense_) {
-    dense_matrix_.setZero();
-    for (int c = 0; c < A.outerSize(); ++c)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(A, c); it; ++it) dense_matrix_(it.row(), c) = it.value();
-    dense_lu_.compute(dense_matrix_);
-    // Singular: a pivot that is tiny against the largest entry (σ_min ≤ n min|u_kk|). Eigen's
-    // condition estimate would be sharper but allocates and costs a few solves per call.
-    const double amax = dense_matrix_.cwiseAbs().maxCoeff();
-    const double pmin = dense_lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
-    return std::isfinite(pmin) && amax > 0.0 && pmin > 1e-13 * amax;
-  }
-  // Overflowed entries (a trial state far out of range) would pass as a "successful" factorization.
-  if (!Eigen::Map<const Eigen::VectorXd>(A.valuePtr(), A.nonZeros()).allFinite()) return false;
-  sparse_lu_.factorize(A);
-  return sparse_lu_.info() == Eigen::Success;
-}
+bool LinearSolver::factorize(const Eigen::SparseMatrix<double>& A) { return lu_.factorize(A); }
 
 void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
-  if (n_ == 0) return;
-  if (dense_) x = dense_lu_.solve(b);
-  else x = sparse_lu_.solve(b);
+  x.resize(n_);
+  lu_.solve(b.data(), x.data());
 }
 
-void LinearSolver::solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-  if (n_ == 0) return;
-  if (dense_) x = dense_lu_.transpose().solve(b);
-  else x = sparse_lu_.transpose().solve(b);
+void LinearSolver::solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+  x.resize(n_);
+  lu_.solve_transposed(b.data(), x.data());
 }
 
 void LinearSolver::solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
-  if (n_ == 0) return;
-  if (dense_) x = dense_lu_.solve(b);
-  else x = sparse_lu_.solve(b);
+  x.resize(n_, b.cols());
+  for (int j = 0; j < b.cols(); ++j) {
+    in_ = b.col(j);
+    lu_.solve(in_.data(), out_.data());
+    x.col(j) = out_;
+  }
 }
 
 }  // namespace spacar

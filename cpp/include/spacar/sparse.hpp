@@ -1,12 +1,14 @@
-// Sparse assembly with a fixed pattern, and a linear solver that is dense for small systems
-// and sparse for large ones. The constraint blocks and the equations of motion of a mechanism
-// are assembled from element blocks whose places never change: the pattern is built once per
-// System, and every evaluation only writes values (no allocation in the step loop).
+// Sparse assembly with a fixed pattern, and its LU factorization. The constraint blocks and the
+// equations of motion of a mechanism are assembled from element blocks whose places never
+// change: the pattern is built once per System, and every evaluation only writes values (no
+// allocation in the step loop).
 #pragma once
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <vector>
+
+#include "spacar/sparse_lu.hpp"
 
 namespace spacar {
 
@@ -43,28 +45,21 @@ class BlockMatrix {
   Eigen::SparseMatrix<double> A_;
 };
 
-// LU factorization of a square matrix given in sparse form: dense partial pivoting up to
-// kDenseLimit unknowns (most mechanisms; no sparse overhead), sparse LU with a column ordering
-// computed once (analyze) above.
+// LU factorization of a square matrix given in sparse form (sparse_lu.hpp), with Eigen vectors.
 class LinearSolver {
  public:
-  static constexpr int kDenseLimit = 30;
-
   void analyze(const Eigen::SparseMatrix<double>& A);
   // False if the matrix is (numerically) singular.
   bool factorize(const Eigen::SparseMatrix<double>& A);
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
   void solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const;
-  void solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  void solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
   int size() const { return n_; }
-  bool dense() const { return dense_; }
 
  private:
   int n_ = 0;
-  bool dense_ = true;
-  Eigen::MatrixXd dense_matrix_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu_;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> sparse_lu_;
+  SparseLU lu_;
+  mutable Eigen::VectorXd in_, out_;  // contiguous columns of a matrix right-hand side
 };
 
 }  // namespace spacar

@@ -1,0 +1,57 @@
+// Test-only binding of the sparse LU (sparse_lu.hpp): factorize scipy.sparse matrices of one
+// pattern, solve, and count the factorizations that chose pivots, so that the tests can check
+// the replayed elimination against dense solves.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "spacar/sparse_lu.hpp"
+
+namespace py = pybind11;
+
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
+
+struct TestLU {
+  Sparse pattern;
+  spacar::SparseLU lu;
+
+  explicit TestLU(const Sparse& A) : pattern(A) {
+    if (A.rows() != A.cols()) throw std::invalid_argument("SparseLU: the matrix must be square");
+    pattern.makeCompressed();
+    lu.analyze(pattern);
+  }
+
+  bool factorize(const Sparse& A) {
+    Sparse B = A;
+    B.makeCompressed();
+    const bool same = B.rows() == pattern.rows() && B.nonZeros() == pattern.nonZeros() &&
+                      std::equal(B.outerIndexPtr(), B.outerIndexPtr() + B.cols() + 1, pattern.outerIndexPtr()) &&
+                      std::equal(B.innerIndexPtr(), B.innerIndexPtr() + B.nonZeros(), pattern.innerIndexPtr());
+    if (!same) throw std::invalid_argument("SparseLU.factorize: the pattern differs from the analyzed one");
+    return lu.factorize(B);
+  }
+
+  Eigen::VectorXd solve(const Eigen::VectorXd& b, bool transposed) const {
+    if (b.size() != pattern.rows()) throw std::invalid_argument("SparseLU.solve: wrong length of b");
+    Eigen::VectorXd x(b.size());
+    if (transposed) lu.solve_transposed(b.data(), x.data());
+    else lu.solve(b.data(), x.data());
+    return x;
+  }
+};
+
+}  // namespace
+
+void bind_sparse(py::module_& m) {
+  py::class_<TestLU>(m, "SparseLU")
+      .def(py::init<const Sparse&>(), py::arg("A"))
+      .def("factorize", &TestLU::factorize, py::arg("A"))
+      .def("solve", [](const TestLU& t, const Eigen::VectorXd& b) { return t.solve(b, false); })
+      .def("solve_transposed", [](const TestLU& t, const Eigen::VectorXd& b) { return t.solve(b, true); })
+      .def_property_readonly("pivotings", [](const TestLU& t) { return t.lu.pivotings(); })
+      .def_property_readonly("factor_nonzeros", [](const TestLU& t) { return t.lu.factor_nonzeros(); });
+}

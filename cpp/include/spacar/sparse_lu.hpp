@@ -1,0 +1,68 @@
+// Sparse LU with a pivot sequence that is reused across factorizations (refactorization, as in
+// KLU). The matrices of a mechanism keep their pattern and change their values slowly along a
+// motion: the rows chosen as pivots at one state stay good pivots at the next, so after one
+// factorization with partial pivoting every further one replays the same elimination on the
+// new values, with the fill pattern, the permutations and the order of operations computed
+// once. Each replayed pivot is checked against its column; a poor one (the motion has changed
+// which rows are large) makes that factorization choose its pivots again.
+//
+// Left-looking elimination (Gilbert and Peierls): column k of L and U comes from one sparse
+// triangular solve with the columns of L found so far. With the fixed pivot order, the columns
+// of U are visited in increasing pivot order, a valid topological order of that solve, so a
+// refactorization needs no graph search: it costs only the floating-point operations of the
+// factors (for a chain of links: linear in the number of links).
+#pragma once
+
+#include <Eigen/Sparse>
+#include <vector>
+
+namespace spacar {
+
+class SparseLU {
+ public:
+  // Choose the column ordering from the pattern (once per pattern): the one of COLAMD and AMD on
+  // A + Aᵀ that gives the fewer nonzeros in the factors of A's values at the first factorization.
+  void analyze(const Eigen::SparseMatrix<double>& A);
+  // Factorize A (same pattern as in analyze); false if A is numerically singular: a pivot below
+  // kSingular times the largest entry of A, or non-finite values.
+  bool factorize(const Eigen::SparseMatrix<double>& A);
+  // x = A⁻¹ b and x = A⁻ᵀ b; x may not alias b.
+  void solve(const double* b, double* x) const;
+  void solve_transposed(const double* b, double* x) const;
+
+  int size() const { return n_; }
+  int factor_nonzeros() const { return static_cast<int>(Li_.size() + Ui_.size()) + n_; }
+  int pivotings() const { return pivotings_; }  // factorizations that chose pivots (not replays)
+
+  static constexpr double kSingular = 1e-13;
+  // A replayed pivot must be at least this fraction of the largest entry of its column of L.
+  static constexpr double kReplayThreshold = 1e-3;
+  // Partial pivoting: keep the diagonal entry of the ordered matrix (symmetric orderings) if it
+  // is at least this fraction of the largest candidate.
+  static constexpr double kDiagonalPreference = 0.1;
+
+ private:
+  bool factorize_pivoting(const Eigen::SparseMatrix<double>& A, const std::vector<int>& order);
+  bool replay(const Eigen::SparseMatrix<double>& A);
+  int reach(const Eigen::SparseMatrix<double>& A, int col);
+
+  int n_ = 0;
+  double amax_ = 0.0;
+  bool have_pivots_ = false;
+  int pivotings_ = 0;
+  std::vector<int> colamd_, amd_;  // candidate column orderings, until the first factorization
+  std::vector<int> q_;             // step k eliminates column q_[k] of A
+  std::vector<int> pinv_;          // row i of A is the pivot of step pinv_[i]
+  // L (unit diagonal, not stored) and U (diagonal in Ud_) by columns, rows as step indices; the
+  // rows of a column of U are increasing.
+  std::vector<int> Lp_, Li_, Up_, Ui_;
+  std::vector<double> Lx_, Ux_, Ud_;
+  // For the replay: where each entry of A goes in the work vector (its pivot step), column by
+  // column in the order of q_.
+  std::vector<int> Ap_, Ai_, Apos_;
+  // Work space of size n (values) and 2n (graph search), never reallocated after analyze.
+  mutable std::vector<double> w_;
+  std::vector<int> stack_, mark_;
+};
+
+}  // namespace spacar

@@ -1,0 +1,263 @@
+#include "spacar/sparse_lu.hpp"
+
+#include <Eigen/OrderingMethods>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace spacar {
+
+namespace {
+
+using Perm = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
+
+// Step → column orders. Eigen's COLAMD functor returns column → step, its AMD functor step →
+// column (the conventions of SparseLU and SimplicialLDLT).
+std::vector<int> colamd_order(const Eigen::SparseMatrix<double>& A) {
+  Eigen::SparseMatrix<double> B = A;
+  Perm perm;
+  Eigen::COLAMDOrdering<int>()(B, perm);
+  std::vector<int> q(A.cols());
+  for (int c = 0; c < A.cols(); ++c) q[perm.indices()[c]] = c;
+  return q;
+}
+
+std::vector<int> amd_order(const Eigen::SparseMatrix<double>& A) {
+  Perm perm;
+  Eigen::AMDOrdering<int>()(A, perm);
+  return std::vector<int>(perm.indices().data(), perm.indices().data() + A.cols());
+}
+
+}  // namespace
+
+void SparseLU::analyze(const Eigen::SparseMatrix<double>& A) {
+  n_ = static_cast<int>(A.rows());
+  have_pivots_ = false;
+  w_.assign(n_, 0.0);
+  stack_.assign(2 * n_, 0);
+  mark_.assign(n_, 0);
+  if (n_ == 0) return;
+  colamd_ = colamd_order(A);
+  amd_ = amd_order(A);
+}
+
+// Rows reachable from the pattern of column col of A in the graph of L (row i → rows of the
+// column of L whose pivot it is), in topological order in stack_[top, n). Depth first, without
+// recursion; stack_[n, 2n) holds the positions reached in each column of the path.
+int SparseLU::reach(const Eigen::SparseMatrix<double>& A, int col) {
+  int top = n_;
+  int* pos = stack_.data() + n_;
+  for (Eigen::SparseMatrix<double>::InnerIterator it(A, col); it; ++it) {
+    const int start = static_cast<int>(it.row());
+    if (mark_[start]) continue;
+    // path[0..head] is the current path, kept in stack_ below `top` (disjoint from the output).
+    int head = 0;
+    stack_[0] = start;
+    while (head >= 0) {
+      const int i = stack_[head];
+      const int s = pinv_[i];
+      if (!mark_[i]) {
+        mark_[i] = 1;
+        pos[head] = s < 0 ? 0 : Lp_[s];
+      }
+      bool done = true;
+      const int end = s < 0 ? 0 : Lp_[s + 1];
+      for (int p = pos[head]; p < end; ++p) {
+        const int r = Li_[p];
+        if (mark_[r]) continue;
+        pos[head] = p + 1;
+        stack_[++head] = r;
+        done = false;
+        break;
+      }
+      if (done) {
+        --head;
+        stack_[--top] = i;
+      }
+    }
+  }
+  for (int p = top; p < n_; ++p) mark_[stack_[p]] = 0;
+  return top;
+}
+
+bool SparseLU::factorize_pivoting(const Eigen::SparseMatrix<double>& A, const std::vector<int>& order) {
+  ++pivotings_;
+  q_ = order;
+  pinv_.assign(n_, -1);
+  Lp_.assign(1, 0);
+  Up_.assign(1, 0);
+  Li_.clear();
+  Lx_.clear();
+  Ui_.clear();
+  Ux_.clear();
+  Ud_.clear();
+  std::fill(w_.begin(), w_.end(), 0.0);
+  for (int k = 0; k < n_; ++k) {
+    const int col = q_[k];
+    const int top = reach(A, col);
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, col); it; ++it) w_[it.row()] = it.value();
+    // Sparse triangular solve with the columns of L so far, in topological order.
+    for (int p = top; p < n_; ++p) {
+      const int i = stack_[p];
+      const int s = pinv_[i];
+      if (s < 0) continue;
+      const double xi = w_[i];
+      for (int t = Lp_[s]; t < Lp_[s + 1]; ++t) w_[Li_[t]] -= Lx_[t] * xi;
+    }
+    // Pivot: the largest candidate, or the diagonal of the ordered matrix if it is not much smaller.
+    int ipiv = -1;
+    double best = -1.0;
+    for (int p = top; p < n_; ++p) {
+      const int i = stack_[p];
+      if (pinv_[i] >= 0) continue;
+      const double a = std::abs(w_[i]);
+      if (a > best || std::isnan(a)) {
+        best = a;
+        ipiv = i;
+      }
+    }
+    if (ipiv < 0 || !(best > kSingular * amax_) || !std::isfinite(best)) {
+      std::fill(w_.begin(), w_.end(), 0.0);
+      have_pivots_ = false;
+      return false;
+    }
+    if (pinv_[col] < 0 && std::abs(w_[col]) >= kDiagonalPreference * best) ipiv = col;
+    const double pivot = w_[ipiv];
+    for (int p = top; p < n_; ++p) {
+      const int i = stack_[p];
+      if (pinv_[i] >= 0) {
+        Ui_.push_back(pinv_[i]);
+        Ux_.push_back(w_[i]);
+      } else if (i != ipiv) {
+        Li_.push_back(i);
+        Lx_.push_back(w_[i] / pivot);
+      }
+      w_[i] = 0.0;
+    }
+    Ud_.push_back(pivot);
+    pinv_[ipiv] = k;
+    Lp_.push_back(static_cast<int>(Li_.size()));
+    Up_.push_back(static_cast<int>(Ui_.size()));
+  }
+  // Rows of L as steps; columns of U sorted by step, the order of the replay.
+  for (int& i : Li_) i = pinv_[i];
+  std::vector<std::pair<int, double>> column;
+  for (int k = 0; k < n_; ++k) {
+    column.clear();
+    for (int p = Up_[k]; p < Up_[k + 1]; ++p) column.emplace_back(Ui_[p], Ux_[p]);
+    std::sort(column.begin(), column.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (int p = Up_[k], j = 0; p < Up_[k + 1]; ++p, ++j) {
+      Ui_[p] = column[j].first;
+      Ux_[p] = column[j].second;
+    }
+  }
+  // Where A's entries go in the replay.
+  Ap_.assign(1, 0);
+  Ai_.clear();
+  Apos_.clear();
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  for (int k = 0; k < n_; ++k) {
+    for (int p = outer[q_[k]]; p < outer[q_[k] + 1]; ++p) {
+      Apos_.push_back(p);
+      Ai_.push_back(pinv_[inner[p]]);
+    }
+    Ap_.push_back(static_cast<int>(Apos_.size()));
+  }
+  have_pivots_ = true;
+  return true;
+}
+
+bool SparseLU::replay(const Eigen::SparseMatrix<double>& A) {
+  const double* Ax = A.valuePtr();
+  double* w = w_.data();
+  for (int k = 0; k < n_; ++k) {
+    for (int p = Ap_[k]; p < Ap_[k + 1]; ++p) w[Ai_[p]] = Ax[Apos_[p]];
+    for (int p = Up_[k]; p < Up_[k + 1]; ++p) {
+      const int s = Ui_[p];
+      const double xs = w[s];
+      Ux_[p] = xs;
+      w[s] = 0.0;
+      for (int t = Lp_[s]; t < Lp_[s + 1]; ++t) w[Li_[t]] -= Lx_[t] * xs;
+    }
+    const double pivot = w[k];
+    w[k] = 0.0;
+    double column_max = 0.0;
+    for (int t = Lp_[k]; t < Lp_[k + 1]; ++t) column_max = std::max(column_max, std::abs(w[Li_[t]]));
+    const double a = std::abs(pivot);
+    if (!(a > kSingular * amax_) || a < kReplayThreshold * column_max || !std::isfinite(column_max)) {
+      std::fill(w_.begin(), w_.end(), 0.0);
+      return false;
+    }
+    Ud_[k] = pivot;
+    const double inv = 1.0 / pivot;
+    for (int t = Lp_[k]; t < Lp_[k + 1]; ++t) {
+      Lx_[t] = w[Li_[t]] * inv;
+      w[Li_[t]] = 0.0;
+    }
+  }
+  return true;
+}
+
+bool SparseLU::factorize(const Eigen::SparseMatrix<double>& A) {
+  if (n_ == 0) return true;
+  const Eigen::Map<const Eigen::VectorXd> values(A.valuePtr(), A.nonZeros());
+  // Overflowed entries (a trial state far out of range) would pass as a "successful" factorization.
+  if (!values.allFinite()) return false;
+  amax_ = values.size() ? values.cwiseAbs().maxCoeff() : 0.0;
+  if (have_pivots_ && replay(A)) return true;
+  if (!colamd_.empty()) {
+    // First factorization: keep the ordering with the sparser factors.
+    const bool ok_amd = factorize_pivoting(A, amd_);
+    const int fill_amd = ok_amd ? factor_nonzeros() : -1;
+    const bool okc = factorize_pivoting(A, colamd_);
+    if (okc && (!ok_amd || factor_nonzeros() <= fill_amd)) {
+      colamd_.clear();
+      amd_.clear();
+      return true;
+    }
+    if (!ok_amd) return false;
+    colamd_.clear();
+    const std::vector<int> order = amd_;
+    amd_.clear();
+    return factorize_pivoting(A, order);
+  }
+  return factorize_pivoting(A, q_);
+}
+
+void SparseLU::solve(const double* b, double* x) const {
+  double* y = w_.data();
+  for (int i = 0; i < n_; ++i) y[pinv_[i]] = b[i];
+  for (int k = 0; k < n_; ++k) {
+    const double yk = y[k];
+    for (int t = Lp_[k]; t < Lp_[k + 1]; ++t) y[Li_[t]] -= Lx_[t] * yk;
+  }
+  for (int k = n_ - 1; k >= 0; --k) {
+    const double yk = y[k] / Ud_[k];
+    y[k] = yk;
+    for (int p = Up_[k]; p < Up_[k + 1]; ++p) y[Ui_[p]] -= Ux_[p] * yk;
+  }
+  for (int k = 0; k < n_; ++k) {
+    x[q_[k]] = y[k];
+    y[k] = 0.0;
+  }
+}
+
+void SparseLU::solve_transposed(const double* b, double* x) const {
+  // Aᵀ = Q Uᵀ Lᵀ P.
+  double* y = w_.data();
+  for (int k = 0; k < n_; ++k) {
+    double v = b[q_[k]];
+    for (int p = Up_[k]; p < Up_[k + 1]; ++p) v -= Ux_[p] * y[Ui_[p]];
+    y[k] = v / Ud_[k];
+  }
+  for (int k = n_ - 1; k >= 0; --k) {
+    double v = y[k];
+    for (int t = Lp_[k]; t < Lp_[k + 1]; ++t) v -= Lx_[t] * y[Li_[t]];
+    y[k] = v;
+  }
+  for (int i = 0; i < n_; ++i) x[i] = y[pinv_[i]];
+  std::fill(w_.begin(), w_.end(), 0.0);
+}
+
+}  // namespace spacar

@@ -1,0 +1,162 @@
+"""The sparse LU of the constraint blocks and the equations of motion (cpp/src/sparse_lu.cpp):
+solutions against dense solves, the replay of the pivot sequence on new values, re-pivoting
+when a replayed pivot is poor, singular and non-finite matrices, and linear fill on a chain."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from spacar import _core
+
+
+def random_sparse(n, density, rng, diagonal=True):
+    A = sp.random(n, n, density=density, random_state=rng, format="csc")
+    if diagonal:
+        A = A + sp.diags(rng.uniform(0.5, 2.0, n) * rng.choice([-1.0, 1.0], n))
+    A = sp.csc_matrix(A)
+    A.sort_indices()
+    return A
+
+
+def same_pattern(A, values):
+    B = A.copy()
+    B.data = np.asarray(values, dtype=float)
+    return B
+
+
+def relative_residual(A, x, b):
+    return np.linalg.norm(A @ x - b) / (np.linalg.norm(A.toarray(), np.inf) * np.linalg.norm(x) + np.linalg.norm(b))
+
+
+@pytest.mark.parametrize("n, density", [(1, 1.0), (5, 0.5), (40, 0.08), (300, 0.01)])
+def test_solves_match_dense_solves(n, density):
+    rng = np.random.default_rng(n)
+    A = random_sparse(n, density, rng)
+    lu = _core.SparseLU(A)
+    assert lu.factorize(A)
+    dense = A.toarray()
+    for _ in range(3):
+        b = rng.normal(size=n)
+        x, xt = lu.solve(b), lu.solve_transposed(b)
+        assert relative_residual(A, x, b) < 1e-14
+        assert relative_residual(A.T.tocsc(), xt, b) < 1e-14
+        np.testing.assert_allclose(x, np.linalg.solve(dense, b), rtol=1e-8 * np.linalg.cond(dense), atol=0)
+
+
+def test_new_values_replay_the_pivot_sequence():
+    """Values that change by a few percent keep the pivots: no new pivot choice, exact solves."""
+    rng = np.random.default_rng(7)
+    A = random_sparse(200, 0.02, rng)
+    lu = _core.SparseLU(A)
+    assert lu.factorize(A)
+    chosen = lu.pivotings
+    for _ in range(20):
+        B = same_pattern(A, A.data * (1.0 + 0.05 * rng.uniform(-1.0, 1.0, A.nnz)))
+        assert lu.factorize(B)
+        b = rng.normal(size=200)
+        assert relative_residual(B, lu.solve(b), b) < 1e-14
+    assert lu.pivotings == chosen
+
+
+def test_a_poor_replayed_pivot_chooses_pivots_again():
+    """Diagonally dominant values first (diagonal pivots), then a zero diagonal: the replay
+    meets a zero pivot, the factorization pivots again and still solves exactly."""
+    A = sp.csc_matrix(np.array([[10.0, 1.0, 1.0], [1.0, 10.0, 1.0], [1.0, 1.0, 10.0]]))
+    lu = _core.SparseLU(A)
+    assert lu.factorize(A)
+    chosen = lu.pivotings
+    B = same_pattern(A, A.data)
+    B.data[:] = [0.0, 1.0, 2.0, 1.0, 0.0, 3.0, 2.0, 3.0, 0.0]  # symmetric, zero diagonal, det 12
+    assert lu.factorize(B)
+    assert lu.pivotings > chosen
+    b = np.array([1.0, -2.0, 0.5])
+    np.testing.assert_allclose(B @ lu.solve(b), b, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(B.T @ lu.solve_transposed(b), b, rtol=0, atol=1e-14)
+
+
+def test_saddle_point_matrix_with_zero_block():
+    """The equations of motion with constraint rows: [[M, Bᵀ], [B, 0]], M positive definite
+    and banded, B of full row rank; zero diagonal in the constraint block."""
+    rng = np.random.default_rng(3)
+    n, m = 60, 25
+    L = sp.diags([rng.uniform(1, 2, n), rng.uniform(-0.3, 0.3, n - 1)], [0, -1])
+    M = (L @ L.T).tocsc()
+    B = sp.random(m, n, density=0.08, random_state=rng) + sp.eye(m, n)
+    K = sp.bmat([[M, B.T], [B, None]], format="csc")
+    K.sort_indices()
+    lu = _core.SparseLU(K)
+    assert lu.factorize(K)
+    b = rng.normal(size=n + m)
+    assert relative_residual(K, lu.solve(b), b) < 1e-14
+    np.testing.assert_allclose(lu.solve(b), np.linalg.solve(K.toarray(), b), rtol=1e-10, atol=1e-12)
+
+
+def test_singular_and_non_finite_matrices_are_refused():
+    rng = np.random.default_rng(11)
+    A = random_sparse(30, 0.1, rng)
+    lu = _core.SparseLU(A)
+    assert lu.factorize(A)
+    dense = A.toarray()
+    dense[:, 4] = 0.0  # a zero column, kept in the pattern
+    assert not lu.factorize(same_pattern(A, _values_of(A, dense)))
+    near = A.toarray()
+    near[:, 7] = near[:, 3] * (1.0 + 1e-16)  # numerically dependent columns
+    pattern = sp.csc_matrix((near != 0) | (A.toarray() != 0), dtype=float)
+    lu2 = _core.SparseLU(pattern)
+    assert not lu2.factorize(_with_values(pattern, near))
+    assert lu.factorize(A)  # and a good matrix again afterwards
+    for bad in (np.nan, np.inf):
+        values = A.data.copy()
+        values[5] = bad
+        assert not lu.factorize(same_pattern(A, values))
+    assert lu.factorize(A)
+    b = rng.normal(size=30)
+    assert relative_residual(A, lu.solve(b), b) < 1e-14
+
+
+def _values_of(A, dense):
+    """The entries of dense at the pattern of A, in A's storage order."""
+    rows, cols = A.indices, np.repeat(np.arange(A.shape[1]), np.diff(A.indptr))
+    return dense[rows, cols]
+
+
+def _with_values(pattern, dense):
+    pattern = pattern.copy()
+    pattern.sort_indices()
+    return same_pattern(pattern, _values_of(pattern, dense))
+
+
+def test_pattern_must_not_change():
+    A = sp.csc_matrix(np.eye(3))
+    lu = _core.SparseLU(A)
+    with pytest.raises(ValueError, match="pattern"):
+        lu.factorize(sp.csc_matrix(np.ones((3, 3))))
+
+
+def test_fill_of_a_chain_grows_linearly():
+    """Block tridiagonal matrices (a chain of links, 3 unknowns each): nonzeros of the factors
+    proportional to the number of links."""
+    def chain(links, rng):
+        blocks = 3 * links
+        A = sp.lil_matrix((blocks, blocks))
+        for i in range(links):
+            s = slice(3 * i, 3 * i + 3)
+            A[s, s] = rng.normal(size=(3, 3)) + 3 * np.eye(3)
+            if i:
+                A[s, 3 * i - 3:3 * i] = rng.normal(size=(3, 3))
+                A[3 * i - 3:3 * i, s] = rng.normal(size=(3, 3))
+        A = A.tocsc()
+        A.sort_indices()
+        return A
+
+    rng = np.random.default_rng(5)
+    fill = {}
+    for links in (100, 1000):
+        A = chain(links, rng)
+        lu = _core.SparseLU(A)
+        assert lu.factorize(A)
+        b = rng.normal(size=A.shape[0])
+        assert relative_residual(A, lu.solve(b), b) < 1e-13
+        fill[links] = lu.factor_nonzeros
+    assert fill[1000] < 11 * fill[100]
