@@ -521,6 +521,11 @@ class GenericElementChecks:
                     assert not k.gravity(x, g).any() and k.gravity_potential(x, g) == 0.0
                     continue
                 worst = max(worst, gravity_error(k, x, g, coordinate_scales(case.kinds, ref)))
+                # The combined call of every right-hand side: the same numbers as the two calls.
+                v = rng.normal(size=x.size)
+                M, h, f = k.mass_and_gravity(x, v, g)
+                M1, h1 = k.mass(x, v)
+                assert rel_err(M, M1) < 1e-14 and rel_err(h, h1) < 1e-14 and rel_err(f, k.gravity(x, g)) < 1e-14
             record(case, "gravity" + suffix, worst)
             worst_all = max(worst_all, worst)
         assert worst_all < REL_TOL

@@ -92,6 +92,15 @@ void bind_kernels(py::module_& m) {
              h.k->gravity(x.data(), g.data(), f.data());
              return f;
            })
+      .def("mass_and_gravity",
+           [](const KernelHandle& h, const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::Vector3d& g) {
+             h.check(x, h.nc(), "x");
+             h.check(v, h.nc(), "v");
+             Eigen::MatrixXd M(h.nc(), h.nc());
+             Eigen::VectorXd hv(h.nc()), f(h.nc());
+             h.k->mass_and_gravity(x.data(), v.data(), g.data(), M.data(), hv.data(), f.data());
+             return py::make_tuple(M, hv, f);
+           })
       .def("gravity_potential",
            [](const KernelHandle& h, const Eigen::VectorXd& x, const Eigen::Vector3d& g) {
              h.check(x, h.nc(), "x");

@@ -93,12 +93,13 @@ void compute_inertia_and_loads(const System& sys, Data& data) {
     if (!se.has_mass) continue;
     ElementWork& w = data.work[i];
     const int n = static_cast<int>(se.coords.size());
-    se.kernel->mass(w.x.data(), w.v.data(), w.M.data(), w.h.data());
-    for (int a = 0; a < n; ++a) data.h[se.coords[a]] += w.h[a];
     if (gravity) {
-      se.kernel->gravity(w.x.data(), sys.gravity.data(), w.f.data());
+      se.kernel->mass_and_gravity(w.x.data(), w.v.data(), sys.gravity.data(), w.M.data(), w.h.data(), w.f.data());
       for (int a = 0; a < n; ++a) data.f[se.coords[a]] += w.f[a];
+    } else {
+      se.kernel->mass(w.x.data(), w.v.data(), w.M.data(), w.h.data());
     }
+    for (int a = 0; a < n; ++a) data.h[se.coords[a]] += w.h[a];
   }
   // Rigid bodies on LAMBDA nodes and body-fixed torques (formulation.md §3.2, §3.4).
   const int four[1] = {0};

@@ -79,10 +79,13 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
 
   void mass(const double* x, const double* v, double* M, double* h) const override {
     Base::mass(x, v, M, h);
-    if (rotary_) {
-      const int lam[2] = {3, 10};
-      add_rotational_inertia(14, x, v, lam, 2, A_, M, h);
-    }
+    add_rotary_inertia(x, v, M, h);
+  }
+
+  void mass_and_gravity(const double* x, const double* v, const double* g, double* M, double* h,
+                        double* f) const override {
+    Base::mass_and_gravity(x, v, g, M, h, f);
+    add_rotary_inertia(x, v, M, h);
   }
 
   double kinetic_energy(const double* x, const double* v) const override {
@@ -90,8 +93,7 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
     if (rotary_) {
       Eigen::MatrixXd M = Eigen::MatrixXd::Zero(14, 14);
       Eigen::VectorXd h = Eigen::VectorXd::Zero(14);
-      const int lam[2] = {3, 10};
-      add_rotational_inertia(14, x, v, lam, 2, A_, M.data(), h.data());
+      add_rotary_inertia(x, v, M.data(), h.data());
       const Eigen::Map<const Eigen::VectorXd> vm(v, 14);
       T += 0.5 * vm.dot(M * vm);
     }
@@ -115,6 +117,12 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
   }
 
  private:
+  void add_rotary_inertia(const double* x, const double* v, double* M, double* h) const {
+    if (!rotary_) return;
+    const int lam[2] = {3, 10};
+    add_rotational_inertia(14, x, v, lam, 2, A_, M, h);
+  }
+
   double l0_;
   Eigen::Matrix3d C0_;
   MassPoints<4, 3> mass_;

@@ -65,6 +65,13 @@ class ElementKernel {
   virtual void mass(const double* x, const double* v, double* M, double* h) const;
   // Generalized load of uniform gravity g (2 or 3 components) on the element mass.
   virtual void gravity(const double* x, const double* g, double* f) const;
+  // mass() and gravity() together (every right-hand side needs both; mass-point elements share
+  // the Jacobian of their points).
+  virtual void mass_and_gravity(const double* x, const double* v, const double* g, double* M, double* h,
+                                double* f) const {
+    mass(x, v, M, h);
+    gravity(x, g, f);
+  }
   // Potential of that gravity load, V = −∫ ρA g·r ds (for tests and energy checks).
   virtual double gravity_potential(const double* x, const double* g) const;
   // Kinetic energy (for tests and energy checks).
@@ -238,13 +245,28 @@ class AutoDiffElement : public ElementKernel {
     hm.setZero();
     if constexpr (detail::has_kinetic<Derived>::value) lagrange(x, v, Mm, hm);
     if constexpr (NG > 0) {
-      const auto& mp = self().mass_model();
       Eigen::Matrix<double, NG * DIM, NC> Jg;
       Eigen::Matrix<double, NG * DIM, 1> gamma;
       point_derivatives(x, v, Jg, gamma);
-      const auto Wfull = kron(mp.W);
-      Mm.noalias() = Jg.transpose() * Wfull * Jg;
-      hm.noalias() = Jg.transpose() * (Wfull * gamma);
+      Eigen::Matrix<double, NC, NC> Mp;
+      Eigen::Matrix<double, NC, 1> hp;
+      points_mass(Jg, gamma, Mp.data(), hp.data());
+      Mm += Mp;
+      hm += hp;
+    }
+  }
+
+  void mass_and_gravity(const double* x, const double* v, const double* g, double* M, double* h,
+                        double* f) const override {
+    if constexpr (NG > 0 && !detail::has_kinetic<Derived>::value) {
+      Eigen::Matrix<double, NG * DIM, NC> Jg;
+      Eigen::Matrix<double, NG * DIM, 1> gamma;
+      point_derivatives(x, v, Jg, gamma);
+      points_mass(Jg, gamma, M, h);
+      points_gravity(Jg, g, f);
+    } else {
+      mass(x, v, M, h);
+      gravity(x, g, f);
     }
   }
 
@@ -259,15 +281,13 @@ class AutoDiffElement : public ElementKernel {
       for (int k = 0; k < NC; ++k) fm[k] = -V.d[k];
     }
     if constexpr (NG > 0) {
-      const auto& mp = self().mass_model();
       Eigen::Matrix<double, NG * DIM, NC> Jg;
       Eigen::Matrix<double, NG * DIM, 1> gamma;
       double zero[NC] = {};
       point_derivatives(x, zero, Jg, gamma);
-      Eigen::Matrix<double, NG * DIM, 1> load;
-      for (int p = 0; p < NG; ++p)
-        for (int d = 0; d < DIM; ++d) load[p * DIM + d] = mp.w[p] * g[d];
-      fm.noalias() = Jg.transpose() * load;
+      Eigen::Matrix<double, NC, 1> fp;
+      points_gravity(Jg, g, fp.data());
+      fm += fp;
     }
   }
 
@@ -337,6 +357,25 @@ class AutoDiffElement : public ElementKernel {
       const J1 T = self().kinetic(xj, vc);
       for (int a = 0; a < NC; ++a) h[a] -= T.d[a];
     }
+  }
+
+  // M = Jgᵀ (W ⊗ I) Jg and h = Jgᵀ (W ⊗ I) γ from the Jacobian and convective accelerations
+  // of the mass points. Coefficient-based products: at these sizes Eigen's default would run
+  // its blocked GEMM, several times slower for matrices of a few dozen entries.
+  template <class MJ, class MG>
+  void points_mass(const MJ& Jg, const MG& gamma, double* M, double* h) const {
+    const Eigen::Matrix<double, NG * DIM, NC> WJ = kron(self().mass_model().W).lazyProduct(Jg);
+    Eigen::Map<Eigen::Matrix<double, NC, NC>>(M).noalias() = Jg.transpose().lazyProduct(WJ);
+    Eigen::Map<Eigen::Matrix<double, NC, 1>>(h).noalias() = WJ.transpose() * gamma;
+  }
+
+  // f = Jgᵀ (w ⊗ g): gravity on the point weights.
+  template <class MJ>
+  void points_gravity(const MJ& Jg, const double* g, double* f) const {
+    Eigen::Matrix<double, NG * DIM, 1> load;
+    for (int p = 0; p < NG; ++p)
+      for (int d = 0; d < DIM; ++d) load[p * DIM + d] = self().mass_model().w[p] * g[d];
+    Eigen::Map<Eigen::Matrix<double, NC, 1>>(f).noalias() = Jg.transpose() * load;
   }
 
   static Eigen::Matrix<double, NG * DIM, NG * DIM> kron(const Eigen::Matrix<double, NG, NG>& W) {
