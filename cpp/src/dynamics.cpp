@@ -250,8 +250,9 @@ void solve_dynamics_direct(const System& sys, Data& data) {
           "stiffnesses and rates)";
     return Error(os.str());
   };
-  if (!data.kkt_rhs.allFinite() || !K_values.allFinite()) throw overflow();
+  if (!data.kkt_rhs.allFinite()) throw overflow();
   if (!data.luK.factorize(K)) {
+    if (!K_values.allFinite()) throw overflow();
     // Name the degrees of freedom without inertia through the reduced equations.
     solve_transfer(sys, data);
     solve_velocities(sys, data);
@@ -262,12 +263,7 @@ void solve_dynamics_direct(const System& sys, Data& data) {
   data.xdd = data.acc_known;
   for (int g = 0; g < sys.nx; ++g)
     if (data.free_index[g] >= 0) data.xdd[g] = data.kkt_sol[data.free_index[g]];
-  for (size_t i = 0; i < sys.elements.size(); ++i) {
-    const SystemElement& se = sys.elements[i];
-    ElementWork& w = data.work[i];
-    for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.xdd[se.coords[j]];
-    data.edd.segment(se.def_offset, se.nd).noalias() = w.B * w.a + w.c;
-  }
+  deformation_accelerations(sys, data);
   // Stresses of the constraint rows are the multipliers: the reactions of (6.1).
   for (int k = 0; k < sys.ne; ++k)
     if (data.c_row[k] >= 0) data.sigma[k] = data.kkt_sol[nf + data.c_row[k]];

@@ -285,16 +285,19 @@ void solve_velocities(const System& sys, Data& data) {
   }
 }
 
-namespace {
-// ë = B ẍ + c, element by element, for the current ẍ.
 void deformation_accelerations(const System& sys, Data& data) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
     ElementWork& w = data.work[i];
     for (size_t j = 0; j < se.coords.size(); ++j) w.a[j] = data.xdd[se.coords[j]];
-    data.edd.segment(se.def_offset, se.nd).noalias() = w.B * w.a + w.c;
+    // In two statements: B ẍ + c in one would evaluate the product into a heap temporary.
+    auto edd = data.edd.segment(se.def_offset, se.nd);
+    edd = w.c;
+    edd.noalias() += w.B * w.a;
   }
 }
+
+namespace {
 
 // Rates y of all coordinates from the rates of q̂ (inputs and DOF coordinates; fixed ones rest)
 // with the factorized velocity block: A_V y^c = ė^V − s^V − B_{V,x̄} y_x̄, ė^V the q̂ rates of

@@ -141,7 +141,7 @@ bool SparseLU::factorize_pivoting(const Eigen::SparseMatrix<double>& A, const st
   }
   // Rows of L as steps; columns of U sorted by step, the order of the replay.
   for (int& i : Li_) i = pinv_[i];
-  std::vector<std::pair<int, double>> column;
+  auto& column = sort_space_;
   for (int k = 0; k < n_; ++k) {
     column.clear();
     for (int p = Up_[k]; p < Up_[k + 1]; ++p) column.emplace_back(Ui_[p], Ux_[p]);
@@ -201,10 +201,16 @@ bool SparseLU::replay(const Eigen::SparseMatrix<double>& A) {
 
 bool SparseLU::factorize(const Eigen::SparseMatrix<double>& A) {
   if (n_ == 0) return true;
-  const Eigen::Map<const Eigen::VectorXd> values(A.valuePtr(), A.nonZeros());
-  // Overflowed entries (a trial state far out of range) would pass as a "successful" factorization.
-  if (!values.allFinite()) return false;
-  amax_ = values.size() ? values.cwiseAbs().maxCoeff() : 0.0;
+  // Overflowed entries (a trial state far out of range) would pass as a "successful"
+  // factorization: refuse NaN (it fails every comparison) and infinity (it becomes amax_).
+  amax_ = 0.0;
+  const double* values = A.valuePtr();
+  for (Eigen::Index p = 0; p < A.nonZeros(); ++p) {
+    const double a = std::abs(values[p]);
+    if (a > amax_) amax_ = a;
+    else if (a != a) return false;
+  }
+  if (!std::isfinite(amax_)) return false;
   if (have_pivots_ && replay(A)) return true;
   if (!colamd_.empty()) {
     // First factorization: keep the ordering with the sparser factors.

@@ -37,6 +37,8 @@ void solve_velocities_direct(const System& sys, Data& data);
 
 // ẍ = DF q̂̈ + acc0 and ë = B ẍ + c, for the current q̂̈.
 void solve_accelerations(const System& sys, Data& data);
+// ë = B ẍ + c, element by element, for the current ẍ (B and c at the current state).
+void deformation_accelerations(const System& sys, Data& data);
 
 // The same without transfer functions: ẍ^c from one solve with the velocity block (after
 // solve_velocities_direct), ë = B ẍ + c.

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <Eigen/Sparse>
+#include <utility>
 #include <vector>
 
 namespace spacar {
@@ -63,6 +64,7 @@ class SparseLU {
   // Work space of size n (values) and 2n (graph search), never reallocated after analyze.
   mutable std::vector<double> w_;
   std::vector<int> stack_, mark_;
+  std::vector<std::pair<int, double>> sort_space_;  // a column of U being sorted
 };
 
 }  // namespace spacar
