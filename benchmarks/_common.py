@@ -34,11 +34,13 @@ def cpu_model() -> str:
 
 
 def compiler() -> str:
-    """Compiler of the extension module: from the CMake build directory next to it (editable or
-    build-tree installs), else the system's c++."""
+    """Compiler of the extension module: from the CMake build directory next to it (build-tree
+    installs) or the repository's build/ (editable installs, which copy the module), else the
+    system's c++."""
     here = Path(spacar._core.__file__).resolve()
-    for parent in list(here.parents)[:5]:
-        cache = parent / "CMakeCache.txt"
+    repo_builds = sorted((Path(__file__).resolve().parents[1] / "build").glob("*/CMakeCache.txt"))
+    for cache in [p / "CMakeCache.txt" for p in list(here.parents)[:5]] + repo_builds:
+        parent = cache.parent
         if not cache.is_file():
             continue
         text = cache.read_text(errors="replace")
