@@ -160,3 +160,51 @@ def test_fill_of_a_chain_grows_linearly():
         assert relative_residual(A, lu.solve(b), b) < 1e-13
         fill[links] = lu.factor_nonzeros
     assert fill[1000] < 11 * fill[100]
+
+
+def test_solves_without_valid_factors_are_nan():
+    """Before any factorization and after a failed one the factors are incomplete: the solution
+    is NaN (never a read outside the work space)."""
+    A = sp.csc_matrix(np.array([[2.0, 1.0], [1.0, 3.0]]))
+    lu = _core.SparseLU(A)
+    assert np.isnan(lu.solve(np.ones(2))).all()
+    assert lu.factorize(A)
+    assert not lu.factorize(same_pattern(A, [1.0, 1.0, 1.0, 1.0]))  # singular
+    assert np.isnan(lu.solve(np.ones(2))).all() and np.isnan(lu.solve_transposed(np.ones(2))).all()
+    assert lu.factorize(A)
+    np.testing.assert_allclose(A @ lu.solve(np.ones(2)), np.ones(2), rtol=0, atol=1e-15)
+
+
+def test_overflow_in_a_replay_chooses_pivots_again():
+    """Values near the largest double: the replayed elimination overflows (an infinite pivot),
+    a new pivot choice does not, and the solution is exact."""
+    A = sp.csc_matrix(np.array([[1.0, 1.0], [0.5, 1.0]]))
+    lu = _core.SparseLU(A)
+    assert lu.factorize(A)
+    B = sp.csc_matrix(np.array([[1e305, 1e308], [-9e307, 1e308]]))
+    assert lu.factorize(B)
+    x = lu.solve(np.array([1.0, 0.0]))
+    assert np.isfinite(x).all()
+    np.testing.assert_allclose(B @ x, [1.0, 0.0], rtol=0, atol=1e-12)
+
+
+def test_a_preferred_diagonal_pivot_respects_the_singularity_threshold():
+    """The diagonal is kept as pivot only above 1e-13 of the largest entry: otherwise the
+    larger candidate, whose replay then holds (no new pivot choice at every factorization)."""
+    A = sp.csc_matrix(np.array([[0.6e-13, 1.0], [5e-13, 1.0]]))
+    lu = _core.SparseLU(A)
+    assert lu.factorize(A)
+    chosen = lu.pivotings
+    for _ in range(3):
+        assert lu.factorize(A)
+    assert lu.pivotings == chosen
+    b = np.array([1.0, 2.0])
+    np.testing.assert_allclose(A @ lu.solve(b), b, rtol=1e-12)
+
+
+def test_binding_refuses_another_shape():
+    """A 3×2 matrix whose stored entries match the first columns of a 3×3 pattern with an
+    empty last column."""
+    lu = _core.SparseLU(sp.csc_matrix(np.diag([1.0, 1.0, 0.0])))
+    with pytest.raises(ValueError, match="pattern"):
+        lu.factorize(sp.csc_matrix(np.eye(3)[:, :2]))

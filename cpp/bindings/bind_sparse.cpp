@@ -28,7 +28,7 @@ struct TestLU {
   bool factorize(const Sparse& A) {
     Sparse B = A;
     B.makeCompressed();
-    const bool same = B.rows() == pattern.rows() && B.nonZeros() == pattern.nonZeros() &&
+    const bool same = B.rows() == pattern.rows() && B.cols() == pattern.cols() && B.nonZeros() == pattern.nonZeros() &&
                       std::equal(B.outerIndexPtr(), B.outerIndexPtr() + B.cols() + 1, pattern.outerIndexPtr()) &&
                       std::equal(B.innerIndexPtr(), B.innerIndexPtr() + B.nonZeros(), pattern.innerIndexPtr());
     if (!same) throw std::invalid_argument("SparseLU.factorize: the pattern differs from the analyzed one");

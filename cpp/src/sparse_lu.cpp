@@ -3,6 +3,7 @@
 #include <Eigen/OrderingMethods>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace spacar {
@@ -33,6 +34,7 @@ std::vector<int> amd_order(const Eigen::SparseMatrix<double>& A) {
 void SparseLU::analyze(const Eigen::SparseMatrix<double>& A) {
   n_ = static_cast<int>(A.rows());
   have_pivots_ = false;
+  valid_ = n_ == 0;
   w_.assign(n_, 0.0);
   stack_.assign(2 * n_, 0);
   mark_.assign(n_, 0);
@@ -121,18 +123,26 @@ bool SparseLU::factorize_pivoting(const Eigen::SparseMatrix<double>& A, const st
       have_pivots_ = false;
       return false;
     }
-    if (pinv_[col] < 0 && std::abs(w_[col]) >= kDiagonalPreference * best) ipiv = col;
+    const double diagonal = pinv_[col] < 0 ? std::abs(w_[col]) : 0.0;
+    if (diagonal >= kDiagonalPreference * best && diagonal > kSingular * amax_) ipiv = col;
     const double pivot = w_[ipiv];
+    double total = 0.0;  // of the column's magnitudes: not finite if any entry overflowed or is NaN
     for (int p = top; p < n_; ++p) {
       const int i = stack_[p];
       if (pinv_[i] >= 0) {
         Ui_.push_back(pinv_[i]);
         Ux_.push_back(w_[i]);
+        total += std::abs(w_[i]);
       } else if (i != ipiv) {
         Li_.push_back(i);
         Lx_.push_back(w_[i] / pivot);
+        total += std::abs(Lx_.back());
       }
       w_[i] = 0.0;
+    }
+    if (!std::isfinite(total)) {
+      have_pivots_ = false;
+      return false;
     }
     Ud_.push_back(pivot);
     pinv_[ipiv] = k;
@@ -173,19 +183,26 @@ bool SparseLU::replay(const Eigen::SparseMatrix<double>& A) {
   double* w = w_.data();
   for (int k = 0; k < n_; ++k) {
     for (int p = Ap_[k]; p < Ap_[k + 1]; ++p) w[Ai_[p]] = Ax[Apos_[p]];
+    double total = 0.0;  // of the column's magnitudes: not finite if any entry overflowed or is NaN
     for (int p = Up_[k]; p < Up_[k + 1]; ++p) {
       const int s = Ui_[p];
       const double xs = w[s];
       Ux_[p] = xs;
+      total += std::abs(xs);
       w[s] = 0.0;
       for (int t = Lp_[s]; t < Lp_[s + 1]; ++t) w[Li_[t]] -= Lx_[t] * xs;
     }
     const double pivot = w[k];
     w[k] = 0.0;
     double column_max = 0.0;
-    for (int t = Lp_[k]; t < Lp_[k + 1]; ++t) column_max = std::max(column_max, std::abs(w[Li_[t]]));
+    for (int t = Lp_[k]; t < Lp_[k + 1]; ++t) {
+      const double a = std::abs(w[Li_[t]]);
+      column_max = std::max(column_max, a);
+      total += a;
+    }
     const double a = std::abs(pivot);
-    if (!(a > kSingular * amax_) || a < kReplayThreshold * column_max || !std::isfinite(column_max)) {
+    total += a;
+    if (!(a > kSingular * amax_) || a < kReplayThreshold * column_max || !std::isfinite(total)) {
       std::fill(w_.begin(), w_.end(), 0.0);
       return false;
     }
@@ -200,6 +217,11 @@ bool SparseLU::replay(const Eigen::SparseMatrix<double>& A) {
 }
 
 bool SparseLU::factorize(const Eigen::SparseMatrix<double>& A) {
+  valid_ = compute(A);
+  return valid_;
+}
+
+bool SparseLU::compute(const Eigen::SparseMatrix<double>& A) {
   if (n_ == 0) return true;
   // Overflowed entries (a trial state far out of range) would pass as a "successful"
   // factorization: refuse NaN (it fails every comparison) and infinity (it becomes amax_).
@@ -231,7 +253,16 @@ bool SparseLU::factorize(const Eigen::SparseMatrix<double>& A) {
   return factorize_pivoting(A, q_);
 }
 
+// Without valid factors (none yet, or the last factorization failed part way) the solution is
+// NaN: the factors and permutations are incomplete then.
+bool SparseLU::refuse_solve(double* x) const {
+  if (valid_) return false;
+  std::fill(x, x + n_, std::numeric_limits<double>::quiet_NaN());
+  return true;
+}
+
 void SparseLU::solve(const double* b, double* x) const {
+  if (refuse_solve(x)) return;
   double* y = w_.data();
   for (int i = 0; i < n_; ++i) y[pinv_[i]] = b[i];
   for (int k = 0; k < n_; ++k) {
@@ -250,6 +281,7 @@ void SparseLU::solve(const double* b, double* x) const {
 }
 
 void SparseLU::solve_transposed(const double* b, double* x) const {
+  if (refuse_solve(x)) return;
   // Aᵀ = Q Uᵀ Lᵀ P.
   double* y = w_.data();
   for (int k = 0; k < n_; ++k) {

@@ -27,13 +27,14 @@ class SparseLU {
   // Factorize A (same pattern as in analyze); false if A is numerically singular: a pivot below
   // kSingular times the largest entry of A, or non-finite values.
   bool factorize(const Eigen::SparseMatrix<double>& A);
-  // x = A⁻¹ b and x = A⁻ᵀ b; x may not alias b.
+  // x = A⁻¹ b and x = A⁻ᵀ b; x may not alias b. NaN if the last factorization failed.
   void solve(const double* b, double* x) const;
   void solve_transposed(const double* b, double* x) const;
 
   int size() const { return n_; }
   int factor_nonzeros() const { return static_cast<int>(Li_.size() + Ui_.size()) + n_; }
-  int pivotings() const { return pivotings_; }  // factorizations that chose pivots (not replays)
+  // Pivot choices made (not replays); the first factorization counts one per ordering tried.
+  int pivotings() const { return pivotings_; }
 
   static constexpr double kSingular = 1e-13;
   // A replayed pivot must be at least this fraction of the largest entry of its column of L.
@@ -43,13 +44,16 @@ class SparseLU {
   static constexpr double kDiagonalPreference = 0.1;
 
  private:
+  bool compute(const Eigen::SparseMatrix<double>& A);
   bool factorize_pivoting(const Eigen::SparseMatrix<double>& A, const std::vector<int>& order);
+  bool refuse_solve(double* x) const;
   bool replay(const Eigen::SparseMatrix<double>& A);
   int reach(const Eigen::SparseMatrix<double>& A, int col);
 
   int n_ = 0;
   double amax_ = 0.0;
-  bool have_pivots_ = false;
+  bool have_pivots_ = false;  // a pivot sequence to replay
+  bool valid_ = false;        // factors of the last factorized matrix, for solves
   int pivotings_ = 0;
   std::vector<int> colamd_, amd_;  // candidate column orderings, until the first factorization
   std::vector<int> q_;             // step k eliminates column q_[k] of A
