@@ -68,8 +68,6 @@ void BlockMatrix::add_transposed(int id, const Eigen::MatrixXd& local) {
 void LinearSolver::analyze(const Eigen::SparseMatrix<double>& A) {
   n_ = static_cast<int>(A.rows());
   lu_.analyze(A);
-  in_.setZero(n_);
-  out_.setZero(n_);
 }
 
 bool LinearSolver::factorize(const Eigen::SparseMatrix<double>& A) { return lu_.factorize(A); }
@@ -86,11 +84,7 @@ void LinearSolver::solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x
 
 void LinearSolver::solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
   x.resize(n_, b.cols());
-  for (int j = 0; j < b.cols(); ++j) {
-    in_ = b.col(j);
-    lu_.solve(in_.data(), out_.data());
-    x.col(j) = out_;
-  }
+  for (int j = 0; j < b.cols(); ++j) lu_.solve(b.col(j).data(), x.col(j).data());  // contiguous columns
 }
 
 }  // namespace spacar

@@ -59,7 +59,6 @@ class LinearSolver {
  private:
   int n_ = 0;
   SparseLU lu_;
-  mutable Eigen::VectorXd in_, out_;  // contiguous columns of a matrix right-hand side
 };
 
 }  // namespace spacar

@@ -265,8 +265,7 @@ class AutoDiffElement : public ElementKernel {
       points_mass(Jg, gamma, M, h);
       points_gravity(Jg, g, f);
     } else {
-      mass(x, v, M, h);
-      gravity(x, g, f);
+      ElementKernel::mass_and_gravity(x, v, g, M, h, f);
     }
   }
 
