@@ -11,7 +11,7 @@ void BlockMatrix::reset(int rows, int cols) {
 }
 
 int BlockMatrix::add_block(const std::vector<int>& rows, const std::vector<int>& cols) {
-  blocks_.push_back({rows, cols, {}});
+  blocks_.push_back({rows, cols, {}, {}, {}, {}});
   return static_cast<int>(blocks_.size()) - 1;
 }
 
@@ -28,6 +28,9 @@ void BlockMatrix::finalize() {
   for (Block& b : blocks_) {
     const int nr = static_cast<int>(b.rows.size()), nc = static_cast<int>(b.cols.size());
     b.index.assign(nr * nc, -1);
+    b.value.clear();
+    b.local.clear();
+    b.local_transposed.clear();
     for (int j = 0; j < nc; ++j) {
       const int c = b.cols[j];
       if (c < 0) continue;
@@ -36,6 +39,9 @@ void BlockMatrix::finalize() {
         if (r < 0) continue;
         const int* pos = std::lower_bound(inner + outer[c], inner + outer[c + 1], r);
         b.index[i + j * nr] = static_cast<int>(pos - inner);
+        b.value.push_back(static_cast<int>(pos - inner));
+        b.local.push_back(i + j * nr);
+        b.local_transposed.push_back(j + i * nc);
       }
     }
   }
@@ -46,23 +52,15 @@ void BlockMatrix::set_zero() { std::fill(A_.valuePtr(), A_.valuePtr() + A_.nonZe
 void BlockMatrix::add(int id, const Eigen::MatrixXd& local) {
   const Block& b = blocks_[id];
   double* v = A_.valuePtr();
-  const int nr = static_cast<int>(b.rows.size()), nc = static_cast<int>(b.cols.size());
-  for (int j = 0; j < nc; ++j)
-    for (int i = 0; i < nr; ++i) {
-      const int k = b.index[i + j * nr];
-      if (k >= 0) v[k] += local(i, j);
-    }
+  const double* l = local.data();
+  for (size_t t = 0; t < b.value.size(); ++t) v[b.value[t]] += l[b.local[t]];
 }
 
 void BlockMatrix::add_transposed(int id, const Eigen::MatrixXd& local) {
   const Block& b = blocks_[id];
   double* v = A_.valuePtr();
-  const int nr = static_cast<int>(b.rows.size()), nc = static_cast<int>(b.cols.size());
-  for (int j = 0; j < nc; ++j)
-    for (int i = 0; i < nr; ++i) {
-      const int k = b.index[i + j * nr];
-      if (k >= 0) v[k] += local(j, i);
-    }
+  const double* l = local.data();
+  for (size_t t = 0; t < b.value.size(); ++t) v[b.value[t]] += l[b.local_transposed[t]];
 }
 
 void LinearSolver::analyze(const Eigen::SparseMatrix<double>& A) {

@@ -225,13 +225,8 @@ bool SparseLU::compute(const Eigen::SparseMatrix<double>& A) {
   if (n_ == 0) return true;
   // Overflowed entries (a trial state far out of range) would pass as a "successful"
   // factorization: refuse NaN (it fails every comparison) and infinity (it becomes amax_).
-  amax_ = 0.0;
-  const double* values = A.valuePtr();
-  for (Eigen::Index p = 0; p < A.nonZeros(); ++p) {
-    const double a = std::abs(values[p]);
-    if (a > amax_) amax_ = a;
-    else if (a != a) return false;
-  }
+  const Eigen::Map<const Eigen::ArrayXd> values(A.valuePtr(), A.nonZeros());
+  amax_ = values.size() ? values.abs().maxCoeff<Eigen::PropagateNaN>() : 0.0;
   if (!std::isfinite(amax_)) return false;
   if (have_pivots_ && replay(A)) return true;
   if (!colamd_.empty()) {

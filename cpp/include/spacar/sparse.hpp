@@ -40,6 +40,9 @@ class BlockMatrix {
   struct Block {
     std::vector<int> rows, cols;
     std::vector<int> index;  // position in the value array of each local entry (column-major), −1
+    // The entries that are stored, as lists: value position, local entry (column-major) and
+    // local entry of the transpose; add() runs down them without tests.
+    std::vector<int> value, local, local_transposed;
   };
   std::vector<Block> blocks_;
   Eigen::SparseMatrix<double> A_;

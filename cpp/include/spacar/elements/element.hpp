@@ -359,13 +359,42 @@ class AutoDiffElement : public ElementKernel {
   }
 
   // M = Jgᵀ (W ⊗ I) Jg and h = Jgᵀ (W ⊗ I) γ from the Jacobian and convective accelerations
-  // of the mass points. Coefficient-based products: at these sizes Eigen's default would run
-  // its blocked GEMM, several times slower for matrices of a few dozen entries.
+  // of the mass points. A mass point moves with few of the element coordinates (a beam end with
+  // its node, a tangent with its rotation), so the products run over the nonzeros of Jg: for
+  // PLBEAM 32 products instead of 670 for the dense ones.
   template <class MJ, class MG>
   void points_mass(const MJ& Jg, const MG& gamma, double* M, double* h) const {
-    const Eigen::Matrix<double, NG * DIM, NC> WJ = kron(self().mass_model().W).lazyProduct(Jg);
-    Eigen::Map<Eigen::Matrix<double, NC, NC>>(M).noalias() = Jg.transpose().lazyProduct(WJ);
-    Eigen::Map<Eigen::Matrix<double, NC, 1>>(h).noalias() = WJ.transpose() * gamma;
+    constexpr int R = NG * DIM;
+    int start[R + 1], col[R * NC];
+    double val[R * NC];
+    start[0] = 0;
+    for (int i = 0; i < R; ++i) {
+      int n = start[i];
+      for (int k = 0; k < NC; ++k)
+        if (Jg(i, k) != 0.0) {
+          col[n] = k;
+          val[n++] = Jg(i, k);
+        }
+      start[i + 1] = n;
+    }
+    const auto& W = self().mass_model().W;
+    Eigen::Map<Eigen::Matrix<double, NC, NC>> Mm(M);
+    Eigen::Map<Eigen::Matrix<double, NC, 1>> hm(h);
+    Mm.setZero();
+    hm.setZero();
+    for (int a = 0; a < NG; ++a)
+      for (int b = 0; b < NG; ++b) {
+        const double wab = W(a, b);
+        if (wab == 0.0) continue;
+        for (int d = 0; d < DIM; ++d) {
+          const int i = a * DIM + d, j = b * DIM + d;
+          for (int p = start[i]; p < start[i + 1]; ++p) {
+            const double wp = wab * val[p];
+            hm[col[p]] += wp * gamma[j];
+            for (int q = start[j]; q < start[j + 1]; ++q) Mm(col[p], col[q]) += wp * val[q];
+          }
+        }
+      }
   }
 
   // f = Jgᵀ (w ⊗ g): gravity on the point weights.
