@@ -34,6 +34,43 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
     if constexpr (Nonlinear) e[0] += (2.0 * e[1] * e[1] + e[1] * e[2] + 2.0 * e[2] * e[2]) / (30.0 * l0_);
   }
 
+  // The same first derivatives written out (the hot path of Newton's method, where the jets cost
+  // four times as much): with d = x_q − x_p, l = |d|, t = d / l and the normals n = (−sin φ, cos φ),
+  // u = d · n: ∂e1/∂d = t, ∂e2/∂d = −(l0 / l)(n_p − (u_p / l) t), ∂e2/∂φp = (l0 / l) d · (cos φp, sin φp),
+  // and e3 likewise at q with the opposite sign.
+  void first_derivatives(const double* x, double* e, double* B) const override {
+    const double dx = x[3] - x[0], dy = x[4] - x[1];
+    const double l = std::sqrt(dx * dx + dy * dy), inv = 1.0 / l;
+    const double tx = dx * inv, ty = dy * inv, k = l0_ * inv;
+    const double sp = std::sin(alpha0_ + x[2]), cp = std::cos(alpha0_ + x[2]);
+    const double sq = std::sin(alpha0_ + x[5]), cq = std::cos(alpha0_ + x[5]);
+    const double up = dy * cp - dx * sp, uq = dy * cq - dx * sq;
+    e[0] = l - l0_;
+    e[1] = -k * up;
+    e[2] = k * uq;
+    // ∂e/∂d per deformation (the x_q columns, the x_p ones with the opposite sign), then ∂e/∂φ;
+    // B is 3 × 6, column-major.
+    const double rows[3][2] = {{tx, ty},
+                               {k * (sp + up * inv * tx), -k * (cp - up * inv * ty)},
+                               {-k * (sq + uq * inv * tx), k * (cq - uq * inv * ty)}};
+    for (int a = 0; a < 3; ++a) {
+      B[a + 0] = -rows[a][0];
+      B[a + 3] = -rows[a][1];
+      B[a + 9] = rows[a][0];
+      B[a + 12] = rows[a][1];
+      B[a + 6] = 0.0;
+      B[a + 15] = 0.0;
+    }
+    B[1 + 6] = k * (dx * cp + dy * sp);
+    B[2 + 15] = -k * (dx * cq + dy * sq);
+    if constexpr (Nonlinear) {
+      // e1 += (2 e2² + e2 e3 + 2 e3²) / (30 l0)
+      const double g2 = (4.0 * e[1] + e[2]) / (30.0 * l0_), g3 = (e[1] + 4.0 * e[2]) / (30.0 * l0_);
+      e[0] += (2.0 * e[1] * e[1] + e[1] * e[2] + 2.0 * e[2] * e[2]) / (30.0 * l0_);
+      for (int j = 0; j < 6; ++j) B[3 * j] += g2 * B[1 + 3 * j] + g3 * B[2 + 3 * j];
+    }
+  }
+
   // Mass points: x_p, l0 t_p, x_q, l0 t_q (position field r = H1 x_p + H2 l0 t_p + H3 x_q + H4 l0 t_q).
   template <class S>
   void mass_points(const S* x, S* g) const {
@@ -49,6 +86,19 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   }
   const MassPoints<4, 2>& mass_model() const { return mass_; }
 
+  // The mass matrix, convective inertia and gravity of the mass points written out (every
+  // right-hand side needs them; the jets and the products with the 8 × 6 point Jacobian cost ten
+  // times as much). The points are x_p, l0 t_p, x_q, l0 t_q, and a tangent turns with its β:
+  // ∂(l0 t)/∂β = l0 n, n = (−sin φ, cos φ), and its convective acceleration is −l0 t β̇². With
+  // W the 4 × 4 point mass matrix: M(node a, node b) = W(a, b) I for two positions, W(a, b) l0 n
+  // between a position and a rotation, W(a, b) l0² n_a · n_b between two rotations;
+  // h = Jgᵀ (W ⊗ I) γ and f = Jgᵀ (w ⊗ g) the same way.
+  void mass(const double* x, const double* v, double* M, double* h) const override { inertia(x, v, nullptr, M, h, nullptr); }
+  void mass_and_gravity(const double* x, const double* v, const double* g, double* M, double* h,
+                        double* f) const override {
+    inertia(x, v, g, M, h, f);
+  }
+
   // σ1 = (EA/l0) e1, [σ2; σ3] = (EI/l0³) [[4, −2], [−2, 4]] [e2; e3].
   void constitutive(const std::vector<double>& v, double* S) const override {
     const double EA = v.size() > 0 ? v[0] : 0.0, EI = v.size() > 1 ? v[1] : 0.0;
@@ -62,6 +112,58 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   }
 
  private:
+  void inertia(const double* x, const double* v, const double* g, double* M, double* h, double* f) const {
+    const auto& W = mass_.W;
+    const double cp = std::cos(alpha0_ + x[2]), sp = std::sin(alpha0_ + x[2]);
+    const double cq = std::cos(alpha0_ + x[5]), sq = std::sin(alpha0_ + x[5]);
+    // Per mass point a: its coordinate columns and, for tangents, l0 n (the column of βp or βq).
+    const double tangent[4][2] = {{0, 0}, {-l0_ * sp, l0_ * cp}, {0, 0}, {-l0_ * sq, l0_ * cq}};
+    const int column[4] = {0, 2, 3, 5};
+    const bool turns[4] = {false, true, false, true};
+    for (int i = 0; i < 36; ++i) M[i] = 0.0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) {
+        const double w = W(a, b);
+        const int ca = column[a], cb = column[b];
+        if (!turns[a] && !turns[b]) {
+          M[ca + 6 * cb] += w;
+          M[ca + 1 + 6 * (cb + 1)] += w;
+        } else if (!turns[a]) {
+          M[ca + 6 * cb] += w * tangent[b][0];
+          M[ca + 1 + 6 * cb] += w * tangent[b][1];
+        } else if (!turns[b]) {
+          M[ca + 6 * cb] += w * tangent[a][0];
+          M[ca + 6 * (cb + 1)] += w * tangent[a][1];
+        } else {
+          M[ca + 6 * cb] += w * (tangent[a][0] * tangent[b][0] + tangent[a][1] * tangent[b][1]);
+        }
+      }
+    // γ of the tangents, −l0 t β̇² (the positions have none); (W ⊗ I) γ per point.
+    const double wp = v[2] * v[2], wq = v[5] * v[5];
+    const double gamma[4][2] = {{0, 0}, {-l0_ * cp * wp, -l0_ * sp * wp}, {0, 0}, {-l0_ * cq * wq, -l0_ * sq * wq}};
+    for (int i = 0; i < 6; ++i) h[i] = 0.0;
+    for (int a = 0; a < 4; ++a) {
+      const double Gx = W(a, 1) * gamma[1][0] + W(a, 3) * gamma[3][0];
+      const double Gy = W(a, 1) * gamma[1][1] + W(a, 3) * gamma[3][1];
+      project(a, tangent, column, turns, Gx, Gy, h);
+    }
+    if (!g) return;
+    for (int i = 0; i < 6; ++i) f[i] = 0.0;
+    for (int a = 0; a < 4; ++a) project(a, tangent, column, turns, mass_.w[a] * g[0], mass_.w[a] * g[1], f);
+  }
+
+  // out += Jgᵀ (load (px, py) on point a): the position columns take the load itself, the
+  // rotation column its product with l0 n.
+  static void project(int a, const double (&tangent)[4][2], const int (&column)[4], const bool (&turns)[4], double px,
+                      double py, double* out) {
+    if (turns[a]) {
+      out[column[a]] += tangent[a][0] * px + tangent[a][1] * py;
+    } else {
+      out[column[a]] += px;
+      out[column[a] + 1] += py;
+    }
+  }
+
   double l0_, alpha0_;
   MassPoints<4, 2> mass_;
 };
