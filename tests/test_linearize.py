@@ -650,7 +650,8 @@ def test_line_parameters_along_the_slider_crank_motion():
         for name in ("M0", "K0"):
             assert np.allclose(getattr(lin, name), getattr(ref, name), rtol=1e-12, atol=1e-14), name
         # C0 + D0 vanish here (no damping, no velocity-dependent forces on the rod's bending):
-        # both are the round-off of central differences of the residual, 1e-14 to 2e-13.
+        # both are the round-off of central differences of the residual, 1e-14 to 1.4e-13 (it
+        # depends on the rounding of the element code).
         assert np.abs(lin.damping - ref.damping).max() <= 1e-12
         sim.move_to(lin.t, zero, zero)
         Mb, qdd = np.array(sim.data.Mbar), np.array(sim.data.qdd)

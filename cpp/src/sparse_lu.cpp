@@ -226,8 +226,9 @@ bool SparseLU::compute(const Eigen::SparseMatrix<double>& A) {
   // Overflowed entries (a trial state far out of range) would pass as a "successful"
   // factorization: refuse NaN (it fails every comparison) and infinity (it becomes amax_).
   const Eigen::Map<const Eigen::ArrayXd> values(A.valuePtr(), A.nonZeros());
-  amax_ = values.size() ? values.abs().maxCoeff<Eigen::PropagateNaN>() : 0.0;
-  if (!std::isfinite(amax_)) return false;
+  // Two vectorized passes (maxCoeff may skip a NaN); Eigen 3.3 has no NaN-propagating maxCoeff.
+  amax_ = values.size() ? values.abs().maxCoeff() : 0.0;
+  if (!std::isfinite(amax_) || values.hasNaN()) return false;
   if (have_pivots_ && replay(A)) return true;
   if (!colamd_.empty()) {
     // First factorization: keep the ordering with the sparser factors.

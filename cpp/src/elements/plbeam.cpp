@@ -34,8 +34,8 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
     if constexpr (Nonlinear) e[0] += (2.0 * e[1] * e[1] + e[1] * e[2] + 2.0 * e[2] * e[2]) / (30.0 * l0_);
   }
 
-  // The same first derivatives written out (the hot path of Newton's method, where the jets cost
-  // four times as much): with d = x_q − x_p, l = |d|, t = d / l and the normals n = (−sin φ, cos φ),
+  // The same first derivatives written out (the hot path of Newton's method, where the jets took
+  // twice as long): with d = x_q − x_p, l = |d|, t = d / l and the normals n = (−sin φ, cos φ),
   // u = d · n: ∂e1/∂d = t, ∂e2/∂d = −(l0 / l)(n_p − (u_p / l) t), ∂e2/∂φp = (l0 / l) d · (cos φp, sin φp),
   // and e3 likewise at q with the opposite sign.
   void first_derivatives(const double* x, double* e, double* B) const override {
@@ -87,8 +87,8 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   const MassPoints<4, 2>& mass_model() const { return mass_; }
 
   // The mass matrix, convective inertia and gravity of the mass points written out (every
-  // right-hand side needs them; the jets and the products with the 8 × 6 point Jacobian cost ten
-  // times as much). The points are x_p, l0 t_p, x_q, l0 t_q, and a tangent turns with its β:
+  // right-hand side needs them; the jets and the products with the 8 × 6 point Jacobian took four
+  // to five times as long). The points are x_p, l0 t_p, x_q, l0 t_q, and a tangent turns with its β:
   // ∂(l0 t)/∂β = l0 n, n = (−sin φ, cos φ), and its convective acceleration is −l0 t β̇². With
   // W the 4 × 4 point mass matrix: M(node a, node b) = W(a, b) I for two positions, W(a, b) l0 n
   // between a position and a rotation, W(a, b) l0² n_a · n_b between two rotations;

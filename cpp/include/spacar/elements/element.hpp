@@ -306,7 +306,7 @@ class AutoDiffElement : public ElementKernel {
     if constexpr (detail::has_kinetic<Derived>::value) return self().kinetic(x, v);
     if constexpr (NG > 0) {
       // ġ from the mass points themselves (a directional jet), not from point_derivatives:
-      // the checks of the mass matrix against T then test a written-out point Jacobian too.
+      // the checks of the mass matrix against T then also test an element's written-out mass.
       using J1 = Jet<double, 1>;
       J1 xj[NC], gj[NG * DIM];
       for (int k = 0; k < NC; ++k) xj[k] = J1(x[k], {v[k]});
