@@ -224,10 +224,9 @@ bool SparseLU::factorize(const Eigen::SparseMatrix<double>& A) {
 bool SparseLU::compute(const Eigen::SparseMatrix<double>& A) {
   if (n_ == 0) return true;
   // Overflowed entries (a trial state far out of range) would pass as a "successful"
-  // factorization: refuse NaN (it fails every comparison) and infinity (it becomes amax_).
+  // factorization: refuse NaN and infinity. Two vectorized passes: maxCoeff may skip a NaN
+  // (Eigen 3.3 has no NaN-propagating one), and Σ 0·a is 0 unless an entry is NaN or infinite.
   const Eigen::Map<const Eigen::ArrayXd> values(A.valuePtr(), A.nonZeros());
-  // Two vectorized passes: maxCoeff may skip a NaN (Eigen 3.3 has no NaN-propagating one), and
-  // Σ 0·a is 0 unless an entry is NaN or infinite.
   amax_ = values.size() ? values.abs().maxCoeff() : 0.0;
   if (!std::isfinite(amax_) || (values * 0.0).sum() != 0.0) return false;
   if (have_pivots_ && replay(A)) return true;

@@ -116,10 +116,11 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
     const auto& W = mass_.W;
     const double cp = std::cos(alpha0_ + x[2]), sp = std::sin(alpha0_ + x[2]);
     const double cq = std::cos(alpha0_ + x[5]), sq = std::sin(alpha0_ + x[5]);
-    // Per mass point a: its coordinate columns and, for tangents, l0 n (the column of βp or βq).
-    const double tangent[4][2] = {{0, 0}, {-l0_ * sp, l0_ * cp}, {0, 0}, {-l0_ * sq, l0_ * cq}};
+    // Mass point a: its first coordinate column (x of a position, β of a tangent); the tangents
+    // (a = 1, 3) turn, with ∂(l0 t)/∂β = l0 n.
     const int column[4] = {0, 2, 3, 5};
     const bool turns[4] = {false, true, false, true};
+    const double tangent[4][2] = {{0, 0}, {-l0_ * sp, l0_ * cp}, {0, 0}, {-l0_ * sq, l0_ * cq}};
     for (int i = 0; i < 36; ++i) M[i] = 0.0;
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b) {
@@ -138,30 +139,24 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
           M[ca + 6 * cb] += w * (tangent[a][0] * tangent[b][0] + tangent[a][1] * tangent[b][1]);
         }
       }
-    // γ of the tangents, −l0 t β̇² (the positions have none); (W ⊗ I) γ per point.
+    // out += Jgᵀ (load (px, py) on point a): a position column takes the load itself, a rotation
+    // column its product with l0 n.
+    auto project = [&](int a, double px, double py, double* out) {
+      if (turns[a]) {
+        out[column[a]] += tangent[a][0] * px + tangent[a][1] * py;
+      } else {
+        out[column[a]] += px;
+        out[column[a] + 1] += py;
+      }
+    };
+    // γ of the tangents p and q, −l0 t β̇² (the positions have none); (W ⊗ I) γ per point.
     const double wp = v[2] * v[2], wq = v[5] * v[5];
-    const double gamma[4][2] = {{0, 0}, {-l0_ * cp * wp, -l0_ * sp * wp}, {0, 0}, {-l0_ * cq * wq, -l0_ * sq * wq}};
+    const double gp[2] = {-l0_ * cp * wp, -l0_ * sp * wp}, gq[2] = {-l0_ * cq * wq, -l0_ * sq * wq};
     for (int i = 0; i < 6; ++i) h[i] = 0.0;
-    for (int a = 0; a < 4; ++a) {
-      const double Gx = W(a, 1) * gamma[1][0] + W(a, 3) * gamma[3][0];
-      const double Gy = W(a, 1) * gamma[1][1] + W(a, 3) * gamma[3][1];
-      project(a, tangent, column, turns, Gx, Gy, h);
-    }
+    for (int a = 0; a < 4; ++a) project(a, W(a, 1) * gp[0] + W(a, 3) * gq[0], W(a, 1) * gp[1] + W(a, 3) * gq[1], h);
     if (!g) return;
     for (int i = 0; i < 6; ++i) f[i] = 0.0;
-    for (int a = 0; a < 4; ++a) project(a, tangent, column, turns, mass_.w[a] * g[0], mass_.w[a] * g[1], f);
-  }
-
-  // out += Jgᵀ (load (px, py) on point a): the position columns take the load itself, the
-  // rotation column its product with l0 n.
-  static void project(int a, const double (&tangent)[4][2], const int (&column)[4], const bool (&turns)[4], double px,
-                      double py, double* out) {
-    if (turns[a]) {
-      out[column[a]] += tangent[a][0] * px + tangent[a][1] * py;
-    } else {
-      out[column[a]] += px;
-      out[column[a] + 1] += py;
-    }
+    for (int a = 0; a < 4; ++a) project(a, mass_.w[a] * g[0], mass_.w[a] * g[1], f);
   }
 
   double l0_, alpha0_;
