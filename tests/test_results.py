@@ -148,6 +148,29 @@ def test_geometry_describes_the_model(run):
     assert spacar.Geometry.from_dict(g.to_dict()) == g
 
 
+def test_geometry_is_that_of_the_model_at_the_run():
+    """res.geometry is built on first use (from a copy of the model taken at the run), so later
+    changes of the model before the next block do not reach it."""
+    model = spacar.read(EXAMPLE)
+    res = spacar.simulate(model)
+    expected = spacar.Geometry.from_model(model)
+    assert res._geometry_source is not None          # not built yet
+    model.mass(8, 0.5)                                # element, class and mass changes before the next block
+    model.lgeomy(3, 0.01)
+    model.dynx(2, 1)
+    model.timestep(5, 0.05)
+    second = spacar.simulate(model)
+    assert spacar.Geometry.from_model(model) != expected
+    assert second.geometry == spacar.Geometry.from_model(model)
+    assert second.geometry.coordinate_classes[2] == ("dynamic",) and second.geometry.masses == {8: (0.5,)}
+    again = pickle.loads(pickle.dumps(res))           # pickling a results whose geometry is not built yet
+    assert res.geometry == expected and again.geometry == expected
+    assert res.geometry is res.geometry               # built once
+    assert res.geometry.coordinate_classes[2] == ("input",) and res.geometry.elements[2].lgeomy == (0.0,)
+    res.geometry = None
+    assert res.geometry is None and res.supported_columns() == list(range(13))
+
+
 def test_supported_columns_are_the_fixed_and_input_coordinates(run):
     _, res, _ = run
     # FIX 1 (both), INPUTX 2 1, FIX 8 2 in the input file

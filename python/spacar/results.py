@@ -126,6 +126,32 @@ class Results:
         self._coord = {lbl: i for i, lbl in enumerate(self.coordinate_labels)}
         self._def = {lbl: i for i, lbl in enumerate(self.deformation_labels)}
 
+    # The geometry is only needed for drawing, plotting and saving, and building it costs more than
+    # a small run: spacar.simulate stores a copy of the model's core as it was at the run
+    # (``_geometry_source``) and the Geometry is made from it on first access.
+    @property
+    def geometry(self) -> Geometry | None:
+        if self._geometry_source is not None:
+            self._geometry = Geometry.from_model(self._geometry_source)
+            self._geometry_source = None
+        return self._geometry
+
+    @geometry.setter
+    def geometry(self, value: Geometry | None):
+        self._geometry, self._geometry_source = value, None
+
+    def __getstate__(self):
+        # Pickles hold the Geometry (plain data, as before it was lazy), not the model's core.
+        state = {k: v for k, v in self.__dict__.items() if k not in ("_geometry", "_geometry_source")}
+        state["geometry"] = self.geometry
+        return state
+
+    def __setstate__(self, state):
+        state = dict(state)
+        geometry = state.pop("geometry", None)
+        self.__dict__.update(state)
+        self.geometry = geometry
+
     @property
     def reactions(self) -> np.ndarray:
         """Alias of :attr:`reaction`."""

@@ -4,7 +4,6 @@ from __future__ import annotations
 from . import _core
 from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
-from .geometry import Geometry
 from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
 from .results import Results
@@ -14,8 +13,9 @@ def _results(arrays: dict, system, model) -> Results:
     stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
                                     "newton_iterations", "wall_time")}
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
-    return Results(arrays, system.coord_label, system.def_label, stats, Geometry.from_model(model), lins,
-                   model.settings.linear)
+    res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear)
+    res._geometry_source = model._core.copy()  # res.geometry is built from this copy when first used
+    return res
 
 
 def simulate(model, *, method: str = "dop853", on_output=None, progress=None, output_stem=None,
