@@ -92,7 +92,7 @@ bool SparseLU::factorize_pivoting(const Eigen::SparseMatrix<double>& A, const st
   Lx_.clear();
   Ui_.clear();
   Ux_.clear();
-  Ud_.clear();
+  Uinv_.clear();
   std::fill(w_.begin(), w_.end(), 0.0);
   for (int k = 0; k < n_; ++k) {
     const int col = q_[k];
@@ -144,7 +144,7 @@ bool SparseLU::factorize_pivoting(const Eigen::SparseMatrix<double>& A, const st
       have_pivots_ = false;
       return false;
     }
-    Ud_.push_back(pivot);
+    Uinv_.push_back(1.0 / pivot);
     pinv_[ipiv] = k;
     Lp_.push_back(static_cast<int>(Li_.size()));
     Up_.push_back(static_cast<int>(Ui_.size()));
@@ -206,8 +206,8 @@ bool SparseLU::replay(const Eigen::SparseMatrix<double>& A) {
       std::fill(w_.begin(), w_.end(), 0.0);
       return false;
     }
-    Ud_[k] = pivot;
     const double inv = 1.0 / pivot;
+    Uinv_[k] = inv;
     for (int t = Lp_[k]; t < Lp_[k + 1]; ++t) {
       Lx_[t] = w[Li_[t]] * inv;
       w[Li_[t]] = 0.0;
@@ -266,7 +266,7 @@ void SparseLU::solve(const double* b, double* x) const {
     for (int t = Lp_[k]; t < Lp_[k + 1]; ++t) y[Li_[t]] -= Lx_[t] * yk;
   }
   for (int k = n_ - 1; k >= 0; --k) {
-    const double yk = y[k] / Ud_[k];
+    const double yk = y[k] * Uinv_[k];
     y[k] = yk;
     for (int p = Up_[k]; p < Up_[k + 1]; ++p) y[Ui_[p]] -= Ux_[p] * yk;
   }
@@ -283,7 +283,7 @@ void SparseLU::solve_transposed(const double* b, double* x) const {
   for (int k = 0; k < n_; ++k) {
     double v = b[q_[k]];
     for (int p = Up_[k]; p < Up_[k + 1]; ++p) v -= Ux_[p] * y[Ui_[p]];
-    y[k] = v / Ud_[k];
+    y[k] = v * Uinv_[k];
   }
   for (int k = n_ - 1; k >= 0; --k) {
     double v = y[k];

@@ -58,10 +58,11 @@ class SparseLU {
   std::vector<int> colamd_, amd_;  // candidate column orderings, until the first factorization
   std::vector<int> q_;             // step k eliminates column q_[k] of A
   std::vector<int> pinv_;          // row i of A is the pivot of step pinv_[i]
-  // L (unit diagonal, not stored) and U (diagonal in Ud_) by columns, rows as step indices; the
-  // rows of a column of U are increasing.
+  // L (unit diagonal, not stored) and U by columns, rows as step indices; the rows of a column of
+  // U are increasing. U's diagonal is kept as reciprocals: the solves multiply, and a division
+  // in their chain of dependent rows would cost its latency at every row.
   std::vector<int> Lp_, Li_, Up_, Ui_;
-  std::vector<double> Lx_, Ux_, Ud_;
+  std::vector<double> Lx_, Ux_, Uinv_;
   // For the replay: where each entry of A goes in the work vector (its pivot step), column by
   // column in the order of q_.
   std::vector<int> Ap_, Ai_, Apos_;
