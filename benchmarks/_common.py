@@ -129,6 +129,22 @@ def simulate_best(model, repeat: int = 3, budget: float = 2.0):
     return res, best
 
 
+def in_run_per_rhs(model, min_time: float = 0.5, min_runs: int = 3):
+    """Seconds per right-hand side inside a run of ``spacar.simulate``: the best block wall time
+    (``stats["wall_time"]``, the C++ integration loop) over runs repeated for at least
+    ``min_time`` seconds, divided by the run's right-hand sides (the same in every run); with
+    the statistics of the last run. The protocol of :func:`per_call` for the peers' calls."""
+    best, spent, runs, stats = float("inf"), 0.0, 0, None
+    while runs < min_runs or spent < min_time:
+        m = model.copy()
+        start = time.perf_counter()
+        stats = spacar.simulate(m).stats
+        spent += time.perf_counter() - start
+        runs += 1
+        best = min(best, stats["wall_time"])
+    return best / stats["rhs_evaluations"], stats
+
+
 def per_call(fn, min_time: float = 0.2, max_calls: int = 100000, min_calls: int = 1) -> float:
     """Seconds per call of fn(), from a loop of at least min_time seconds (best of 3 loops)."""
     start = time.perf_counter()
