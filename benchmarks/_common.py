@@ -188,7 +188,7 @@ def fmt_time(s) -> str:
 def fmt_ratio(a, b) -> str:
     if a is None or b is None:
         return "—"
-    return f"{a / b:.2g}×"
+    return f"{a / b:.3g}×"  # three digits: 2.96× must not read as 3×
 
 
 def fmt_err(e) -> str:

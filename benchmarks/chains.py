@@ -186,7 +186,7 @@ def section(r: dict, plots: dict | None = None) -> str:
         ratio = x["spacar_in_run"] / x["pinocchio_aba"]
         lines += ["", f"Issue #8 target, time per right-hand side within 3× of Pinocchio's ABA at N = 20: "
                   f"**{'met' if ratio <= 3 else 'NOT met'}** (spacar {C.fmt_time(x['spacar_in_run'])} in a run, "
-                  f"ABA {C.fmt_time(x['pinocchio_aba'])}: {ratio:.0f}×)."]
+                  f"ABA {C.fmt_time(x['pinocchio_aba'])}: {ratio:.2f}×)."]
     lines += ["", "### Time to accuracy", "",
               "Error: largest joint-angle error (rad) at T against Pinocchio's ABA integrated by DOP853 at rtol 1e-13. "
               "Time: wall time of the shortest run that reached the error (model building excluded; spacar's time "
@@ -208,7 +208,7 @@ def section(r: dict, plots: dict | None = None) -> str:
     if verdicts:
         lines += ["", f"Issue #8 target, time-to-accuracy at least 3× better than exudyn on the rigid chains: "
                   f"**{'met' if min(verdicts) >= 3 else 'NOT met'}** (exudyn's best / spacar ranges from "
-                  f"{min(verdicts):.2g}× to {max(verdicts):.2g}× over the rows above)."]
+                  f"{min(verdicts):.3g}× to {max(verdicts):.3g}× over the rows above)."]
     lines += ["", "Runs (error at T, wall time) per program:", ""]
     for n in sizes:
         parts = []

@@ -123,8 +123,8 @@ def section(r: dict, plots: dict | None = None) -> str:
                      f"{C.fmt_time(t['exudyn trapezoidal (index 2)'])} | {C.fmt_ratio(best, t['spacar'])} |")
     if ratios:
         lines += ["", f"Issue #8 target, time-to-accuracy at least 3× better than exudyn on the four-bar: "
-                  f"**{'met' if min(ratios) >= 3 else 'NOT met'}** (exudyn's best / spacar: {min(ratios):.2g}× to "
-                  f"{max(ratios):.2g}× where both reached the error; where exudyn did not reach it within its finest "
+                  f"**{'met' if min(ratios) >= 3 else 'NOT met'}** (exudyn's best / spacar: {min(ratios):.3g}× to "
+                  f"{max(ratios):.3g}× where both reached the error; where exudyn did not reach it within its finest "
                   "step the advantage is larger)."]
     lines += ["", "Runs (setting → error at T, wall time):", ""]
     for k, v in r["acc"].items():
