@@ -11,7 +11,7 @@ void BlockMatrix::reset(int rows, int cols) {
 }
 
 int BlockMatrix::add_block(const std::vector<int>& rows, const std::vector<int>& cols) {
-  blocks_.push_back({rows, cols, {}, {}, {}, {}});
+  blocks_.push_back({rows, cols, {}, {}, {}});
   return static_cast<int>(blocks_.size()) - 1;
 }
 
@@ -27,7 +27,6 @@ void BlockMatrix::finalize() {
   const int* inner = A_.innerIndexPtr();
   for (Block& b : blocks_) {
     const int nr = static_cast<int>(b.rows.size()), nc = static_cast<int>(b.cols.size());
-    b.index.assign(nr * nc, -1);
     b.value.clear();
     b.local.clear();
     b.local_transposed.clear();
@@ -38,7 +37,6 @@ void BlockMatrix::finalize() {
         const int r = b.rows[i];
         if (r < 0) continue;
         const int* pos = std::lower_bound(inner + outer[c], inner + outer[c + 1], r);
-        b.index[i + j * nr] = static_cast<int>(pos - inner);
         b.value.push_back(static_cast<int>(pos - inner));
         b.local.push_back(i + j * nr);
         b.local_transposed.push_back(j + i * nc);
@@ -54,6 +52,13 @@ void BlockMatrix::add(int id, const Eigen::MatrixXd& local) {
   double* v = A_.valuePtr();
   const double* l = local.data();
   for (size_t t = 0; t < b.value.size(); ++t) v[b.value[t]] += l[b.local[t]];
+}
+
+void BlockMatrix::add_value(int id, int a, int b, double v) {
+  const Block& k = blocks_[id];
+  const int entry = a + b * static_cast<int>(k.rows.size());
+  for (size_t t = 0; t < k.local.size(); ++t)
+    if (k.local[t] == entry) A_.valuePtr()[k.value[t]] += v;
 }
 
 void BlockMatrix::add_transposed(int id, const Eigen::MatrixXd& local) {

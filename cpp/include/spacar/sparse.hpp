@@ -27,10 +27,8 @@ class BlockMatrix {
   // local(b, a).
   void add(int id, const Eigen::MatrixXd& local);
   void add_transposed(int id, const Eigen::MatrixXd& local);
-  void add_value(int id, int a, int b, double v) {
-    const int i = blocks_[id].index[a + b * static_cast<int>(blocks_[id].rows.size())];
-    if (i >= 0) A_.valuePtr()[i] += v;
-  }
+  // Add v to local entry (a, b), if it is stored.
+  void add_value(int id, int a, int b, double v);
 
   const Eigen::SparseMatrix<double>& matrix() const { return A_; }
   int rows() const { return static_cast<int>(A_.rows()); }
@@ -39,7 +37,6 @@ class BlockMatrix {
  private:
   struct Block {
     std::vector<int> rows, cols;
-    std::vector<int> index;  // position in the value array of each local entry (column-major), −1
     // The entries that are stored, as lists: value position, local entry (column-major) and
     // local entry of the transpose; add() runs down them without tests.
     std::vector<int> value, local, local_transposed;
