@@ -31,7 +31,7 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
     e[1] = -l0_ * (dy * cos(phip) - dx * sin(phip)) / l;
     e[2] = l0_ * (dy * cos(phiq) - dx * sin(phiq)) / l;
     e[0] = l - l0_;
-    if constexpr (Nonlinear) e[0] += (2.0 * e[1] * e[1] + e[1] * e[2] + 2.0 * e[2] * e[2]) / (30.0 * l0_);
+    if constexpr (Nonlinear) e[0] += bending_elongation(e[1], e[2]);
   }
 
   // The same first derivatives written out (the hot path of Newton's method, where the jets took
@@ -66,7 +66,7 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
     if constexpr (Nonlinear) {
       // e1 += (2 e2² + e2 e3 + 2 e3²) / (30 l0)
       const double g2 = (4.0 * e[1] + e[2]) / (30.0 * l0_), g3 = (e[1] + 4.0 * e[2]) / (30.0 * l0_);
-      e[0] += (2.0 * e[1] * e[1] + e[1] * e[2] + 2.0 * e[2] * e[2]) / (30.0 * l0_);
+      e[0] += bending_elongation(e[1], e[2]);
       for (int j = 0; j < 6; ++j) B[3 * j] += g2 * B[1 + 3 * j] + g3 * B[2 + 3 * j];
     }
   }
@@ -112,6 +112,12 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   }
 
  private:
+  // PLBEAMNL's second-order elongation from bending, (2 e2² + e2 e3 + 2 e3²) / (30 l0).
+  template <class S>
+  S bending_elongation(const S& e2, const S& e3) const {
+    return (2.0 * e2 * e2 + e2 * e3 + 2.0 * e3 * e3) / (30.0 * l0_);
+  }
+
   void inertia(const double* x, const double* v, const double* g, double* M, double* h, double* f) const {
     const auto& W = mass_.W;
     const double cp = std::cos(alpha0_ + x[2]), sp = std::sin(alpha0_ + x[2]);
