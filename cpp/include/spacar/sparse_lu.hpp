@@ -14,6 +14,7 @@
 #pragma once
 
 #include <Eigen/Sparse>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -45,7 +46,9 @@ class SparseLU {
 
  private:
   bool compute(const Eigen::SparseMatrix<double>& A);
-  bool factorize_pivoting(const Eigen::SparseMatrix<double>& A, const std::vector<int>& order);
+  // False if A is singular in this order, or once the factors have more than max_nonzeros.
+  bool factorize_pivoting(const Eigen::SparseMatrix<double>& A, const std::vector<int>& order,
+                          int max_nonzeros = std::numeric_limits<int>::max());
   bool refuse_solve(double* x) const;
   bool replay(const Eigen::SparseMatrix<double>& A);
   int reach(const Eigen::SparseMatrix<double>& A, int col);
