@@ -429,6 +429,7 @@ py::dict block_results_to_dict(BlockResults&& r) {
   d["newton_iterations"] = r.newton_iterations;
   d["last_step"] = r.last_step;
   d["wall_time"] = r.wall_time;
+  d["recursive"] = r.recursive;
   d["warnings"] = r.warnings;
   return d;
 }
@@ -533,6 +534,16 @@ void bind_simulation(py::module_& m) {
                throw InputError("solve_state(): q and qd must have one value per degree of freedom");
              s.solve_state(t, q.data(), qd.data());
            })
+      .def("recursive_accelerations",
+           [](Simulation& s, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) -> py::object {
+             // q̈ by the recursive path of planar rigid trees (None for other systems), with the
+             // tree taken at the last solved state: a check of it against solve_state().
+             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
+               throw InputError("recursive_accelerations(): q and qd must have one value per degree of freedom");
+             Eigen::VectorXd qdd;
+             if (!s.recursive_accelerations(q.data(), qd.data(), qdd)) return py::none();
+             return py::cast(qdd);
+           })
       .def("move_to",
            [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
              if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
@@ -542,8 +553,9 @@ void bind_simulation(py::module_& m) {
       .def(
           "run",
           [](Simulation& s, py::object on_output, double initial_step, const std::string& method,
-             double time_limit) {
+             double time_limit, bool recursive) {
             RunOptions opt;
+            opt.recursive = recursive;
             opt.initial_step = initial_step;
             if (method == "dop853") opt.method = Method::DOP853;
             else if (method == "dopri5") opt.method = Method::DOPRI5;
@@ -580,7 +592,7 @@ void bind_simulation(py::module_& m) {
             return block_results_to_dict(std::move(r));
           },
           py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
-          py::arg("time_limit") = 0.0,
+          py::arg("time_limit") = 0.0, py::arg("recursive") = true,
           "Run the block; on failure the exception has the results up to the failure as `results`.");
 }
 

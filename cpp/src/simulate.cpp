@@ -87,6 +87,7 @@ bool Simulation::continuous_with_step_start(std::string& why) const {
 
 void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
   if (t > kinematic_failure_t_) kinematic_failure_.clear();  // passed: the failure is history
+  if (tree_) return;  // explicit positions: no Newton start to anchor, no branch to leave
   if (anchor_.valid && anchor_.t == t) return;                // the same step again, smaller
   // The integrator has just evaluated the right-hand side at the accepted state, unless an
   // output time was evaluated since: then solve it again.
@@ -237,6 +238,13 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   check_time(t);
+  if (tree_ && tree_->solve(Y.data(), Y.data() + nd, base_.x, base_.xd, base_.xdd, dY.data() + nd)) {
+    // The solved state is the start of the Newton iterations at the next output time.
+    base_.valid = true;
+    base_.t = t;
+    dY.head(nd) = Y.tail(nd);
+    return;
+  }
   struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side
     bool& flag;
     explicit InRhs(bool& f) : flag(f) { flag = true; }
@@ -253,6 +261,15 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   dY.head(nd) = Y.tail(nd);
   for (int i = 0; i < ny; ++i) dY[nd + i] = data_->ed[sys_->y_defs[i]];
   dY.tail(nd) = data_->qdd;
+}
+
+bool Simulation::recursive_accelerations(const double* q, const double* qd, Eigen::VectorXd& qdd) {
+  std::unique_ptr<PlanarTree> tree = PlanarTree::detect(*sys_, *data_);
+  if (!tree) return false;
+  Eigen::VectorXd x = data_->x, xd = data_->xd, xdd = data_->xdd, out(sys_->n_dof());
+  if (!tree->solve(q, qd, x, xd, xdd, out.data())) return false;
+  qdd = out;
+  return true;
 }
 
 void Simulation::record(BlockResults& res, int k) {
@@ -387,6 +404,12 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   };
   try {
     assemble();
+    tree_ = integrate && options.recursive ? PlanarTree::detect(*sys_, *data_) : nullptr;
+    res.recursive = tree_ != nullptr;
+    if (tree_) {
+      base_.xd = base_.xdd = Eigen::VectorXd::Zero(sys_->nx);
+      base_.t = t0;
+    }
     const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
     auto output = [&](double t, const Eigen::VectorXd& Y) {
       check_time(t);
@@ -458,9 +481,11 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     cut_rows(res, k_out);
     finish();
     has_deadline_ = false;
+    tree_.reset();
     throw;
   }
   has_deadline_ = false;
+  tree_.reset();
   finish();
   store_state();
 }

@@ -11,7 +11,7 @@ from .results import Results
 
 def _results(arrays: dict, system, model) -> Results:
     stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
-                                    "newton_iterations", "wall_time")}
+                                    "newton_iterations", "wall_time", "recursive")}
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
     res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear)
     res._geometry_source = model._core.copy()  # res.geometry is built from this copy when first used
@@ -19,7 +19,7 @@ def _results(arrays: dict, system, model) -> Results:
 
 
 def simulate(model, *, method: str = "dop853", on_output=None, progress=None, output_stem=None,
-             time_limit=None) -> Results:
+             time_limit=None, recursive: bool = True) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
     The mechanism is assembled at the current time; with degrees of freedom the reduced
@@ -40,6 +40,12 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
 
     ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
     :class:`spacar.TimeLimitError`.
+
+    ``recursive``: planar open trees of rigid bodies (rigid PLBEAMs joined by PLHINGEs whose
+    rotations are the degrees of freedom) integrate with the articulated-body algorithm in the
+    hinge angles instead of the constraint formulation (the same equations, several times
+    cheaper per right-hand side; the output times are solved by the general path). ``False``
+    always takes the general path. ``res.stats["recursive"]`` says which path ran.
 
     Returns :class:`spacar.Results` (with ``res.geometry`` for drawing). If the analysis fails
     midway, the :class:`spacar.SpacarError` raised carries the results up to the failure as
@@ -89,7 +95,8 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     restart = settings.restart == 1
     step = 0.0 if restart else model._continue_step
     try:
-        arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit)
+        arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit,
+                         recursive=bool(recursive))
     except SpacarError as err:
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):

@@ -17,6 +17,7 @@
 #include "spacar/linearize.hpp"
 #include "spacar/model.hpp"
 #include "spacar/system.hpp"
+#include "spacar/tree.hpp"
 
 namespace spacar {
 
@@ -32,6 +33,9 @@ struct RunOptions {
   double time_limit = 0.0;
   // Integration steps (accepted and rejected) over the whole block.
   long max_steps = Integrator::kMaxSteps;
+  // Planar trees of rigid bodies take the recursive (articulated-body) right-hand side
+  // (tree.hpp); false: always the general constraint formulation.
+  bool recursive = true;
 };
 
 // Tolerances below this (100 machine epsilons) cannot be met in double precision: EPSINT and
@@ -48,6 +52,7 @@ struct BlockResults {
   long rhs_evaluations = 0, steps = 0, accepted = 0, rejected = 0, newton_iterations = 0;
   double last_step = 0.0;
   double wall_time = 0.0;      // seconds spent in the block
+  bool recursive = false;      // the right-hand sides took the recursive path (tree.hpp)
   std::vector<std::string> warnings;
 };
 
@@ -81,6 +86,9 @@ class Simulation {
   void evaluate_state(double t, const Eigen::VectorXd& Y);
   // Right-hand side of the first-order system Y = (q, y, q̇).
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
+  // q̈ at (q, q̇) by the recursive path, its tree taken at the last solved state: false (qdd
+  // untouched) if the system is not a planar tree of rigid bodies or a body moves no mass.
+  bool recursive_accelerations(const double* q, const double* qd, Eigen::VectorXd& qdd);
 
   BlockResults run(const RunOptions& options = {});
   // The same, into `res`. If the run fails (an exception), `res` holds what was computed up to
@@ -125,6 +133,8 @@ class Simulation {
   Eigen::VectorXd predicted_;    // change of the positions predicted by the transfer function
   bool have_transfer_ = false;
   std::unique_ptr<Linearizer> linearizer_;
+  // The recursive right-hand side of planar rigid trees, set for a run (RunOptions::recursive).
+  std::unique_ptr<PlanarTree> tree_;
   // Message and time of the last right-hand side that failed in Newton, kept while the
   // integration has not passed that time: at a step-size collapse it says that the kinematics
   // has no solution ahead (formulation.md §2.2), whatever rejected the very last attempt.

@@ -1,0 +1,457 @@
+#include "spacar/tree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <string>
+
+#include "spacar/catalogue.hpp"
+
+namespace spacar {
+
+namespace {
+
+constexpr int kGround = -1;
+
+struct NodeInfo {
+  NodeKind kind = NodeKind::Any;
+  int coord = 0;       // first coordinate
+  bool fixed = true;   // every coordinate fixed
+  bool free = true;    // every coordinate calculable or dynamic (DYNX)
+};
+
+// Node numbers of an element's coordinates, in slot order.
+std::vector<int> element_nodes(const System& sys, const SystemElement& se) {
+  std::vector<int> nodes;
+  for (int g : se.coords) {
+    const int id = sys.coord_label[g][0];
+    if (nodes.empty() || nodes.back() != id) nodes.push_back(id);
+  }
+  return nodes;
+}
+
+// Rigid-motion row of a coordinate: its rate for the body twist (ω, vx, vy) at the pin, with
+// b the coordinate's point relative to the pin (world axes at the reference state).
+Eigen::RowVector3d rigid_row(NodeKind kind, int component, const Eigen::Vector2d& b) {
+  if (kind == NodeKind::Beta) return {1.0, 0.0, 0.0};
+  return component == 0 ? Eigen::RowVector3d(-b.y(), 1.0, 0.0) : Eigen::RowVector3d(b.x(), 0.0, 1.0);
+}
+
+}  // namespace
+
+// Recognizes the tree in a system and fills a PlanarTree, step by step; any step may find that
+// the system is not a planar rigid tree (false).
+class PlanarTree::Builder {
+ public:
+  Builder(const System& sys, const Data& data, PlanarTree& tree) : sys_(sys), x_(data.x), tree_(tree) {}
+
+  bool build() {
+    return supported_classes() && read_nodes() && read_elements() && group_bodies() && place_bodies() &&
+           attach_springs();
+  }
+
+ private:
+  struct Hinge {
+    int element, a, b;  // e = β_b − β_a
+    int dof;            // position in q, −1: a released hinge (a spring between two bodies)
+    bool used = false;
+  };
+
+  bool supported_classes() const {
+    return sys_.n_dof() > 0 && sys_.x_input.empty() && sys_.e_input.empty() && sys_.e_line.empty() &&
+           sys_.e_nonholonomic.empty() && sys_.e_kinematic.empty() && sys_.y_defs.empty() &&
+           sys_.auto_released.empty() && sys_.bodies.empty() && sys_.torquel.empty();
+  }
+
+  bool read_nodes() {
+    for (int g = 0; g < sys_.nx; ++g) {
+      const NodeKind kind = sys_.coord_node_kind[g];
+      const CoordClass c = sys_.coord_class[g];
+      if (kind != NodeKind::XY && kind != NodeKind::Beta) return false;
+      if (c == CoordClass::Dynamic && kind != NodeKind::Beta) return false;  // DYNX only on rotations
+      auto [it, fresh] = nodes_.try_emplace(sys_.coord_label[g][0]);
+      if (fresh) {
+        it->second.kind = kind;
+        it->second.coord = g;
+      }
+      it->second.fixed = it->second.fixed && c == CoordClass::Fixed;
+      it->second.free = it->second.free && (c == CoordClass::Calculable || c == CoordClass::Dynamic);
+    }
+    for (const auto& [id, n] : nodes_)
+      if (!n.fixed && !n.free) return false;  // partly fixed: neither a pin nor a body node
+    return true;
+  }
+
+  // Rigid beams, joined into bodies by shared BETA nodes (union-find), and hinges.
+  bool read_elements() {
+    for (size_t i = 0; i < sys_.elements.size(); ++i) {
+      const SystemElement& se = sys_.elements[i];
+      const std::string& name = element_catalogue()[se.type].name;
+      const std::vector<int> ids = element_nodes(sys_, se);
+      if (name == "PLBEAM" || name == "PLBEAMNL") {
+        if (!read_beam(static_cast<int>(i), se, ids)) return false;
+      } else if (name == "PLHINGE") {
+        const int k = se.def_offset;
+        if (sys_.def_class[k] == DefClass::Dynamic) {
+          const auto dof = std::find(sys_.e_dyn.begin(), sys_.e_dyn.end(), k) - sys_.e_dyn.begin();
+          hinges_.push_back({static_cast<int>(i), ids.front(), ids.back(), static_cast<int>(sys_.x_dyn.size() + dof)});
+        } else if (sys_.def_class[k] == DefClass::Released) {
+          hinges_.push_back({static_cast<int>(i), ids.front(), ids.back(), -1});
+        } else {
+          return false;
+        }
+      } else {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  bool read_beam(int i, const SystemElement& se, const std::vector<int>& ids) {
+    for (int a = 0; a < se.nd; ++a)
+      if (sys_.def_class[se.def_offset + a] != DefClass::Fixed) return false;
+    bool all_fixed = true, beta_fixed = false;
+    for (int id : ids) {
+      all_fixed = all_fixed && nodes_[id].fixed;
+      beta_fixed = beta_fixed || (nodes_[id].kind == NodeKind::Beta && nodes_[id].fixed);
+    }
+    if (all_fixed) return true;   // part of the ground
+    if (beta_fixed) return false;  // a fixed rotation with free points
+    int first = -1;
+    for (int id : ids) {
+      if (nodes_[id].kind != NodeKind::Beta) continue;
+      root_.try_emplace(id, id);
+      if (first < 0) first = id;
+      else root_[root(id)] = root(first);
+    }
+    beams_.push_back(i);
+    return true;
+  }
+
+  int root(int id) {
+    int a = id;
+    while (root_[a] != a) a = root_[a] = root_[root_[a]];
+    return a;
+  }
+
+  bool group_bodies() {
+    for (int i : beams_) {
+      const std::vector<int> ids = element_nodes(sys_, sys_.elements[i]);
+      int r = -1;
+      for (int id : ids)
+        if (nodes_[id].kind == NodeKind::Beta) r = root(id);
+      auto [it, fresh] = body_of_root_.try_emplace(r, static_cast<int>(xy_.size()));
+      if (fresh) {
+        xy_.emplace_back();
+        beta_.emplace_back();
+        beams_of_.emplace_back();
+      }
+      const int b = it->second;
+      beams_of_[b].push_back(i);
+      for (int id : ids) (nodes_[id].kind == NodeKind::Beta ? beta_[b] : xy_[b]).insert(id);
+    }
+    placed_.assign(xy_.size(), -1);
+    // Every free node moves with a body.
+    std::set<int> moving;
+    for (size_t b = 0; b < xy_.size(); ++b) {
+      moving.insert(xy_[b].begin(), xy_[b].end());
+      moving.insert(beta_[b].begin(), beta_[b].end());
+    }
+    for (const auto& [id, n] : nodes_)
+      if (!n.fixed && !moving.count(id)) return false;
+    for (const auto& [id, n] : nodes_)
+      if (n.kind == NodeKind::XY && n.fixed) owner_[id] = kGround;
+    return true;
+  }
+
+  int body_of_beta(int id) { return nodes_[id].fixed ? kGround : body_of_root_.at(root(id)); }
+  bool is_placed(int body) const { return body == kGround || placed_[body] >= 0; }
+  Eigen::Vector2d xy(int id) const { return {x_[nodes_.at(id).coord], x_[nodes_.at(id).coord + 1]}; }
+
+  // The DYNX rotation coordinate of a body, −1 if none (−2: more than one).
+  int dynamic_rotation(int body) const {
+    int found = -1;
+    for (int id : beta_[body])
+      if (sys_.coord_class[nodes_.at(id).coord] == CoordClass::Dynamic) found = found == -1 ? nodes_.at(id).coord : -2;
+    return found;
+  }
+
+  // The one XY node of the body on a placed body (or fixed): its pin, −1 if none, −2 if more.
+  int pin_of(int body) const {
+    int pin = -1;
+    for (int id : xy_[body])
+      if (owner_.count(id)) pin = pin == -1 ? id : -2;
+    return pin;
+  }
+
+  // From the ground outwards: a body joins at its pin, turned by the one DOF hinge to its
+  // parent or by its own DYNX rotation.
+  bool place_bodies() {
+    for (size_t done = 0; done < xy_.size();) {
+      bool progress = false;
+      for (Hinge& h : hinges_) {
+        if (h.used || h.dof < 0) continue;
+        const int ba = body_of_beta(h.a), bb = body_of_beta(h.b);
+        if (is_placed(ba) && is_placed(bb)) return false;  // a closed loop (or a hinge inside a body)
+        if (!is_placed(ba) && !is_placed(bb)) continue;
+        const bool forward = is_placed(ba);
+        const int body = forward ? bb : ba;
+        if (dynamic_rotation(body) != -1) return false;  // two DOFs for one rotation
+        const int parent_beta = forward ? h.a : h.b, own_beta = forward ? h.b : h.a;
+        Body bd;
+        bd.dof = h.dof;
+        bd.sign = forward ? 1.0 : -1.0;
+        bd.offset = x_[nodes_[parent_beta].coord] - x_[nodes_[own_beta].coord];
+        const SystemElement& se = sys_.elements[h.element];
+        if (se.has_constitutive) {
+          bd.stiffness = se.S(0, 0);
+          bd.damping = se.D(0, 0);
+        }
+        const int parent = forward ? ba : bb;
+        if (!place(body, parent == kGround ? kGround : placed_[parent], bd)) return false;
+        h.used = true;
+        ++done;
+        progress = true;
+      }
+      for (size_t b = 0; b < xy_.size(); ++b) {
+        const int coord = dynamic_rotation(static_cast<int>(b));
+        if (placed_[b] >= 0 || coord == -1) continue;
+        if (coord < 0) return false;
+        const int pin = pin_of(static_cast<int>(b));
+        if (pin == -1) continue;  // its parent is not placed yet
+        Body bd;
+        bd.absolute = true;
+        bd.dof = static_cast<int>(std::find(sys_.x_dyn.begin(), sys_.x_dyn.end(), coord) - sys_.x_dyn.begin());
+        bd.offset = x_[coord];
+        if (pin < 0 || !place(static_cast<int>(b), owner_[pin], bd)) return false;
+        ++done;
+        progress = true;
+      }
+      if (!progress) return false;  // bodies not connected to the ground
+    }
+    for (const Hinge& h : hinges_)
+      if (h.dof >= 0 && !h.used) return false;
+    return static_cast<int>(tree_.bodies_.size()) == sys_.n_dof();
+  }
+
+  // Adds the body to the tree under `parent` (index in bodies_ or kGround) with its joint `bd`:
+  // the pin, the inertia about it, the coordinates and loads moving with it.
+  bool place(int body, int parent, Body bd) {
+    const int pin = pin_of(body);
+    if (pin < 0 || owner_.at(pin) != parent) return false;  // no pin, two, or one on another body
+    const int index = static_cast<int>(tree_.bodies_.size());
+    placed_[body] = index;
+    const Eigen::Vector2d p0 = xy(pin);
+    bd.parent = parent;
+    bd.r = parent == kGround ? p0 : Eigen::Vector2d(p0 - pin0_[parent]);
+    for (int id : xy_[body])
+      if (id != pin) owner_[id] = index;
+    Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
+    for (int i : beams_of_[body]) I += element_inertia(sys_.elements[i], p0);
+    for (int id : xy_[body])
+      if (id != pin) follow(id, index, p0, I);
+    for (int id : beta_[body]) follow(id, index, p0, I);
+    // The projection is a rigid body's inertia only if the mass model moves rigidly with the
+    // nodes (equal masses in x and y, no coupling between them).
+    const double scale = I.cwiseAbs().maxCoeff();
+    if (std::abs(I(1, 1) - I(2, 2)) > 1e-12 * scale || std::abs(I(1, 2)) > 1e-12 * scale) return false;
+    bd.inertia = I;
+    tree_.bodies_.push_back(bd);
+    pin0_.push_back(p0);
+    return true;
+  }
+
+  // The element's mass matrix on the rigid motions about the pin p0: Tᵀ M T.
+  Eigen::Matrix3d element_inertia(const SystemElement& se, const Eigen::Vector2d& p0) {
+    if (!se.has_mass) return Eigen::Matrix3d::Zero();
+    const int n = static_cast<int>(se.coords.size());
+    Eigen::VectorXd xl(n), vl = Eigen::VectorXd::Zero(n), h(n);
+    Eigen::MatrixXd M(n, n), T(n, 3);
+    for (int a = 0; a < n; ++a) xl[a] = x_[se.coords[a]];
+    se.kernel->mass(xl.data(), vl.data(), M.data(), h.data());
+    for (int a = 0; a < n; ++a) {
+      const int g = se.coords[a];
+      const NodeInfo& node = nodes_[sys_.coord_label[g][0]];
+      const Eigen::Vector2d b = node.kind == NodeKind::XY ? Eigen::Vector2d(xy(sys_.coord_label[g][0]) - p0)
+                                                          : Eigen::Vector2d::Zero();
+      T.row(a) = rigid_row(node.kind, g - node.coord, b);
+    }
+    return T.transpose() * M * T;
+  }
+
+  // A node moving with body `index`: its point mass into I, its loads, its coordinates.
+  void follow(int id, int index, const Eigen::Vector2d& p0, Eigen::Matrix3d& I) {
+    const NodeInfo& n = nodes_[id];
+    const bool point = n.kind == NodeKind::XY;
+    const Eigen::Vector2d b = point ? Eigen::Vector2d(xy(id) - p0) : Eigen::Vector2d::Zero();
+    for (int c = 0; c < (point ? 2 : 1); ++c) {
+      const int g = n.coord + c;
+      const Eigen::RowVector3d row = rigid_row(n.kind, c, b);
+      I += sys_.point_mass[g] * row.transpose() * row;
+      if (sys_.force[g] != 0.0) tree_.loads_.push_back({index, point ? c : 2, b, sys_.force[g]});
+    }
+    tree_.followers_.push_back({n.coord, index, point ? 0 : 2, b, x_[n.coord]});
+  }
+
+  // Released hinges: springs and dampers between two bodies (or a body and the ground).
+  bool attach_springs() {
+    for (const Hinge& h : hinges_) {
+      if (h.dof >= 0) continue;
+      const SystemElement& se = sys_.elements[h.element];
+      if (!se.has_constitutive) continue;  // a released hinge without stiffness only measures
+      Spring s;
+      auto end = [&](int id, int& body, double& beta0) {
+        const int b = body_of_beta(id);
+        body = b == kGround ? kGround : placed_[b];
+        beta0 = x_[nodes_[id].coord];
+      };
+      end(h.a, s.body_a, s.beta0_a);
+      end(h.b, s.body_b, s.beta0_b);
+      s.stiffness = se.S(0, 0);
+      s.damping = se.D(0, 0);
+      tree_.springs_.push_back(s);
+    }
+    return true;
+  }
+
+  const System& sys_;
+  const Eigen::VectorXd& x_;
+  PlanarTree& tree_;
+  std::map<int, NodeInfo> nodes_;
+  std::vector<int> beams_;
+  std::vector<Hinge> hinges_;
+  std::map<int, int> root_;            // union-find over the BETA nodes of beams
+  std::map<int, int> body_of_root_;
+  std::vector<std::set<int>> xy_, beta_;  // nodes of each body
+  std::vector<std::vector<int>> beams_of_;
+  std::vector<int> placed_;            // body → index in bodies_, −1: not yet
+  std::map<int, int> owner_;           // XY node → body (index in bodies_) it moves with, kGround
+  std::vector<Eigen::Vector2d> pin0_;  // reference pin of each placed body
+};
+
+std::unique_ptr<PlanarTree> PlanarTree::detect(const System& sys, const Data& data) {
+  auto tree = std::unique_ptr<PlanarTree>(new PlanarTree());
+  if (!Builder(sys, data, *tree).build()) return nullptr;
+  tree->base_acceleration_ = Vec3(0.0, -sys.gravity[0], -sys.gravity[1]);
+  return tree;
+}
+
+PlanarTree::Vec3 PlanarTree::to_child(const Body& bd, const Vec3& m) {
+  const double c = bd.c, s = bd.s, rx = bd.r.x(), ry = bd.r.y();
+  return {m[0], (s * rx - c * ry) * m[0] + c * m[1] + s * m[2], (c * rx + s * ry) * m[0] - s * m[1] + c * m[2]};
+}
+
+PlanarTree::Vec3 PlanarTree::to_parent(const Body& bd, const Vec3& f) {
+  const double c = bd.c, s = bd.s, rx = bd.r.x(), ry = bd.r.y();
+  return {f[0] + (s * rx - c * ry) * f[1] + (c * rx + s * ry) * f[2], c * f[1] - s * f[2], s * f[1] + c * f[2]};
+}
+
+PlanarTree::Mat3 PlanarTree::inertia_to_parent(const Body& bd, const Mat3& I) {
+  const double c = bd.c, s = bd.s, rx = bd.r.x(), ry = bd.r.y();
+  Mat3 X;
+  X << 1.0, 0.0, 0.0, s * rx - c * ry, c, s, c * rx + s * ry, -s, c;
+  return X.transpose() * I * X;
+}
+
+bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
+                       Eigen::VectorXd& xdd, double* qdd) {
+  // Outwards: rotations, pins, velocities, velocity-product accelerations and bias forces.
+  for (Body& bd : bodies_) {
+    const Body* p = bd.parent == kGround ? nullptr : &bodies_[bd.parent];
+    double theta;  // rotation relative to the parent
+    if (bd.absolute) {  // q is the rotation of a BETA node of the body
+      theta = q[bd.dof] - bd.offset - (p ? p->phi : 0.0);
+      bd.ud = qd[bd.dof] - (p ? p->v[0] : 0.0);
+      bd.tau = 0.0;
+    } else {  // q is the hinge's rotation; its stress acts on the joint as τ_q = −σ
+      theta = bd.sign * q[bd.dof] + bd.offset;
+      bd.ud = bd.sign * qd[bd.dof];
+      bd.tau = -bd.sign * (bd.stiffness * q[bd.dof] + bd.damping * qd[bd.dof]);
+    }
+    bd.c = std::cos(theta);
+    bd.s = std::sin(theta);
+    Vec3 v(bd.ud, 0.0, 0.0);
+    if (bd.parent == kGround) {
+      bd.phi = theta;
+      bd.cw = bd.c;
+      bd.sw = bd.s;
+      bd.pin = bd.r;
+    } else {
+      bd.phi = p->phi + theta;
+      bd.cw = p->cw * bd.c - p->sw * bd.s;
+      bd.sw = p->sw * bd.c + p->cw * bd.s;
+      bd.pin = p->pin + Eigen::Vector2d(p->cw * bd.r.x() - p->sw * bd.r.y(), p->sw * bd.r.x() + p->cw * bd.r.y());
+      v += to_child(bd, p->v);
+    }
+    bd.v = v;
+    bd.bias = Vec3(0.0, bd.ud * v[2], -bd.ud * v[1]);  // v ×ₘ S u̇
+    bd.IA = bd.inertia;
+    const Vec3 Iv = bd.inertia * v;
+    bd.pA = Vec3(-v[2] * Iv[1] + v[1] * Iv[2], -v[0] * Iv[2], v[0] * Iv[1]);  // v ×* I v
+  }
+  for (const Spring& sp : springs_) {  // released hinges: torque −σ on node b's body, +σ on a's
+    auto angle = [&](int b, double beta0) { return beta0 + (b == kGround ? 0.0 : bodies_[b].phi); };
+    auto rate = [&](int b) { return b == kGround ? 0.0 : bodies_[b].v[0]; };
+    const double sigma = sp.stiffness * (angle(sp.body_b, sp.beta0_b) - angle(sp.body_a, sp.beta0_a)) +
+                         sp.damping * (rate(sp.body_b) - rate(sp.body_a));
+    if (sp.body_b != kGround) bodies_[sp.body_b].pA[0] += sigma;
+    if (sp.body_a != kGround) bodies_[sp.body_a].pA[0] -= sigma;
+  }
+  for (const Load& l : loads_) {
+    Body& bd = bodies_[l.body];
+    if (l.component == 2) {
+      bd.pA[0] -= l.value;
+      continue;
+    }
+    const double fx = l.component == 0 ? l.value : 0.0, fy = l.component == 1 ? l.value : 0.0;
+    const double bx = bd.cw * fx + bd.sw * fy, by = -bd.sw * fx + bd.cw * fy;  // in body coordinates
+    bd.pA -= Vec3(l.b.x() * by - l.b.y() * bx, bx, by);
+  }
+  // Inwards: articulated inertias and bias forces.
+  for (int i = static_cast<int>(bodies_.size()) - 1; i >= 0; --i) {
+    Body& bd = bodies_[i];
+    bd.U = bd.IA.col(0);
+    bd.d = bd.U[0];
+    if (!(bd.d > 0.0) || !std::isfinite(bd.d)) return false;
+    bd.u = bd.tau - bd.pA[0];  // the joint force left for the joint acceleration
+    if (bd.parent == kGround) continue;
+    const Mat3 Ia = bd.IA - bd.U * bd.U.transpose() / bd.d;
+    const Vec3 pa = bd.pA + Ia * bd.bias + bd.U * (bd.u / bd.d);
+    Body& p = bodies_[bd.parent];
+    p.IA += inertia_to_parent(bd, Ia);
+    p.pA += to_parent(bd, pa);
+  }
+  // Outwards: accelerations (relative to the fictitious upward acceleration of the ground).
+  for (Body& bd : bodies_) {
+    Vec3 a = to_child(bd, bd.parent == kGround ? base_acceleration_ : bodies_[bd.parent].a) + bd.bias;
+    const double udd = (bd.u - bd.U.dot(a)) / bd.d;
+    a[0] += udd;
+    bd.a = a;
+    qdd[bd.dof] = bd.absolute ? a[0] : bd.sign * udd;
+  }
+  // The coordinates moving with the bodies.
+  const double gx = -base_acceleration_[1], gy = -base_acceleration_[2];
+  for (const Follower& f : followers_) {
+    const Body& bd = bodies_[f.body];
+    const double w = bd.v[0], wd = bd.a[0];
+    if (f.component == 2) {
+      x[f.coord] = f.value0 + bd.phi;
+      xd[f.coord] = w;
+      xdd[f.coord] = wd;
+      continue;
+    }
+    const double bx = f.b.x(), by = f.b.y();
+    const double vx = bd.v[1] - w * by, vy = bd.v[2] + w * bx;
+    const double ax = bd.a[1] - wd * by - w * vy, ay = bd.a[2] + wd * bx + w * vx;
+    x[f.coord] = bd.pin.x() + bd.cw * bx - bd.sw * by;
+    x[f.coord + 1] = bd.pin.y() + bd.sw * bx + bd.cw * by;
+    xd[f.coord] = bd.cw * vx - bd.sw * vy;
+    xd[f.coord + 1] = bd.sw * vx + bd.cw * vy;
+    xdd[f.coord] = bd.cw * ax - bd.sw * ay + gx;
+    xdd[f.coord + 1] = bd.sw * ax + bd.cw * ay + gy;
+  }
+  return true;
+}
+
+}  // namespace spacar

@@ -1,0 +1,149 @@
+"""The recursive path of planar rigid trees (cpp/include/spacar/tree.hpp, formulation.md §5.4).
+
+Its accelerations are checked against the constraint formulation's sparse solve at random states
+(the two share no code beyond the element mass matrices) and against Pinocchio's ABA; runs on
+both paths give the same motion and output; every model that is not a planar tree of rigid bodies
+takes the general path. The pendulum periods of test_planar_dynamics.py (elliptic integrals) and
+the chain trajectories of test_compare.py (exudyn, Pinocchio) run on this path as well.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import spacar
+from spacar import _core
+from spacar.compare import models
+
+G = 9.81
+
+
+def branched_tree(spring=False):
+    """A trunk hinged to the ground, two branches hinged at its tip (one hinge points from the
+    child to the parent), one branch two beams rigidly joined at a shared BETA node; masses on XY
+    and BETA nodes, FORCE on points and a rotation, a hinge spring-damper, gravity with an x
+    component; ``spring``: a released hinge with stiffness and damping between the branches."""
+    m = spacar.Model()
+    for node, xy in {1: (0, 0), 2: (1, 0.2), 3: (1.8, 0.9), 4: (1.6, -0.7), 5: (2.4, -0.5)}.items():
+        m.x(node, *xy)
+    m.plbeam(1, 1, 11, 2, 12)
+    m.plbeam(2, 2, 21, 3, 22)
+    m.plbeam(3, 2, 31, 4, 32)
+    m.plbeam(4, 4, 32, 5, 42)
+    m.plhinge(101, 100, 11)
+    m.plhinge(102, 12, 21)
+    m.plhinge(103, 31, 12)
+    for h in (101, 102, 103):
+        m.dyne(h, 1)
+    m.fix(1)
+    m.fix(100)
+    for e, rho in ((1, 1.0), (2, 0.7), (3, 1.3), (4, 0.4)):
+        m.emass(e, rho)
+    m.mass(3, 0.2)
+    m.mass(5, 0.1)
+    m.mass(21, 0.05)
+    m.force(3, 0.5, -0.2)
+    m.force(5, 0.0, 1.0)
+    m.force(31, 0.3)
+    m.estiff(103, 2.0)
+    m.edampp(103, 0.1)
+    if spring:
+        m.plhinge(104, 22, 42)
+        m.rlse(104, 1)
+        m.estiff(104, 1.5)
+        m.edampp(104, 0.3)
+    m.gravity(1.0, -G)
+    m.epsint(1e-10)
+    m.epsind(1e-10)
+    m.epskin(1e-12)
+    m.timestep(4, 0.4)
+    return m
+
+
+TREES = {
+    "chain": lambda: models.planar_chain(6, rho_a=1.5, tip_mass=0.3, joint_inertia=0.02, angle=0.3),
+    "chain springs": lambda: models.planar_chain(4, stiffness=3.0, damping=0.2, ground_angle=0.3, angle=-0.2),
+    "chain absolute": lambda: models.planar_chain(5, dof="absolute", angle=0.3),
+    "chain absolute springs": lambda: models.planar_chain(5, dof="absolute", stiffness=3.0, damping=0.2),
+    "branched": branched_tree,
+    "branched spring": lambda: branched_tree(spring=True),
+}
+
+
+def assembled(model):
+    model.prepare()
+    sim = _core.Simulation(model._core)
+    sim.assemble()
+    return sim
+
+
+@pytest.mark.parametrize("name", list(TREES))
+def test_recursive_accelerations_equal_the_constraint_formulation(name):
+    sim = assembled(TREES[name]())
+    rng = np.random.default_rng(7)
+    q0 = np.array(sim.system.q0)
+    for _ in range(5):
+        q = q0 + rng.uniform(-0.6, 0.6, q0.size)
+        qd = rng.uniform(-2.0, 2.0, q0.size)
+        sim.solve_state(0.0, q, qd)  # the sparse solve of the constraint formulation
+        expected = np.array(sim.data.qdd)
+        got = sim.recursive_accelerations(q, qd)
+        assert got is not None
+        np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max()))
+
+
+def test_recursive_accelerations_equal_pinocchio_aba():
+    pytest.importorskip("pinocchio")
+    from spacar.compare import pinocchio as sp
+
+    model = models.planar_chain(8, rho_a=1.2, tip_mass=0.1, joint_inertia=0.01, angle=0.2)
+    pm = sp.build(model.copy())
+    sim = assembled(model)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q = rng.uniform(-1.0, 1.0, 8)
+        qd = rng.uniform(-2.0, 2.0, 8)
+        aba = sp.pin.aba(pm.model, pm.data, q, qd, np.zeros(8))
+        np.testing.assert_allclose(sim.recursive_accelerations(q, qd), aba, rtol=0, atol=1e-11 * np.abs(aba).max())
+
+
+@pytest.mark.parametrize("name", ["chain springs", "chain absolute springs", "branched spring"])
+def test_runs_on_both_paths_agree(name):
+    model = TREES[name]()
+    model.forcemode(1)
+    model.epsint(1e-10)
+    model.epsind(1e-10)
+    model.timestep(3, 0.3)
+    fast = spacar.simulate(model.copy())
+    general = spacar.simulate(model.copy(), recursive=False)
+    assert fast.stats["recursive"] and not general.stats["recursive"]
+    assert fast.stats["newton_iterations"] < general.stats["newton_iterations"]
+    for field in ("x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction"):
+        a, b = getattr(fast, field), getattr(general, field)
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-7 * max(1.0, np.abs(b).max()), err_msg=field)
+
+
+NOT_TREES = {
+    "four-bar (closed loop)": lambda: models.four_bar(),
+    "flexible links": lambda: models.cantilever(3),
+    "input-driven slider-crank": lambda: models.slider_crank(n_rod=2, t_end=0.01, n_out=1),
+}
+
+
+@pytest.mark.parametrize("name", list(NOT_TREES))
+def test_other_models_take_the_general_path(name):
+    model = NOT_TREES[name]()
+    sim = assembled(model.copy())
+    q0 = np.array(sim.system.q0)
+    if q0.size:
+        assert sim.recursive_accelerations(q0, np.zeros(q0.size)) is None
+    model.timestep(1, 1e-3)
+    assert not spacar.simulate(model).stats["recursive"]
+
+
+def test_a_body_without_mass_is_named_by_the_general_path():
+    model = models.planar_chain(2, rho_a=0.0, tip_mass=0.0)
+    sim = assembled(model.copy())
+    assert sim.recursive_accelerations(np.zeros(2), np.zeros(2)) is None
+    with pytest.raises(spacar.SingularMassError, match="move no mass"):
+        spacar.simulate(model)
