@@ -94,6 +94,14 @@ bool SparseLU::factorize_pivoting(const Eigen::SparseMatrix<double>& A, const st
   Ui_.clear();
   Ux_.clear();
   Uinv_.clear();
+  // Room for the factors of a modest fill (twice A's nonzeros each), so that they do not grow
+  // entry by entry in the first factorization.
+  const size_t room = 2 * static_cast<size_t>(A.nonZeros());
+  for (auto* v : {&Li_, &Ui_}) v->reserve(room);
+  for (auto* v : {&Lx_, &Ux_}) v->reserve(room);
+  Lp_.reserve(n_ + 1);
+  Up_.reserve(n_ + 1);
+  Uinv_.reserve(n_);
   std::fill(w_.begin(), w_.end(), 0.0);
   for (int k = 0; k < n_; ++k) {
     const int col = q_[k];
