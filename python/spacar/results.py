@@ -119,8 +119,8 @@ class Results:
         self.reaction = arrays["reaction"]
         self.linearizations = list(linearizations)  # one spacar.Linearization per output time
         self.settings_linear = settings_linear
-        self.coordinate_labels = [tuple(int(v) for v in lbl) for lbl in coordinate_labels]
-        self.deformation_labels = [tuple(int(v) for v in lbl) for lbl in deformation_labels]
+        self.coordinate_labels = [(int(n), int(c)) for n, c in coordinate_labels]
+        self.deformation_labels = [(int(n), int(k)) for n, k in deformation_labels]
         self.stats = dict(stats)
         self.geometry = geometry
         self._coord = {lbl: i for i, lbl in enumerate(self.coordinate_labels)}
