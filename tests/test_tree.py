@@ -78,18 +78,21 @@ def assembled(model):
 
 
 @pytest.mark.parametrize("name", list(TREES))
-def test_recursive_accelerations_equal_the_constraint_formulation(name):
+def test_recursive_state_equals_the_constraint_formulation(name):
     sim = assembled(TREES[name]())
     rng = np.random.default_rng(7)
     q0 = np.array(sim.system.q0)
     for _ in range(5):
         q = q0 + rng.uniform(-0.6, 0.6, q0.size)
         qd = rng.uniform(-2.0, 2.0, q0.size)
-        sim.solve_state(0.0, q, qd)  # the sparse solve of the constraint formulation
-        expected = np.array(sim.data.qdd)
-        got = sim.recursive_accelerations(q, qd)
+        sim.solve_state(0.0, q, qd)  # Newton and the sparse solve of the constraint formulation
+        got = sim.recursive_state(q, qd)
         assert got is not None
-        np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max()))
+        d = sim.data
+        for key, expected, tol in (("qdd", d.qdd, 1e-12), ("x", d.x, 1e-9), ("xd", d.xd, 1e-9), ("xdd", d.xdd, 1e-9)):
+            expected = np.array(expected)
+            np.testing.assert_allclose(got[key], expected, rtol=0, atol=tol * max(1.0, np.abs(expected).max()),
+                                       err_msg=key)
 
 
 def test_recursive_accelerations_equal_pinocchio_aba():
@@ -104,7 +107,7 @@ def test_recursive_accelerations_equal_pinocchio_aba():
         q = rng.uniform(-1.0, 1.0, 8)
         qd = rng.uniform(-2.0, 2.0, 8)
         aba = sp.pin.aba(pm.model, pm.data, q, qd, np.zeros(8))
-        np.testing.assert_allclose(sim.recursive_accelerations(q, qd), aba, rtol=0, atol=1e-11 * np.abs(aba).max())
+        np.testing.assert_allclose(sim.recursive_state(q, qd)["qdd"], aba, rtol=0, atol=1e-11 * np.abs(aba).max())
 
 
 @pytest.mark.parametrize("name", ["chain springs", "chain absolute springs", "branched spring"])
@@ -136,7 +139,7 @@ def test_other_models_take_the_general_path(name):
     sim = assembled(model.copy())
     q0 = np.array(sim.system.q0)
     if q0.size:
-        assert sim.recursive_accelerations(q0, np.zeros(q0.size)) is None
+        assert sim.recursive_state(q0, np.zeros(q0.size)) is None
     model.timestep(1, 1e-3)
     assert not spacar.simulate(model).stats["recursive"]
 
@@ -144,6 +147,6 @@ def test_other_models_take_the_general_path(name):
 def test_a_body_without_mass_is_named_by_the_general_path():
     model = models.planar_chain(2, rho_a=0.0, tip_mass=0.0)
     sim = assembled(model.copy())
-    assert sim.recursive_accelerations(np.zeros(2), np.zeros(2)) is None
+    assert sim.recursive_state(np.zeros(2), np.zeros(2)) is None
     with pytest.raises(spacar.SingularMassError, match="move no mass"):
         spacar.simulate(model)

@@ -534,15 +534,21 @@ void bind_simulation(py::module_& m) {
                throw InputError("solve_state(): q and qd must have one value per degree of freedom");
              s.solve_state(t, q.data(), qd.data());
            })
-      .def("recursive_accelerations",
+      .def("recursive_state",
            [](Simulation& s, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) -> py::object {
-             // q̈ by the recursive path of planar rigid trees (None for other systems), with the
-             // tree taken at the last solved state: a check of it against solve_state().
+             // The recursive path of planar rigid trees at (q, q̇), its tree taken at the last
+             // solved state: a dict of qdd, x, xd, xdd (None for other systems); a check of it
+             // against solve_state().
              if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
-               throw InputError("recursive_accelerations(): q and qd must have one value per degree of freedom");
-             Eigen::VectorXd qdd;
-             if (!s.recursive_accelerations(q.data(), qd.data(), qdd)) return py::none();
-             return py::cast(qdd);
+               throw InputError("recursive_state(): q and qd must have one value per degree of freedom");
+             Eigen::VectorXd qdd, x, xd, xdd;
+             if (!s.recursive_state(q.data(), qd.data(), qdd, x, xd, xdd)) return py::none();
+             py::dict out;
+             out["qdd"] = qdd;
+             out["x"] = x;
+             out["xd"] = xd;
+             out["xdd"] = xdd;
+             return out;
            })
       .def("move_to",
            [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {

@@ -263,12 +263,16 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   dY.tail(nd) = data_->qdd;
 }
 
-bool Simulation::recursive_accelerations(const double* q, const double* qd, Eigen::VectorXd& qdd) {
+bool Simulation::recursive_state(const double* q, const double* qd, Eigen::VectorXd& qdd, Eigen::VectorXd& x,
+                                 Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
   std::unique_ptr<PlanarTree> tree = PlanarTree::detect(*sys_, *data_);
   if (!tree) return false;
-  Eigen::VectorXd x = data_->x, xd = data_->xd, xdd = data_->xdd, out(sys_->n_dof());
-  if (!tree->solve(q, qd, x, xd, xdd, out.data())) return false;
-  qdd = out;
+  Eigen::VectorXd x1 = data_->x, xd1 = Eigen::VectorXd::Zero(sys_->nx), xdd1 = xd1, qdd1(sys_->n_dof());
+  if (!tree->solve(q, qd, x1, xd1, xdd1, qdd1.data())) return false;
+  qdd = qdd1;
+  x = x1;
+  xd = xd1;
+  xdd = xdd1;
   return true;
 }
 

@@ -356,7 +356,17 @@ PlanarTree::Mat3 PlanarTree::inertia_to_parent(const Body& bd, const Mat3& I) {
 
 bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
                        Eigen::VectorXd& xdd, double* qdd) {
-  // Outwards: rotations, pins, velocities, velocity-product accelerations and bias forces.
+  velocities(q, qd);
+  applied_loads();
+  if (!articulate()) return false;
+  accelerations(qdd);
+  move_coordinates(x, xd, xdd);
+  return true;
+}
+
+// Outwards: rotations, pins, velocities, velocity-product accelerations and the bias forces of
+// the bodies' inertia, with the joint torques.
+void PlanarTree::velocities(const double* q, const double* qd) {
   for (Body& bd : bodies_) {
     const Body* p = bd.parent == kGround ? nullptr : &bodies_[bd.parent];
     double theta;  // rotation relative to the parent
@@ -372,7 +382,7 @@ bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Ei
     bd.c = std::cos(theta);
     bd.s = std::sin(theta);
     Vec3 v(bd.ud, 0.0, 0.0);
-    if (bd.parent == kGround) {
+    if (!p) {
       bd.phi = theta;
       bd.cw = bd.c;
       bd.sw = bd.s;
@@ -390,7 +400,11 @@ bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Ei
     const Vec3 Iv = bd.inertia * v;
     bd.pA = Vec3(-v[2] * Iv[1] + v[1] * Iv[2], -v[0] * Iv[2], v[0] * Iv[1]);  // v ×* I v
   }
-  for (const Spring& sp : springs_) {  // released hinges: torque −σ on node b's body, +σ on a's
+}
+
+// Springs of released hinges and FORCE, subtracted from the bias forces.
+void PlanarTree::applied_loads() {
+  for (const Spring& sp : springs_) {  // torque −σ on node b's body, +σ on node a's
     auto angle = [&](int b, double beta0) { return beta0 + (b == kGround ? 0.0 : bodies_[b].phi); };
     auto rate = [&](int b) { return b == kGround ? 0.0 : bodies_[b].v[0]; };
     const double sigma = sp.stiffness * (angle(sp.body_b, sp.beta0_b) - angle(sp.body_a, sp.beta0_a)) +
@@ -408,7 +422,11 @@ bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Ei
     const double bx = bd.cw * fx + bd.sw * fy, by = -bd.sw * fx + bd.cw * fy;  // in body coordinates
     bd.pA -= Vec3(l.b.x() * by - l.b.y() * bx, bx, by);
   }
-  // Inwards: articulated inertias and bias forces.
+}
+
+// Inwards: articulated inertias and bias forces; false if a joint's articulated inertia is not
+// positive.
+bool PlanarTree::articulate() {
   for (int i = static_cast<int>(bodies_.size()) - 1; i >= 0; --i) {
     Body& bd = bodies_[i];
     bd.U = bd.IA.col(0);
@@ -422,7 +440,12 @@ bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Ei
     p.IA += inertia_to_parent(bd, Ia);
     p.pA += to_parent(bd, pa);
   }
-  // Outwards: accelerations (relative to the fictitious upward acceleration of the ground).
+  return true;
+}
+
+// Outwards: joint and body accelerations (relative to the fictitious upward acceleration of the
+// ground), q̈.
+void PlanarTree::accelerations(double* qdd) {
   for (Body& bd : bodies_) {
     Vec3 a = to_child(bd, bd.parent == kGround ? base_acceleration_ : bodies_[bd.parent].a) + bd.bias;
     const double udd = (bd.u - bd.U.dot(a)) / bd.d;
@@ -430,7 +453,10 @@ bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Ei
     bd.a = a;
     qdd[bd.dof] = bd.absolute ? a[0] : bd.sign * udd;
   }
-  // The coordinates moving with the bodies.
+}
+
+// Positions, velocities and accelerations of the coordinates moving with the bodies.
+void PlanarTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const {
   const double gx = -base_acceleration_[1], gy = -base_acceleration_[2];
   for (const Follower& f : followers_) {
     const Body& bd = bodies_[f.body];
@@ -442,7 +468,7 @@ bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Ei
       continue;
     }
     const double bx = f.b.x(), by = f.b.y();
-    const double vx = bd.v[1] - w * by, vy = bd.v[2] + w * bx;
+    const double vx = bd.v[1] - w * by, vy = bd.v[2] + w * bx;  // of the point, in body axes
     const double ax = bd.a[1] - wd * by - w * vy, ay = bd.a[2] + wd * bx + w * vx;
     x[f.coord] = bd.pin.x() + bd.cw * bx - bd.sw * by;
     x[f.coord + 1] = bd.pin.y() + bd.sw * bx + bd.cw * by;
@@ -451,7 +477,6 @@ bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Ei
     xdd[f.coord] = bd.cw * ax - bd.sw * ay + gx;
     xdd[f.coord + 1] = bd.sw * ax + bd.cw * ay + gy;
   }
-  return true;
 }
 
 }  // namespace spacar

@@ -86,9 +86,11 @@ class Simulation {
   void evaluate_state(double t, const Eigen::VectorXd& Y);
   // Right-hand side of the first-order system Y = (q, y, q̇).
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
-  // q̈ at (q, q̇) by the recursive path, its tree taken at the last solved state: false (qdd
-  // untouched) if the system is not a planar tree of rigid bodies or a body moves no mass.
-  bool recursive_accelerations(const double* q, const double* qd, Eigen::VectorXd& qdd);
+  // The state at (q, q̇) by the recursive path, its tree taken at the last solved state: q̈ and
+  // the coordinates' positions, velocities and accelerations; false (nothing written) if the
+  // system is not a planar tree of rigid bodies or a body moves no mass.
+  bool recursive_state(const double* q, const double* qd, Eigen::VectorXd& qdd, Eigen::VectorXd& x,
+                       Eigen::VectorXd& xd, Eigen::VectorXd& xdd);
 
   BlockResults run(const RunOptions& options = {});
   // The same, into `res`. If the run fails (an exception), `res` holds what was computed up to

@@ -84,6 +84,13 @@ class PlanarTree {
   };
   class Builder;
 
+  // The phases of solve().
+  void velocities(const double* q, const double* qd);
+  void applied_loads();
+  bool articulate();
+  void accelerations(double* qdd);
+  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const;
+
   // Transform of motion vectors from the parent's coordinates to the body's.
   static Vec3 to_child(const Body& bd, const Vec3& m);
   // Transform of force vectors from the body's coordinates to the parent's (the transpose).
