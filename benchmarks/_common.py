@@ -113,15 +113,15 @@ def best_time(fn, repeat: int = 3, budget: float = 5.0):
     return best, value
 
 
-def simulate_best(model, repeat: int = 3, budget: float = 2.0):
+def simulate_best(model, repeat: int = 3, budget: float = 2.0, recursive: bool = True):
     """Best wall time of ``spacar.simulate`` over up to ``repeat`` runs, each on a fresh copy of
     the model (copied outside the timing), stopping once ``budget`` seconds are spent; returns
-    (results of the last run, seconds)."""
+    (results of the last run, seconds). ``recursive=False``: the general path only."""
     best, res, spent = float("inf"), None, 0.0
     for _ in range(repeat):
         m = model.copy()
         start = time.perf_counter()
-        res = spacar.simulate(m)
+        res = spacar.simulate(m, recursive=recursive)
         wall = time.perf_counter() - start
         best, spent = min(best, wall), spent + wall
         if spent > budget:
@@ -129,16 +129,17 @@ def simulate_best(model, repeat: int = 3, budget: float = 2.0):
     return res, best
 
 
-def in_run_per_rhs(model, min_time: float = 0.5, min_runs: int = 3):
+def in_run_per_rhs(model, min_time: float = 0.5, min_runs: int = 3, recursive: bool = True):
     """Seconds per right-hand side inside a run of ``spacar.simulate``: the best block wall time
     (``stats["wall_time"]``, the C++ integration loop) over runs repeated for at least
     ``min_time`` seconds, divided by the run's right-hand sides (the same in every run); with
-    the statistics of the last run. The protocol of :func:`per_call` for the peers' calls."""
+    the statistics of the last run. The protocol of :func:`per_call` for the peers' calls.
+    ``recursive=False``: the general path only."""
     best, spent, runs, stats = float("inf"), 0.0, 0, None
     while runs < min_runs or spent < min_time:
         m = model.copy()
         start = time.perf_counter()
-        stats = spacar.simulate(m).stats
+        stats = spacar.simulate(m, recursive=recursive).stats
         spent += time.perf_counter() - start
         runs += 1
         best = min(best, stats["wall_time"])

@@ -6,12 +6,15 @@ length 1 m), PLHINGE joints whose angles are the DOFs, released from rest horizo
 gravity, simulated over T = 0.3 s.
 
 * time per right-hand side: spacar — block wall time / right-hand-side evaluations of a run
-  (EPSINT = 1e-6), and ``Simulation.evaluate`` called from Python; Pinocchio — ``aba`` called
+  (EPSINT = 1e-6) on its default recursive path (a planar tree of rigid bodies: the
+  articulated-body algorithm, cpp/include/spacar/tree.hpp) and on the general path
+  (``recursive=False``: the sparse constraint formulation every other model takes), and
+  ``Simulation.evaluate`` called from Python; Pinocchio — ``aba`` called
   from Python; exudyn — kinematic tree (``ObjectKinematicTree``) with fixed-step RK44, wall
   time / (4 · steps);
 * time-to-accuracy: every program at a range of tolerances (steps); error = largest joint-angle
   error at T against a reference (Pinocchio's ABA integrated by DOP853 at rtol 1e-13); the
-  time to reach an error is the shortest run that reached it. Peers: exudyn's kinematic tree
+  time to reach an error is the shortest run that reached it. spacar on both paths. Peers: exudyn's kinematic tree
   with its error-controlled DOPRI5, exudyn's redundant coordinates with generalized-α (its
   default), Pinocchio's ABA with spacar's C++ DOP853 (right-hand side called into Python);
 * growth of the cost per right-hand side with N: log-log fit for N ≥ 10.
@@ -54,10 +57,10 @@ def hinge_columns(labels, n):
     return [labels.index((models.HINGE + i, 1)) for i in range(1, n + 1)]
 
 
-def run_spacar(n, t_end, eps, repeat=3):
+def run_spacar(n, t_end, eps, repeat=3, recursive=True):
     """Best wall time of ``spacar.simulate`` over up to ``repeat`` runs (each on a fresh copy of
     the model, built outside the timing); joint angles at T and the run's statistics."""
-    res, best = C.simulate_best(chain(n, t_end, eps), repeat)
+    res, best = C.simulate_best(chain(n, t_end, eps), repeat, recursive=recursive)
     q = res.e[-1, hinge_columns(res.deformation_labels, n)]
     return q, best, res.stats
 
@@ -79,6 +82,8 @@ def per_rhs(n, t_end, quick):
     qd0 = np.full(q0.size, 0.3)
     t_eval = C.per_call(lambda: sim.evaluate(0.0, q0, qd0), min_time=0.1 if quick else 0.5)
     t_run, run_stats = C.in_run_per_rhs(chain(n, t_end, 1e-6), min_time=0.1 if quick else 0.5)
+    t_general, general_stats = C.in_run_per_rhs(chain(n, t_end, 1e-6), min_time=0.1 if quick else 0.5,
+                                                recursive=False)
     pm = sp.build(chain(n, 1.0))
     tau = np.zeros(n)
     aba = sp.pin.aba
@@ -92,8 +97,8 @@ def per_rhs(n, t_end, quick):
     st = em.settings(0.0, steps * h, "rk44", None, None, h)
     wall, _ = C.best_time(lambda: em.mbs.SolveDynamic(st, solverType=exu.DynamicSolverType.RK44), repeat=3)
     t_exu = wall / (4 * steps)
-    return {"spacar_in_run": t_run,
-            "spacar_newton_per_rhs": run_stats["newton_iterations"] / run_stats["rhs_evaluations"],
+    return {"spacar_in_run": t_run, "spacar_recursive": run_stats["recursive"], "spacar_general_in_run": t_general,
+            "spacar_newton_per_rhs": general_stats["newton_iterations"] / general_stats["rhs_evaluations"],
             "spacar_evaluate": t_eval, "pinocchio_aba": t_aba, "pinocchio_rhs_python": t_rhs_py, "exudyn_tree_rk44": t_exu}
 
 
@@ -106,15 +111,17 @@ def accuracy_runs(n, t_end, tols, ga_steps):
     pm_model = chain(n, t_end)
     _, q_ref, _, _ = sp.simulate(pm_model, rtol=1e-13, atol=1e-16)
     q_ref = q_ref[-1]
-    out = {"spacar": [], "exudyn tree DOPRI5": [], "exudyn redundant GA": [], "Pinocchio ABA + DOP853": []}
+    out = {"spacar": [], "spacar general path": [], "exudyn tree DOPRI5": [], "exudyn redundant GA": [],
+           "Pinocchio ABA + DOP853": []}
     stats = {}
-    for eps in tols:
-        q, wall, st = run_spacar(n, t_end, eps)
-        out["spacar"].append((float(np.abs(q - q_ref).max()), wall, eps))
-        stats.setdefault("spacar_runs", {})[eps] = (st["rhs_evaluations"], st["steps"], st["rejected"])
-        C.log(f"  N={n} spacar eps={eps:g}: err {out['spacar'][-1][0]:.2e}, {wall:.3f} s")
-        if wall > RUN_BUDGET / 3:
-            break
+    for key, recursive in (("spacar", True), ("spacar general path", False)):
+        for eps in tols:
+            q, wall, st = run_spacar(n, t_end, eps, recursive=recursive)
+            out[key].append((float(np.abs(q - q_ref).max()), wall, eps))
+            stats.setdefault(key, {})[eps] = (st["rhs_evaluations"], st["steps"], st["rejected"])
+            C.log(f"  N={n} {key} eps={eps:g}: err {out[key][-1][0]:.2e}, {wall:.3f} s")
+            if wall > RUN_BUDGET / 3:
+                break
     em = sx.build(chain(n, t_end), formulation="tree")
     for eps in tols:
         wall, er = C.best_time(lambda: em.solve(t_end=t_end, n_out=1, solver="dopri5", rtol=eps, atol=1e-3 * eps),
@@ -162,37 +169,46 @@ def section(r: dict, plots: dict | None = None) -> str:
              f"released from rest horizontally under gravity, T = {r['t_end']} s. All programs run in one process, "
              "one after the other.", "", *C.machine_table(r["machine"]), "",
              "### Time per right-hand side", "",
-             "| N | spacar in a run | spacar `evaluate()` from Python | Pinocchio `aba` from Python | ratio spacar/ABA | "
+             "| N | spacar in a run | spacar general path in a run | spacar `evaluate()` from Python | "
+             "Pinocchio `aba` from Python | ratio spacar/ABA | ratio general path/ABA | "
              "Pinocchio rhs in Python (ABA + packing) | exudyn tree, RK44 stage |",
-             "|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|"]
     for n in sizes:
         x = r["rhs"][n]
-        lines.append(f"| {n} | {C.fmt_time(x['spacar_in_run'])} | {C.fmt_time(x['spacar_evaluate'])} | "
-                     f"{C.fmt_time(x['pinocchio_aba'])} | {C.fmt_ratio(x['spacar_in_run'], x['pinocchio_aba'])} | "
+        lines.append(f"| {n} | {C.fmt_time(x['spacar_in_run'])} | {C.fmt_time(x['spacar_general_in_run'])} | "
+                     f"{C.fmt_time(x['spacar_evaluate'])} | {C.fmt_time(x['pinocchio_aba'])} | "
+                     f"{C.fmt_ratio(x['spacar_in_run'], x['pinocchio_aba'])} | "
+                     f"{C.fmt_ratio(x['spacar_general_in_run'], x['pinocchio_aba'])} | "
                      f"{C.fmt_time(x['pinocchio_rhs_python'])} | {C.fmt_time(x['exudyn_tree_rk44'])} |")
     big = [n for n in sizes if n >= 10]
     if len(big) >= 2:
         fits = {k: C.fit_exponent(big, [r["rhs"][n][k] for n in big])
-                for k in ("spacar_in_run", "spacar_evaluate", "pinocchio_aba", "exudyn_tree_rk44")}
+                for k in ("spacar_in_run", "spacar_general_in_run", "spacar_evaluate", "pinocchio_aba", "exudyn_tree_rk44")}
         lines += ["", f"Growth of the cost per right-hand side for N = {big[0]}…{big[-1]} (log-log fit t ∝ Nᵖ): "
-                  f"spacar p = {fits['spacar_in_run']:.2f} (in a run), {fits['spacar_evaluate']:.2f} (`evaluate`); "
+                  f"spacar p = {fits['spacar_in_run']:.2f} (in a run), {fits['spacar_general_in_run']:.2f} (general path "
+                  f"in a run), {fits['spacar_evaluate']:.2f} (`evaluate`); "
                   f"Pinocchio ABA p = {fits['pinocchio_aba']:.2f}; exudyn tree p = {fits['exudyn_tree_rk44']:.2f}."]
-    lines += ["", "'spacar in a run': the best block wall time (the C++ integration loop) of the EPSINT = 1e-6 run, "
-              "repeated for at least 0.5 s like the peers' calls, over its right-hand sides; Newton iterations per "
-              "right-hand side: " + ", ".join(
+    lines += ["", "'spacar in a run': the best block wall time (the C++ integration loop, with the assembly and the "
+              "output times, which the general path solves) of the EPSINT = 1e-6 run, repeated for at least 0.5 s like "
+              "the peers' calls, over its right-hand sides; on the default path, which for these chains (a planar tree "
+              "of rigid bodies) is the recursive one" + (
+                  "" if all(r["rhs"][n].get("spacar_recursive", True) for n in sizes) else " (NOT taken in every run)") +
+              ", and on the general path (`recursive=False`), whose Newton iterations per right-hand side are: " + ", ".join(
         f"N = {n}: {r['rhs'][n].get('spacar_newton_per_rhs', float('nan')):.2f}" for n in sizes) + "."]
     if 20 in r["rhs"]:
         x = r["rhs"][20]
         ratio = x["spacar_in_run"] / x["pinocchio_aba"]
         lines += ["", f"Issue #8 target, time per right-hand side within 3× of Pinocchio's ABA at N = 20: "
                   f"**{'met' if ratio <= 3 else 'NOT met'}** (spacar {C.fmt_time(x['spacar_in_run'])} in a run, "
-                  f"ABA {C.fmt_time(x['pinocchio_aba'])}: {ratio:.2f}×)."]
+                  f"ABA {C.fmt_time(x['pinocchio_aba'])}: {ratio:.2f}×; the general path "
+                  f"{C.fmt_time(x['spacar_general_in_run'])}: {x['spacar_general_in_run'] / x['pinocchio_aba']:.2f}×)."]
     lines += ["", "### Time to accuracy", "",
               "Error: largest joint-angle error (rad) at T against Pinocchio's ABA integrated by DOP853 at rtol 1e-13. "
               "Time: wall time of the shortest run that reached the error (model building excluded; spacar's time "
               "includes its assembly). '—': no run reached it within the run budget.", "",
-              "| N | target | spacar | exudyn tree DOPRI5 | exudyn redundant GA | Pinocchio ABA + DOP853 | exudyn best / spacar |",
-              "|---|---|---|---|---|---|---|"]
+              "| N | target | spacar | spacar general path | exudyn tree DOPRI5 | exudyn redundant GA | "
+              "Pinocchio ABA + DOP853 | exudyn best / spacar | exudyn best / spacar general path |",
+              "|---|---|---|---|---|---|---|---|---|"]
     verdicts = []
     for n in sizes:
         acc = r["acc"][n]
@@ -201,10 +217,12 @@ def section(r: dict, plots: dict | None = None) -> str:
             ex = [v for k, v in t.items() if k.startswith("exudyn") and v is not None]
             best_ex = min(ex) if ex else None
             ratio = C.fmt_ratio(best_ex, t["spacar"])
+            general = C.fmt_ratio(best_ex, t["spacar general path"])
             if best_ex is not None and t["spacar"] is not None:
                 verdicts.append(best_ex / t["spacar"])
-            lines.append(f"| {n} | {target:.0e} | {C.fmt_time(t['spacar'])} | {C.fmt_time(t['exudyn tree DOPRI5'])} | "
-                         f"{C.fmt_time(t['exudyn redundant GA'])} | {C.fmt_time(t['Pinocchio ABA + DOP853'])} | {ratio} |")
+            lines.append(f"| {n} | {target:.0e} | {C.fmt_time(t['spacar'])} | {C.fmt_time(t['spacar general path'])} | "
+                         f"{C.fmt_time(t['exudyn tree DOPRI5'])} | {C.fmt_time(t['exudyn redundant GA'])} | "
+                         f"{C.fmt_time(t['Pinocchio ABA + DOP853'])} | {ratio} | {general} |")
     if verdicts:
         lines += ["", f"Issue #8 target, time-to-accuracy at least 3× better than exudyn on the rigid chains: "
                   f"**{'met' if min(verdicts) >= 3 else 'NOT met'}** (exudyn's best / spacar ranges from "
@@ -215,8 +233,9 @@ def section(r: dict, plots: dict | None = None) -> str:
         for k, v in r["acc"][n].items():
             parts.append(f"{k}: " + ", ".join(f"{s:g} → {C.fmt_err(e)} in {C.fmt_time(w)}" for e, w, s in v))
         lines.append(f"* N = {n}: " + "; ".join(parts) + ".")
-    lines += ["", "spacar's work per run (EPSINT → right-hand sides / steps / rejected): " + "; ".join(
-        f"N = {n}: " + ", ".join(f"{e:g} → {a}/{b}/{c}" for e, (a, b, c) in r["stats"][n].get("spacar_runs", {}).items())
+    lines += ["", "spacar's work per run (EPSINT → right-hand sides / steps / rejected; the same on both paths up to "
+              "round-off): " + "; ".join(
+        f"N = {n}: " + ", ".join(f"{e:g} → {a}/{b}/{c}" for e, (a, b, c) in r["stats"][n].get("spacar", {}).items())
         for n in sizes) + "."]
     if plots:
         lines += [""] + [f"![{k}]({v})" for k, v in plots.items()]
@@ -226,7 +245,8 @@ def section(r: dict, plots: dict | None = None) -> str:
 def plot(r: dict) -> dict:
     sizes = r["sizes"]
     fig, ax = C.new_figure("Rigid planar chains: time per right-hand side")
-    for key, label in (("spacar_in_run", "spacar (in a run)"), ("pinocchio_aba", "Pinocchio ABA (from Python)"),
+    for key, label in (("spacar_in_run", "spacar (in a run)"), ("spacar_general_in_run", "spacar general path (in a run)"),
+                       ("pinocchio_aba", "Pinocchio ABA (from Python)"),
                        ("exudyn_tree_rk44", "exudyn kinematic tree (RK44 stage)")):
         ax.loglog(sizes, [r["rhs"][n][key] for n in sizes], "o-", label=label)
     ax.set_xlabel("N links")
