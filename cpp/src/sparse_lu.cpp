@@ -40,7 +40,8 @@ void SparseLU::analyze(const Eigen::SparseMatrix<double>& A) {
   mark_.assign(n_, 0);
   if (n_ == 0) return;
   colamd_ = colamd_order(A);
-  amd_ = amd_order(A);
+  replays_ = 0;
+  amd_tried_ = false;
 }
 
 // Rows reachable from the pattern of column col of A in the graph of L (row i → rows of the
@@ -242,21 +243,26 @@ bool SparseLU::compute(const Eigen::SparseMatrix<double>& A) {
   const Eigen::Map<const Eigen::ArrayXd> values(A.valuePtr(), A.nonZeros());
   amax_ = values.size() ? values.abs().maxCoeff() : 0.0;
   if (!std::isfinite(amax_) || (values * 0.0).sum() != 0.0) return false;
-  if (have_pivots_ && replay(A)) return true;
-  if (!colamd_.empty()) {
-    // First factorization: keep the ordering with the sparser factors, COLAMD on a tie. AMD on
-    // A + Aᵀ can fill a constraint matrix densely (a 100-link chain's equations of motion:
-    // 184 672 nonzeros against COLAMD's 9540, 30 ms), so its trial stops once it is fuller.
-    if (factorize_pivoting(A, colamd_)) {
-      if (!factorize_pivoting(A, amd_, factor_nonzeros() - 1) && !factorize_pivoting(A, colamd_)) return false;
-    } else if (!factorize_pivoting(A, amd_)) {
-      return false;  // singular: both orderings are tried again at the next factorization
+  if (have_pivots_ && replay(A)) {
+    if (!amd_tried_ && ++replays_ >= kReplaysBeforeTrial) return try_amd(A);
+    return true;
+  }
+  if (!colamd_.empty()) {  // the first factorization
+    if (!factorize_pivoting(A, colamd_)) {
+      amd_tried_ = true;  // singular in COLAMD's order: AMD's
+      if (!factorize_pivoting(A, amd_order(A))) return false;  // both again at the next factorization
     }
     colamd_.clear();
-    amd_.clear();
     return true;
   }
   return factorize_pivoting(A, q_);
+}
+
+bool SparseLU::try_amd(const Eigen::SparseMatrix<double>& A) {
+  amd_tried_ = true;
+  const std::vector<int> current = q_;
+  if (factorize_pivoting(A, amd_order(A), factor_nonzeros() - 1)) return true;
+  return factorize_pivoting(A, current);
 }
 
 // Without valid factors (none yet, or the last factorization failed part way) the solution is
