@@ -17,6 +17,9 @@ int BlockMatrix::add_block(const std::vector<int>& rows, const std::vector<int>&
 
 void BlockMatrix::finalize() {
   std::vector<Eigen::Triplet<double>> entries;
+  size_t total = 0;
+  for (const Block& b : blocks_) total += b.rows.size() * b.cols.size();
+  entries.reserve(total);
   for (const Block& b : blocks_)
     for (int r : b.rows)
       for (int c : b.cols)
@@ -27,9 +30,10 @@ void BlockMatrix::finalize() {
   const int* inner = A_.innerIndexPtr();
   for (Block& b : blocks_) {
     const int nr = static_cast<int>(b.rows.size()), nc = static_cast<int>(b.cols.size());
-    b.value.clear();
-    b.local.clear();
-    b.local_transposed.clear();
+    for (auto* v : {&b.value, &b.local, &b.local_transposed}) {
+      v->clear();
+      v->reserve(static_cast<size_t>(nr) * nc);
+    }
     for (int j = 0; j < nc; ++j) {
       const int c = b.cols[j];
       if (c < 0) continue;
