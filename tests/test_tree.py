@@ -150,3 +150,9 @@ def test_a_body_without_mass_is_named_by_the_general_path():
     assert sim.recursive_state(np.zeros(2), np.zeros(2)) is None
     with pytest.raises(spacar.SingularMassError, match="move no mass"):
         spacar.simulate(model)
+
+
+@pytest.mark.parametrize("bad", ["no", 2, None])
+def test_recursive_must_be_a_boolean(bad):
+    with pytest.raises(spacar.InputError, match="recursive must be True or False"):
+        spacar.simulate(models.planar_chain(2), recursive=bad)

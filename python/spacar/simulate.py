@@ -60,6 +60,8 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
     if not isinstance(method, str):
         raise InputError(f"method must be 'dop853' or 'dopri5', got {show(method)}")
+    if recursive not in (True, False):
+        raise InputError(f"recursive must be True or False, got {show(recursive)}")
     model.prepare()
     sim = _core.Simulation(model._core)
     system = sim.system
@@ -96,7 +98,7 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     step = 0.0 if restart else model._continue_step
     try:
         arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit,
-                         recursive=bool(recursive))
+                         recursive=bool(recursive))  # numpy booleans too
     except SpacarError as err:
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):
