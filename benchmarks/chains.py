@@ -43,10 +43,11 @@ def tolerance_floor(n):
     return 1e-12 if n <= 10 else 1e-10 if n <= 20 else 1e-8
 GA_STEPS, QUICK_GA_STEPS = [1e-3, 1e-4], [1e-3]
 TARGETS = [1e-4, 1e-6, 1e-8]
-# Every program's run at a setting: the best of up to REPEAT runs within REPEAT_BUDGET seconds
-# (the runs of small chains take a few hundred microseconds, where the best of three still
-# varies by 20 % between benchmark runs).
-REPEAT, REPEAT_BUDGET = 20, 2.0
+# Every program's run at a setting: the best of at least REPEAT runs repeated for at least
+# MIN_TIME seconds, within REPEAT_BUDGET seconds. The runs of small chains take a few hundred
+# microseconds: three of them, back to back, all fall into one burst of load on the shared
+# machine (which slowed spacar's 2-link runs by 20–70 % in some benchmark runs and not in others).
+REPEAT, MIN_TIME, REPEAT_BUDGET = 3, 0.25, 2.0
 RUN_BUDGET = 10.0  # s: a tool stops tightening its tolerance once a run took a third of it
 # (each tightening by 100 costs at least about three times as much; exudyn's DOPRI5 at N = 100
 # took 9 s at rtol 1e-6 and did not finish in 25 minutes at 1e-8)
@@ -62,9 +63,10 @@ def hinge_columns(labels, n):
 
 
 def run_spacar(n, t_end, eps, recursive=True):
-    """Best wall time of ``spacar.simulate`` over up to REPEAT runs (each on a fresh copy of the
-    model, built outside the timing); joint angles at T and the run's statistics."""
-    res, best = C.simulate_best(chain(n, t_end, eps), REPEAT, REPEAT_BUDGET, recursive=recursive)
+    """Best wall time of ``spacar.simulate`` (each run on a fresh copy of the model, built outside
+    the timing; see REPEAT); joint angles at T and the run's statistics."""
+    res, best = C.simulate_best(chain(n, t_end, eps), REPEAT, REPEAT_BUDGET, recursive=recursive,
+                                min_time=MIN_TIME)
     q = res.e[-1, hinge_columns(res.deformation_labels, n)]
     return q, best, res.stats
 
@@ -129,7 +131,8 @@ def accuracy_runs(n, t_end, tols, ga_steps):
     em = sx.build(chain(n, t_end), formulation="tree")
     for eps in tols:
         wall, er = C.best_time(lambda: em.solve(t_end=t_end, n_out=1, solver="dopri5", rtol=eps, atol=1e-3 * eps),
-                               repeat=REPEAT, budget=REPEAT_BUDGET)
+                               repeat=REPEAT, budget=REPEAT_BUDGET,
+                               min_time=MIN_TIME)
         out["exudyn tree DOPRI5"].append((float(np.abs(er.q[-1] - q_ref).max()), wall, eps))
         C.log(f"  N={n} exudyn tree DOPRI5 rtol={eps:g}: err {out['exudyn tree DOPRI5'][-1][0]:.2e}, {wall:.3f} s")
         if wall > RUN_BUDGET / 3:
@@ -138,14 +141,15 @@ def accuracy_runs(n, t_end, tols, ga_steps):
     cols = hinge_columns(em.def_labels, n)
     for h in ga_steps:
         wall, er = C.best_time(lambda: em.solve(t_end=t_end, n_out=1, solver="generalized_alpha", step=h),
-                               repeat=REPEAT, budget=REPEAT_BUDGET)
+                               repeat=REPEAT, budget=REPEAT_BUDGET,
+                               min_time=MIN_TIME)
         out["exudyn redundant GA"].append((float(np.abs(er.e[-1, cols] - q_ref).max()), wall, h))
         C.log(f"  N={n} exudyn GA h={h:g}: err {out['exudyn redundant GA'][-1][0]:.2e}, {wall:.3f} s")
         if wall > RUN_BUDGET / 3:
             break
     for eps in tols:
         wall, (_, q, _, _) = C.best_time(lambda: sp.simulate(pm_model, rtol=eps, atol=1e-3 * eps), repeat=REPEAT,
-                                         budget=REPEAT_BUDGET)
+                                         budget=REPEAT_BUDGET, min_time=MIN_TIME)
         out["Pinocchio ABA + DOP853"].append((float(np.abs(q[-1] - q_ref).max()), wall, eps))
         if wall > RUN_BUDGET / 3:
             break
@@ -210,8 +214,9 @@ def section(r: dict, plots: dict | None = None) -> str:
     lines += ["", "### Time to accuracy", "",
               "Error: largest joint-angle error (rad) at T against Pinocchio's ABA integrated by DOP853 at rtol 1e-13. "
               "Time: wall time of the shortest run that reached the error (model building excluded; spacar's time "
-              f"includes its assembly); every program's run at a setting is the best of up to {REPEAT} runs within "
-              f"{REPEAT_BUDGET:g} s. '—': no run reached it within the run budget.", "",
+              f"includes its assembly); every program's run at a setting is the best of at least {REPEAT} runs repeated "
+              f"for at least {MIN_TIME:g} s (within {REPEAT_BUDGET:g} s). '—': no run reached it within the run budget.",
+              "",
               "| N | target | spacar | spacar general path | exudyn tree DOPRI5 | exudyn redundant GA | "
               "Pinocchio ABA + DOP853 | exudyn best / spacar | exudyn best / spacar general path |",
               "|---|---|---|---|---|---|---|---|---|"]
