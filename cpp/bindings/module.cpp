@@ -536,9 +536,9 @@ void bind_simulation(py::module_& m) {
            })
       .def("recursive_state",
            [](Simulation& s, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) -> py::object {
-             // The recursive path of planar rigid trees at (q, q̇), its tree taken at the last
-             // solved state: a dict of qdd, x, xd, xdd (None for other systems); a check of it
-             // against solve_state().
+             // The recursive path of planar rigid trees at (q, q̇), its tree taken at the solved
+             // state of the first call: a dict of qdd, x, xd, xdd (None for other systems); a
+             // check of it against solve_state() and move_to().
              if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
                throw InputError("recursive_state(): q and qd must have one value per degree of freedom");
              Eigen::VectorXd qdd, x, xd, xdd;

@@ -231,18 +231,28 @@ Linearization Simulation::linearize() {
 
 void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  // On the recursive path the last solved state may be a stage a whole (large) step away: start
+  // Newton from the tree's exact positions at (q, q̇) instead.
+  if (tree_) tree_state(t, Y, tree_qdd_);
   for (int i = 0; i < ny; ++i) data_->e_integrated[sys_->y_defs[i]] = Y[nd + i];
   solve_state(t, Y.data(), Y.data() + nd + ny, false);
+}
+
+bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& qdd) {
+  const int nd = sys_->n_dof();
+  qdd.resize(nd);
+  if (!tree_->solve(Y.data(), Y.data() + nd, base_.x, base_.xd, base_.xdd, qdd.data())) return false;
+  base_.valid = true;  // the start of Newton's iterations at the next general evaluation
+  base_.t = t;
+  return true;
 }
 
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   check_time(t);
-  if (tree_ && tree_->solve(Y.data(), Y.data() + nd, base_.x, base_.xd, base_.xdd, dY.data() + nd)) {
-    // The solved state is the start of the Newton iterations at the next output time.
-    base_.valid = true;
-    base_.t = t;
+  if (tree_ && tree_state(t, Y, tree_qdd_)) {
     dY.head(nd) = Y.tail(nd);
+    dY.tail(nd) = tree_qdd_;
     return;
   }
   struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side
@@ -265,10 +275,10 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
 
 bool Simulation::recursive_state(const double* q, const double* qd, Eigen::VectorXd& qdd, Eigen::VectorXd& x,
                                  Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
-  std::unique_ptr<PlanarTree> tree = PlanarTree::detect(*sys_, *data_);
-  if (!tree) return false;
+  if (!tree_) tree_ = PlanarTree::detect(*sys_, *data_);
+  if (!tree_) return false;
   Eigen::VectorXd x1 = data_->x, xd1 = Eigen::VectorXd::Zero(sys_->nx), xdd1 = xd1, qdd1(sys_->n_dof());
-  if (!tree->solve(q, qd, x1, xd1, xdd1, qdd1.data())) return false;
+  if (!tree_->solve(q, qd, x1, xd1, xdd1, qdd1.data())) return false;
   qdd = qdd1;
   x = x1;
   xd = xd1;

@@ -86,9 +86,10 @@ class Simulation {
   void evaluate_state(double t, const Eigen::VectorXd& Y);
   // Right-hand side of the first-order system Y = (q, y, q̇).
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
-  // The state at (q, q̇) by the recursive path, its tree taken at the last solved state: q̈ and
-  // the coordinates' positions, velocities and accelerations; false (nothing written) if the
-  // system is not a planar tree of rigid bodies or a body moves no mass.
+  // The state at (q, q̇) by the recursive path: q̈ and the coordinates' positions, velocities and
+  // accelerations; false (nothing written) if the system is not a planar tree of rigid bodies or
+  // a body moves no mass. The tree is taken at the solved state of the first call (after
+  // assemble(): the assembled state) and kept until the next run.
   bool recursive_state(const double* q, const double* qd, Eigen::VectorXd& qdd, Eigen::VectorXd& x,
                        Eigen::VectorXd& xd, Eigen::VectorXd& xdd);
 
@@ -137,6 +138,10 @@ class Simulation {
   std::unique_ptr<Linearizer> linearizer_;
   // The recursive right-hand side of planar rigid trees, set for a run (RunOptions::recursive).
   std::unique_ptr<PlanarTree> tree_;
+  Eigen::VectorXd tree_qdd_;
+  // The tree's state at (t, Y) into base_ (positions, rates, accelerations) and qdd; false if a
+  // body moves no mass.
+  bool tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& qdd);
   // Message and time of the last right-hand side that failed in Newton, kept while the
   // integration has not passed that time: at a step-size collapse it says that the kinematics
   // has no solution ahead (formulation.md §2.2), whatever rejected the very last attempt.
