@@ -65,6 +65,7 @@ class PlanarTree::Builder {
   }
 
   bool read_nodes() {
+    for (size_t j = 0; j < sys_.x_dyn.size(); ++j) dof_of_coord_[sys_.x_dyn[j]] = static_cast<int>(j);
     for (int g = 0; g < sys_.nx; ++g) {
       const NodeKind kind = sys_.coord_node_kind[g];
       const CoordClass c = sys_.coord_class[g];
@@ -94,7 +95,7 @@ class PlanarTree::Builder {
       } else if (name == "PLHINGE") {
         const int k = se.def_offset;
         if (sys_.def_class[k] == DefClass::Dynamic) {
-          const auto dof = std::find(sys_.e_dyn.begin(), sys_.e_dyn.end(), k) - sys_.e_dyn.begin();
+          const auto dof = std::lower_bound(sys_.e_dyn.begin(), sys_.e_dyn.end(), k) - sys_.e_dyn.begin();
           hinges_.push_back({static_cast<int>(i), ids.front(), ids.back(), static_cast<int>(sys_.x_dyn.size() + dof)});
         } else if (sys_.def_class[k] == DefClass::Released) {
           hinges_.push_back({static_cast<int>(i), ids.front(), ids.back(), -1});
@@ -152,6 +153,7 @@ class PlanarTree::Builder {
       for (int id : ids) (nodes_[id].kind == NodeKind::Beta ? beta_[b] : xy_[b]).insert(id);
     }
     placed_.assign(xy_.size(), -1);
+    pin_.assign(xy_.size(), -1);
     // Every free node moves with a body.
     std::set<int> moving;
     for (size_t b = 0; b < xy_.size(); ++b) {
@@ -185,63 +187,92 @@ class PlanarTree::Builder {
     return pin;
   }
 
-  // From the ground outwards: a body joins at its pin, turned by the one DOF hinge to its
-  // parent or by its own DYNX rotation.
+  // From the ground outwards, breadth first: a body joins the tree at its pin, turned by the one
+  // DOF hinge to its parent or by its own DYNX rotation.
   bool place_bodies() {
-    for (size_t done = 0; done < xy_.size();) {
-      bool progress = false;
-      for (Hinge& h : hinges_) {
-        if (h.used || h.dof < 0) continue;
-        const int ba = body_of_beta(h.a), bb = body_of_beta(h.b);
-        if (is_placed(ba) && is_placed(bb)) return false;  // a closed loop (or a hinge inside a body)
-        if (!is_placed(ba) && !is_placed(bb)) continue;
-        const bool forward = is_placed(ba);
-        const int body = forward ? bb : ba;
-        if (dynamic_rotation(body) != -1) return false;  // two DOFs for one rotation
-        const int parent_beta = forward ? h.a : h.b, own_beta = forward ? h.b : h.a;
-        Body bd;
-        bd.dof = h.dof;
-        bd.sign = forward ? 1.0 : -1.0;
-        bd.offset = x_[nodes_[parent_beta].coord] - x_[nodes_[own_beta].coord];
-        const SystemElement& se = sys_.elements[h.element];
-        if (se.has_constitutive) {
-          bd.stiffness = se.S(0, 0);
-          bd.damping = se.D(0, 0);
-        }
-        const int parent = forward ? ba : bb;
-        if (!place(body, parent == kGround ? kGround : placed_[parent], bd)) return false;
-        h.used = true;
-        ++done;
-        progress = true;
-      }
-      for (size_t b = 0; b < xy_.size(); ++b) {
-        const int coord = dynamic_rotation(static_cast<int>(b));
-        if (placed_[b] >= 0 || coord == -1) continue;
-        if (coord < 0) return false;
-        const int pin = pin_of(static_cast<int>(b));
-        if (pin == -1) continue;  // its parent is not placed yet
-        Body bd;
-        bd.absolute = true;
-        bd.dof = static_cast<int>(std::find(sys_.x_dyn.begin(), sys_.x_dyn.end(), coord) - sys_.x_dyn.begin());
-        bd.offset = x_[coord];
-        if (pin < 0 || !place(static_cast<int>(b), owner_[pin], bd)) return false;
-        ++done;
-        progress = true;
-      }
-      if (!progress) return false;  // bodies not connected to the ground
+    std::map<int, std::vector<int>> hinges_at;    // body (or kGround) → its DOF hinges
+    std::map<int, std::vector<int>> bodies_at;    // XY node → the bodies containing it
+    for (size_t i = 0; i < hinges_.size(); ++i) {
+      if (hinges_[i].dof < 0) continue;
+      hinges_at[body_of_beta(hinges_[i].a)].push_back(static_cast<int>(i));
+      hinges_at[body_of_beta(hinges_[i].b)].push_back(static_cast<int>(i));
     }
+    for (size_t b = 0; b < xy_.size(); ++b)
+      for (int id : xy_[b]) bodies_at[id].push_back(static_cast<int>(b));
+    std::vector<int> queue = {kGround};
+    for (size_t k = 0; k < queue.size(); ++k) {
+      const int parent = queue[k];
+      for (int i : hinges_at[parent]) {
+        Hinge& h = hinges_[i];
+        if (h.used) continue;  // the parent's own joint
+        const bool forward = body_of_beta(h.a) == parent;
+        const int child = forward ? body_of_beta(h.b) : body_of_beta(h.a);
+        // A hinge inside a body, between ground nodes, or closing a loop.
+        if (child == parent || is_placed(child)) return false;
+        if (dynamic_rotation(child) != -1) return false;  // two DOFs for one rotation
+        h.used = true;
+        if (!place(child, parent, hinge_joint(h, forward))) return false;
+        queue.push_back(child);
+      }
+      for (int id : owned_points(parent))
+        for (int child : bodies_at[id]) {
+          const int coord = dynamic_rotation(child);
+          if (is_placed(child) || coord == -1) continue;
+          if (coord < 0 || !place(child, parent, rotation_joint(coord))) return false;
+          queue.push_back(child);
+        }
+    }
+    for (int index : placed_)
+      if (index < 0) return false;  // a body not hanging from the ground by joints (a loop's)
     for (const Hinge& h : hinges_)
-      if (h.dof >= 0 && !h.used) return false;
+      if (h.dof >= 0 && !h.used) return false;  // a hinge between bodies not on the ground
     return static_cast<int>(tree_.bodies_.size()) == sys_.n_dof();
   }
 
-  // Adds the body to the tree under `parent` (index in bodies_ or kGround) with its joint `bd`:
-  // the pin, the inertia about it, the coordinates and loads moving with it.
-  bool place(int body, int parent, Body bd) {
+  // The joint of a DOF hinge, from the parent's end (forward: node a) to the child's.
+  Body hinge_joint(const Hinge& h, bool forward) {
+    Body bd;
+    bd.dof = h.dof;
+    bd.sign = forward ? 1.0 : -1.0;  // e = β_b − β_a
+    const int parent_beta = forward ? h.a : h.b, own_beta = forward ? h.b : h.a;
+    bd.offset = x_[nodes_[parent_beta].coord] - x_[nodes_[own_beta].coord];
+    const SystemElement& se = sys_.elements[h.element];
+    if (se.has_constitutive) {
+      bd.stiffness = se.S(0, 0);
+      bd.damping = se.D(0, 0);
+    }
+    return bd;
+  }
+
+  // The joint of a body turned by its own DYNX rotation coordinate.
+  Body rotation_joint(int coord) const {
+    Body bd;
+    bd.absolute = true;
+    bd.dof = dof_of_coord_.at(coord);
+    bd.offset = x_[coord];
+    return bd;
+  }
+
+  // The XY nodes a placed body (or the ground) carries: pins of its children.
+  std::vector<int> owned_points(int body) const {
+    std::vector<int> out;
+    for (const auto& [id, owner] : owner_)
+      if (body == kGround && owner == kGround) out.push_back(id);
+    if (body != kGround)
+      for (int id : xy_[body])
+        if (id != pin_[body]) out.push_back(id);
+    return out;
+  }
+
+  // Adds the body to the tree under the placed body `parent_body` (or kGround) with its joint
+  // `bd`: the pin, the inertia about it, the coordinates and loads moving with it.
+  bool place(int body, int parent_body, Body bd) {
+    const int parent = parent_body == kGround ? kGround : placed_[parent_body];
     const int pin = pin_of(body);
     if (pin < 0 || owner_.at(pin) != parent) return false;  // no pin, two, or one on another body
     const int index = static_cast<int>(tree_.bodies_.size());
     placed_[body] = index;
+    pin_[body] = pin;
     const Eigen::Vector2d p0 = xy(pin);
     bd.parent = parent;
     bd.r = parent == kGround ? p0 : Eigen::Vector2d(p0 - pin0_[parent]);
@@ -319,6 +350,7 @@ class PlanarTree::Builder {
   const Eigen::VectorXd& x_;
   PlanarTree& tree_;
   std::map<int, NodeInfo> nodes_;
+  std::map<int, int> dof_of_coord_;    // DYNX coordinate → its position in q
   std::vector<int> beams_;
   std::vector<Hinge> hinges_;
   std::map<int, int> root_;            // union-find over the BETA nodes of beams
@@ -326,6 +358,7 @@ class PlanarTree::Builder {
   std::vector<std::set<int>> xy_, beta_;  // nodes of each body
   std::vector<std::vector<int>> beams_of_;
   std::vector<int> placed_;            // body → index in bodies_, −1: not yet
+  std::vector<int> pin_;               // body → its pin node, −1: not placed
   std::map<int, int> owner_;           // XY node → body (index in bodies_) it moves with, kGround
   std::vector<Eigen::Vector2d> pin0_;  // reference pin of each placed body
 };
@@ -356,7 +389,7 @@ PlanarTree::Mat3 PlanarTree::inertia_to_parent(const Body& bd, const Mat3& I) {
 
 bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
                        Eigen::VectorXd& xdd, double* qdd) {
-  velocities(q, qd);
+  outward(q, qd);
   applied_loads();
   if (!articulate()) return false;
   accelerations(qdd);
@@ -365,8 +398,8 @@ bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Ei
 }
 
 // Outwards: rotations, pins, velocities, velocity-product accelerations and the bias forces of
-// the bodies' inertia, with the joint torques.
-void PlanarTree::velocities(const double* q, const double* qd) {
+// the bodies' inertia, with the joint torques; the articulated inertias start as the bodies'.
+void PlanarTree::outward(const double* q, const double* qd) {
   for (Body& bd : bodies_) {
     const Body* p = bd.parent == kGround ? nullptr : &bodies_[bd.parent];
     double theta;  // rotation relative to the parent
@@ -431,7 +464,9 @@ bool PlanarTree::articulate() {
     Body& bd = bodies_[i];
     bd.U = bd.IA.col(0);
     bd.d = bd.U[0];
-    if (!(bd.d > 0.0) || !std::isfinite(bd.d)) return false;
+    // Not positive: a body that moves no mass. Not finite (a trial state out of range): the
+    // integrator rejects the non-finite q̈ like the general path's.
+    if (bd.d <= 0.0) return false;
     bd.u = bd.tau - bd.pA[0];  // the joint force left for the joint acceleration
     if (bd.parent == kGround) continue;
     const Mat3 Ia = bd.IA - bd.U * bd.U.transpose() / bd.d;

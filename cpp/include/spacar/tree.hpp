@@ -1,4 +1,4 @@
-// Recursive dynamics of planar open trees of rigid bodies (formulation.md §5.4).
+// Recursive dynamics of planar open trees of rigid bodies (formulation.md §7).
 //
 // A planar model of rigid PLBEAMs (every deformation fixed) connected as an open tree is a
 // kinematic tree of rigid bodies with revolute joints: beams sharing a BETA node are one body, a
@@ -65,7 +65,7 @@ class PlanarTree {
   // A coordinate moving with a body: XY components at body point b, or a BETA angle.
   struct Follower {
     int coord = 0, body = 0;
-    int component = 0;            // 0: x, 1: y, 2: rotation
+    int component = 0;            // 0: the XY node's x (and y, the next coordinate), 2: a rotation
     Eigen::Vector2d b;            // body coordinates of the point (XY)
     double value0 = 0.0;          // rotation at the reference state (BETA)
   };
@@ -85,7 +85,7 @@ class PlanarTree {
   class Builder;
 
   // The phases of solve().
-  void velocities(const double* q, const double* qd);
+  void outward(const double* q, const double* qd);
   void applied_loads();
   bool articulate();
   void accelerations(double* qdd);
