@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <tuple>
 
 namespace spacar {
 
@@ -248,9 +249,9 @@ bool SparseLU::compute(const Eigen::SparseMatrix<double>& A) {
     return true;
   }
   if (!colamd_.empty()) {  // the first factorization
-    if (!factorize_pivoting(A, colamd_)) {
-      amd_tried_ = true;  // singular in COLAMD's order: AMD's
+    if (!factorize_pivoting(A, colamd_)) {  // singular in COLAMD's order: AMD's
       if (!factorize_pivoting(A, amd_order(A))) return false;  // both again at the next factorization
+      amd_tried_ = true;
     }
     colamd_.clear();
     return true;
@@ -260,9 +261,12 @@ bool SparseLU::compute(const Eigen::SparseMatrix<double>& A) {
 
 bool SparseLU::try_amd(const Eigen::SparseMatrix<double>& A) {
   amd_tried_ = true;
-  const std::vector<int> current = q_;
+  // The trial factorizes into the members: keep the replayed factors of A to return to.
+  auto factors = std::make_tuple(q_, pinv_, Lp_, Li_, Lx_, Up_, Ui_, Ux_, Uinv_, Ap_, Ai_, Apos_);
   if (factorize_pivoting(A, amd_order(A), factor_nonzeros() - 1)) return true;
-  return factorize_pivoting(A, current);
+  std::tie(q_, pinv_, Lp_, Li_, Lx_, Up_, Ui_, Ux_, Uinv_, Ap_, Ai_, Apos_) = std::move(factors);
+  have_pivots_ = true;
+  return true;
 }
 
 // Without valid factors (none yet, or the last factorization failed part way) the solution is
