@@ -227,3 +227,21 @@ def test_amd_ordering_is_tried_after_enough_replays():
         b = rng.normal(size=A.shape[0])
         assert relative_residual(B, lu.solve(b), b) < 1e-14
     assert lu.factor_nonzeros < 0.8 * colamd_fill
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_amd_trial_keeps_exact_factors_either_way(seed):
+    """Random patterns, whichever ordering fills less: after the trial (kept or not) the factors
+    are never fuller than COLAMD's and every solve stays exact."""
+    rng = np.random.default_rng(seed)
+    A = random_sparse(150, 0.03, rng)
+    lu = _core.SparseLU(A)
+    assert lu.factorize(A)
+    colamd_fill = lu.factor_nonzeros
+    for _ in range(40):
+        B = same_pattern(A, A.data * (1.0 + 0.05 * rng.uniform(-1.0, 1.0, A.nnz)))
+        assert lu.factorize(B)
+        b = rng.normal(size=150)
+        assert relative_residual(B, lu.solve(b), b) < 1e-13
+        assert relative_residual(B.T.tocsc(), lu.solve_transposed(b), b) < 1e-13
+    assert lu.factor_nonzeros <= colamd_fill

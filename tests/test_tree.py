@@ -1,4 +1,4 @@
-"""The recursive path of planar rigid trees (cpp/include/spacar/tree.hpp, formulation.md §5.4).
+"""The recursive path of planar rigid trees (cpp/include/spacar/tree.hpp, formulation.md §7).
 
 Its accelerations are checked against the constraint formulation's sparse solve at random states
 (the two share no code beyond the element mass matrices) and against Pinocchio's ABA; runs on
@@ -60,6 +60,25 @@ def branched_tree(spring=False):
     return m
 
 
+def plbeamnl_chain():
+    """Two rigid PLBEAMNL links, the second hinged by its own DYNX rotation (no PLHINGE)."""
+    m = spacar.Model()
+    m.x(2, 0.8, 0.3)
+    m.x(3, 1.5, -0.2)
+    m.plbeamnl(1, 1, 11, 2, 12)
+    m.plbeamnl(2, 2, 21, 3, 22)
+    m.fix(1)
+    m.dynx(11, 1)
+    m.dynx(21, 1)
+    m.emass(1, 1.0)
+    m.emass(2, 0.5)
+    m.mass(3, 0.2)
+    m.gravity(0.0, -G)
+    m.epskin(1e-12)
+    m.timestep(1, 0.1)
+    return m
+
+
 TREES = {
     "chain": lambda: models.planar_chain(6, rho_a=1.5, tip_mass=0.3, joint_inertia=0.02, angle=0.3),
     "chain springs": lambda: models.planar_chain(4, stiffness=3.0, damping=0.2, ground_angle=0.3, angle=-0.2),
@@ -67,6 +86,7 @@ TREES = {
     "chain absolute springs": lambda: models.planar_chain(5, dof="absolute", stiffness=3.0, damping=0.2),
     "branched": branched_tree,
     "branched spring": lambda: branched_tree(spring=True),
+    "PLBEAMNL, DYNX": plbeamnl_chain,
 }
 
 
@@ -79,17 +99,19 @@ def assembled(model):
 
 @pytest.mark.parametrize("name", list(TREES))
 def test_recursive_state_equals_the_constraint_formulation(name):
+    """The tree is taken at the assembled state; the states compared are reached from it by the
+    general path's continuation (move_to), so every joint has turned."""
     sim = assembled(TREES[name]())
-    rng = np.random.default_rng(7)
     q0 = np.array(sim.system.q0)
+    assert sim.recursive_state(q0, np.zeros(q0.size)) is not None  # the tree, at the assembly
+    rng = np.random.default_rng(7)
     for _ in range(5):
-        q = q0 + rng.uniform(-0.6, 0.6, q0.size)
+        q = q0 + rng.uniform(-1.0, 1.0, q0.size)
         qd = rng.uniform(-2.0, 2.0, q0.size)
-        sim.solve_state(0.0, q, qd)  # Newton and the sparse solve of the constraint formulation
+        sim.move_to(0.0, q, qd)  # Newton along the path, the sparse solve of the constraint formulation
         got = sim.recursive_state(q, qd)
-        assert got is not None
         d = sim.data
-        for key, expected, tol in (("qdd", d.qdd, 1e-12), ("x", d.x, 1e-9), ("xd", d.xd, 1e-9), ("xdd", d.xdd, 1e-9)):
+        for key, expected, tol in (("qdd", d.qdd, 1e-11), ("x", d.x, 1e-9), ("xd", d.xd, 1e-9), ("xdd", d.xdd, 1e-9)):
             expected = np.array(expected)
             np.testing.assert_allclose(got[key], expected, rtol=0, atol=tol * max(1.0, np.abs(expected).max()),
                                        err_msg=key)
@@ -126,8 +148,43 @@ def test_runs_on_both_paths_agree(name):
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-7 * max(1.0, np.abs(b).max()), err_msg=field)
 
 
+def held_hinge():
+    """A 2-link chain whose second hinge is not a DOF (its rotation held fixed)."""
+    m = models.planar_chain(1)
+    m.x(3, 2.0, 0.0)
+    m.plbeam(2, 2, 21, 3, 22)
+    m.plhinge(9, models.END + 1, 21)
+    m.emass(2, 1.0)
+    return m
+
+
+def position_dof():
+    """A pendulum whose DOF is the x coordinate of its tip (DYNX on an XY node)."""
+    m = spacar.Model()
+    m.x(2, 0.6, -0.8)
+    m.plbeam(1, 1, 11, 2, 12)
+    m.fix(1)
+    m.dynx(2, 1)
+    m.emass(1, 1.0)
+    m.gravity(0.0, -G)
+    return m
+
+
+def truss_brace():
+    """A pendulum braced by a PLTRUSS (an element the recursive path does not take)."""
+    m = models.planar_chain(1)
+    m.x(5, 0.5, -0.5)
+    m.pltruss(9, 2, 5)
+    m.fix(5)
+    m.rlse(9, 1)
+    return m
+
+
 NOT_TREES = {
     "four-bar (closed loop)": lambda: models.four_bar(),
+    "hinge held fixed": held_hinge,
+    "DYNX on a position": position_dof,
+    "PLTRUSS": truss_brace,
     "flexible links": lambda: models.cantilever(3),
     "input-driven slider-crank": lambda: models.slider_crank(n_rod=2, t_end=0.01, n_out=1),
 }
@@ -152,7 +209,25 @@ def test_a_body_without_mass_is_named_by_the_general_path():
         spacar.simulate(model)
 
 
-@pytest.mark.parametrize("bad", ["no", 2, None])
+@pytest.mark.parametrize("bad", ["no", 2, 1, 0.0, None])
 def test_recursive_must_be_a_boolean(bad):
     with pytest.raises(spacar.InputError, match="recursive must be True or False"):
         spacar.simulate(models.planar_chain(2), recursive=bad)
+
+
+@pytest.mark.parametrize("n_out", [2, 10])
+def test_output_times_of_a_fast_spin_stay_on_the_branch(n_out):
+    """A straight 2-link chain spinning at 5 rad/s without gravity turns rigidly. Its steps grow
+    long (the motion is easy to integrate), so the output times are solved by Newton from the
+    tree's positions at the output, not from a stage a step away: the tip stays on the circle and
+    the links do not flip."""
+    model = models.planar_chain(2, gravity=None, eps=1e-8, epskin=1e-12)
+    model.ed(models.HINGE + 1, 1, 5.0)
+    model.timestep(n_out, 20.0)
+    res = spacar.simulate(model)
+    assert res.stats["recursive"]
+    tip = res.node(3).x
+    np.testing.assert_allclose(tip[:, 0], np.cos(5.0 * res.t), atol=1e-6)
+    np.testing.assert_allclose(tip[:, 1], np.sin(5.0 * res.t), atol=1e-6)
+    np.testing.assert_allclose(res.deformation(models.HINGE + 1, 1), 5.0 * res.t, rtol=1e-8)
+    np.testing.assert_allclose(res.deformation(models.HINGE + 2, 1), 0.0, atol=1e-8)

@@ -1,6 +1,8 @@
 """Running an analysis block from Python."""
 from __future__ import annotations
 
+import numpy as np
+
 from . import _core
 from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
@@ -60,7 +62,7 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
     if not isinstance(method, str):
         raise InputError(f"method must be 'dop853' or 'dopri5', got {show(method)}")
-    if recursive not in (True, False):
+    if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
     model.prepare()
     sim = _core.Simulation(model._core)
