@@ -25,6 +25,21 @@ def same_pattern(A, values):
     return B
 
 
+def perturbed(A, rng, size):
+    """A with every value changed by a relative amount up to ``size`` (the same pattern)."""
+    return same_pattern(A, A.data * (1.0 + size * rng.uniform(-1.0, 1.0, A.nnz)))
+
+
+def factorize_perturbed(lu, A, rng, count, size=0.05, tol=1e-14):
+    """``count`` factorizations of perturbed values of A, each solving exactly both ways."""
+    for _ in range(count):
+        B = perturbed(A, rng, size)
+        assert lu.factorize(B)
+        b = rng.normal(size=A.shape[0])
+        assert relative_residual(B, lu.solve(b), b) < tol
+        assert relative_residual(B.T.tocsc(), lu.solve_transposed(b), b) < tol
+
+
 def relative_residual(A, x, b):
     return np.linalg.norm(A @ x - b) / (np.linalg.norm(A.toarray(), np.inf) * np.linalg.norm(x) + np.linalg.norm(b))
 
@@ -51,11 +66,7 @@ def test_new_values_replay_the_pivot_sequence():
     lu = _core.SparseLU(A)
     assert lu.factorize(A)
     chosen = lu.pivotings
-    for _ in range(20):
-        B = same_pattern(A, A.data * (1.0 + 0.05 * rng.uniform(-1.0, 1.0, A.nnz)))
-        assert lu.factorize(B)
-        b = rng.normal(size=200)
-        assert relative_residual(B, lu.solve(b), b) < 1e-14
+    factorize_perturbed(lu, A, rng, 20)
     assert lu.pivotings == chosen
 
 
@@ -221,7 +232,7 @@ def test_amd_ordering_is_tried_after_enough_replays():
     colamd_fill, chosen = lu.factor_nonzeros, lu.pivotings
     rng = np.random.default_rng(0)
     for i in range(40):
-        B = same_pattern(A, A.data * (1.0 + 0.01 * rng.uniform(-1.0, 1.0, A.nnz)))
+        B = perturbed(A, rng, 0.01)
         assert lu.factorize(B)
         assert lu.pivotings == (chosen if i < 31 else chosen + 1)
         b = rng.normal(size=A.shape[0])
@@ -238,10 +249,5 @@ def test_amd_trial_keeps_exact_factors_either_way(seed):
     lu = _core.SparseLU(A)
     assert lu.factorize(A)
     colamd_fill = lu.factor_nonzeros
-    for _ in range(40):
-        B = same_pattern(A, A.data * (1.0 + 0.05 * rng.uniform(-1.0, 1.0, A.nnz)))
-        assert lu.factorize(B)
-        b = rng.normal(size=150)
-        assert relative_residual(B, lu.solve(b), b) < 1e-13
-        assert relative_residual(B.T.tocsc(), lu.solve_transposed(b), b) < 1e-13
+    factorize_perturbed(lu, A, rng, 40, tol=1e-13)
     assert lu.factor_nonzeros <= colamd_fill
