@@ -274,6 +274,7 @@ def test_concatenate_blocks():
     np.testing.assert_array_equal(both.x[101:], second.x)
     np.testing.assert_allclose(both.x[101], both.x[100], rtol=0, atol=1e-12)  # continuous at the boundary
     assert both.stats["rhs_evaluations"] == first.stats["rhs_evaluations"] + second.stats["rhs_evaluations"]
+    assert both.stats["recursive"] is False  # the slider-crank's flexible rod: the general path
     assert both.geometry == second.geometry
     other = spacar.simulate(cantilever(2))
     with pytest.raises(spacar.InputError, match="different models"):

@@ -231,3 +231,22 @@ def test_output_times_of_a_fast_spin_stay_on_the_branch(n_out):
     np.testing.assert_allclose(tip[:, 1], np.sin(5.0 * res.t), atol=1e-6)
     np.testing.assert_allclose(res.deformation(models.HINGE + 1, 1), 5.0 * res.t, rtol=1e-8)
     np.testing.assert_allclose(res.deformation(models.HINGE + 2, 1), 0.0, atol=1e-8)
+
+
+def test_blocks_continue_on_the_recursive_path():
+    """Two blocks of 0.2 s on the recursive path end where one block of 0.4 s on the general path
+    does; the concatenated results say that every block took the recursive path."""
+    def chain():
+        return models.planar_chain(3, angle=0.4, eps=1e-10, epskin=1e-12)
+    model = chain()
+    model.timestep(2, 0.2)
+    first = spacar.simulate(model)
+    model.timestep(2, 0.2)
+    second = spacar.simulate(model)
+    both = spacar.Results.concatenate([first, second])
+    assert both.stats["recursive"] is True
+    one = chain()
+    one.timestep(4, 0.4)
+    general = spacar.simulate(one, recursive=False)
+    np.testing.assert_allclose(second.x[-1], general.x[-1], rtol=0, atol=1e-7)
+    np.testing.assert_allclose(second.e[-1], general.e[-1], rtol=0, atol=1e-7)

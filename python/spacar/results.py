@@ -348,7 +348,9 @@ class Results:
         stats: dict = {}
         for r in results:
             for k, v in r.stats.items():
-                if isinstance(v, (int, float)) and not isinstance(v, bool):
+                if isinstance(v, bool):  # e.g. "recursive": true of the whole only if of every block
+                    stats[k] = stats.get(k, True) and v
+                elif isinstance(v, (int, float)):
                     stats[k] = stats.get(k, 0) + v
         lins = [lin for r in results for lin in r.linearizations]
         return cls(arrays, first.coordinate_labels, first.deformation_labels, stats,
