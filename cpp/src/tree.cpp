@@ -53,8 +53,9 @@ class PlanarTree::Builder {
 
  private:
   struct Hinge {
-    int element, a, b;  // e = β_b − β_a
+    int a, b;           // e = β_b − β_a
     int dof;            // position in q, −1: a released hinge (a spring between two bodies)
+    double stiffness, damping;  // σ = S e + D ė (0 without ESTIFF / EDAMPP)
     bool used = false;
   };
 
@@ -94,14 +95,14 @@ class PlanarTree::Builder {
         if (!read_beam(static_cast<int>(i), se, ids)) return false;
       } else if (name == "PLHINGE") {
         const int k = se.def_offset;
-        if (sys_.def_class[k] == DefClass::Dynamic) {
-          const auto dof = std::lower_bound(sys_.e_dyn.begin(), sys_.e_dyn.end(), k) - sys_.e_dyn.begin();
-          hinges_.push_back({static_cast<int>(i), ids.front(), ids.back(), static_cast<int>(sys_.x_dyn.size() + dof)});
-        } else if (sys_.def_class[k] == DefClass::Released) {
-          hinges_.push_back({static_cast<int>(i), ids.front(), ids.back(), -1});
-        } else {
+        int dof = -1;
+        if (sys_.def_class[k] == DefClass::Dynamic)
+          dof = static_cast<int>(sys_.x_dyn.size() +
+                                 (std::lower_bound(sys_.e_dyn.begin(), sys_.e_dyn.end(), k) - sys_.e_dyn.begin()));
+        else if (sys_.def_class[k] != DefClass::Released)
           return false;
-        }
+        const bool law = se.has_constitutive;
+        hinges_.push_back({ids.front(), ids.back(), dof, law ? se.S(0, 0) : 0.0, law ? se.D(0, 0) : 0.0});
       } else {
         return false;
       }
@@ -126,7 +127,7 @@ class PlanarTree::Builder {
       if (first < 0) first = id;
       else root_[root(id)] = root(first);
     }
-    beams_.push_back(i);
+    beams_.push_back({i, ids});
     return true;
   }
 
@@ -137,8 +138,7 @@ class PlanarTree::Builder {
   }
 
   bool group_bodies() {
-    for (int i : beams_) {
-      const std::vector<int> ids = element_nodes(sys_, sys_.elements[i]);
+    for (const auto& [i, ids] : beams_) {
       int r = -1;
       for (int id : ids)
         if (nodes_[id].kind == NodeKind::Beta) r = root(id);
@@ -236,11 +236,8 @@ class PlanarTree::Builder {
     bd.sign = forward ? 1.0 : -1.0;  // e = β_b − β_a
     const int parent_beta = forward ? h.a : h.b, own_beta = forward ? h.b : h.a;
     bd.offset = x_[nodes_[parent_beta].coord] - x_[nodes_[own_beta].coord];
-    const SystemElement& se = sys_.elements[h.element];
-    if (se.has_constitutive) {
-      bd.stiffness = se.S(0, 0);
-      bd.damping = se.D(0, 0);
-    }
+    bd.stiffness = h.stiffness;
+    bd.damping = h.damping;
     return bd;
   }
 
@@ -293,6 +290,14 @@ class PlanarTree::Builder {
     return true;
   }
 
+  // The rigid-motion row of coordinate g for a body pinned at p0 (see rigid_row).
+  Eigen::RowVector3d rigid_row_of(int g, const Eigen::Vector2d& p0) const {
+    const int id = sys_.coord_label[g][0];
+    const NodeInfo& node = nodes_.at(id);
+    const Eigen::Vector2d b = node.kind == NodeKind::XY ? Eigen::Vector2d(xy(id) - p0) : Eigen::Vector2d::Zero();
+    return rigid_row(node.kind, g - node.coord, b);
+  }
+
   // The element's mass matrix on the rigid motions about the pin p0: Tᵀ M T.
   Eigen::Matrix3d element_inertia(const SystemElement& se, const Eigen::Vector2d& p0) {
     if (!se.has_mass) return Eigen::Matrix3d::Zero();
@@ -301,13 +306,7 @@ class PlanarTree::Builder {
     Eigen::MatrixXd M(n, n), T(n, 3);
     for (int a = 0; a < n; ++a) xl[a] = x_[se.coords[a]];
     se.kernel->mass(xl.data(), vl.data(), M.data(), h.data());
-    for (int a = 0; a < n; ++a) {
-      const int g = se.coords[a];
-      const NodeInfo& node = nodes_[sys_.coord_label[g][0]];
-      const Eigen::Vector2d b = node.kind == NodeKind::XY ? Eigen::Vector2d(xy(sys_.coord_label[g][0]) - p0)
-                                                          : Eigen::Vector2d::Zero();
-      T.row(a) = rigid_row(node.kind, g - node.coord, b);
-    }
+    for (int a = 0; a < n; ++a) T.row(a) = rigid_row_of(se.coords[a], p0);
     return T.transpose() * M * T;
   }
 
@@ -318,7 +317,7 @@ class PlanarTree::Builder {
     const Eigen::Vector2d b = point ? Eigen::Vector2d(xy(id) - p0) : Eigen::Vector2d::Zero();
     for (int c = 0; c < (point ? 2 : 1); ++c) {
       const int g = n.coord + c;
-      const Eigen::RowVector3d row = rigid_row(n.kind, c, b);
+      const Eigen::RowVector3d row = rigid_row_of(g, p0);
       I += sys_.point_mass[g] * row.transpose() * row;
       if (sys_.force[g] != 0.0) tree_.loads_.push_back({index, point ? c : 2, b, sys_.force[g]});
     }
@@ -328,9 +327,7 @@ class PlanarTree::Builder {
   // Released hinges: springs and dampers between two bodies (or a body and the ground).
   bool attach_springs() {
     for (const Hinge& h : hinges_) {
-      if (h.dof >= 0) continue;
-      const SystemElement& se = sys_.elements[h.element];
-      if (!se.has_constitutive) continue;  // a released hinge without stiffness only measures
+      if (h.dof >= 0 || (h.stiffness == 0.0 && h.damping == 0.0)) continue;  // a measuring hinge
       Spring s;
       auto end = [&](int id, int& body, double& beta0) {
         const int b = body_of_beta(id);
@@ -339,8 +336,8 @@ class PlanarTree::Builder {
       };
       end(h.a, s.body_a, s.beta0_a);
       end(h.b, s.body_b, s.beta0_b);
-      s.stiffness = se.S(0, 0);
-      s.damping = se.D(0, 0);
+      s.stiffness = h.stiffness;
+      s.damping = h.damping;
       tree_.springs_.push_back(s);
     }
     return true;
@@ -351,7 +348,7 @@ class PlanarTree::Builder {
   PlanarTree& tree_;
   std::map<int, NodeInfo> nodes_;
   std::map<int, int> dof_of_coord_;    // DYNX coordinate → its position in q
-  std::vector<int> beams_;
+  std::vector<std::pair<int, std::vector<int>>> beams_;  // moving rigid beams: element, nodes
   std::vector<Hinge> hinges_;
   std::map<int, int> root_;            // union-find over the BETA nodes of beams
   std::map<int, int> body_of_root_;
