@@ -98,15 +98,17 @@ def machine_table(info: dict) -> list:
 
 # --- timing ---------------------------------------------------------------------------------
 
-def best_time(fn, repeat: int = 3, budget: float = 5.0, min_time: float = 0.0):
+def best_time(fn, repeat: int = 3, budget: float = 5.0, min_time: float = 0.0, setup=None):
     """Best wall time of fn() over at least ``repeat`` calls that together last at least
     ``min_time`` seconds (short calls are repeated over a window long enough that a burst of
     load on the shared machine cannot cover all of them); fewer once the next call would exceed
-    ``budget`` seconds in all. Returns (seconds, last return value)."""
+    ``budget`` seconds in all. With ``setup``, each call is fn(setup()), setup outside the timing.
+    Returns (seconds, last return value)."""
     best, value, spent, k = float("inf"), None, 0.0, 0
     while True:
+        args = () if setup is None else (setup(),)
         start = time.perf_counter()
-        value = fn()
+        value = fn(*args)
         dt = time.perf_counter() - start
         best, spent, k = min(best, dt), spent + dt, k + 1
         if spent * (k + 1) / k > budget or (k >= repeat and spent >= min_time):
@@ -117,15 +119,9 @@ def simulate_best(model, repeat: int = 3, budget: float = 2.0, recursive: bool =
     """Best wall time of ``spacar.simulate`` as :func:`best_time`, each run on a fresh copy of the
     model (copied outside the timing); returns (results of the last run, seconds).
     ``recursive=False``: the general path only."""
-    best, res, spent, k = float("inf"), None, 0.0, 0
-    while True:
-        m = model.copy()
-        start = time.perf_counter()
-        res = spacar.simulate(m, recursive=recursive)
-        wall = time.perf_counter() - start
-        best, spent, k = min(best, wall), spent + wall, k + 1
-        if spent * (k + 1) / k > budget or (k >= repeat and spent >= min_time):
-            return res, best
+    best, res = best_time(lambda m: spacar.simulate(m, recursive=recursive), repeat, budget, min_time,
+                          setup=model.copy)
+    return res, best
 
 
 def in_run_per_rhs(model, min_time: float = 0.5, min_runs: int = 3, recursive: bool = True):
