@@ -5,7 +5,7 @@ cantilever (cantilever.py) and the manual's slider-crank against exudyn (sliderc
 
     python benchmarks/run_all.py [--quick] [--no-write] [--only chains fourbar ...]
 
-``--quick`` runs tiny sizes in seconds (the smoke test of tests/test_benchmarks.py; it writes
+``--quick`` runs tiny sizes in seconds (the smoke test of tests/peers/test_benchmarks.py; it writes
 nothing unless asked to, so the committed figures stay those of a full run). A full run takes
 about 10–15 minutes on the machine of docs/performance.md, most of it in the 1000-element
 cantilever and the 100-link chain.

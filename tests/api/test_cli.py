@@ -17,7 +17,7 @@ import pytest
 import spacar
 from spacar.keywords import LOOKUP
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
 
 SCRIPT = Path(sys.executable).parent / ("spacar.exe" if os.name == "nt" else "spacar")
 

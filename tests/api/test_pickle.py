@@ -15,7 +15,7 @@ import pytest
 import spacar
 from spacar import InputError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 
 SPATIAL = """\

@@ -26,7 +26,7 @@ from spacar.geometry import ElementGeometry, Geometry, shapes  # noqa: E402
 
 Image = pytest.importorskip("PIL.Image")
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 
 

@@ -8,7 +8,7 @@ import pytest
 import spacar
 import spacar.progress
 
-EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "slidercrank.dat"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
 
 
 def run(**kwargs):

@@ -15,7 +15,7 @@ import pytest
 
 import spacar
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 
 # Nodes of the manual's slider-crank and their kinds (manual §5.7): XY 1, 3, 6, 8; BETA 2, 4, 5, 7, 9.

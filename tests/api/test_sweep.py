@@ -14,7 +14,7 @@ import pytest
 import spacar
 from spacar import InputError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 
 SPEEDS = np.linspace(1.0, 2.0, 8)            # crank speed XD 2 1 [rad/s]; the manual: 1.5

@@ -25,9 +25,9 @@ import pytest
 
 import spacar
 from spacar import _core
-from equilibrium import static_equilibrium
+from support.equilibrium import static_equilibrium
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
 G = 9.81
 
 

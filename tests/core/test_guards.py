@@ -17,7 +17,7 @@ import spacar
 from spacar import InputError, KinematicsError, SpacarError, TimeLimitError
 from spacar.keywords import INT, KEYWORDS, REAL
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 TEXT = EXAMPLE.read_text()
 BODY = TEXT.replace("END\n", "")

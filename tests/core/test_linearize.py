@@ -33,9 +33,9 @@ from numpy.polynomial import legendre as gauss_legendre
 import spacar
 from spacar import _core
 from spacar.cli import main
-from equilibrium import static_equilibrium
+from support.equilibrium import static_equilibrium
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
 
 
 def omegas(lin):

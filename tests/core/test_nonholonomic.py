@@ -33,9 +33,9 @@ from scipy.optimize import brentq
 
 import spacar
 from spacar import _core
-from spatial_models import R_, body_angular_velocity
+from support.spatial_models import R_, body_angular_velocity
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BICYCLE = ROOT / "examples" / "bicycle.dat"
 
 TIGHT = dict(epsint=1e-12, epsind=1e-12, epskin=1e-12)

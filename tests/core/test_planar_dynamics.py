@@ -29,7 +29,7 @@ import spacar
 from spacar import _core
 
 G = 9.81
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def assert_finite(res):

@@ -24,7 +24,7 @@ from scipy.special import ellipk
 
 import spacar
 from spacar import cli
-from spatial_models import (
+from support.spatial_models import (
     PLANAR_EXAMPLE,
     RSSR,
     SPATIAL_EXAMPLE,

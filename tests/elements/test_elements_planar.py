@@ -1,7 +1,7 @@
 """Element-level verification of the planar elements PLTRUSS, PLBEAM, PLBEAMNL, PLHINGE
 (issue #3; formulation.md §4.1–4.4, §10.1) through `spacar._core.element_kernel`.
 
-The generic finite-difference and invariance checks live in element_checks.py (one line per
+The generic finite-difference and invariance checks live in support/element_checks.py (one line per
 element type below); this module adds closed-form and independent physical references:
 deformation formulas of §4, constant curvature, the PLBEAMNL arc expansion, constitutive
 matrices and beam-theory strain energy, rigid-bar kinetic energy, the Hermite-interpolated mass
@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from element_checks import (  # noqa: F401  (record: fixture used by the generic checks)
+from support.element_checks import (  # noqa: F401  (record: fixture used by the generic checks)
     N_CONFIGS,
     ElementCase,
     GenericElementChecks,
@@ -312,7 +312,7 @@ def test_gravity_loads(type_):
 def test_element_checks_finite_differences_are_accurate():
     """The difference helpers themselves reach the accuracy the checks rely on (known
     derivatives of a smooth non-polynomial function)."""
-    from element_checks import (hessian_fd, jacobian_fd, rel_err, second_directional_fd,
+    from support.element_checks import (hessian_fd, jacobian_fd, rel_err, second_directional_fd,
                                 STEP_FIRST, STEP_SECOND)
 
     def f(x):
@@ -329,7 +329,7 @@ def test_element_checks_finite_differences_are_accurate():
 
 def test_element_checks_rigid_motion_of_euler_parameters():
     """Helper for spatial elements: R(q ⊗ λ) = R(q) R(λ), R orthogonal for unit λ."""
-    from element_checks import quat_mul, random_unit_quaternion, rotation_matrix
+    from support.element_checks import quat_mul, random_unit_quaternion, rotation_matrix
 
     rng = np.random.default_rng(1)
     for _ in range(5):

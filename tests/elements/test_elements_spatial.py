@@ -1,7 +1,7 @@
 """Element-level verification of the spatial elements TRUSS, BEAM, BEAMNL, HINGE, L2MIN1
 (issue #4; formulation.md §0, §4.1, §4.8–4.10, §4.13, §10.1) through `spacar._core.element_kernel`.
 
-The generic finite-difference and invariance checks live in element_checks.py (one line per
+The generic finite-difference and invariance checks live in support/element_checks.py (one line per
 case below; for element types with LAMBDA nodes the derivative checks run at unit Euler
 parameters and again off the unit sphere, where R(λ) is the quadratic form of §0). This module
 adds closed forms and independent references: the deformation formulas of §4 evaluated with
@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from element_checks import (  # noqa: F401  (record: fixture used by the generic checks)
+from support.element_checks import (  # noqa: F401  (record: fixture used by the generic checks)
     N_CONFIGS,
     OFF_SPHERE_NORMS,
     ElementCase,

@@ -2,7 +2,7 @@
 and PLBELT (issue #6; formulation.md §4.5–4.7, §4.11, §4.12, §4.14, §10.1) through
 `spacar._core.element_kernel`.
 
-Generic checks (element_checks.py, at N_CONFIGS random configurations, unit and non-unit Euler
+Generic checks (support/element_checks.py, at N_CONFIGS random configurations, unit and non-unit Euler
 parameters): B, the convective term c, Σσ_iΓ_i, mass and gravity against differences. Wheel slips
 are velocity-level deformations (only ė = B(x)ẋ exists), so for those rows
 
@@ -34,7 +34,7 @@ import scipy.optimize
 import pytest
 
 import spacar
-from element_checks import (  # noqa: F401  (record: fixture used by the generic checks)
+from support.element_checks import (  # noqa: F401  (record: fixture used by the generic checks)
     N_CONFIGS,
     REL_TOL,
     STEP_FIRST,

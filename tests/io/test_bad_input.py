@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 import spacar
 from spacar import InputError
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
 
 BASE = EXAMPLE.read_text().splitlines()  # 23 lines, END on line 23
 

@@ -15,7 +15,7 @@ import spacar
 import spacar.docgen
 from spacar.io.matasc import STATE_FILES
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 
 # Manual §5.1: the element types with their deformation counts (formulation.md §4).

@@ -1,5 +1,5 @@
 """Fuzzing (issue #9): hostile input texts and Python API calls raise only spacar errors — no
-crash, no hang, no other exception, no silent non-finite result. The harness is tests/fuzzing.py
+crash, no hang, no other exception, no silent non-finite result. The harness is tests/support/fuzzing.py
 (what is generated and checked: its docstring and docs/robustness.md).
 
 The default run tries 10^3 cases (derandomized: the same cases every run); the long campaign of
@@ -15,7 +15,7 @@ import pytest
 from hypothesis import HealthCheck, event, given, settings
 
 import spacar
-from fuzzing import FUZZ_MEMORY_LIMIT, campaign, cases, run_case
+from support.fuzzing import FUZZ_MEMORY_LIMIT, campaign, cases, run_case
 
 
 @pytest.fixture(autouse=True, scope="module")

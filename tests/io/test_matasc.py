@@ -16,7 +16,7 @@ import pytest
 
 import spacar
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 STATE = {"x": "x", "xd": "xd", "xdd": "xdd", "e": "e", "ed": "ed", "edd": "edd"}
 NUMBER = re.compile(r"^-?\d\.\d{15}E[+-]\d{2,3}$")

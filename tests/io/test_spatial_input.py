@@ -16,7 +16,7 @@ import pytest
 
 import spacar
 from spacar import InputError, KinematicsError
-from spatial_models import RSSR, SPATIAL_EXAMPLE, rssr_model
+from support.spatial_models import RSSR, SPATIAL_EXAMPLE, rssr_model
 
 BASE = SPATIAL_EXAMPLE.read_text().splitlines()
 FILE = "file.dat"

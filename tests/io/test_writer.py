@@ -14,8 +14,8 @@ import pytest
 
 import spacar
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
-MANUAL_OUTPUT = Path(__file__).resolve().parent / "data" / "manual_output.dat"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+MANUAL_OUTPUT = Path(__file__).resolve().parents[1] / "data" / "manual_output.dat"
 
 INT_FIELD = re.compile(r"[+-]?\d+")
 REAL_FIELD = re.compile(r"-?\d\.\d{3}E[+-]\d{2}")  # %10.3E, as the manual prints

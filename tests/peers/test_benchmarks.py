@@ -11,7 +11,7 @@ import pytest
 pytest.importorskip("pinocchio")
 pytest.importorskip("exudyn")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_run_all_quick(tmp_path):

@@ -26,9 +26,9 @@ the default run, by a faulthandler watchdog that ends the process with a traceba
 
 The long campaign::
 
-    python tests/fuzzing.py --cases 100000 --workers 2 --report fuzz-report.json
+    python tests/support/fuzzing.py --cases 100000 --workers 2 --report fuzz-report.json
 
-or ``pytest -m slow tests/test_fuzz.py``; see docs/robustness.md.
+or ``pytest -m slow tests/io/test_fuzz.py``; see docs/robustness.md.
 """
 from __future__ import annotations
 
@@ -60,7 +60,7 @@ from spacar import SpacarError
 from spacar._util import show
 from spacar.keywords import INT, KEYWORDS
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = (ROOT / "examples" / "slidercrank.dat").read_text()
 EXAMPLE_LINES = EXAMPLE.splitlines()
 

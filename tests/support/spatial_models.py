@@ -10,7 +10,7 @@ import numpy as np
 
 import spacar
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 PLANAR_EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 SPATIAL_EXAMPLE = ROOT / "examples" / "slidercrank3d.dat"
 

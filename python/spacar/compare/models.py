@@ -1,4 +1,4 @@
-"""Parametrised spacar models used by the cross-checks (tests/test_compare.py) and the
+"""Parametrised spacar models used by the cross-checks (tests/peers/test_compare.py) and the
 benchmarks (benchmarks/*.py): pendulum chains, a four-bar linkage, a flexible cantilever and the
 manual's slider-crank with a refinable connecting rod. Every function returns a new
 :class:`spacar.Model`; none needs a peer library.
