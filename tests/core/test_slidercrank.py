@@ -9,79 +9,20 @@ reference of formulation.md §10.5 with a tight run.
 from __future__ import annotations
 
 import math
-import re
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+from support.manual import OUTPUT, parse_dump, values
+
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 
-# The state after 5 s as printed in the manual (§5.7), line for line.
-MANUAL_DUMP = """\
-PLBEAM 1 1 2 3 4
-PLBEAM 2 3 5 6 7
-PLBEAM 3 6 7 8 9
-XY 1 0.000E+00 0.000E+00
-BETA 2 7.500E+00
-XY 3 5.199E-02 1.407E-01
-BETA 4 7.500E+00
-BETA 5 -4.443E-01
-XY 6 1.863E-01 7.383E-02
-BETA 7 -4.903E-01
-XY 8 3.168E-01 0.000E+00
-BETA 9 -5.279E-01
-FIX 1 1
-FIX 1 2
-INPUTX 2 1
-FIX 8 2
-DYNE 2 2
-DYNE 2 3
-DYNE 3 2
-DYNE 3 3
-TIME 5.000E+00
-XD 2 1 1.500E+00
-XDD 2 1 0.000E+00
-E 2 2 2.673E-03
-ED 2 2 -3.049E-03
-EDD 2 2 -6.476E-02
-E 2 3 4.227E-03
-ED 2 3 -5.511E-04
-EDD 2 3 -2.260E-02
-E 3 2 3.644E-03
-ED 3 2 -4.904E-03
-EDD 3 2 -1.124E-01
-E 3 3 1.996E-03
-ED 3 3 -5.660E-04
-EDD 3 3 -1.237E-02
-LENGTHO 1 1.500E-01
-LENGTHO 2 1.500E-01
-LENGTHO 3 1.500E-01
-LGEOMY 1 0.000E+00
-LGEOMY 2 0.000E+00
-LGEOMY 3 0.000E+00
-MASS 8 3.337E-02
-EMASS 1 2.225E-01
-EMASS 2 2.225E-01
-EMASS 3 2.225E-01
-ESTIFF 2 0.000E+00 1.272E-03
-ESTIFF 3 0.000E+00 1.272E-03
-HMAX 9.999E+03
-MAXITERAT 10
-EPSKIN 1.000E-05
-EPSINT 1.000E-03
-EPSIND 1.000E-03
-FORCEMODE 1
-ANIMATE 0
-MATASC 0
-RESTART 0
-TIMESTEP 100 5.000E+00
-END
-"""
-
-MANUAL_E = {(2, 2): 2.673e-3, (2, 3): 4.227e-3, (3, 2): 3.644e-3, (3, 3): 1.996e-3}
+# The state after 5 s as printed in the manual (§5.7), line for line (tests/data/manual_output.dat).
+MANUAL_DUMP = OUTPUT.read_text()
+MANUAL_E = values(parse_dump(MANUAL_DUMP), "E")
 
 # formulation.md §10.5: EPSINT = EPSIND <= 1e-9, EPSKIN <= 1e-10, computed independently.
 REFERENCE_X = {(6, 1): 0.18626269, (6, 2): 0.073824983, (8, 1): 0.31683785,
@@ -89,26 +30,6 @@ REFERENCE_X = {(6, 1): 0.18626269, (6, 2): 0.073824983, (8, 1): 0.31683785,
 REFERENCE_E = {(2, 2): 2.667780e-3, (2, 3): 4.226856e-3, (3, 2): 3.642987e-3, (3, 3): 1.996420e-3}
 REFERENCE_ED = {(2, 2): -1.071406e-3, (2, 3): -2.305586e-3, (3, 2): -3.190691e-3, (3, 3): -2.067621e-3}
 REFERENCE_EDD = {(2, 2): -7.801533e-3, (2, 3): -6.124673e-2, (3, 2): -7.692693e-2, (3, 3): -3.710492e-2}
-
-_INT = re.compile(r"^[+-]?\d+$")
-
-
-def parse_line(line):
-    """(keyword, integer fields, real fields as (value, text)) of one dump line."""
-    tokens = line.split()
-    ints, reals = [], []
-    for tok in tokens[1:]:
-        if _INT.match(tok) and not reals:
-            ints.append(int(tok))
-        else:
-            reals.append((float(tok), tok))
-    return tokens[0].upper(), tuple(ints), reals
-
-
-def parse_dump(text):
-    """The non-comment lines of a dump, parsed."""
-    return [parse_line(line) for line in text.splitlines() if line.strip() and not line.startswith("*")]
-
 
 def last_digit_units(ours: float, manual_text: str) -> float:
     """|ours - manual| in units of the last printed digit of the manual's 4-digit mantissa."""
@@ -125,20 +46,6 @@ def run_cli(path, *options):
     dump = parse_dump(proc.stdout)
     assert all(math.isfinite(v) for _, _, reals in dump for v, _ in reals), "non-finite value printed"
     return dump
-
-
-def values(dump, keyword):
-    """{(n, i): value} of XY/BETA (per component) or E/ED/EDD lines."""
-    out = {}
-    for kw, ints, reals in dump:
-        if kw != keyword:
-            continue
-        if keyword in ("XY", "BETA"):
-            for i, (v, _) in enumerate(reals, start=1):
-                out[(ints[0], i)] = v
-        else:
-            out[(ints[0], ints[1])] = reals[0][0]
-    return out
 
 
 @pytest.fixture(scope="module")

@@ -1,41 +1,14 @@
 """The element catalogue and the keyword table against the manual (§5.1-5.6) and formulation.md §4.
 
-The expected tables are transcribed here from those documents, not taken from the code.
+The expected tables are transcribed from those documents in support/manual.py, not taken from the code.
 """
 import pytest
 
 import spacar
+from support.manual import ELEMENTS, KEYWORDS
 
-XY, BETA, XYZ, LAMBDA = "XY", "BETA", "XYZ", "LAMBDA"
-
-# type: (node kinds in order, number of deformations, (min, max) numbers on the definition line
-# after the nodes) -- manual §5.1 (nodes, parameters), formulation §4 (kinds, deformations).
-ELEMENTS = {
-    "BEAM": ((XYZ, LAMBDA, XYZ, LAMBDA), 6, (3, 3)),      # x y z
-    "BEAMNL": ((XYZ, LAMBDA, XYZ, LAMBDA), 6, (3, 3)),    # x y z
-    "TRUSS": ((XYZ, XYZ), 1, (0, 0)),
-    "HINGE": ((LAMBDA, LAMBDA), 3, (3, 3)),               # axis x y z
-    "BEARING": ((XYZ, LAMBDA, XYZ, LAMBDA), 6, (3, 3)),   # axis x y z
-    "SURFACE": ((XYZ,), 1, (10, 10)),                     # c1..c10
-    "L2MIN1": ((LAMBDA,), 1, (0, 0)),
-    "PLBEAM": ((XY, BETA, XY, BETA), 3, (0, 0)),
-    "PLBEAMNL": ((XY, BETA, XY, BETA), 3, (0, 0)),
-    "PLHINGE": ((BETA, BETA), 1, (0, 0)),
-    "PLTRUSS": ((XY, XY), 1, (0, 0)),
-    "PLBELT": ((XY, BETA, XY, BETA), 1, (2, 2)),          # r1 r2
-    "PLBEAR": ((XY, BETA, XY, BETA), 3, (0, 0)),
-    "PLWHEEL": ((XY, BETA, BETA), 2, (3, 3)),             # r x y
-}
-
-# Every keyword of manual §5.1-5.6 (element keywords above).
-MANUAL_KEYWORDS = list(ELEMENTS) + [
-    "X", "XY", "BETA", "XYZ", "LAMBDA",                                       # §5.2
-    "FIX", "INPUTX", "DYNX", "RLSE", "INPUTE", "DYNE", "LINE", "ENHC",        # §5.3
-    "XD", "XDD", "E", "ED", "EDD", "TIME", "DIR", "LGEOMY", "LENGTHO",        # §5.4
-    "MASS", "EMASS", "ESTIFF", "EDAMPP", "FORCE", "TORQUEL",                  # §5.5
-    "TIMESTEP", "HMAX", "MAXITERAT", "EPSKIN", "EPSINT", "EPSIND", "FORCEMODE",  # §5.6
-    "ANIMATE", "MATASC", "JOBID", "RESTART", "EOF", "END",
-]
+# Manual §5.1 (the element types) and every keyword of §5.1-5.6.
+MANUAL_KEYWORDS = list(ELEMENTS) + KEYWORDS
 
 
 @pytest.fixture(scope="module")

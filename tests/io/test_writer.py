@@ -13,9 +13,10 @@ from pathlib import Path
 import pytest
 
 import spacar
+from support.manual import OUTPUT
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
-MANUAL_OUTPUT = Path(__file__).resolve().parents[1] / "data" / "manual_output.dat"
+MANUAL_OUTPUT = OUTPUT
 
 INT_FIELD = re.compile(r"[+-]?\d+")
 REAL_FIELD = re.compile(r"-?\d\.\d{3}E[+-]\d{2}")  # %10.3E, as the manual prints
