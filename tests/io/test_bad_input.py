@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 import spacar
 from spacar import InputError
+from support.fuzzing import LINE_EDITS, mutated_lines
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
 
@@ -192,40 +193,9 @@ tokens = st.one_of(
 )
 
 
-@st.composite
-def mutated_example(draw):
-    lines = list(BASE)
-    for _ in range(draw(st.integers(1, 5))):
-        op = draw(st.sampled_from(["delete", "duplicate", "swap", "token", "keyword", "insert", "append_token",
-                                   "drop_token", "truncate"]))
-        if not lines:
-            lines.append(draw(st.sampled_from(EXTRA_LINES)))
-            continue
-        i = draw(st.integers(0, len(lines) - 1))
-        words = lines[i].split()
-        if op == "delete":
-            del lines[i]
-        elif op == "duplicate":
-            lines.insert(i, lines[i])
-        elif op == "swap":
-            j = draw(st.integers(0, len(lines) - 1))
-            lines[i], lines[j] = lines[j], lines[i]
-        elif op == "token" and words:
-            words[draw(st.integers(0, len(words) - 1))] = draw(tokens)
-            lines[i] = " ".join(words)
-        elif op == "keyword" and words:
-            words[0] = draw(st.sampled_from(KEYWORD_NAMES))
-            lines[i] = " ".join(words)
-        elif op == "insert":
-            lines.insert(i, draw(st.sampled_from(EXTRA_LINES)))
-        elif op == "append_token":
-            lines[i] = " ".join(words + [draw(tokens)])
-        elif op == "drop_token" and words:
-            lines[i] = " ".join(words[:-1])
-        elif op == "truncate":
-            text = "\n".join(lines)
-            lines = text[:draw(st.integers(0, len(text)))].split("\n")
-    return "\n".join(lines) + "\n"
+def mutated_example():
+    return mutated_lines(BASE, LINE_EDITS, max_edits=5, token=tokens, keyword=st.sampled_from(KEYWORD_NAMES),
+                         new_line=st.sampled_from(EXTRA_LINES))
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -142,14 +142,22 @@ EXTREME_LINES = ["TIMESTEP 1000000000 1", "TIMESTEP 10000000 5.0", "TIMESTEP 100
                  "FORCEMODE 2", "RESTART 1", "RLSE 2", "INPUTE 3 1", "ED 3 1 0.1", "DYNX 8 1", "INPUTX 8 1"]
 
 
+# The edits of mutated_lines that need no pool beyond its token, keyword and new_line strategies
+# ("extreme" needs extreme_line; "random_line" inserts a new_line, as "insert" does).
+LINE_EDITS = ["delete", "duplicate", "swap", "token", "keyword", "insert", "append_token", "drop_token", "truncate"]
+
+
 @st.composite
-def mutated_example(draw):
-    lines = list(EXAMPLE_LINES)
-    for _ in range(draw(st.integers(1, 3))):
-        op = draw(st.sampled_from(["delete", "duplicate", "swap", "token", "keyword", "insert", "extreme",
-                                   "append_token", "drop_token", "truncate", "random_line"]))
+def mutated_lines(draw, lines, edits, max_edits, token, keyword, new_line, extreme_line=None):
+    """The text of ``lines`` after 1 to ``max_edits`` random edits, each one of ``edits``: delete,
+    duplicate or swap lines, replace a token (drawn from ``token``) or the keyword (``keyword``),
+    insert a line (``new_line``; "random_line" does the same, "extreme" inserts an
+    ``extreme_line`` anywhere), append or drop a token, or truncate the text anywhere."""
+    lines = list(lines)
+    for _ in range(draw(st.integers(1, max_edits))):
+        op = draw(st.sampled_from(edits))
         if not lines:
-            lines.append(draw(keyword_line()))
+            lines.append(draw(new_line))
             continue
         i = draw(st.integers(0, len(lines) - 1))
         words = lines[i].split()
@@ -161,23 +169,31 @@ def mutated_example(draw):
             j = draw(st.integers(0, len(lines) - 1))
             lines[i], lines[j] = lines[j], lines[i]
         elif op == "token" and words:
-            words[draw(st.integers(0, len(words) - 1))] = draw(tokens())
+            words[draw(st.integers(0, len(words) - 1))] = draw(token)
             lines[i] = " ".join(words)
         elif op == "keyword" and words:
-            words[0] = draw(st.sampled_from(_keyword_names()))
+            words[0] = draw(keyword)
             lines[i] = " ".join(words)
         elif op in ("insert", "random_line"):
-            lines.insert(i, draw(keyword_line()))
+            lines.insert(i, draw(new_line))
         elif op == "extreme":
-            lines.insert(draw(st.integers(0, len(lines) - 1)), draw(st.sampled_from(EXTREME_LINES)))
+            lines.insert(draw(st.integers(0, len(lines) - 1)), draw(extreme_line))
         elif op == "append_token":
-            lines[i] = " ".join(words + [draw(tokens())])
+            lines[i] = " ".join(words + [draw(token)])
         elif op == "drop_token" and words:
             lines[i] = " ".join(words[:-1])
         elif op == "truncate":
             text = "\n".join(lines)
             lines = text[:draw(st.integers(0, len(text)))].split("\n")
     return "\n".join(lines) + "\n"
+
+
+def mutated_example():
+    """The manual's slider-crank with 1 to 3 edits, random keyword lines and extreme values among them."""
+    return mutated_lines(EXAMPLE_LINES, ["delete", "duplicate", "swap", "token", "keyword", "insert", "extreme",
+                                         "append_token", "drop_token", "truncate", "random_line"],
+                         max_edits=3, token=tokens(), keyword=st.sampled_from(_keyword_names()),
+                         new_line=keyword_line(), extreme_line=st.sampled_from(EXTREME_LINES))
 
 
 def _catalogue():
