@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import spacar
+from support.planar_models import compressed_cantilever
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
@@ -229,17 +230,7 @@ def test_pickle(run):
 
 
 def cantilever(n=4):
-    m = spacar.Model()
-    for k in range(1, n + 1):
-        m.plbeamnl(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
-        m.x(2 * k + 1, k / n, 0.0)
-        m.emass(k, 1.0)
-        m.estiff(k, 0.0, 1.0)
-        m.dyne(k, 2, 3)
-    m.fix(1)
-    m.fix(2)
-    m.force(2 * n + 1, -1.0, 0.0)
-    m.linear(2)
+    m = compressed_cantilever(n)
     m.timestep(2, 0.1)
     return m
 

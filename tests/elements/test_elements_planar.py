@@ -14,10 +14,13 @@ import numpy as np
 import pytest
 
 from support.element_checks import (  # noqa: F401  (record: fixture used by the generic checks)
+    GAUSS_W,
+    GAUSS_XI,
     N_CONFIGS,
     ElementCase,
     GenericElementChecks,
     chord,
+    hermite,
     orientations_only,
     random_configuration,
     record,
@@ -247,15 +250,6 @@ def test_pltruss_consistent_mass_matrix():
         np.testing.assert_allclose(M, ref.emass[0] * ref.l0 / 6 * np.block([[2 * I2, I2], [I2, 2 * I2]]),
                                    rtol=1e-14)
         assert not h.any()
-
-
-# Four-point Gauss-Legendre on [0, 1]: exact for |ṙ|² (degree 6 in ξ) of the Hermite field.
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
-GAUSS_XI, GAUSS_W = 0.5 * (_GL_X + 1), 0.5 * _GL_W
-
-
-def hermite(xi):
-    return np.array([1 - 3 * xi**2 + 2 * xi**3, xi - 2 * xi**2 + xi**3, 3 * xi**2 - 2 * xi**3, -(xi**2) + xi**3])
 
 
 @pytest.mark.parametrize("type_", BEAMS)

@@ -18,6 +18,8 @@ import numpy as np
 import pytest
 
 from support.element_checks import (  # noqa: F401  (record: fixture used by the generic checks)
+    GAUSS_W,
+    GAUSS_XI,
     N_CONFIGS,
     OFF_SPHERE_NORMS,
     ElementCase,
@@ -25,6 +27,7 @@ from support.element_checks import (  # noqa: F401  (record: fixture used by the
     Reference,
     assemble,
     chord,
+    hermite,
     jacobian_fd,
     orientations_only,
     quat_mul,
@@ -35,14 +38,10 @@ from support.element_checks import (  # noqa: F401  (record: fixture used by the
     skew,
     wrap_to_pi,
 )
+from support.spatial_models import E_ as E_of, G_ as G_of, hinge_frame, unit
 from spacar import _core
 
 TOL = 1e-14  # closed forms: round-off of a few operations on O(1) numbers
-
-
-def unit(v):
-    v = np.asarray(v, dtype=float)
-    return v / np.linalg.norm(v)
 
 
 def section_frame(rng, ex):
@@ -121,14 +120,6 @@ def samples_on_and_off_sphere(case, check):
 # Euler-parameter matrices of §0 (independent numpy versions)
 # ---------------------------------------------------------------------------------------------
 
-def E_of(l):
-    return np.array([[-l[1], l[0], -l[3], l[2]], [-l[2], l[3], l[0], -l[1]], [-l[3], -l[2], l[1], l[0]]])
-
-
-def G_of(l):
-    return np.array([[-l[1], l[0], l[3], -l[2]], [-l[2], -l[3], l[0], l[1]], [-l[3], l[2], -l[1], l[0]]])
-
-
 def T_of(l, c):
     """T_c(λ) = ∂(R(λ)c)/∂λ = 2 [λ0 c + λ̄×c | (λ̄·c)I + λ̄cᵀ − cλ̄ᵀ − λ0 c~] (§0)."""
     l0, lb = l[0], np.asarray(l[1:4])
@@ -160,15 +151,6 @@ def test_euler_parameter_helpers():
 # ---------------------------------------------------------------------------------------------
 # Deformations: closed forms of §4 with R(λ) as the quadratic form (unit and non-unit λ)
 # ---------------------------------------------------------------------------------------------
-
-def hinge_frame(axis):
-    """§4.10: e_x0 = axis/|axis|; e_y0 = the global unit axis along which |e_x0| has its smallest
-    component (ties → first), orthogonalised; e_z0 = e_x0 × e_y0."""
-    ex = unit(axis)
-    k = int(np.argmin(np.abs(np.asarray(axis, float))))  # argmin: first of equal minima
-    y = unit(np.eye(3)[k] - ex[k] * ex)
-    return np.column_stack([ex, y, np.cross(ex, y)])
-
 
 def beam_closed_form(x, l0, C0, nonlinear):
     d = x[7:10] - x[0:3]
@@ -515,15 +497,6 @@ def test_rotary_inertia_adds_section_energy():
             plain = _core.element_kernel("BEAM", l0=ref.l0, lgeomy=list(ref.lgeomy), emass=[emass[0]])
             np.testing.assert_allclose(full.kinetic_energy(x, xd) - plain.kinetic_energy(x, xd), T_rot,
                                        rtol=1e-12, atol=1e-14)
-
-
-# Four-point Gauss-Legendre on [0, 1]: exact for the degree-6 polynomials of the Hermite field.
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
-GAUSS_XI, GAUSS_W = 0.5 * (_GL_X + 1), 0.5 * _GL_W
-
-
-def hermite(xi):
-    return np.array([1 - 3 * xi**2 + 2 * xi**3, xi - 2 * xi**2 + xi**3, 3 * xi**2 - 2 * xi**3, -(xi**2) + xi**3])
 
 
 @pytest.mark.parametrize("label", ["BEAM", "BEAM+rotary", "BEAMNL+rotary"])

@@ -56,32 +56,14 @@ from support.element_checks import (  # noqa: F401  (record: fixture used by the
     second_directional_fd,
     skew,
 )
+from support.spatial_models import E_ as E_of, hinge_frame, unit
 from spacar import _core
 
 TOL = 1e-13  # closed forms: round-off of a few operations on O(1) numbers
 
 
-def unit(v):
-    v = np.asarray(v, dtype=float)
-    return v / np.linalg.norm(v)
-
-
 def rot2(b):
     return np.array([[math.cos(b), -math.sin(b)], [math.sin(b), math.cos(b)]])
-
-
-def hinge_frame(axis):
-    """§4.10: e_x0 = axis/|axis|; e_y0 = the global unit axis along which |e_x0| has its smallest
-    component (ties → first), orthogonalised; e_z0 = e_x0 × e_y0."""
-    ex = unit(axis)
-    k = int(np.argmin(np.abs(np.asarray(axis, float))))
-    y = unit(np.eye(3)[k] - ex[k] * ex)
-    return np.column_stack([ex, y, np.cross(ex, y)])
-
-
-def E_of(l):
-    """E(λ) of §0: ω = 2 E(λ) λ̇."""
-    return np.array([[-l[1], l[0], -l[3], l[2]], [-l[2], l[3], l[0], -l[1]], [-l[3], -l[2], l[1], l[0]]])
 
 
 def velocity_rows(k):

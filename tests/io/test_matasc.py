@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import spacar
+from support.planar_models import compressed_cantilever
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
@@ -244,17 +245,7 @@ def test_models_built_in_python_write_spacar_files(tmp_path, monkeypatch):
 def test_linearization_files(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     n = 3
-    model = spacar.Model()
-    for k in range(1, n + 1):
-        model.plbeamnl(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
-        model.x(2 * k + 1, k / n, 0.0)
-        model.emass(k, 1.0)
-        model.estiff(k, 0.0, 1.0)
-        model.dyne(k, 2, 3)
-    model.fix(1)
-    model.fix(2)
-    model.force(2 * n + 1, -1.0, 0.0)
-    model.linear(2)
+    model = compressed_cantilever(n)
     model.matasc(1)
     model.timestep(4, 0.2)
     res = spacar.simulate(model)

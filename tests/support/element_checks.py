@@ -160,6 +160,20 @@ def random_unit_quaternion(rng):
 
 
 # ---------------------------------------------------------------------------------------------
+# Beam fields (the mass models by quadrature)
+# ---------------------------------------------------------------------------------------------
+
+def hermite(xi):
+    """The cubic Hermite shape functions on [0, 1] (values at 0 and 1, slopes at 0 and 1)."""
+    return np.array([1 - 3 * xi**2 + 2 * xi**3, xi - 2 * xi**2 + xi**3, 3 * xi**2 - 2 * xi**3, -(xi**2) + xi**3])
+
+
+# Four-point Gauss-Legendre on [0, 1]: exact for the degree-6 polynomials of the Hermite field.
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
+GAUSS_XI, GAUSS_W = 0.5 * (_GL_X + 1), 0.5 * _GL_W
+
+
+# ---------------------------------------------------------------------------------------------
 # Element cases, reference geometries, configurations
 # ---------------------------------------------------------------------------------------------
 

@@ -1,6 +1,7 @@
 """Models and closed-form references shared by the spatial dynamics and spatial input tests
-(issue #4): Euler-parameter matrices (formulation.md §0), the spatial RSSR/RSUR linkage with the
-closed-form solution of its loop equation, the BEAM cantilever and its numerical linearization.
+(issue #4) and the spatial element tests: Euler-parameter matrices (formulation.md §0), the HINGE
+reference frame (§4.10), the spatial RSSR/RSUR linkage with the closed-form solution of its loop
+equation, the BEAM cantilever and its numerical linearization.
 """
 from __future__ import annotations
 
@@ -44,6 +45,15 @@ def body_angular_velocity(lam, lamd):
 def unit(v):
     v = np.asarray(v, dtype=float)
     return v / np.linalg.norm(v)
+
+
+def hinge_frame(axis):
+    """§4.10: e_x0 = axis/|axis|; e_y0 = the global unit axis along which |e_x0| has its smallest
+    component (ties → first), orthogonalised; e_z0 = e_x0 × e_y0."""
+    ex = unit(axis)
+    k = int(np.argmin(np.abs(np.asarray(axis, float))))  # argmin: first of equal minima
+    y = unit(np.eye(3)[k] - ex[k] * ex)
+    return np.column_stack([ex, y, np.cross(ex, y)])
 
 
 def lambda_nodes(model):
