@@ -2,8 +2,9 @@
 
 * ``docs/keywords.md`` — every input keyword (spacar.docgen.keyword_reference),
 * ``docs/elements.md`` — the element catalogue (spacar.docgen.element_catalogue_markdown),
-* ``docs/figures/elements/<type>.svg`` — a small drawing of every implemented element type with
-  its nodes and deformations (matplotlib).
+* ``docs/figures/elements/<type>.svg`` — a small drawing of every element type with its nodes
+  and deformations (matplotlib): its own (FIGURES_BY_TYPE) or, until it has one, the default
+  figure (its node slots and deformation names).
 
 Usage: ``python docs/generate.py`` (write), ``python docs/generate.py --check`` (exit 1 if a
 generated text file differs from the committed one). The SVG files are written reproducibly
@@ -335,6 +336,27 @@ def fig_wheel(t):
     return fig
 
 
+def fig_default(t):
+    """The figure of a type without its own drawing: its node slots in input order (positions
+    as circles, orientations as arrows at the position before them) and its deformations."""
+    fig, ax, axt = _figure()
+    position, after_position = 0.0, False
+    for role, kind in zip(t.node_roles, t.nodes):
+        if kind.name in ("XY", "XYZ"):
+            position += 1.0
+            _node(ax, (position, 0.0), role, offset=(0.0, -0.15))
+            after_position = True
+        else:
+            position += 0.0 if after_position else 1.0
+            _arrow(ax, (position, 0.0), (0.3, 0.3))
+            ax.annotate(role, (position + 0.3, 0.3), xytext=(position + 0.32, 0.32), fontsize=9)
+            after_position = False
+    ax.set_xlim(0.4, position + 0.8)
+    ax.set_ylim(-0.5, 0.7)
+    _legend(axt, t, [], "Default figure: this element type has no drawing of its own in docs/generate.py.")
+    return fig
+
+
 FIGURES_BY_TYPE = {
     "PLBEAR": fig_plbear,
     "PLBELT": fig_plbelt,
@@ -365,12 +387,7 @@ def write_figures(directory: Path = FIGURES) -> list:
     directory.mkdir(parents=True, exist_ok=True)
     written = []
     for t in spacar.element_catalogue():
-        if not t.implemented:
-            continue
-        make = FIGURES_BY_TYPE.get(t.name)
-        if make is None:
-            raise SystemExit(f"docs/generate.py: no figure for the implemented element type {t.name}")
-        fig = make(t)
+        fig = FIGURES_BY_TYPE.get(t.name, fig_default)(t)
         path = directory / f"{t.name.lower()}.svg"
         fig.savefig(path, metadata={"Date": None, "Creator": None})
         plt.close(fig)

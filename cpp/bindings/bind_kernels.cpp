@@ -119,7 +119,6 @@ void bind_kernels(py::module_& m) {
         const int t = find_element_type(type);
         if (t < 0) throw InputError("unknown element type " + type);
         const ElementType& et = element_catalogue()[t];
-        if (!et.make) throw NotImplementedError(et.name + " is not implemented yet");
         ElementSetup s;
         s.params = params;
         s.l0 = l0;

@@ -107,6 +107,14 @@ void bind_catalogue(py::module_& m) {
       .value("XYZ", NodeKind::XYZ)
       .value("LAMBDA", NodeKind::Lambda);
   m.def("node_size", &node_size);
+  py::enum_<ElementFamily>(m, "ElementFamily")
+      .value("Other", ElementFamily::Other)
+      .value("Beam", ElementFamily::Beam)
+      .value("Truss", ElementFamily::Truss)
+      .value("Hinge", ElementFamily::Hinge)
+      .value("Belt", ElementFamily::Belt)
+      .value("Wheel", ElementFamily::Wheel);
+
   py::class_<ElementType>(m, "ElementType")
       .def_readonly("name", &ElementType::name)
       .def_readonly("nodes", &ElementType::nodes)
@@ -124,15 +132,11 @@ void bind_catalogue(py::module_& m) {
       .def_readonly("n_lgeomy", &ElementType::n_lgeomy)
       .def_readonly("has_direction", &ElementType::has_direction)
       .def_readonly("extension", &ElementType::extension)
-      .def_property_readonly("velocity_level",
-                             [](const ElementType& t) {
-                               std::vector<bool> v(t.deformations.size(), false);
-                               for (size_t i = 0; i < t.velocity_level.size() && i < v.size(); ++i)
-                                 v[i] = t.velocity_level[i];
-                               return v;
-                             })
+      .def_readonly("velocity_level", &ElementType::velocity_level)
+      .def_readonly("signed_emass_extras", &ElementType::signed_emass_extras)
+      .def_readonly("automatic", &ElementType::automatic)
+      .def_readonly("family", &ElementType::family)
       .def_readonly("description", &ElementType::description)
-      .def_property_readonly("implemented", [](const ElementType& t) { return t.make != nullptr; })
       .def_property_readonly("n_deformations", &ElementType::n_deformations);
   m.def("element_catalogue", &element_catalogue, py::return_value_policy::reference);
 }

@@ -428,7 +428,7 @@ void Model::set_emass(int id, const std::vector<double>& values) {
   if (t.n_emass == 0) fail(t.name, " has no distributed mass (EMASS); use MASS on its nodes");
   require_count(values, 1, t.n_emass, ("EMASS of " + t.name).c_str());
   if (values[0] < 0.0) fail("EMASS value 1 is negative (", values[0], ")");
-  if (t.name != "PLBELT") require_nonnegative(values, "EMASS");
+  if (!t.signed_emass_extras) require_nonnegative(values, "EMASS");
   el.emass = values;
 }
 
@@ -549,7 +549,7 @@ void Model::add_automatic_constraints() {
   std::map<int, bool> has_constraint;
   for (const auto& [id, n] : nodes)
     if (n.kind == NodeKind::Lambda) has_constraint[id] = false;
-  const int l2 = find_element_type("L2MIN1");
+  const int l2 = automatic_element_type();
   for (const auto& [id, el] : elements)
     if (el.type == l2) has_constraint[el.nodes[0]] = true;
   // Numbers after the largest element number; once that is the largest int (an input may use
@@ -564,7 +564,7 @@ void Model::add_automatic_constraints() {
   for (const auto& [node_id, has] : has_constraint) {
     if (has) continue;
     const int id = free_number();
-    add_element("L2MIN1", id, {node_id}, {});
+    add_element(element_catalogue()[l2].name, id, {node_id}, {});
     elements.at(id).automatic = true;
   }
 }

@@ -62,9 +62,6 @@ void number_coordinates(const Model& model, System& sys, std::map<int, int>& nod
 void build_elements(const Model& model, System& sys, const std::map<int, int>& node_offset, bool line_as_dof) {
   for (const auto& [id, el] : model.elements) {
     const ElementType& t = element_catalogue()[el.type];
-    if (!t.make)
-      throw NotImplementedError("element " + std::to_string(id) + ": the physics of " + t.name +
-                                " elements is not available in this version of spacar yet");
     ElementSetup setup;
     setup.params = el.params;
     setup.l0 = el.l0.value_or(0.0);
@@ -298,7 +295,7 @@ std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& de
   masses_and_loads(model, *sys, node_offset);
   length_scales(model, *sys);
   for (int k : sys->auto_released)
-    if (element_catalogue()[sys->elements[sys->e_element[k]].type].name != "L2MIN1")  // a fixed LAMBDA node is normal
+    if (!element_catalogue()[sys->elements[sys->e_element[k]].type].automatic)  // a fixed LAMBDA node is normal
       sys->warnings.push_back(sys->def_name(k) + " is fixed but none of its coordinates is calculable: it is checked, not solved for");
   return sys;
 }

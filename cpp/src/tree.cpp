@@ -89,11 +89,12 @@ class PlanarTree::Builder {
   bool read_elements() {
     for (size_t i = 0; i < sys_.elements.size(); ++i) {
       const SystemElement& se = sys_.elements[i];
-      const std::string& name = element_catalogue()[se.type].name;
+      // Every node is planar (read_nodes): the beams are PLBEAM(NL), the hinges PLHINGE.
+      const ElementFamily family = element_catalogue()[se.type].family;
       const std::vector<int> ids = element_nodes(sys_, se);
-      if (name == "PLBEAM" || name == "PLBEAMNL") {
+      if (family == ElementFamily::Beam) {
         if (!read_beam(static_cast<int>(i), se, ids)) return false;
-      } else if (name == "PLHINGE") {
+      } else if (family == ElementFamily::Hinge) {
         const int k = se.def_offset;
         int dof = -1;
         if (sys_.def_class[k] == DefClass::Dynamic)

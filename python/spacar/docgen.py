@@ -107,15 +107,14 @@ def keyword_reference() -> str:
     for group, kws in groups.items():
         out.append(f"\n## {group}\n")
         if group == ELEMENTS:
-            out.append("| keyword | line | meaning | nodes | deformations | implemented | Python |")
-            out.append("|---|---|---|---|---|---|---|")
+            out.append("| keyword | line | meaning | nodes | deformations | Python |")
+            out.append("|---|---|---|---|---|---|")
             for kw in kws:
                 t = catalogue[kw.name]
                 nodes = ", ".join(f"{r} {k.name}" for r, k in zip(t.node_roles, t.nodes))
                 meaning = t.description + (f"; {t.params}" if t.params else "")
-                impl = "yes" if t.implemented else "not yet (input accepted, analysis raises NotImplementedError)"
                 out.append(f"| <a id=\"{_anchor(kw.name)}\"></a>`{kw.name}` | `{element_usage(t)}` | {meaning} | "
-                           f"{nodes} | {t.n_deformations} ([list](elements.md#{_anchor(kw.name)})) | {impl} | "
+                           f"{nodes} | {t.n_deformations} ([list](elements.md#{_anchor(kw.name)})) | "
                            f"`Model.{kw.builder}` |")
             out.append("\nThe element keywords are followed by the element number, the node numbers in the order "
                        "of the *nodes* column and the numbers of the definition line. Nodes are created by the "
@@ -158,20 +157,16 @@ def element_catalogue_markdown() -> str:
            "Node kinds: `XY` planar position (x, y), `BETA` planar orientation (β), `XYZ` spatial position "
            "(x, y, z), `LAMBDA` spatial orientation (Euler parameters). Role names: `p` position, `o` "
            "orientation node.\n",
-           "| element | meaning | nodes | deformations | implemented |",
-           "|---|---|---|---|---|"]
+           "| element | meaning | nodes | deformations |",
+           "|---|---|---|---|"]
     cat = list(_core.element_catalogue())
     for t in cat:
         out.append(f"| [`{t.name}`](#{_anchor(t.name)}) | {t.description} | "
-                   f"{' '.join(k.name for k in t.nodes)} | {t.n_deformations} | {'yes' if t.implemented else 'not yet'} |")
+                   f"{' '.join(k.name for k in t.nodes)} | {t.n_deformations} |")
     for t in cat:
         out.append(f"\n<a id=\"{_anchor(t.name)}\"></a>\n## {t.name}: {t.description}\n")
         out.append(f"Input line: `{element_usage(t)}`" + ("  *(extension)*" if t.extension else "") + "\n")
-        if t.implemented:
-            out.append(f"![{t.name}](figures/elements/{t.name.lower()}.svg)\n")
-        else:
-            out.append("*Not implemented in the core yet*: the input is read and written, an analysis raises "
-                       "`spacar.NotImplementedError`.\n")
+        out.append(f"![{t.name}](figures/elements/{t.name.lower()}.svg)\n")
         out.append("| node | role | kind |")
         out.append("|---|---|---|")
         for j, (role, kind) in enumerate(zip(t.node_roles, t.nodes), start=1):

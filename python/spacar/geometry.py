@@ -15,18 +15,35 @@ consistent mass (formulation.md §4.2, §4.8)::
     H1 = 1 − 3ξ² + 2ξ³,  H2 = ξ − 2ξ² + ξ³,  H3 = 3ξ² − 2ξ³,  H4 = −ξ² + ξ³
 
 with t = (cos(α0 + β), sin(α0 + β)) for PLBEAM(NL) and t = R(λ) e_x0 for BEAM(NL).
+
+Each element is drawn by the drawing of its family (``ElementType.family`` of the catalogue:
+beams, trusses, hinges, belts, wheels); a type of another family is drawn as a line through its
+position nodes (a point if it has one, nothing if it has none).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
 
 POSITION_KINDS = ("XY", "XYZ")
 ORIENTATION_KINDS = ("BETA", "LAMBDA")
-BEAMS = ("PLBEAM", "PLBEAMNL", "BEAM", "BEAMNL")
+
+
+@lru_cache(maxsize=None)
+def _families() -> dict:
+    from . import _core
+
+    return {t.name: t.family.name for t in _core.element_catalogue()}
+
+
+def family(type_name: str) -> str:
+    """The catalogue family of an element type ("Beam", "Truss", "Hinge", "Belt", "Wheel"), or
+    "Other" (also for a type the catalogue does not know)."""
+    return _families().get(type_name, "Other")
 
 
 @dataclass
@@ -117,7 +134,7 @@ class Geometry:
         while changed:  # hinge chains: o1 -- HINGE -- o2
             changed = False
             for el in self.elements:
-                if el.type in ("HINGE", "PLHINGE"):
+                if family(el.type) == "Hinge":
                     a, b = el.nodes
                     if a in out and b not in out:
                         out[b] = out[a]
@@ -138,7 +155,7 @@ class Geometry:
                     continue
                 nxt = el.nodes[j + 1] if j + 1 < len(el.nodes) else None
                 orient = nxt if nxt is not None and self.node_kinds.get(nxt) in ORIENTATION_KINDS else None
-                if el.type in ("TRUSS", "PLTRUSS"):
+                if family(el.type) == "Truss":
                     orient = None
                 ends.setdefault(n, []).append(orient)
         pins = []
@@ -187,7 +204,7 @@ def hermite(xp, tp, xq, tq, l0: float, n: int = 21) -> np.ndarray:
 def beam_tangents(el: ElementGeometry, coords: dict):
     """Material tangents (t_p, t_q) of a beam element at the nodal coordinates ``coords``."""
     p, rp, q, rq = el.nodes
-    if el.type in ("PLBEAM", "PLBEAMNL"):
+    if len(coords[rp]) == 1:  # a BETA node: a planar beam
         a0 = el.lgeomy[0] if el.lgeomy else 0.0
         bp, bq = a0 + coords[rp][0], a0 + coords[rq][0]
         return np.array([math.cos(bp), math.sin(bp)]), np.array([math.cos(bq), math.sin(bq)])
@@ -249,50 +266,9 @@ def shapes(geometry: Geometry, coords: dict, scale: float = 1.0, beam_points: in
         return x
 
     anchors = geometry.anchors()
+    context = _DrawContext(geometry, coords, pos, anchors, scale, beam_points)
     for el in geometry.elements:
-        t = el.type
-        nodes = el.nodes
-        if t in BEAMS:
-            c = {n: np.asarray(coords[n], dtype=float) for n in nodes}
-            c[nodes[0]], c[nodes[2]] = pos(nodes[0]), pos(nodes[2])
-            out.append(Shape("beam", el.id, None, beam_curve(el, c, beam_points)))
-        elif t in ("TRUSS", "PLTRUSS"):
-            out.append(Shape("truss", el.id, None, np.array([pos(nodes[0]), pos(nodes[1])])))
-        elif t in ("PLBEAR", "BEARING"):
-            out.append(Shape("link", el.id, None, np.array([pos(nodes[0]), pos(nodes[2])])))
-        elif t == "PLBELT":
-            out.extend(_belt(el, coords, pos))
-        elif t == "PLWHEEL":
-            centre = pos(nodes[0])
-            axis = _unit(el.params[1:3])
-            b = float(coords[nodes[1]][0])
-            a = np.array([math.cos(b) * axis[0] - math.sin(b) * axis[1], math.sin(b) * axis[0] + math.cos(b) * axis[1]])
-            roll = np.array([a[1], -a[0]])
-            r = el.params[0]
-            out.append(Shape("wheel", el.id, None, np.array([centre - r * roll, centre + r * roll])))
-            out.append(Shape("axis", el.id, None, np.array([centre - 0.5 * r * a, centre + 0.5 * r * a])))
-        elif t == "WHEEL":
-            centre = pos(nodes[0])
-            R = rotation(coords[nodes[1]])
-            a0 = _unit(el.params[0:3])
-            r = el.params[3]
-            u0, v0 = _perpendicular_pair(a0)
-            out.append(Shape("wheel", el.id, None, _circle(centre, R @ u0, R @ v0, r)))
-            out.append(Shape("spoke", el.id, None, np.array([centre, centre + r * (R @ u0)])))
-            out.append(Shape("axis", el.id, None, np.array([centre - 0.3 * r * (R @ a0), centre + 0.3 * r * (R @ a0)])))
-        elif t == "HINGE":
-            anchor = anchors.get(nodes[0])
-            centre = pos(anchor) if anchor is not None else np.zeros(3)
-            a = rotation(coords[nodes[0]]) @ _unit(el.params[0:3])
-            out.append(Shape("axis", el.id, None, np.array([centre - 0.08 * scale * a, centre + 0.08 * scale * a])))
-            out.append(Shape("pin", el.id, None, centre[None, :]))
-        elif t == "PLHINGE":
-            anchor = anchors.get(nodes[0])
-            if anchor is not None:
-                out.append(Shape("pin", el.id, None, pos(anchor)[None, :]))
-        elif t == "SURFACE":
-            out.append(Shape("point", el.id, None, pos(nodes[0])[None, :]))
-        # L2MIN1 and unknown types: nothing to draw
+        out.extend(_DRAWINGS.get(family(el.type), _draw_default)(el, context))
     # Bodies: LAMBDA nodes with inertia get their body frame drawn (at their anchor or the origin).
     for n, m in sorted(geometry.masses.items()):
         if geometry.node_kinds.get(n) == "LAMBDA":
@@ -315,9 +291,74 @@ def shapes(geometry: Geometry, coords: dict, scale: float = 1.0, beam_points: in
     return out
 
 
-def _belt(el, coords, pos):
+class _DrawContext(NamedTuple):
+    """What the drawing of an element needs besides the element: the geometry, the nodal
+    coordinates, pos(node) (its position padded to the drawing's dimension), the anchors of the
+    orientation nodes and the symbol and beam-curve sizes."""
+
+    geometry: Geometry
+    coords: dict
+    pos: object
+    anchors: dict
+    scale: float
+    beam_points: int
+
+
+def _draw_default(el, f):
+    """An element without a drawing of its family: the line through its position nodes."""
+    points = [f.pos(n) for n in el.nodes if f.geometry.node_kinds.get(n) in POSITION_KINDS]
+    if not points:
+        return []
+    if len(points) == 1:
+        return [Shape("point", el.id, None, points[0][None, :])]
+    return [Shape("link", el.id, None, np.array(points))]
+
+
+def _draw_beam(el, f):
+    nodes = el.nodes
+    c = {n: np.asarray(f.coords[n], dtype=float) for n in nodes}
+    c[nodes[0]], c[nodes[2]] = f.pos(nodes[0]), f.pos(nodes[2])
+    return [Shape("beam", el.id, None, beam_curve(el, c, f.beam_points))]
+
+
+def _draw_truss(el, f):
+    return [Shape("truss", el.id, None, np.array([f.pos(el.nodes[0]), f.pos(el.nodes[1])]))]
+
+
+def _draw_wheel(el, f):
+    nodes, centre = el.nodes, f.pos(el.nodes[0])
+    if f.geometry.node_kinds.get(nodes[0]) == "XY":  # seen from above: the wheel's track, its axle
+        axis = _unit(el.params[1:3])
+        b = float(f.coords[nodes[1]][0])
+        a = np.array([math.cos(b) * axis[0] - math.sin(b) * axis[1], math.sin(b) * axis[0] + math.cos(b) * axis[1]])
+        roll = np.array([a[1], -a[0]])
+        r = el.params[0]
+        return [Shape("wheel", el.id, None, np.array([centre - r * roll, centre + r * roll])),
+                Shape("axis", el.id, None, np.array([centre - 0.5 * r * a, centre + 0.5 * r * a]))]
+    R = rotation(f.coords[nodes[1]])
+    a0 = _unit(el.params[0:3])
+    r = el.params[3]
+    u0, v0 = _perpendicular_pair(a0)
+    return [Shape("wheel", el.id, None, _circle(centre, R @ u0, R @ v0, r)),
+            Shape("spoke", el.id, None, np.array([centre, centre + r * (R @ u0)])),
+            Shape("axis", el.id, None, np.array([centre - 0.3 * r * (R @ a0), centre + 0.3 * r * (R @ a0)]))]
+
+
+def _draw_hinge(el, f):
+    """A pin at the anchor of the hinge's first node; a spatial hinge also shows its axis."""
+    anchor = f.anchors.get(el.nodes[0])
+    if f.geometry.node_kinds.get(el.nodes[0]) == "BETA":
+        return [] if anchor is None else [Shape("pin", el.id, None, f.pos(anchor)[None, :])]
+    centre = f.pos(anchor) if anchor is not None else np.zeros(3)
+    a = rotation(f.coords[el.nodes[0]]) @ _unit(el.params[0:3])
+    return [Shape("axis", el.id, None, np.array([centre - 0.08 * f.scale * a, centre + 0.08 * f.scale * a])),
+            Shape("pin", el.id, None, centre[None, :])]
+
+
+def _draw_belt(el, f):
     """PLBELT: the two pulleys (with a mark showing their rotation) and the free span on the
     external tangent with both centres on its right (formulation.md §4.6)."""
+    coords, pos = f.coords, f.pos
     p1, o1, p2, o2 = el.nodes
     r1, r2 = el.params[:2]
     c1, c2 = pos(p1), pos(p2)
@@ -339,6 +380,11 @@ def _belt(el, coords, pos):
     else:
         out.append(Shape("belt", el.id, None, np.array([c1, c2])))
     return out
+
+
+
+_DRAWINGS = {"Beam": _draw_beam, "Truss": _draw_truss, "Hinge": _draw_hinge, "Belt": _draw_belt,
+             "Wheel": _draw_wheel}
 
 
 def frame_coordinates(node_columns: dict, xrow) -> dict:

@@ -446,3 +446,20 @@ def test_plot_functions_are_reachable_from_the_package():
         assert name in dir(spacar)
     with pytest.raises(AttributeError):
         spacar.no_such_function  # noqa: B018
+
+
+def test_a_type_without_a_drawing_of_its_own_is_drawn_through_its_position_nodes():
+    """Drawing falls back to the line through an element's position nodes (a point for one,
+    nothing for none) for a type whose catalogue family has no drawing, also for a type the
+    catalogue does not know (a geometry saved by another version)."""
+    g = Geometry(node_kinds={1: "XY", 2: "BETA", 3: "XY", 4: "XY", 5: "BETA"},
+                 elements=[ElementGeometry(1, "NEWTYPE", (1, 2, 3, 4)), ElementGeometry(2, "NEWTYPE", (4,)),
+                           ElementGeometry(3, "NEWTYPE", (2, 5)), ElementGeometry(4, "PLBEAR", (1, 2, 3, 5))])
+    coords = {1: np.array([0.0, 0.0]), 2: np.array([0.1]), 3: np.array([1.0, 0.0]), 4: np.array([1.0, 1.0]),
+              5: np.array([0.2])}
+    drawn = {}
+    for s in shapes(g, coords):
+        if s.element is not None:
+            drawn.setdefault(s.element, []).append((s.kind, s.points.tolist()))
+    assert drawn == {1: [("link", [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])], 2: [("point", [[1.0, 1.0]])],
+                     4: [("link", [[0.0, 0.0], [1.0, 0.0]])]}

@@ -113,7 +113,7 @@ struct System {
 };
 
 // Compile a prepared model (Model::prepare() has run). Throws InputError for classifications
-// that cannot be analysed and NotImplementedError for element types without physics.
+// that cannot be analysed.
 // `dependent` overrides the dependent Euler parameter (0..3) of free rotations by node number.
 // line_as_dof: LINE parameters become coordinates (dynamic), for the linearized equations.
 std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& dependent = {},

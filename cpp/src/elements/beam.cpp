@@ -130,10 +130,9 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
   Eigen::Matrix3d A_[4];
 };
 
-}  // namespace
-
+// LGEOMY (the frame C0, column by column) and LENGTHO from the reference geometry x = (p(3),
+// λp(4), q(3), λq(4)); params: the initial direction of the cross-section's principal y-axis.
 void reference_beam(const double* x, const std::vector<double>& params, double& l0, std::vector<double>& lgeomy) {
-  // x = (p(3), λp(4), q(3), λq(4)) with the orientations at the reference.
   const Eigen::Vector3d chord(x[7] - x[0], x[8] - x[1], x[9] - x[2]);
   l0 = chord.norm();
   if (!(l0 > 0.0)) return;  // the caller reports the zero length
@@ -141,7 +140,28 @@ void reference_beam(const double* x, const std::vector<double>& params, double& 
   lgeomy.assign(C.data(), C.data() + 9);
 }
 
-std::unique_ptr<ElementKernel> make_beam(const ElementSetup& s) { return std::make_unique<Beam<false>>(s); }
-std::unique_ptr<ElementKernel> make_beamnl(const ElementSetup& s) { return std::make_unique<Beam<true>>(s); }
+template <bool Nonlinear>
+ElementType beam_type() {
+  const NodeKind p = NodeKind::XYZ, o = NodeKind::Lambda;
+  ElementType t = element_type<Beam<Nonlinear>>(
+      Nonlinear ? "BEAMNL" : "BEAM", {p, o, p, o}, {"p1", "o1", "p2", "o2"},
+      {Nonlinear ? "bending-corrected elongation" : "elongation", "torsion", "bending about local y at p1",
+       "bending about local y at p2", "bending about local z at p1", "bending about local z at p2"},
+      Nonlinear ? "spatial beam with bending-corrected elongation" : "spatial beam");
+  set_params(t, 3, 3, "x y z: initial direction of the principal y-axis of the cross-section");
+  set_stiffness(t, 4, "EA GIp EIy EIz");
+  set_emass(t, 4, "rhoA [rhoIp rhoIy rhoIz] (rotary inertia: extension)");
+  t.has_length = true;
+  t.n_lgeomy = 9;
+  t.has_direction = true;
+  t.reference = reference_beam;
+  t.family = ElementFamily::Beam;
+  return t;
+}
+
+}  // namespace
+
+ElementType beam_element_type() { return beam_type<false>(); }
+ElementType beamnl_element_type() { return beam_type<true>(); }
 
 }  // namespace spacar

@@ -42,14 +42,26 @@ class Bearing : public AutoDiffElement<Bearing, 14, 6> {
   Eigen::Vector3d d0_;
 };
 
-}  // namespace
-
 void reference_bearing(const double* x, const std::vector<double>& params, double&, std::vector<double>& lgeomy) {
   const Eigen::Matrix3d C0 = hinge_frame(Eigen::Vector3d(params[0], params[1], params[2]), "");
   const Eigen::Vector3d d = C0.transpose() * Eigen::Vector3d(x[7] - x[0], x[8] - x[1], x[9] - x[2]);
   lgeomy = {d[0], d[1], d[2]};
 }
 
-std::unique_ptr<ElementKernel> make_bearing(const ElementSetup& s) { return std::make_unique<Bearing>(s); }
+}  // namespace
+
+ElementType bearing_element_type() {
+  const NodeKind p = NodeKind::XYZ, o = NodeKind::Lambda;
+  ElementType t = element_type<Bearing>("BEARING", {p, o, p, o}, {"p1", "o1", "p2", "o2"},
+                                        {"axial displacement", "radial displacement along local y",
+                                         "radial displacement along local z", "rotation about the axis",
+                                         "misalignment about local y", "misalignment about local z"},
+                                        "spatial bearing");
+  set_params(t, 3, 3, "x y z: initial axis of rotation");
+  t.n_lgeomy = 3;
+  t.has_direction = true;
+  t.reference = reference_bearing;
+  return t;
+}
 
 }  // namespace spacar

@@ -1,9 +1,7 @@
-// Defaults of the element interface for elements without stiffness or mass.
+// The base-class versions of ElementKernel's stiffness, mass and gravity functions: zero, for
+// the element types without stiffness data or distributed mass (AutoDiffElement overrides the
+// mass and gravity functions, an element file its constitutive matrix).
 #include "spacar/elements/element.hpp"
-
-#include <cmath>
-
-#include "spacar/elements/registry.hpp"
 
 namespace spacar {
 
@@ -25,11 +23,5 @@ void ElementKernel::gravity(const double*, const double*, double* f) const {
 double ElementKernel::gravity_potential(const double*, const double*) const { return 0.0; }
 
 double ElementKernel::kinetic_energy(const double*, const double*) const { return 0.0; }
-
-double reference_chord(const double* p, const double* q, int dim) {
-  double s = 0.0;
-  for (int i = 0; i < dim; ++i) s += (q[i] - p[i]) * (q[i] - p[i]);
-  return std::sqrt(s);
-}
 
 }  // namespace spacar

@@ -44,6 +44,15 @@ class Hinge : public AutoDiffElement<Hinge, 8, 3> {
 
 }  // namespace
 
-std::unique_ptr<ElementKernel> make_hinge(const ElementSetup& s) { return std::make_unique<Hinge>(s); }
+ElementType hinge_element_type() {
+  ElementType t = element_type<Hinge>(
+      "HINGE", {NodeKind::Lambda, NodeKind::Lambda}, {"o1", "o2"},
+      {"rotation about the axis", "misalignment about local y", "misalignment about local z"}, "spatial hinge");
+  set_params(t, 3, 3, "x y z: initial axis of rotation");
+  set_stiffness(t, 1, "St (torsional stiffness of the rotation)");
+  t.has_direction = true;
+  t.family = ElementFamily::Hinge;
+  return t;
+}
 
 }  // namespace spacar

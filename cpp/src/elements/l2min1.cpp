@@ -15,6 +15,12 @@ class L2Min1 : public AutoDiffElement<L2Min1, 4, 1> {
 
 }  // namespace
 
-std::unique_ptr<ElementKernel> make_l2min1(const ElementSetup&) { return std::make_unique<L2Min1>(); }
+ElementType l2min1_element_type() {
+  ElementType t = element_type<L2Min1>("L2MIN1", {NodeKind::Lambda}, {"o1"}, {"Euler parameter norm λᵀλ − 1"},
+                                       "constraint on the Euler parameters (created automatically for every "
+                                       "LAMBDA node)");
+  t.automatic = true;
+  return t;
+}
 
 }  // namespace spacar

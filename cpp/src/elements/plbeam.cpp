@@ -169,15 +169,32 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   MassPoints<4, 2> mass_;
 };
 
-}  // namespace
-
+// LENGTHO and LGEOMY α0 (the chord angle) from the reference geometry x = (xp, yp, βp, xq, yq,
+// βq), β at the reference 0.
 void reference_plbeam(const double* x, const std::vector<double>&, double& l0, std::vector<double>& lgeomy) {
-  // x = (xp, yp, βp, xq, yq, βq) with β at the reference 0.
   l0 = std::hypot(x[3] - x[0], x[4] - x[1]);
   lgeomy = {std::atan2(x[4] - x[1], x[3] - x[0])};
 }
 
-std::unique_ptr<ElementKernel> make_plbeam(const ElementSetup& s) { return std::make_unique<PlBeam<false>>(s); }
-std::unique_ptr<ElementKernel> make_plbeamnl(const ElementSetup& s) { return std::make_unique<PlBeam<true>>(s); }
+template <bool Nonlinear>
+ElementType plbeam_type() {
+  const NodeKind p = NodeKind::XY, o = NodeKind::Beta;
+  ElementType t = element_type<PlBeam<Nonlinear>>(
+      Nonlinear ? "PLBEAMNL" : "PLBEAM", {p, o, p, o}, {"p1", "o1", "p2", "o2"},
+      {Nonlinear ? "bending-corrected elongation" : "elongation", "bending at p1", "bending at p2"},
+      Nonlinear ? "planar beam with bending-corrected elongation" : "planar beam");
+  set_stiffness(t, 2, "EA EI");
+  set_emass(t, 1, "rhoA");
+  t.has_length = true;
+  t.n_lgeomy = 1;
+  t.reference = reference_plbeam;
+  t.family = ElementFamily::Beam;
+  return t;
+}
+
+}  // namespace
+
+ElementType plbeam_element_type() { return plbeam_type<false>(); }
+ElementType plbeamnl_element_type() { return plbeam_type<true>(); }
 
 }  // namespace spacar

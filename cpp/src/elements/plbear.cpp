@@ -34,12 +34,22 @@ class PlBear : public AutoDiffElement<PlBear, 6, 3> {
   double d0_[2];
 };
 
-}  // namespace
-
 void reference_plbear(const double* x, const std::vector<double>&, double&, std::vector<double>& lgeomy) {
   lgeomy = {x[3] - x[0], x[4] - x[1]};
 }
 
-std::unique_ptr<ElementKernel> make_plbear(const ElementSetup& s) { return std::make_unique<PlBear>(s); }
+}  // namespace
+
+ElementType plbear_element_type() {
+  const NodeKind p = NodeKind::XY, o = NodeKind::Beta;
+  ElementType t = element_type<PlBear>(
+      "PLBEAR", {p, o, p, o}, {"p1", "o1", "p2", "o2"},
+      {"relative displacement along local x", "relative displacement along local y", "relative rotation"},
+      "planar bearing");
+  set_stiffness(t, 3, "Sx Sy St (linear and torsional stiffness)");
+  t.n_lgeomy = 2;
+  t.reference = reference_plbear;
+  return t;
+}
 
 }  // namespace spacar

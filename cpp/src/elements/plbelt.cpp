@@ -115,8 +115,6 @@ class PlBelt : public AutoDiffElement<PlBelt, 6, 1> {
   double l0_, r1_, r2_, delta_, alpha0_, lf0_, rhoA_, a10_, a20_;
 };
 
-}  // namespace
-
 void reference_plbelt(const double* x, const std::vector<double>& params, double& l0, std::vector<double>& lgeomy) {
   l0 = std::hypot(x[3] - x[0], x[4] - x[1]);
   if (!(l0 > std::abs(params[1] - params[0])))
@@ -124,6 +122,21 @@ void reference_plbelt(const double* x, const std::vector<double>& params, double
   lgeomy = {std::atan2(x[4] - x[1], x[3] - x[0])};
 }
 
-std::unique_ptr<ElementKernel> make_plbelt(const ElementSetup& s) { return std::make_unique<PlBelt>(s); }
+}  // namespace
+
+ElementType plbelt_element_type() {
+  const NodeKind p = NodeKind::XY, o = NodeKind::Beta;
+  ElementType t = element_type<PlBelt>("PLBELT", {p, o, p, o}, {"p1", "o1", "p2", "o2"}, {"belt elongation"},
+                                       "planar belt");
+  set_params(t, 2, 2, "r1 r2: radii of pulley 1 and pulley 2");
+  set_stiffness(t, 1, "EA");
+  set_emass(t, 3, "rhoA a1 a2 (belt wound on the pulleys: a1*r1 and a2*r2)");
+  t.signed_emass_extras = true;
+  t.has_length = true;
+  t.n_lgeomy = 1;
+  t.reference = reference_plbelt;
+  t.family = ElementFamily::Belt;
+  return t;
+}
 
 }  // namespace spacar

@@ -15,6 +15,12 @@ class PlHinge : public AutoDiffElement<PlHinge, 2, 1> {
 
 }  // namespace
 
-std::unique_ptr<ElementKernel> make_plhinge(const ElementSetup&) { return std::make_unique<PlHinge>(); }
+ElementType plhinge_element_type() {
+  ElementType t = element_type<PlHinge>("PLHINGE", {NodeKind::Beta, NodeKind::Beta}, {"o1", "o2"},
+                                        {"relative rotation"}, "planar hinge");
+  set_stiffness(t, 1, "St (torsional stiffness)");
+  t.family = ElementFamily::Hinge;
+  return t;
+}
 
 }  // namespace spacar

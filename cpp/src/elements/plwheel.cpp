@@ -54,6 +54,14 @@ class PlWheel : public AutoDiffElement<PlWheel, 4, 2> {
 
 }  // namespace
 
-std::unique_ptr<ElementKernel> make_plwheel(const ElementSetup& s) { return std::make_unique<PlWheel>(s); }
+ElementType plwheel_element_type() {
+  ElementType t = element_type<PlWheel>("PLWHEEL", {NodeKind::XY, NodeKind::Beta, NodeKind::Beta},
+                                        {"p1", "o1", "o2"}, {"longitudinal slip", "lateral slip"}, "planar wheel");
+  set_params(t, 3, 3, "r x y: radius and initial axis of rotation");
+  t.edampp = "d1 d2: linear creep damping of the released slips (extension)";
+  t.n_estiff = 2;
+  t.family = ElementFamily::Wheel;
+  return t;
+}
 
 }  // namespace spacar

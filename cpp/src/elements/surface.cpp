@@ -27,6 +27,11 @@ class Surface : public AutoDiffElement<Surface, 3, 1> {
 
 }  // namespace
 
-std::unique_ptr<ElementKernel> make_surface(const ElementSetup& s) { return std::make_unique<Surface>(s); }
+ElementType surface_element_type() {
+  ElementType t = element_type<Surface>("SURFACE", {NodeKind::XYZ}, {"p1"}, {"surface function value"},
+                                        "point on a quadratic surface");
+  set_params(t, 10, 10, "c1..c10: coefficients of c1x²+c2y²+c3z²+c4xy+c5yz+c6zx+c7x+c8y+c9z+c10");
+  return t;
+}
 
 }  // namespace spacar

@@ -196,6 +196,19 @@ class Wheel : public AutoDiffElement<Wheel, 7, 3> {
 
 }  // namespace
 
-std::unique_ptr<ElementKernel> make_wheel(const ElementSetup& s) { return std::make_unique<Wheel>(s); }
+ElementType wheel_element_type() {
+  ElementType t = element_type<Wheel>(
+      "WHEEL", {NodeKind::XYZ, NodeKind::Lambda}, {"p1", "o1"},
+      {"height of the contact point", "longitudinal slip", "lateral slip"},
+      "knife-edge wheel rolling on a plane or a quadratic surface (extension)");
+  set_params(t, 4, 14,
+             "ax ay az r [nx ny nz or c1 .. c10]: initial axle direction, radius; ground-plane normal "
+             "(default 0 0 1) or the coefficients of a quadratic surface as for SURFACE, positive on the "
+             "wheel's side");
+  t.n_params_allowed = {4, 7, 14};
+  t.extension = true;
+  t.family = ElementFamily::Wheel;
+  return t;
+}
 
 }  // namespace spacar

@@ -129,10 +129,15 @@ struct has_kinetic<T, std::void_t<decltype(&T::template kinetic<double>)>> : std
 template <class Derived, int NC, int ND, int NG = 0, int DIM = 2>
 class AutoDiffElement : public ElementKernel {
  public:
+  // The sizes, for the catalogue row (element_type<Kernel> in registry.hpp).
+  static constexpr int kCoords = NC;
+  static constexpr int kDeformations = ND;
+  static constexpr unsigned kVelocityMask = detail::velocity_rows<Derived>::value;
+
   int n_coords() const override { return NC; }
   int n_deformations() const override { return ND; }
 
-  bool velocity_level(int i) const override { return (kVelocity >> i) & 1u; }
+  bool velocity_level(int i) const override { return (kVelocityMask >> i) & 1u; }
 
   void deformations(const double* x, double* e) const override {
     self().deform(x, e);
@@ -149,7 +154,7 @@ class AutoDiffElement : public ElementKernel {
       e[i] = ej[i].a;
       for (int k = 0; k < NC; ++k) B[i + ND * k] = ej[i].d[k];
     }
-    if constexpr (kVelocity != 0) {
+    if constexpr (kVelocityMask != 0) {
       // Rows of velocity-level deformations: ė = B(x) v, B from the rates with v as variables.
       J xc[NC], vj[NC], rj[ND];
       for (int k = 0; k < NC; ++k) {
@@ -171,7 +176,7 @@ class AutoDiffElement : public ElementKernel {
     for (int k = 0; k < NC; ++k) xj[k] = J1(x[k], {v[k]});
     self().deform(xj, ej);
     for (int i = 0; i < ND; ++i) edot[i] = ej[i].d[0];
-    if constexpr (kVelocity != 0) {
+    if constexpr (kVelocityMask != 0) {
       double r[ND];
       self().slip_rates(x, v, r);
       for (int i = 0; i < ND; ++i)
@@ -186,7 +191,7 @@ class AutoDiffElement : public ElementKernel {
     for (int k = 0; k < NC; ++k) xj[k] = J2(J1(x[k], {v[k]}), {J1(v[k], {0.0})});
     self().deform(xj, ej);
     for (int i = 0; i < ND; ++i) c[i] = ej[i].d[0].d[0];
-    if constexpr (kVelocity != 0) {
+    if constexpr (kVelocityMask != 0) {
       // c = ∂(B(x) v)/∂x v for velocity-level rows.
       J1 xv[NC], vc[NC], rj[ND];
       for (int k = 0; k < NC; ++k) {
@@ -216,7 +221,7 @@ class AutoDiffElement : public ElementKernel {
           if (!velocity_level(i)) s += sigma[i] * ej[i].d[j].d[k];
         G[j + NC * k] = s;
       }
-    if constexpr (kVelocity != 0) {
+    if constexpr (kVelocityMask != 0) {
       // Γ_i = ∂(B_iᵀ)/∂x: outer jet over x, inner jet over the unit rates v_j.
       J2 xo[NC], vo[NC], rj[ND];
       for (int k = 0; k < NC; ++k) {
@@ -319,7 +324,6 @@ class AutoDiffElement : public ElementKernel {
   }
 
  private:
-  static constexpr unsigned kVelocity = detail::velocity_rows<Derived>::value;
   const Derived& self() const { return static_cast<const Derived&>(*this); }
 
   // Lagrange's equations from T(x, v): M = ∂²T/∂v², h = (∂²T/∂v∂x) v − ∂T/∂x.
