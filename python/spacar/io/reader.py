@@ -151,7 +151,6 @@ def read_string(text: str, file: str = "<string>") -> Model:
     blocks = parse(text, file)
     model = Model()
     model.source = file
-    model.blocks = blocks
     for b in blocks:
         if not b.ended:
             first, last = b.commands[0], b.commands[-1]
