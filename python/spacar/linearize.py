@@ -157,7 +157,7 @@ def linearize(model, state=None) -> Linearization:
     and then moved continuously to ``state`` (the inputs at time t), so that the calculable
     coordinates stay on the branch of the assembled mechanism."""
     model.prepare()
-    sim = _core.Simulation(model._core)
+    sim = _core.Simulation(model.core)
     sim.assemble()
     system = sim.system
     if state is None:

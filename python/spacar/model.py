@@ -1,7 +1,7 @@
 """The builder API: :class:`Model` has one method per input keyword, so a SPACAR user recognises
 every line (``model.plbeam(1, 1, 2, 3, 4)``, ``model.x(3, 0.15, 0.0)``, ``model.fix(8, 2)``,
 ``model.dyne(2, 2)``). The reader (:mod:`spacar.io.reader`) is a thin dispatcher onto these
-methods. The model itself lives in the C++ core (``spacar._core.Model``).
+methods. The model itself lives in the C++ core (``spacar._core.Model``), public as :attr:`Model.core`.
 """
 from __future__ import annotations
 
@@ -332,6 +332,13 @@ class Model:
         self._core.set_linear(*self._call("LINEAR", mode))
 
     # --- inspection -------------------------------------------------------------------------
+
+    @property
+    def core(self) -> _core.Model:
+        """The C++ model this Model builds (``spacar._core.Model``), itself and not a copy: what
+        the core's functions take, e.g. ``spacar._core.Simulation(model.core)``. Change the model
+        through the keyword methods, which check their arguments and name the input line."""
+        return self._core
 
     @property
     def nodes(self):

@@ -341,7 +341,7 @@ def analyse(model, sim=None) -> Topology:
     """Analyse a :class:`spacar.Model` (prepared and assembled here if no ``sim`` is given)."""
     model.prepare()
     if sim is None:
-        sim = _core.Simulation(model._core)
+        sim = _core.Simulation(model.core)
         sim.assemble()
     system = sim.system
     # assemble() solves the positions only; the rates come with an evaluation at the initial state
@@ -663,7 +663,7 @@ def analyse(model, sim=None) -> Topology:
         if n not in bodies_of_point and n not in flexible_pos:
             raise UnsupportedModelError(f"position node {n} belongs to no rigid body or flexible beam")
 
-    gravity = np.asarray(model._core.gravity, dtype=float)
+    gravity = np.asarray(model.core.gravity, dtype=float)
     return Topology(planar, bodies, joints, flex, body_of_orientation, bodies_of_point, partial_fix,
                     point_masses, ground_rotation, gravity, node_kind, x0, xd0, coord_index, def_index,
                     float(model.settings.epsint), float(model.settings.epsind))
