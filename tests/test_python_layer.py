@@ -26,3 +26,24 @@ def test_no_module_but_model_reaches_into_the_private_core():
     for path in package.rglob("*.py"):
         if path.name != "model.py":
             assert not re.search(r"\b(?!spacar\b)\w+\._core\b", path.read_text()), path  # spacar._core: the module
+
+
+def test_reader_and_builder_group_the_values_of_a_line_alike():
+    from spacar.io.reader import _parse_line
+    from spacar.keywords import KEYWORDS
+    from spacar.model import check_args
+
+    # MASS n m(1..6): the node, then up to six masses; X n x(1..4) likewise.
+    assert KEYWORDS["MASS"].counts(4) == [1, 3] and KEYWORDS["X"].counts(7) == [1, 4]
+    assert KEYWORDS["FIX"].counts(1) == [1, 0]
+    for kw in KEYWORDS.values():
+        least = sum(p.count_min for p in kw.params)
+        for n in range(least, least + 5):
+            values = _parse_line(kw, ["1"] * n)
+            try:
+                groups = check_args(kw, values)
+            except spacar.InputError:
+                assert n > sum(p.count_max for p in kw.params), kw.name   # too many values
+                continue
+            sizes = [1 if p.count_min == p.count_max == 1 else len(g) for p, g in zip(kw.params, groups)]
+            assert sizes == kw.counts(n), kw.name

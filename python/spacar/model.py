@@ -49,14 +49,11 @@ def check_args(kw: Keyword, args) -> list:
     """Validate the arguments of a keyword against its signature; returns them grouped: one entry
     per parameter group (a scalar for single values, a list for variable counts)."""
     args = list(args)
+    if len(args) < sum(p.count_min for p in kw.params):
+        raise InputError(f"{kw.name} expects {kw.usage()}: too few values ({len(args)} given)")
     out = []
     pos = 0
-    for i, p in enumerate(kw.params):
-        rest = sum(q.count_min for q in kw.params[i + 1:])
-        avail = len(args) - pos - rest
-        n = min(max(avail, p.count_min), p.count_max)
-        if avail < p.count_min:
-            raise InputError(f"{kw.name} expects {kw.usage()}: too few values ({len(args)} given)")
+    for p, n in zip(kw.params, kw.counts(len(args))):
         vals = [_check_value(kw, p.name, p.kind, v) for v in args[pos:pos + n]]
         pos += n
         out.append(vals[0] if p.count_min == p.count_max == 1 else vals)
