@@ -47,3 +47,28 @@ def test_reader_and_builder_group_the_values_of_a_line_alike():
                 continue
             sizes = [1 if p.count_min == p.count_max == 1 else len(g) for p, g in zip(kw.params, groups)]
             assert sizes == kw.counts(n), kw.name
+
+
+def test_sweep_and_simulate_detect_a_jupyter_kernel_alike(capsys, monkeypatch):
+    # sweep.py had its own detection: a terminal only (no bar by default in Jupyter), and always
+    # tqdm.auto, whose notebook bar fails without ipywidgets. Both now follow spacar.progress: a
+    # Jupyter kernel is interactive; without ipywidgets the text bar shows.
+    import sys
+    import types
+
+    import pytest
+
+    import spacar.progress
+
+    tqdm = pytest.importorskip("tqdm")
+    monkeypatch.setitem(sys.modules, "ipykernel", types.ModuleType("ipykernel"))
+    monkeypatch.setitem(sys.modules, "ipywidgets", None)   # import ipywidgets now fails
+    monkeypatch.delenv("SPACAR_PROGRESS", raising=False)
+    assert spacar.progress.interactive() and spacar.progress.automatic()
+    assert spacar.progress.tqdm_class() is tqdm.tqdm
+    spacar.sweep(spacar.read(EXAMPLE), {"XD 2 1": [1.0, 2.0], "TIMESTEP": [(1, 0.05)]}, workers=1)
+    assert "spacar.sweep" in capsys.readouterr().err
+    monkeypatch.setenv("SPACAR_PROGRESS", "0")             # the one switch turns both off
+    assert not spacar.progress.automatic()
+    spacar.sweep(spacar.read(EXAMPLE), {"XD 2 1": [1.0, 2.0], "TIMESTEP": [(1, 0.05)]}, workers=1)
+    assert capsys.readouterr().err == ""
