@@ -72,3 +72,15 @@ def test_sweep_and_simulate_detect_a_jupyter_kernel_alike(capsys, monkeypatch):
     assert not spacar.progress.automatic()
     spacar.sweep(spacar.read(EXAMPLE), {"XD 2 1": [1.0, 2.0], "TIMESTEP": [(1, 0.05)]}, workers=1)
     assert capsys.readouterr().err == ""
+
+
+def test_one_rotation_matrix_of_euler_parameters():
+    import numpy as np
+
+    import spacar.geometry
+    from spacar.compare import _topology
+
+    assert _topology.rotation is spacar.geometry.rotation and not hasattr(_topology, "rot_lambda")
+    # λ = (1, 1, −1, 1)/2: 120° about (1, −1, 1)/√3, which takes e_x to e_z, e_y to −e_x, e_z to −e_y
+    R = spacar.geometry.rotation([0.5, 0.5, -0.5, 0.5])
+    np.testing.assert_allclose(R, [[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]], atol=1e-15)

@@ -34,6 +34,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import InputError
+from ..geometry import rotation  # R(λ), body → global
 
 PLANAR_BEAMS = ("PLBEAM", "PLBEAMNL")
 SPATIAL_BEAMS = ("BEAM", "BEAMNL")
@@ -62,17 +63,6 @@ def rot_z(beta: float) -> np.ndarray:
 def E_matrix(lam) -> np.ndarray:
     l0, l1, l2, l3 = lam
     return np.array([[-l1, l0, -l3, l2], [-l2, l3, l0, -l1], [-l3, -l2, l1, l0]])
-
-
-def G_matrix(lam) -> np.ndarray:
-    l0, l1, l2, l3 = lam
-    return np.array([[-l1, l0, l3, -l2], [-l2, -l3, l0, l1], [-l3, l2, -l1, l0]])
-
-
-def rot_lambda(lam) -> np.ndarray:
-    """R(λ) = E Gᵀ (body → global), formulation.md §0."""
-    lam = np.asarray(lam, dtype=float)
-    return E_matrix(lam) @ G_matrix(lam).T
 
 
 def lambda_of_rotation(R: np.ndarray, near=None) -> np.ndarray:
@@ -256,7 +246,7 @@ class Topology:
         n = self.bodies[b].orientation_nodes[0]
         if self.planar:
             return rot_z(x[self.coord_index[(n, 1)]])
-        return rot_lambda([x[self.coord_index[(n, i)]] for i in range(1, 5)])
+        return rotation([x[self.coord_index[(n, i)]] for i in range(1, 5)])
 
     def body_angle(self, b: int, x) -> float:
         """Planar: absolute rotation angle of body b (not wrapped)."""
@@ -451,7 +441,7 @@ def analyse(model, sim=None) -> Topology:
         def node_rot(n):
             if planar:
                 return rot_z(x0[coord_index[(n, 1)]])
-            return rot_lambda([x0[coord_index[(n, i)]] for i in range(1, 5)])
+            return rotation([x0[coord_index[(n, i)]] for i in range(1, 5)])
         ground_rotation = node_rot(gnodes[0])
         for n in gnodes[1:]:
             if np.abs(node_rot(n) - ground_rotation).max() > 1e-9:
