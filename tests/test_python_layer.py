@@ -84,3 +84,16 @@ def test_one_rotation_matrix_of_euler_parameters():
     # λ = (1, 1, −1, 1)/2: 120° about (1, −1, 1)/√3, which takes e_x to e_z, e_y to −e_x, e_z to −e_y
     R = spacar.geometry.rotation([0.5, 0.5, -0.5, 0.5])
     np.testing.assert_allclose(R, [[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]], atol=1e-15)
+
+
+def test_one_union_find_of_rigid_bodies():
+    from spacar.compare import _topology
+
+    # links sharing a node are one body; a node of no link is a body; link nodes are added
+    assert _core.rigid_bodies([5, 1, 9], [[3, 2], [2, 7], [9, 4]]) == [[1], [2, 3, 7], [4, 9], [5]]
+    assert _core.rigid_bodies([], []) == [] and _core.rigid_bodies([4], [[4, 4]]) == [[4]]
+    assert not hasattr(_topology, "_union_find")     # spacar.compare groups with the core's
+    # the manual's slider-crank: the rigid crank (BETA 2, 4) is the one rigid body besides the
+    # ground; the BETA nodes of the flexible rod (beams 2, 3) belong to none
+    model = spacar.read(EXAMPLE)
+    assert [b.orientation_nodes for b in _topology.analyse(model).bodies] == [[], [2, 4]]
