@@ -194,12 +194,9 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
        << " has infinite or NaN entries): the model's values exceed double precision";
     throw Error(os.str());
   };
-  for (const auto& [name, m] : {std::pair<const char*, const Eigen::MatrixXd*>{"M0", &lin.M0}, {"C0", &lin.C0},
-                                {"D0", &lin.D0}, {"K0", &lin.K0}, {"N0", &lin.N0}, {"G0", &lin.G0},
-                                {"Kk", &lin.Kk}, {"AK0", &lin.AK0}, {"BK0", &lin.BK0},
-                                {"DF", &lin.DFz}, {"DFe", &lin.DFez}})
-    if (!m->allFinite()) refuse(name);
-  if (!lin.r0.allFinite()) refuse("r0");
+  lin.for_each_array([&](const char* name, const auto& m) {
+    if (!m.allFinite()) refuse(name);  // throws: the first non-finite array is named
+  });
   return lin;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "spacar/catalogue.hpp"
+#include "spacar/topology.hpp"
 
 namespace spacar {
 
@@ -85,7 +86,7 @@ class PlanarTree::Builder {
     return true;
   }
 
-  // Rigid beams, joined into bodies by shared BETA nodes (union-find), and hinges.
+  // Rigid beams (joined into bodies by shared BETA nodes in group_bodies) and hinges.
   bool read_elements() {
     for (size_t i = 0; i < sys_.elements.size(); ++i) {
       const SystemElement& se = sys_.elements[i];
@@ -121,29 +122,27 @@ class PlanarTree::Builder {
     }
     if (all_fixed) return true;   // part of the ground
     if (beta_fixed) return false;  // a fixed rotation with free points
-    int first = -1;
-    for (int id : ids) {
-      if (nodes_[id].kind != NodeKind::Beta) continue;
-      root_.try_emplace(id, id);
-      if (first < 0) first = id;
-      else root_[root(id)] = root(first);
-    }
     beams_.push_back({i, ids});
     return true;
   }
 
-  int root(int id) {
-    int a = id;
-    while (root_[a] != a) a = root_[a] = root_[root_[a]];
-    return a;
-  }
-
+  // The bodies: moving rigid beams sharing a BETA node are one (rigid_bodies), numbered in the
+  // order of their first beam.
   bool group_bodies() {
+    std::vector<std::vector<int>> links;
+    for (const auto& [i, ids] : beams_) {
+      links.emplace_back();
+      for (int id : ids)
+        if (nodes_[id].kind == NodeKind::Beta) links.back().push_back(id);
+    }
+    const std::vector<std::vector<int>> rigid = rigid_bodies({}, links);
+    for (size_t r = 0; r < rigid.size(); ++r)
+      for (int id : rigid[r]) rigid_body_of_[id] = static_cast<int>(r);
     for (const auto& [i, ids] : beams_) {
       int r = -1;
       for (int id : ids)
-        if (nodes_[id].kind == NodeKind::Beta) r = root(id);
-      auto [it, fresh] = body_of_root_.try_emplace(r, static_cast<int>(xy_.size()));
+        if (nodes_[id].kind == NodeKind::Beta) r = rigid_body_of_.at(id);
+      auto [it, fresh] = body_of_rigid_.try_emplace(r, static_cast<int>(xy_.size()));
       if (fresh) {
         xy_.emplace_back();
         beta_.emplace_back();
@@ -168,7 +167,7 @@ class PlanarTree::Builder {
     return true;
   }
 
-  int body_of_beta(int id) { return nodes_[id].fixed ? kGround : body_of_root_.at(root(id)); }
+  int body_of_beta(int id) { return nodes_[id].fixed ? kGround : body_of_rigid_.at(rigid_body_of_.at(id)); }
   bool is_placed(int body) const { return body == kGround || placed_[body] >= 0; }
   Eigen::Vector2d xy(int id) const { return {x_[nodes_.at(id).coord], x_[nodes_.at(id).coord + 1]}; }
 
@@ -351,8 +350,8 @@ class PlanarTree::Builder {
   std::map<int, int> dof_of_coord_;    // DYNX coordinate → its position in q
   std::vector<std::pair<int, std::vector<int>>> beams_;  // moving rigid beams: element, nodes
   std::vector<Hinge> hinges_;
-  std::map<int, int> root_;            // union-find over the BETA nodes of beams
-  std::map<int, int> body_of_root_;
+  std::map<int, int> rigid_body_of_;   // BETA node of a moving beam → its rigid_bodies() index
+  std::map<int, int> body_of_rigid_;    // rigid_bodies() index → body
   std::vector<std::set<int>> xy_, beta_;  // nodes of each body
   std::vector<std::vector<int>> beams_of_;
   std::vector<int> placed_;            // body → index in bodies_, −1: not yet

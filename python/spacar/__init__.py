@@ -22,7 +22,6 @@ from .errors import (
     InputError,
     IntegrationError,
     KinematicsError,
-    NotImplementedError,
     SingularMassError,
     SpacarError,
     TimeLimitError,
@@ -114,7 +113,6 @@ __all__ = [
     "SingularMassError",
     "IntegrationError",
     "TimeLimitError",
-    "NotImplementedError",
     "memory_limit",
     "set_memory_limit",
 ]

@@ -89,7 +89,7 @@ def check(model) -> Check:
         return Check(summary(model), Diagnosis(0, 0, 0, [], [], "  the model is empty"))
     copy = model.copy()
     copy.prepare()
-    d = _core.Simulation(copy._core).diagnose()
+    d = _core.Simulation(copy.core).diagnose()
     diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
                           list(d["undetermined"]), d["text"])
     return Check(summary(model), diagnosis)
@@ -99,7 +99,7 @@ def summary(model) -> Summary:
     """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
     nodes are included (they are created at the first END). An empty model (e.g. an input of
     comments only) has all counts zero."""
-    core = model._core.copy()
+    core = model.core.copy()
     if not core.nodes and not core.elements:
         return Summary(Counter(), Counter(), Counter(), Counter())
     core.prepare()

@@ -5,19 +5,20 @@ An analysis that fails midway (:func:`spacar.simulate`) raises its error with th
 until the failure as the attribute ``results`` (a :class:`spacar.Results` with the output times
 recorded so far; possibly none).
 
+Every element type of the catalogue has its physics, so there is no spacar error for a missing
+one (an earlier ``spacar.NotImplementedError`` shadowed Python's builtin of that name).
+
 - :class:`SpacarError` — base class of every spacar error.
 - :class:`InputError` — invalid input; from the reader it names file, line and keyword.
 - :class:`KinematicsError` — the kinematic analysis cannot be solved.
 - :class:`SingularMassError` — a degree of freedom without inertia.
 - :class:`IntegrationError` — the integrator cannot continue.
 - :class:`TimeLimitError` — the analysis did not finish within its ``time_limit``.
-- :class:`NotImplementedError` — a specified element type whose physics is not available yet.
 """
 from ._core import (  # noqa: F401
     InputError,
     IntegrationError,
     KinematicsError,
-    NotImplementedError,
     SingularMassError,
     SpacarError,
     TimeLimitError,
@@ -30,5 +31,4 @@ __all__ = [
     "SingularMassError",
     "IntegrationError",
     "TimeLimitError",
-    "NotImplementedError",
 ]

@@ -72,8 +72,9 @@ class Geometry:
 
     @classmethod
     def from_model(cls, model) -> "Geometry":
-        """The geometry of a :class:`spacar.Model` (prepared: with reference geometry)."""
-        core = model._core if hasattr(model, "_core") else model
+        """The geometry of a :class:`spacar.Model` or of its core (:attr:`spacar.Model.core`),
+        prepared: with reference geometry."""
+        core = getattr(model, "core", model)
         nodes = core.nodes
         elements = core.elements
         return cls(

@@ -37,6 +37,19 @@ class Keyword:
     def builder(self) -> str:
         return self.method or self.name.lower()
 
+    def counts(self, n_values: int) -> list[int]:
+        """How many of ``n_values`` values each parameter group takes, in order: as many as it
+        can, up to its maximum, while leaving the later groups their minimum counts. The reader
+        and the builder methods group a line's values by this one rule. With too few values
+        every group still gets its minimum (the sum then exceeds ``n_values``)."""
+        counts, pos = [], 0
+        for i, p in enumerate(self.params):
+            rest = sum(q.count_min for q in self.params[i + 1:])
+            n = min(max(n_values - pos - rest, p.count_min), p.count_max)
+            counts.append(n)
+            pos += n
+        return counts
+
     def usage(self) -> str:
         parts = [self.name]
         for p in self.params:

@@ -19,39 +19,55 @@ from . import _core
 from .errors import InputError
 
 
+# The arrays of a linearization, by the names of its attributes (formulation.md §7). The core
+# (Linearization::for_each_array, in the same order), the constructors below and
+# Results.save/load all go by this one list.
+MATRICES = ("M0", "C0", "D0", "K0", "N0", "G0", "Kk", "AK0", "BK0", "DF", "DFe", "r0")
+_CORE_KEY = {"DF": "DFz", "DFe": "DFez"}  # the core's names of ∂x/∂z and ∂e/∂z
+
+
 class Linearization:
     """The matrices of the linearized equations at one state, as NumPy arrays, with the
-    eigen-analyses built on them."""
+    eigen-analyses built on them.
+
+    ``z_labels``: ("x", node, component) or ("e", element, deformation) of each z; ``y_labels``:
+    ("e", element, deformation) of each kinematic coordinate y^k; the arrays named in
+    :data:`MATRICES`; ``DF`` (∂x/∂z) and ``DFe`` (∂e/∂z) give the nodal coordinates and
+    deformations per unit z (mode shapes)."""
 
     def __init__(self, d: dict, coordinate_labels, deformation_labels):
-        self.t = d["t"]
-        self.z_labels = [("x" if k == 0 else "e", a, b) for k, a, b in d["z_label"]]
-        self.n_line = d["n_line"]
-        for name in ("M0", "C0", "D0", "K0", "N0", "G0"):
-            setattr(self, name, np.asarray(d[name]))
-        self.r0 = np.asarray(d["r0"])
-        self.y_labels = [("e", a, b) for _, a, b in d["y_label"]]
-        self.Kk = np.asarray(d["Kk"]).reshape(len(self.z_labels), len(self.y_labels))
-        self.AK0 = np.asarray(d["AK0"]).reshape(len(self.y_labels), len(self.z_labels))
-        self.BK0 = np.asarray(d["BK0"]).reshape(len(self.y_labels), len(self.z_labels) + len(self.y_labels))
-        self.DF = np.asarray(d["DFz"])    # ∂x/∂z: nodal coordinates per unit z
-        self.DFe = np.asarray(d["DFez"])  # ∂e/∂z
-        self.coordinate_labels = [tuple(c) for c in coordinate_labels]
-        self.deformation_labels = [tuple(c) for c in deformation_labels]
+        """From the dictionary of the core (``Simulation.linearize()``, the on_output state)."""
+        self._fill(d["t"], [("x" if k == 0 else "e", a, b) for k, a, b in d["z_label"]], d["n_line"],
+                   [("e", a, b) for _, a, b in d["y_label"]],
+                   {name: d[_CORE_KEY.get(name, name)] for name in MATRICES},
+                   coordinate_labels, deformation_labels)
 
     @classmethod
-    def from_arrays(cls, t, z_labels, n_line, matrices: dict, coordinate_labels, deformation_labels):
-        """Rebuild from saved arrays (``matrices``: M0 C0 D0 K0 N0 G0 r0 DF DFe); used by
-        :meth:`spacar.Results.load`."""
+    def from_arrays(cls, t, z_labels, n_line, matrices: dict, coordinate_labels, deformation_labels,
+                    y_labels=None):
+        """Rebuild from saved arrays (``matrices`` by the names of :data:`MATRICES`); used by
+        :meth:`spacar.Results.load`. A file written before the kinematic coordinates were saved
+        has neither ``y_labels`` nor Kk, AK0, BK0: those attributes stay absent."""
         self = cls.__new__(cls)
+        self._fill(t, z_labels, n_line, y_labels, matrices, coordinate_labels, deformation_labels)
+        return self
+
+    def _fill(self, t, z_labels, n_line, y_labels, matrices, coordinate_labels, deformation_labels):
         self.t = float(t)
         self.z_labels = [(str(k), int(a), int(b)) for k, a, b in z_labels]
         self.n_line = int(n_line)
-        for name in ("M0", "C0", "D0", "K0", "N0", "G0", "r0", "DF", "DFe"):
-            setattr(self, name, np.asarray(matrices[name]))
+        for name in MATRICES:
+            if name in matrices:
+                setattr(self, name, np.asarray(matrices[name]))
+        if y_labels is not None:
+            self.y_labels = [(str(k), int(a), int(b)) for k, a, b in y_labels]
+            # An empty matrix may come without its shape (nz x 0, 0 x nz).
+            nz, nk = len(self.z_labels), len(self.y_labels)
+            self.Kk = self.Kk.reshape(nz, nk)
+            self.AK0 = self.AK0.reshape(nk, nz)
+            self.BK0 = self.BK0.reshape(nk, nz + nk)
         self.coordinate_labels = [tuple(int(v) for v in c) for c in coordinate_labels]
         self.deformation_labels = [tuple(int(v) for v in c) for c in deformation_labels]
-        return self
 
     @property
     def stiffness(self) -> np.ndarray:
@@ -141,7 +157,7 @@ def linearize(model, state=None) -> Linearization:
     and then moved continuously to ``state`` (the inputs at time t), so that the calculable
     coordinates stay on the branch of the assembled mechanism."""
     model.prepare()
-    sim = _core.Simulation(model._core)
+    sim = _core.Simulation(model.core)
     sim.assemble()
     system = sim.system
     if state is None:

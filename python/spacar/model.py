@@ -1,7 +1,7 @@
 """The builder API: :class:`Model` has one method per input keyword, so a SPACAR user recognises
 every line (``model.plbeam(1, 1, 2, 3, 4)``, ``model.x(3, 0.15, 0.0)``, ``model.fix(8, 2)``,
 ``model.dyne(2, 2)``). The reader (:mod:`spacar.io.reader`) is a thin dispatcher onto these
-methods. The model itself lives in the C++ core (``spacar._core.Model``).
+methods. The model itself lives in the C++ core (``spacar._core.Model``), public as :attr:`Model.core`.
 """
 from __future__ import annotations
 
@@ -49,14 +49,11 @@ def check_args(kw: Keyword, args) -> list:
     """Validate the arguments of a keyword against its signature; returns them grouped: one entry
     per parameter group (a scalar for single values, a list for variable counts)."""
     args = list(args)
+    if len(args) < sum(p.count_min for p in kw.params):
+        raise InputError(f"{kw.name} expects {kw.usage()}: too few values ({len(args)} given)")
     out = []
     pos = 0
-    for i, p in enumerate(kw.params):
-        rest = sum(q.count_min for q in kw.params[i + 1:])
-        avail = len(args) - pos - rest
-        n = min(max(avail, p.count_min), p.count_max)
-        if avail < p.count_min:
-            raise InputError(f"{kw.name} expects {kw.usage()}: too few values ({len(args)} given)")
+    for p, n in zip(kw.params, kw.counts(len(args))):
         vals = [_check_value(kw, p.name, p.kind, v) for v in args[pos:pos + n]]
         pos += n
         out.append(vals[0] if p.count_min == p.count_max == 1 else vals)
@@ -332,6 +329,13 @@ class Model:
         self._core.set_linear(*self._call("LINEAR", mode))
 
     # --- inspection -------------------------------------------------------------------------
+
+    @property
+    def core(self) -> _core.Model:
+        """The C++ model this Model builds (``spacar._core.Model``), itself and not a copy: what
+        the core's functions take, e.g. ``spacar._core.Simulation(model.core)``. Change the model
+        through the keyword methods, which check their arguments and name the input line."""
+        return self._core
 
     @property
     def nodes(self):

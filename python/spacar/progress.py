@@ -1,4 +1,5 @@
-"""A progress bar over simulated time (tqdm, optional).
+"""A progress bar over simulated time (tqdm, optional), and the one detection of where a bar
+belongs, shared with :func:`spacar.sweep`.
 
 The bar advances at the output times (Python never runs inside the integration). ``progress``
 of :func:`spacar.simulate`: ``None`` (default) shows it only in an interactive session (a
@@ -24,7 +25,17 @@ def interactive() -> bool:
         return False
 
 
-def _tqdm_class():
+def automatic() -> bool:
+    """Whether ``progress=None`` shows a bar: in an interactive session, unless
+    ``SPACAR_PROGRESS`` turns it off."""
+    if os.environ.get("SPACAR_PROGRESS", "").strip() in ("0", "false", "no", "off"):
+        return False
+    return interactive()
+
+
+def tqdm_class():
+    """The tqdm bar class for this session, None without tqdm: the notebook bar in a Jupyter
+    kernel with ipywidgets (without them the notebook bar cannot show), the text bar otherwise."""
     try:
         if "ipykernel" in sys.modules:
             try:
@@ -44,7 +55,7 @@ class ProgressBar:
     """Callback ``bar(k, state)`` advancing a tqdm bar to the simulated time ``state["t"]``."""
 
     def __init__(self, t0: float, period: float, delay: float, desc: str = "spacar"):
-        tqdm = _tqdm_class()
+        tqdm = tqdm_class()
         self.t0, self.period = t0, period
         # n and total are simulated seconds since the start of the block
         self.bar = tqdm(total=period, desc=desc, delay=delay, leave=True, file=sys.stderr,
@@ -68,13 +79,11 @@ def make(progress, t0: float, period: float):
     if progress is False or not period > 0.0:
         return None
     if progress is None:
-        if os.environ.get("SPACAR_PROGRESS", "").strip() in ("0", "false", "no", "off"):
-            return None
-        if not interactive():
+        if not automatic():
             return None
         delay = DELAY
     else:
         delay = 0.0
-    if _tqdm_class() is None:
+    if tqdm_class() is None:
         return None
     return ProgressBar(t0, period, delay)

@@ -25,6 +25,7 @@ import numpy as np
 
 from .errors import InputError
 from .geometry import Geometry
+from .linearize import MATRICES, Linearization
 
 # name: (attribute, over coordinates or deformations, MATASC label prefix, description)
 QUANTITIES = {
@@ -300,12 +301,13 @@ class Results:
         data["deformation_labels"] = np.asarray(self.deformation_labels, dtype=np.int64).reshape(-1, 2)
         lin_meta = []
         for k, lin in enumerate(self.linearizations):
-            lin_meta.append({"t": float(lin.t), "z_labels": [list(z) for z in lin.z_labels], "n_line": int(lin.n_line)})
-            for name in ("M0", "C0", "D0", "K0", "N0", "G0", "r0", "DF", "DFe"):
+            lin_meta.append({"t": float(lin.t), "z_labels": [list(z) for z in lin.z_labels], "n_line": int(lin.n_line),
+                             "y_labels": [list(y) for y in lin.y_labels]})
+            for name in MATRICES:
                 data[f"lin{k}_{name}"] = np.asarray(getattr(lin, name))
         meta = {
             "format": "spacar.Results",
-            "version": 1,
+            "version": 2,  # 2: with the kinematic coordinates of the linearizations
             "stats": {k: (v if isinstance(v, (int, float, str)) else float(v)) for k, v in self.stats.items()},
             "settings_linear": self.settings_linear,
             "geometry": None if self.geometry is None else self.geometry.to_dict(),
@@ -317,8 +319,6 @@ class Results:
     @classmethod
     def load(cls, path) -> "Results":
         """Read a file written by :meth:`save`."""
-        from .linearize import Linearization
-
         with np.load(path, allow_pickle=False) as f:
             meta = json.loads(str(f["meta"]))
             if meta.get("format") != "spacar.Results":
@@ -327,9 +327,10 @@ class Results:
             coord, defs = f["coordinate_labels"], f["deformation_labels"]
             lins = []
             for k, lm in enumerate(meta["linearizations"]):
-                mats = {name: f[f"lin{k}_{name}"] for name in ("M0", "C0", "D0", "K0", "N0", "G0", "r0", "DF", "DFe")}
-                lins.append(Linearization.from_arrays(lm["t"], [tuple(z) for z in lm["z_labels"]], lm["n_line"],
-                                                      mats, coord, defs))
+                # (files of version 1 lack y_labels, Kk, AK0 and BK0)
+                mats = {name: f[f"lin{k}_{name}"] for name in MATRICES if f"lin{k}_{name}" in f}
+                lins.append(Linearization.from_arrays(lm["t"], lm["z_labels"], lm["n_line"], mats, coord, defs,
+                                                      lm.get("y_labels")))
         geometry = None if meta["geometry"] is None else Geometry.from_dict(meta["geometry"])
         return cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"])
 

@@ -16,7 +16,7 @@ def _results(arrays: dict, system, model) -> Results:
                                     "newton_iterations", "wall_time", "recursive")}
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
     res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear)
-    res._geometry_source = model._core.copy()  # res.geometry is built from this copy when first used
+    res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
     return res
 
 
@@ -65,9 +65,9 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
     model.prepare()
-    sim = _core.Simulation(model._core)
+    sim = _core.Simulation(model.core)
     system = sim.system
-    settings = model._core.settings
+    settings = model.core.settings
     callbacks = []
     writer = None
     if settings.matasc == 1:

@@ -32,6 +32,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from . import progress as bars  # named so: sweep()'s argument is `progress`
 from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
 from .keywords import INT, LOOKUP, SETTINGS, Keyword
@@ -356,12 +357,11 @@ class _Progress:
         if callable(progress):
             self.callback = progress
             return
+        tqdm = bars.tqdm_class()
         if progress is None:
-            progress = _tqdm_available() and hasattr(sys.stderr, "isatty") and sys.stderr.isatty()
+            progress = tqdm is not None and bars.automatic()
         if progress:
-            if _tqdm_available():
-                from tqdm.auto import tqdm
-
+            if tqdm is not None:
                 self.bar = tqdm(total=total, desc="spacar.sweep", unit="case")
             else:
                 self.callback = self._print
@@ -381,14 +381,6 @@ class _Progress:
     def close(self):
         if self.bar is not None:
             self.bar.close()
-
-
-def _tqdm_available() -> bool:
-    try:
-        import tqdm  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 # --- the result -------------------------------------------------------------------------------------
@@ -581,7 +573,8 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     of ``chunksize`` (default: about four chunks per worker).
 
     ``progress``: True for a progress bar (tqdm when installed), False for none, None (default)
-    for a bar on an interactive terminal, or a function ``progress(done, total)``.
+    for a bar in an interactive session (a terminal or a Jupyter kernel, unless
+    ``SPACAR_PROGRESS=0``; as :func:`spacar.simulate`), or a function ``progress(done, total)``.
 
     Failed cases do not stop the sweep: they are listed in ``result.errors`` with their
     parameters, exception type and message, and their values are NaN. Returns a

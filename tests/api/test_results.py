@@ -280,3 +280,21 @@ def test_import_spacar_does_not_import_the_optional_packages():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
 
+
+
+def test_save_and_load_keep_the_kinematic_coordinates_of_a_linearization(tmp_path):
+    # Issue 18: y_labels, Kk, AK0 and BK0 were not saved, so that a loaded nonholonomic
+    # linearization (the bicycle: LINEAR 1, one output time) had no eigenvalues or state matrix.
+    from spacar.linearize import MATRICES
+
+    res = spacar.simulate(spacar.read(ROOT / "examples" / "bicycle.dat"), progress=False)
+    res.save(tmp_path / "bicycle.npz")
+    a, b = res.linearizations[0], spacar.Results.load(tmp_path / "bicycle.npz").linearizations[0]
+    assert len(a.y_labels) == 4 and b.y_labels == a.y_labels
+    for name in MATRICES:
+        np.testing.assert_array_equal(getattr(b, name), getattr(a, name))
+    np.testing.assert_array_equal(b.state_matrix(), a.state_matrix())
+    np.testing.assert_array_equal(b.eigenvalues(), a.eigenvalues())
+    for outputs in ("z", "x"):
+        for p, q in zip(b.state_space(outputs), a.state_space(outputs)):
+            np.testing.assert_array_equal(p, q)

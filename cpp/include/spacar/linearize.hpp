@@ -30,6 +30,14 @@ struct Linearization {
   std::vector<std::array<int, 3>> y_label;  // kinematic coordinates {1, element, deformation}
   Eigen::MatrixXd Kk, AK0, BK0; // nz x nk, nk x nz, nk x (nz + nk)
   Eigen::MatrixXd DFz, DFez;    // ∂x/∂z (nx x nz) and ∂e/∂z (ne x nz): mode shapes
+
+  // f(name, array) for each array above, named as the attributes of spacar.Linearization (whose
+  // MATRICES lists them in the same order): the one list of them on this side.
+  template <class F>
+  void for_each_array(F&& f) const {
+    f("M0", M0), f("C0", C0), f("D0", D0), f("K0", K0), f("N0", N0), f("G0", G0);
+    f("Kk", Kk), f("AK0", AK0), f("BK0", BK0), f("DF", DFz), f("DFe", DFez), f("r0", r0);
+  }
 };
 
 class Linearizer {

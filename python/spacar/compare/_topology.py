@@ -34,6 +34,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import InputError
+from ..geometry import rotation  # R(λ), body → global
 
 PLANAR_BEAMS = ("PLBEAM", "PLBEAMNL")
 SPATIAL_BEAMS = ("BEAM", "BEAMNL")
@@ -62,17 +63,6 @@ def rot_z(beta: float) -> np.ndarray:
 def E_matrix(lam) -> np.ndarray:
     l0, l1, l2, l3 = lam
     return np.array([[-l1, l0, -l3, l2], [-l2, l3, l0, -l1], [-l3, -l2, l1, l0]])
-
-
-def G_matrix(lam) -> np.ndarray:
-    l0, l1, l2, l3 = lam
-    return np.array([[-l1, l0, l3, -l2], [-l2, -l3, l0, l1], [-l3, l2, -l1, l0]])
-
-
-def rot_lambda(lam) -> np.ndarray:
-    """R(λ) = E Gᵀ (body → global), formulation.md §0."""
-    lam = np.asarray(lam, dtype=float)
-    return E_matrix(lam) @ G_matrix(lam).T
 
 
 def lambda_of_rotation(R: np.ndarray, near=None) -> np.ndarray:
@@ -256,7 +246,7 @@ class Topology:
         n = self.bodies[b].orientation_nodes[0]
         if self.planar:
             return rot_z(x[self.coord_index[(n, 1)]])
-        return rot_lambda([x[self.coord_index[(n, i)]] for i in range(1, 5)])
+        return rotation([x[self.coord_index[(n, i)]] for i in range(1, 5)])
 
     def body_angle(self, b: int, x) -> float:
         """Planar: absolute rotation angle of body b (not wrapped)."""
@@ -299,23 +289,6 @@ class Topology:
         return next(iter(self.bodies[b].points))
 
 
-def _union_find(items):
-    parent = {i: i for i in items}
-
-    def find(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    def union(a, b):
-        ra, rb = find(a), find(b)
-        if ra != rb:
-            parent[max(ra, rb)] = min(ra, rb)
-
-    return find, union
-
-
 def _chord(el) -> np.ndarray:
     """Reference chord x_q − x_p of a beam element in the reference frame."""
     if el.type_name in PLANAR_BEAMS:
@@ -341,7 +314,7 @@ def analyse(model, sim=None) -> Topology:
     """Analyse a :class:`spacar.Model` (prepared and assembled here if no ``sim`` is given)."""
     model.prepare()
     if sim is None:
-        sim = _core.Simulation(model._core)
+        sim = _core.Simulation(model.core)
         sim.assemble()
     system = sim.system
     # assemble() solves the positions only; the rates come with an evaluation at the initial state
@@ -403,18 +376,19 @@ def analyse(model, sim=None) -> Topology:
             _check_zero_targets(el)
             hinges.append(el)
 
-    # Orientation nodes: union through rigid beams and rigid hinges; fixed ones form the ground.
+    # Orientation nodes: rigid beams and rigid hinges join them into rigid bodies (the core's
+    # union-find); the bodies holding a fixed one are together the ground.
     orient = [n for n, kd in node_kind.items() if kd in ORIENTATION_KINDS and nodes[n].used]
     flexible_orient = {el.nodes[1] for el in flexible} | {el.nodes[3] for el in flexible}
-    find, union = _union_find(orient + [0])
-    for el in rigid_beams:
-        union(el.nodes[1], el.nodes[3])
-    for el in hinges:
-        if el.cls[0] == DC.fixed:
-            union(el.nodes[0], el.nodes[1])
-    fixed_orient = [n for n in orient if all(c == CC.fixed for c in nodes[n].cls)]
-    for n in fixed_orient:
-        union(0, n)
+    links = [[el.nodes[1], el.nodes[3]] for el in rigid_beams]
+    links += [[el.nodes[0], el.nodes[1]] for el in hinges if el.cls[0] == DC.fixed]
+    fixed_orient = {n for n in orient if all(c == CC.fixed for c in nodes[n].cls)}
+    ground, moving = set(), []
+    for group in _core.rigid_bodies(orient, links):
+        if fixed_orient.intersection(group):
+            ground.update(group)
+        else:
+            moving.append(group)
     for n in orient:
         cls = nodes[n].cls
         if any(c == CC.fixed for c in cls) and not all(c == CC.fixed for c in cls):
@@ -425,22 +399,22 @@ def analyse(model, sim=None) -> Topology:
     for el in hinges:
         rigid_orient |= set(el.nodes[:2])
     for n in flexible_orient:
-        if n in rigid_orient and find(n) != 0:
+        if n in rigid_orient and n not in ground:
             raise UnsupportedModelError(
                 f"BETA node {n} joins a flexible beam to a rigid body (clamped connection to a moving body); "
                 "only clamping to the ground, pins (shared position nodes) and free ends are converted")
 
-    classes = {0: []}
-    for n in orient:
-        r = find(n)
-        if r != 0 and n in flexible_orient:
-            continue  # a BETA node of flexible beams only (checked above): no rigid body
-        classes.setdefault(r, []).append(n)
-    roots = [0] + sorted(r for r in classes if r != 0)
-    bodies = [Body(i) for i in range(len(roots))]
+    # Body 0 is the ground, then the moving bodies by their first node; a BETA node of flexible
+    # beams only (checked above) is no rigid body.
+    groups = [sorted(ground)]
+    for group in moving:
+        body = [n for n in group if n not in flexible_orient]
+        if body:
+            groups.append(body)
+    bodies = [Body(i) for i in range(len(groups))]
     body_of_orientation = {}
-    for i, r in enumerate(roots):
-        for n in classes[r]:
+    for i, group in enumerate(groups):
+        for n in group:
             bodies[i].orientation_nodes.append(n)
             body_of_orientation[n] = i
 
@@ -451,7 +425,7 @@ def analyse(model, sim=None) -> Topology:
         def node_rot(n):
             if planar:
                 return rot_z(x0[coord_index[(n, 1)]])
-            return rot_lambda([x0[coord_index[(n, i)]] for i in range(1, 5)])
+            return rotation([x0[coord_index[(n, i)]] for i in range(1, 5)])
         ground_rotation = node_rot(gnodes[0])
         for n in gnodes[1:]:
             if np.abs(node_rot(n) - ground_rotation).max() > 1e-9:
@@ -663,7 +637,7 @@ def analyse(model, sim=None) -> Topology:
         if n not in bodies_of_point and n not in flexible_pos:
             raise UnsupportedModelError(f"position node {n} belongs to no rigid body or flexible beam")
 
-    gravity = np.asarray(model._core.gravity, dtype=float)
+    gravity = np.asarray(model.core.gravity, dtype=float)
     return Topology(planar, bodies, joints, flex, body_of_orientation, bodies_of_point, partial_fix,
                     point_masses, ground_rotation, gravity, node_kind, x0, xd0, coord_index, def_index,
                     float(model.settings.epsint), float(model.settings.epsind))

@@ -151,7 +151,7 @@ class ExudynModel:
             raise ValueError("formulation must be 'redundant' or 'tree'")
         self.spacar_model = spacar_model
         self.formulation = formulation
-        self.sim = _core.Simulation(spacar_model._core)
+        self.sim = _core.Simulation(spacar_model.core)
         self.sim.assemble()
         self.topology = topo = analyse(spacar_model, self.sim)
         self.t0 = spacar_model.current_time

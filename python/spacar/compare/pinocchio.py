@@ -56,7 +56,7 @@ class PinocchioModel:
 
     def __init__(self, spacar_model):
         self.spacar_model = spacar_model
-        self.sim = _core.Simulation(spacar_model._core)
+        self.sim = _core.Simulation(spacar_model.core)
         self.sim.assemble()
         topo = analyse(spacar_model, self.sim)
         self.topology = topo
@@ -291,7 +291,7 @@ def build(spacar_model) -> PinocchioModel:
 
 def random_states(spacar_model, n: int, seed=0, scale_q=1.0, scale_qd=1.0):
     """n random spacar states (t, q, q̇) around the model's initial DOF values."""
-    sim = _core.Simulation(spacar_model._core)
+    sim = _core.Simulation(spacar_model.core)
     sim.assemble()
     q0 = np.array(sim.system.q0)
     rng = np.random.default_rng(seed)

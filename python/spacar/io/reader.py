@@ -76,9 +76,7 @@ def _parse_line(kw: Keyword, tokens):
     """Numbers of a line by the keyword's signature (types and counts)."""
     values = []
     pos = 0
-    for i, p in enumerate(kw.params):
-        rest = sum(q.count_min for q in kw.params[i + 1:])
-        n = min(max(len(tokens) - pos - rest, p.count_min), p.count_max)
+    for p, n in zip(kw.params, kw.counts(len(tokens))):
         for tok in tokens[pos:pos + n]:
             values.append(_number(tok, p.kind))
         pos += n
@@ -151,7 +149,6 @@ def read_string(text: str, file: str = "<string>") -> Model:
     blocks = parse(text, file)
     model = Model()
     model.source = file
-    model.blocks = blocks
     for b in blocks:
         if not b.ended:
             first, last = b.commands[0], b.commands[-1]

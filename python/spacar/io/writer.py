@@ -50,7 +50,7 @@ def dump(model, digits: int = 4) -> str:
     Before the first analysis the model is dumped as it will be analysed (a prepared copy: with
     the reference geometry ``LENGTHO``/``LGEOMY`` and the automatic ``L2MIN1`` elements), so the
     layout is the same before and after a run."""
-    core = model._core
+    core = model.core
     if not core.frozen:
         core = core.copy()
         core.prepare()
