@@ -7,7 +7,7 @@ import spacar
 from spacar import _core
 from spacar.geometry import Geometry
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "slidercrank.dat"
 
 
