@@ -17,14 +17,7 @@ namespace {
 py::dict block_results_to_dict(BlockResults&& r) {
   py::dict d;
   d["t"] = std::move(r.t);
-  d["x"] = std::move(r.x);
-  d["xd"] = std::move(r.xd);
-  d["xdd"] = std::move(r.xdd);
-  d["e"] = std::move(r.e);
-  d["ed"] = std::move(r.ed);
-  d["edd"] = std::move(r.edd);
-  d["sigma"] = std::move(r.sigma);
-  d["reaction"] = std::move(r.reaction);
+  for (const OutputArray& a : kOutputArrays) d[a.name] = std::move(r.*a.rows);
   py::list lins;
   for (const Linearization& l : r.linearizations) lins.append(linearization_to_dict(l));
   d["linearizations"] = lins;
@@ -179,14 +172,7 @@ void bind_simulation(py::module_& m) {
                 py::gil_scoped_acquire gil;
                 py::dict state;
                 state["t"] = d.t;
-                state["x"] = d.x;
-                state["xd"] = d.xd;
-                state["xdd"] = d.xdd;
-                state["e"] = d.e;
-                state["ed"] = d.ed;
-                state["edd"] = d.edd;
-                state["sigma"] = d.sigma;
-                state["reaction"] = d.reaction;
+                for (const OutputArray& a : kOutputArrays) state[a.name] = d.*a.now;
                 if (lin) state["linearization"] = linearization_to_dict(*lin);
                 on_output(k, state);
               };

@@ -288,14 +288,7 @@ bool Simulation::recursive_state(const double* q, const double* qd, Eigen::Vecto
 
 void Simulation::record(BlockResults& res, int k) {
   res.t[k] = data_->t;
-  res.x.row(k) = data_->x;
-  res.xd.row(k) = data_->xd;
-  res.xdd.row(k) = data_->xdd;
-  res.e.row(k) = data_->e;
-  res.ed.row(k) = data_->ed;
-  res.edd.row(k) = data_->edd;
-  res.sigma.row(k) = data_->sigma;
-  res.reaction.row(k) = data_->reaction;
+  for (const OutputArray& a : kOutputArrays) (res.*a.rows).row(k) = (*data_).*a.now;
 }
 
 BlockResults Simulation::run(const RunOptions& options) {
@@ -307,14 +300,10 @@ BlockResults Simulation::run(const RunOptions& options) {
 void Simulation::require_finite_state(double t) const {
   // Values beyond double precision (e.g. FORCE 8 1e308 on a support) must not reach the results
   // as infinities or NaNs: the run stops here and keeps the output times before.
-  const std::pair<const char*, const Eigen::VectorXd*> parts[] = {
-      {"coordinates", &data_->x}, {"velocities", &data_->xd}, {"accelerations", &data_->xdd},
-      {"deformations", &data_->e}, {"deformation rates", &data_->ed}, {"deformation accelerations", &data_->edd},
-      {"stresses", &data_->sigma}, {"reactions", &data_->reaction}};
-  for (const auto& [name, v] : parts)
-    if (!v->allFinite()) {
+  for (const OutputArray& a : kOutputArrays)
+    if (!((*data_).*a.now).allFinite()) {
       std::ostringstream os;
-      os << "the " << name << " at t = " << t
+      os << "the " << a.what << " at t = " << t
          << " are not finite: the model's values exceed double precision (check the magnitudes of loads, "
             "masses, stiffnesses and rates)";
       throw Error(os.str());
@@ -341,8 +330,7 @@ std::string num(double v) {
 // Keep the first `rows` rows of every time-indexed array (a run that failed midway).
 void cut_rows(BlockResults& res, int rows) {
   res.t.conservativeResize(rows);
-  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd, &res.reaction, &res.e, &res.ed, &res.edd, &res.sigma})
-    m->conservativeResize(rows, m->cols());
+  for (const OutputArray& a : kOutputArrays) (res.*a.rows).conservativeResize(rows, (res.*a.rows).cols());
 }
 
 }  // namespace
@@ -404,9 +392,8 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
                    "use fewer output intervals (TIMESTEP n) or split the period into blocks");
   }
   res.t.resize(nt);
-  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd, &res.reaction}) m->resize(nt, sys_->nx);
+  for (const OutputArray& a : kOutputArrays) (res.*a.rows).resize(nt, a.per_deformation ? sys_->ne : sys_->nx);
   res.reaction.setZero();
-  for (RowMatrix* m : {&res.e, &res.ed, &res.edd, &res.sigma}) m->resize(nt, sys_->ne);
   std::vector<double> times(nt);
   for (int k = 0; k < nt; ++k) times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
   times.back() = t_end;  // exactly the end of the block, whatever the rounding

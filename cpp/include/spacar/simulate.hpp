@@ -56,6 +56,28 @@ struct BlockResults {
   std::vector<std::string> warnings;
 };
 
+// The arrays recorded at every output time, listed once (recording, allocation, the results
+// handed to Python and the state given to RunOptions::on_output): Data holds the value at the
+// current time, BlockResults one row per output time.
+struct OutputArray {
+  const char* name;
+  const char* what;       // in messages: "the <what> at t = ... are not finite"
+  bool per_deformation;   // ne columns (else nx)
+  Eigen::VectorXd Data::*now;
+  RowMatrix BlockResults::*rows;
+};
+
+inline constexpr OutputArray kOutputArrays[] = {
+    {"x", "coordinates", false, &Data::x, &BlockResults::x},
+    {"xd", "velocities", false, &Data::xd, &BlockResults::xd},
+    {"xdd", "accelerations", false, &Data::xdd, &BlockResults::xdd},
+    {"e", "deformations", true, &Data::e, &BlockResults::e},
+    {"ed", "deformation rates", true, &Data::ed, &BlockResults::ed},
+    {"edd", "deformation accelerations", true, &Data::edd, &BlockResults::edd},
+    {"sigma", "stresses", true, &Data::sigma, &BlockResults::sigma},
+    {"reaction", "reactions", false, &Data::reaction, &BlockResults::reaction},
+};
+
 class Simulation {
  public:
   // Prepares (first END) and compiles the model; the model must outlive the simulation.
