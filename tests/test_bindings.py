@@ -39,3 +39,20 @@ def test_the_pickled_records_hold_the_properties_in_their_order():
             assert stored == value
     settings_fields = properties(_core.Settings)
     assert list(settings) == [getattr(core.settings, name) for name in settings_fields]
+
+
+def test_both_entry_points_refuse_an_unknown_integration_method_alike():
+    """One parser (integrator.hpp parse_method): the simulation and the integrator binding raise
+    the same InputError, which is also a ValueError."""
+    sim = _core.Simulation(spacar.read(EXAMPLE)._core)
+    errors = []
+    for call in (lambda: sim.run(method="rk4"),
+                 lambda: _core.dop853_solve(lambda t, y: y, 0.0, [1.0], 1.0, [1.0], 1e-6, 1e-6, method="rk4")):
+        try:
+            call()
+        except Exception as err:  # noqa: BLE001 - the type is what is checked
+            errors.append(err)
+    assert len(errors) == 2
+    assert [type(e) for e in errors] == [spacar.InputError, spacar.InputError]
+    assert str(errors[0]) == str(errors[1]) == "unknown integration method 'rk4' (dop853, dopri5)"
+    assert isinstance(errors[0], ValueError)

@@ -60,7 +60,9 @@ py::handle python_type(const std::exception_ptr& p, std::string& message) {
 void bind_errors(py::module_& m) {
   PyErrors& e = py_errors();
   e.base = py::exception<Error>(m, "SpacarError").release();
-  e.input = py::exception<InputError>(m, "InputError", e.base).release();
+  // Invalid input is also a ValueError, as Python code expects of a bad argument.
+  e.input = py::exception<InputError>(m, "InputError", py::make_tuple(e.base, py::handle(PyExc_ValueError)))
+                .release();
   e.kinematics = py::exception<KinematicsError>(m, "KinematicsError", e.base).release();
   e.mass = py::exception<SingularMassError>(m, "SingularMassError", e.base).release();
   e.integration = py::exception<IntegrationError>(m, "IntegrationError", e.base).release();

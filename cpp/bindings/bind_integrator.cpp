@@ -14,18 +14,11 @@ namespace py = pybind11;
 
 namespace {
 
-spacar::Method parse_method(const std::string& name) {
-  if (name == "dop853") return spacar::Method::DOP853;
-  if (name == "dopri5") return spacar::Method::DOPRI5;
-  throw std::invalid_argument("dop853_solve: method must be 'dop853' or 'dopri5', not '" + name +
-                              "'");
-}
-
 py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, double t_end,
                const std::vector<double>& touts, double rtol, double atol,
                const std::string& method, double hmax) {
   const int n = static_cast<int>(y0.size());
-  spacar::Integrator integrator(n, parse_method(method));
+  spacar::Integrator integrator(n, spacar::parse_method(method));
   integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol),
                             Eigen::VectorXd::Constant(n, atol));
   integrator.set_max_step(hmax);

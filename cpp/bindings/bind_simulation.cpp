@@ -164,9 +164,7 @@ void bind_simulation(py::module_& m) {
             RunOptions opt;
             opt.recursive = recursive;
             opt.initial_step = initial_step;
-            if (method == "dop853") opt.method = Method::DOP853;
-            else if (method == "dopri5") opt.method = Method::DOPRI5;
-            else throw InputError("unknown integration method '" + method + "' (dop853, dopri5)");
+            opt.method = parse_method(method);
             if (!on_output.is_none()) {
               opt.on_output = [on_output](int k, const Data& d, const Linearization* lin) {
                 py::gil_scoped_acquire gil;
