@@ -56,3 +56,18 @@ def test_both_entry_points_refuse_an_unknown_integration_method_alike():
     assert [type(e) for e in errors] == [spacar.InputError, spacar.InputError]
     assert str(errors[0]) == str(errors[1]) == "unknown integration method 'rk4' (dop853, dopri5)"
     assert isinstance(errors[0], ValueError)
+
+
+def test_every_state_entry_point_checks_the_sizes_of_q_and_qd():
+    """The checks are in the core, at the entry of each algorithm (simulate.hpp)."""
+    import numpy as np
+    import pytest
+
+    sim = _core.Simulation(spacar.read(EXAMPLE)._core)
+    sim.assemble()
+    n = sim.system.n_dof
+    good, bad = np.zeros(n), np.zeros(n + 1)
+    for name, args in (("evaluate", (0.0,)), ("solve_state", (0.0,)), ("move_to", (0.0,)), ("recursive_state", ())):
+        for q, qd in ((bad, good), (good, bad)):
+            with pytest.raises(spacar.InputError, match=rf"{name}\(\): q and qd must have one value per degree"):
+                getattr(sim, name)(*args, q, qd)

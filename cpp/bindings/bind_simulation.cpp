@@ -88,23 +88,7 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", &Simulation::assemble)
       .def("forces", &Simulation::forces)
-      .def("reduced_accelerations",
-           [](Simulation& s) {
-             // q̈ of the reduced equations (3.1) with transfer functions at the last evaluated
-             // state: an independent check of the integration path's sparse solve.
-             Data& d = s.data();
-             const System& sys = s.system();
-             const Eigen::VectorXd qdd = d.qdd, xdd = d.xdd, edd = d.edd, qhat_dd = d.qhat_dd;
-             solve_transfer(sys, d);
-             solve_velocities(sys, d);
-             solve_dynamics(sys, d);
-             const Eigen::VectorXd reduced = d.qdd;
-             d.qdd = qdd;
-             d.xdd = xdd;
-             d.edd = edd;
-             d.qhat_dd = qhat_dd;
-             return reduced;
-           })
+      .def("reduced_accelerations", &Simulation::reduced_accelerations)
       .def("linearize", [](Simulation& s) { return linearization_to_dict(s.linearize()); })
       .def("diagnose",
            [](Simulation& s) {
@@ -122,41 +106,26 @@ void bind_simulation(py::module_& m) {
              out["text"] = d.text;
              return out;
            })
-      .def("evaluate",
-           [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
-               throw InputError("evaluate(): q and qd must have one value per degree of freedom");
-             s.evaluate(t, q.data(), qd.data());
-           })
+      .def("evaluate", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::evaluate))
       .def("solve_state",
-           [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-             // The integration path: positions, velocities, q̈ and stresses without DF.
-             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
-               throw InputError("solve_state(): q and qd must have one value per degree of freedom");
-             s.solve_state(t, q.data(), qd.data());
-           })
-      .def("recursive_state",
-           [](Simulation& s, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) -> py::object {
-             // The recursive path of planar rigid trees at (q, q̇), its tree taken at the solved
-             // state of the first call: a dict of qdd, x, xd, xdd (None for other systems); a
-             // check of it against solve_state() and move_to().
-             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
-               throw InputError("recursive_state(): q and qd must have one value per degree of freedom");
-             Eigen::VectorXd qdd, x, xd, xdd;
-             if (!s.recursive_state(q.data(), qd.data(), qdd, x, xd, xdd)) return py::none();
-             py::dict out;
-             out["qdd"] = qdd;
-             out["x"] = x;
-             out["xd"] = xd;
-             out["xdd"] = xdd;
-             return out;
-           })
-      .def("move_to",
-           [](Simulation& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-             if (q.size() != s.system().n_dof() || qd.size() != s.system().n_dof())
-               throw InputError("move_to(): q and qd must have one value per degree of freedom");
-             s.move_to(t, q.data(), qd.data());
-           })
+           py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::solve_state),
+           "The integration path: positions, velocities, q̈ and stresses without DF.")
+      .def(
+          "recursive_state",
+          [](Simulation& s, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) -> py::object {
+            Eigen::VectorXd qdd, x, xd, xdd;
+            if (!s.recursive_state(q, qd, qdd, x, xd, xdd)) return py::none();
+            py::dict out;
+            out["qdd"] = qdd;
+            out["x"] = x;
+            out["xd"] = xd;
+            out["xdd"] = xdd;
+            return out;
+          },
+          "The recursive path of planar rigid trees at (q, q̇), its tree taken at the solved state of the first "
+          "call: a dict of qdd, x, xd, xdd (None for other systems); a check of it against solve_state() and "
+          "move_to().")
+      .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))
       .def(
           "run",
           [](Simulation& s, py::object on_output, double initial_step, const std::string& method,

@@ -273,17 +273,52 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   dY.tail(nd) = data_->qdd;
 }
 
-bool Simulation::recursive_state(const double* q, const double* qd, Eigen::VectorXd& qdd, Eigen::VectorXd& x,
-                                 Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
+bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
+                                 Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
+  require_dof_sizes("recursive_state", q, qd);
   if (!tree_) tree_ = PlanarTree::detect(*sys_, *data_);
   if (!tree_) return false;
   Eigen::VectorXd x1 = data_->x, xd1 = Eigen::VectorXd::Zero(sys_->nx), xdd1 = xd1, qdd1(sys_->n_dof());
-  if (!tree_->solve(q, qd, x1, xd1, xdd1, qdd1.data())) return false;
+  if (!tree_->solve(q.data(), qd.data(), x1, xd1, xdd1, qdd1.data())) return false;
   qdd = qdd1;
   x = x1;
   xd = xd1;
   xdd = xdd1;
   return true;
+}
+
+Eigen::VectorXd Simulation::reduced_accelerations() {
+  Data& d = *data_;
+  const Eigen::VectorXd qdd = d.qdd, xdd = d.xdd, edd = d.edd, qhat_dd = d.qhat_dd;
+  solve_transfer(*sys_, d);
+  solve_velocities(*sys_, d);
+  solve_dynamics(*sys_, d);
+  Eigen::VectorXd reduced = d.qdd;
+  d.qdd = qdd;
+  d.xdd = xdd;
+  d.edd = edd;
+  d.qhat_dd = qhat_dd;
+  return reduced;
+}
+
+void Simulation::require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const {
+  if (q.size() != sys_->n_dof() || qd.size() != sys_->n_dof())
+    throw InputError(std::string(what) + "(): q and qd must have one value per degree of freedom");
+}
+
+void Simulation::solve_state(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  require_dof_sizes("solve_state", q, qd);
+  solve_state(t, q.data(), qd.data());
+}
+
+void Simulation::evaluate(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  require_dof_sizes("evaluate", q, qd);
+  evaluate(t, q.data(), qd.data());
+}
+
+void Simulation::move_to(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  require_dof_sizes("move_to", q, qd);
+  move_to(t, q.data(), qd.data());
 }
 
 void Simulation::record(BlockResults& res, int k) {

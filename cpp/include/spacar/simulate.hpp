@@ -112,8 +112,17 @@ class Simulation {
   // accelerations; false (nothing written) if the system is not a planar tree of rigid bodies or
   // a body moves no mass. The tree is taken at the solved state of the first call (after
   // assemble(): the assembled state) and kept until the next run.
-  bool recursive_state(const double* q, const double* qd, Eigen::VectorXd& qdd, Eigen::VectorXd& x,
-                       Eigen::VectorXd& xd, Eigen::VectorXd& xdd);
+  bool recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
+                       Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd);
+  // q̈ of the reduced equations (3.1) with transfer functions at the last evaluated state, the
+  // state left as it was: an independent check of the integration path's sparse solve.
+  Eigen::VectorXd reduced_accelerations();
+
+  // The entry points of users and the bindings: q and q̇ are checked to have one value per
+  // degree of freedom (InputError), then the versions above run (recursive_state checks too).
+  void solve_state(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  void evaluate(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  void move_to(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
 
   BlockResults run(const RunOptions& options = {});
   // The same, into `res`. If the run fails (an exception), `res` holds what was computed up to
@@ -125,6 +134,8 @@ class Simulation {
 
  private:
   void record(BlockResults& res, int k);
+  // InputError unless q and q̇ have one value per degree of freedom (`what`: the entry point).
+  void require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;
   // After the integrator gave up: rethrow as a KinematicsError if the kinematics is the cause.
   void explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y);
   // A free rotation whose dependent Euler parameter has become small, or −1.
