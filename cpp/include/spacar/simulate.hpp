@@ -133,6 +133,26 @@ class Simulation {
   void store_state();
 
  private:
+  // A block's run in three stages: plan (the requests checked before any work, the output
+  // times), allocate (the result arrays, within the memory limit), integrate (assemble, then
+  // the output times reached by integration or, without degrees of freedom, by kinematics).
+  struct BlockPlan {
+    Settings st;                 // the system's settings, tolerances raised to kMinTolerance
+    double t0 = 0.0, t_end = 0.0;
+    bool integrate = false;      // degrees of freedom or integrated deformations, and a period
+    bool linear = false;         // linearized equations at every output time
+    std::vector<double> times;   // the output times, the last exactly t_end
+  };
+  BlockPlan plan_block(const RunOptions& options, std::vector<std::string>& warnings) const;
+  void start_clock(const RunOptions& options, std::chrono::steady_clock::time_point start);
+  void allocate_results(BlockResults& res, const BlockPlan& plan) const;
+  // k_out: the output times recorded (also when it throws).
+  void integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out);
+  // One integrator run from t towards t_end through `times`, until the end or a repartition of a
+  // free rotation; the time reached. Counters and the last step go to res.
+  double integrate_segment(BlockResults& res, const RunOptions& options, const Settings& st, double t, double t_end,
+                           double h, Eigen::VectorXd& Y, const std::vector<double>& times,
+                           const Integrator::Output& output);
   void record(BlockResults& res, int k);
   // InputError unless q and q̇ have one value per degree of freedom (`what`: the entry point).
   void require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;
