@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "spacar/diagnosis.hpp"
 #include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
@@ -16,35 +17,6 @@ namespace {
 
 bool constitutive_class(DefClass c) {
   return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
-}
-
-// The DOFs with the largest components of the null vector of M̄: those that move no mass.
-[[noreturn]] void throw_singular_mass(const System& sys, const Data& data, const Eigen::MatrixXd& Mbar) {
-  const int nd = sys.n_dof();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Mbar);
-  const Eigen::VectorXd lam = eig.eigenvalues();
-  const double tol = 1e-10 * std::max(lam.cwiseAbs().maxCoeff(), 1e-300);
-  std::vector<bool> named(nd, false);
-  for (int m = 0; m < nd && (m == 0 || lam[m] <= tol); ++m) {
-    const Eigen::VectorXd v = eig.eigenvectors().col(m);
-    const double vmax = v.cwiseAbs().maxCoeff();
-    for (int j = 0; j < nd; ++j) named[j] = named[j] || std::abs(v[j]) >= 0.1 * vmax;
-  }
-  std::ostringstream os;
-  os << "the reduced mass matrix is singular at t = " << data.t << " (smallest eigenvalue " << lam[0]
-     << "): the degrees of freedom";
-  for (int j = 0; j < nd; ++j) {
-    if (!named[j]) continue;
-    const int col = sys.dof_cols[j];
-    os << " [";
-    for (int g = 0; g < sys.nx; ++g)
-      if (sys.qhat_col_x[g] == col) os << "DYNX " << sys.coord_name(g);
-    for (int k = 0; k < sys.ne; ++k)
-      if (sys.qhat_col_e[k] == col) os << "DYNE " << sys.def_name(k);
-    os << "]";
-  }
-  os << " move no mass; add MASS or EMASS to the nodes or elements they move";
-  throw SingularMassError(os.str());
 }
 
 // out = M acc, element by element (point masses, element masses, rigid bodies).
@@ -253,11 +225,7 @@ void solve_dynamics_direct(const System& sys, Data& data) {
   if (!data.kkt_rhs.allFinite()) throw overflow();
   if (!data.luK.factorize(K)) {
     if (!K_values.allFinite()) throw overflow();
-    // Name the degrees of freedom without inertia through the reduced equations.
-    solve_transfer(sys, data);
-    solve_velocities(sys, data);
-    solve_dynamics(sys, data);
-    throw SingularMassError("the equations of motion are singular at t = " + std::to_string(data.t));
+    explain_singular_equations(sys, data);
   }
   data.luK.solve(data.kkt_rhs, data.kkt_sol);
   data.xdd = data.acc_known;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "spacar/diagnosis.hpp"
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
