@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import spacar
-from spacar import _core
+from spacar import _core, _testing
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "slidercrank.dat"
 
@@ -42,12 +42,12 @@ def test_the_pickled_records_hold_the_properties_in_their_order():
 
 
 def test_both_entry_points_refuse_an_unknown_integration_method_alike():
-    """One parser (integrator.hpp parse_method): the simulation and the integrator binding raise
+    """One parser (integrator.hpp parse_method): the simulation and the integrator raise
     the same InputError, which is also a ValueError."""
     sim = _core.Simulation(spacar.read(EXAMPLE)._core)
     errors = []
     for call in (lambda: sim.run(method="rk4"),
-                 lambda: _core.dop853_solve(lambda t, y: y, 0.0, [1.0], 1.0, [1.0], 1e-6, 1e-6, method="rk4")):
+                 lambda: _testing.explicit_rk_solve(lambda t, y: y, 0.0, [1.0], 1.0, [1.0], 1e-6, 1e-6, method="rk4")):
         try:
             call()
         except Exception as err:  # noqa: BLE001 - the type is what is checked
@@ -71,3 +71,9 @@ def test_every_state_entry_point_checks_the_sizes_of_q_and_qd():
         for q, qd in ((bad, good), (good, bad)):
             with pytest.raises(spacar.InputError, match=rf"{name}\(\): q and qd must have one value per degree"):
                 getattr(sim, name)(*args, q, qd)
+
+
+def test_the_test_bindings_are_not_in_the_shipped_core():
+    for name in ("element_kernel", "ElementKernel", "explicit_rk_solve", "dop853_solve", "SparseLU"):
+        assert not hasattr(_core, name)
+    assert callable(_testing.element_kernel) and callable(_testing.explicit_rk_solve)

@@ -5,10 +5,6 @@
 
 using namespace spacar::bindings;
 
-void bind_kernels(py::module_& m);
-void bind_integrator(py::module_& m);
-void bind_sparse(py::module_& m);
-
 PYBIND11_MODULE(_core, m) {
   m.doc() = "spacar C++ core";
   bind_errors(m);
@@ -17,7 +13,4 @@ PYBIND11_MODULE(_core, m) {
   bind_catalogue(m);
   bind_model(m);
   bind_simulation(m);
-  bind_kernels(m);
-  bind_integrator(m);
-  bind_sparse(m);
 }

@@ -1,4 +1,4 @@
-// Test-only binding of the Runge-Kutta integrator: integrates a Python rhs so that the tests can
+// Binding of the Runge-Kutta integrator (spacar._testing): integrates a Python rhs so that the tests can
 // check accuracy, dense output and failure handling against exact solutions.
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
@@ -48,7 +48,7 @@ py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, doub
 }  // namespace
 
 void bind_integrator(py::module_& m) {
-  m.def("dop853_solve", &solve, py::arg("f"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
+  m.def("explicit_rk_solve", &solve, py::arg("f"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
         py::arg("touts"), py::arg("rtol"), py::arg("atol"), py::arg("method") = "dop853",
         py::arg("hmax") = std::numeric_limits<double>::infinity(),
         "Test helper: integrate dy/dt = f(t, y) from t0 to t_end with the embedded Runge-Kutta "
