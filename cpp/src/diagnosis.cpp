@@ -44,7 +44,7 @@ std::vector<int> dependent_columns(const Eigen::MatrixXd& V, const std::vector<i
 
 ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
   ConstraintDiagnosis d;
-  const std::vector<int>& rows = velocity ? sys.rows_V : sys.rows_P;
+  const std::vector<int>& rows = velocity ? sys.defs_V : sys.defs_P;
   BlockMatrix& block = velocity ? data.AV : data.AP;
   const int nP = static_cast<int>(rows.size());
   const int nc = static_cast<int>(sys.x_calc.size());
@@ -167,7 +167,7 @@ std::string diagnose_constraints(const System& sys, Data& data, bool velocity) {
 }
 
 std::string weakest_constraint(const System& sys, Data& data) {
-  const int nV = static_cast<int>(sys.rows_V.size()), nc = static_cast<int>(sys.x_calc.size());
+  const int nV = static_cast<int>(sys.defs_V.size()), nc = static_cast<int>(sys.x_calc.size());
   if (nV != nc || nc == 0 || nc > kMaxDiagnosisSize) return "";
   assemble_block(sys, data, data.AV, data.AV_block);
   Eigen::BDCSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(data.AV.matrix()), Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -179,7 +179,7 @@ std::string weakest_constraint(const System& sys, Data& data) {
      << ");\n  constraints that lose their independence:";
   const Eigen::VectorXd u = svd.matrixU().col(nc - 1), v = svd.matrixV().col(nc - 1);
   for (int r = 0; r < nV; ++r)
-    if (std::abs(u[r]) > 0.1 * u.cwiseAbs().maxCoeff()) os << " " << sys.def_name(sys.rows_V[r]);
+    if (std::abs(u[r]) > 0.1 * u.cwiseAbs().maxCoeff()) os << " " << sys.def_name(sys.defs_V[r]);
   os << "\n  coordinates of the singular motion:";
   for (int j = 0; j < nc; ++j)
     if (std::abs(v[j]) > 0.1 * v.cwiseAbs().maxCoeff()) os << " " << sys.coord_name(sys.x_calc[j]);

@@ -257,11 +257,11 @@ void nodal_reactions(const System& sys, Data& data) {
     return sys.def_class[k] == DefClass::Released || sys.def_class[k] == DefClass::Kinematic; }, data.residual_load);
   data.sigma_equilibrium.setZero();
   const int nc = static_cast<int>(sys.x_calc.size());
-  if (nc > 0 && static_cast<int>(sys.rows_V.size()) == nc) {
+  if (nc > 0 && static_cast<int>(sys.defs_V.size()) == nc) {
     Eigen::VectorXd rhs(nc), sV(nc);
     for (int j = 0; j < nc; ++j) rhs[j] = -data.residual_load[sys.x_calc[j]];
     data.luV.solve_transposed(rhs, sV);
-    for (int r = 0; r < nc; ++r) data.sigma_equilibrium[sys.rows_V[r]] = sV[r];
+    for (int r = 0; r < nc; ++r) data.sigma_equilibrium[sys.defs_V[r]] = sV[r];
   }
   data.residual_load = data.g;
   add_element_loads(sys, data, [](int) { return true; }, data.residual_load);

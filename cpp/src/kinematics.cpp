@@ -39,8 +39,8 @@ namespace {
 
 // Targets of the position rows: fixed/LINE/kinematic from the system, inputs and DOFs from q̂.
 void set_targets(const System& sys, Data& data) {
-  for (size_t r = 0; r < sys.rows_P.size(); ++r) {
-    const int k = sys.rows_P[r];
+  for (size_t r = 0; r < sys.defs_P.size(); ++r) {
+    const int k = sys.defs_P[r];
     const int col = sys.qhat_col_e[k];
     if (col >= 0) data.target[r] = data.qhat[col];
     else if (sys.def_class[k] == DefClass::Kinematic) data.target[r] = data.e_integrated[k];
@@ -49,7 +49,7 @@ void set_targets(const System& sys, Data& data) {
 }
 
 void compute_residual(const System& sys, Data& data) {
-  for (size_t r = 0; r < sys.rows_P.size(); ++r) data.residual[r] = data.e[sys.rows_P[r]] - data.target[r];
+  for (size_t r = 0; r < sys.defs_P.size(); ++r) data.residual[r] = data.e[sys.defs_P[r]] - data.target[r];
 }
 
 // A number for a message: non-finite values are named as such, never printed as "nan".
@@ -71,7 +71,7 @@ std::string worst_rows(const System& sys, const Data& data, int count) {
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return size(a) > size(b); });
   std::ostringstream os;
   for (int i = 0; i < count && i < static_cast<int>(order.size()); ++i)
-    os << (i ? "; " : "") << sys.def_name(sys.rows_P[order[i]]) << " residual " << number(data.residual[order[i]]);
+    os << (i ? "; " : "") << sys.def_name(sys.defs_P[order[i]]) << " residual " << number(data.residual[order[i]]);
   return os.str();
 }
 
@@ -98,7 +98,7 @@ void factorize_velocity_block(const System& sys, Data& data) {
   factorize(sys, data, data.AV, data.luV, "velocity");
   // Without nonholonomic rows the velocity block is the position block: a Jacobian for the
   // next position solve.
-  data.jacobian_reusable = sys.rows_P == sys.rows_V;
+  data.jacobian_reusable = sys.defs_P == sys.defs_V;
 }
 
 }  // namespace
@@ -130,10 +130,10 @@ void evaluate_elements(const System& sys, Data& data) {
 
 void check_constraint_counts(const System& sys, Data& data) {
   const size_t nc = sys.x_calc.size();
-  if (sys.rows_P.size() != nc || sys.rows_V.size() != nc) {
+  if (sys.defs_P.size() != nc || sys.defs_V.size() != nc) {
     std::ostringstream os;
     os << "the kinematic constraints do not determine the calculable coordinates:\n"
-       << diagnose_constraints(sys, data, sys.rows_P.size() == nc);
+       << diagnose_constraints(sys, data, sys.defs_P.size() == nc);
     throw KinematicsError(os.str());
   }
 }
@@ -278,7 +278,7 @@ void solve_velocities(const System& sys, Data& data) {
   data.acc0.setZero();
   const int nc = static_cast<int>(sys.x_calc.size());
   if (nc > 0) {
-    for (size_t r = 0; r < sys.rows_V.size(); ++r) data.rhs_V[r] = -data.conv[sys.rows_V[r]];
+    for (size_t r = 0; r < sys.defs_V.size(); ++r) data.rhs_V[r] = -data.conv[sys.defs_V[r]];
     data.luV.solve(data.rhs_V, data.sol_V);
     for (int j = 0; j < nc; ++j) data.acc0[sys.x_calc[j]] = data.sol_V[j];
   }
@@ -308,8 +308,8 @@ void calculable_rates(const System& sys, Data& data, const Eigen::VectorXd& qhat
   for (int g : sys.x_dyn) y[g] = qhat_rate[sys.qhat_col_x[g]];
   const int nc = static_cast<int>(sys.x_calc.size());
   if (nc == 0) return;
-  for (size_t r = 0; r < sys.rows_V.size(); ++r) {
-    const int k = sys.rows_V[r];
+  for (size_t r = 0; r < sys.defs_V.size(); ++r) {
+    const int k = sys.defs_V[r];
     const int col = sys.qhat_col_e[k];
     data.rhs_V[r] = (col >= 0 ? qhat_rate[col] : 0.0) - (convective ? data.conv[k] : 0.0);
   }
