@@ -31,7 +31,7 @@ Data::Data(const System& sys) {
   step = Eigen::VectorXd::Zero(std::max(nc, std::max(nP, nV)));
   rhs_V = Eigen::VectorXd::Zero(nV);
   sol_V = Eigen::VectorXd::Zero(nc);
-  h = f = g = reaction = acc_known = residual_load = Eigen::VectorXd::Zero(nx);
+  h = f = inertia_residual = reaction = acc_known = residual_load = Eigen::VectorXd::Zero(nx);
   sigma_equilibrium = Eigen::VectorXd::Zero(ne);
   rhs = qdd = Eigen::VectorXd::Zero(nd);
   body_M.assign(sys.bodies.size(), Eigen::Matrix4d::Zero());
