@@ -77,3 +77,14 @@ def test_the_test_bindings_are_not_in_the_shipped_core():
     for name in ("element_kernel", "ElementKernel", "explicit_rk_solve", "dop853_solve", "SparseLU"):
         assert not hasattr(_core, name)
     assert callable(_testing.element_kernel) and callable(_testing.explicit_rk_solve)
+
+
+def test_simulate_and_linearize_prepare_the_model_once(monkeypatch):
+    """The core's Simulation prepares the model (the first END); the Python layer does not again."""
+    calls = []
+    monkeypatch.setattr(spacar.Model, "prepare", lambda self: calls.append(self))
+    model = spacar.read(EXAMPLE)
+    assert not model._core.frozen
+    spacar.simulate(model)
+    spacar.linearize(model)
+    assert calls == [] and model._core.frozen

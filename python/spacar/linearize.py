@@ -140,8 +140,7 @@ def linearize(model, state=None) -> Linearization:
     DYNE deformations ascending). The mechanism is assembled at the model's current state first
     and then moved continuously to ``state`` (the inputs at time t), so that the calculable
     coordinates stay on the branch of the assembled mechanism."""
-    model.prepare()
-    sim = _core.Simulation(model._core)
+    sim = _core.Simulation(model._core)  # prepares the model (the first END) and compiles it
     sim.assemble()
     system = sim.system
     if state is None:
