@@ -6,9 +6,6 @@
 
 #include "bindings.hpp"
 #include "spacar/diagnosis.hpp"
-#include "spacar/dynamics.hpp"
-#include "spacar/errors.hpp"
-#include "spacar/kinematics.hpp"
 #include "spacar/simulate.hpp"
 
 namespace spacar::bindings {
