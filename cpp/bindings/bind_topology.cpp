@@ -1,10 +1,10 @@
 // Binding of topology.hpp: the one union-find of rigid bodies, for spacar.compare.
-#include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "bindings.hpp"
 #include "spacar/topology.hpp"
 
-namespace py = pybind11;
+namespace spacar::bindings {
 
 void bind_topology(py::module_& m) {
   m.def("rigid_bodies", &spacar::rigid_bodies, py::arg("nodes"), py::arg("links"),
@@ -12,3 +12,5 @@ void bind_topology(py::module_& m) {
         "ascending node numbers, ordered by their first node; links sharing a node are one body,\n"
         "a node of no link is a body by itself.");
 }
+
+}  // namespace spacar::bindings

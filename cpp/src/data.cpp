@@ -10,7 +10,7 @@ namespace spacar {
 
 Data::Data(const System& sys) {
   const int nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
-  const int nP = static_cast<int>(sys.rows_P.size()), nV = static_cast<int>(sys.rows_V.size());
+  const int nP = static_cast<int>(sys.defs_P.size()), nV = static_cast<int>(sys.defs_V.size());
   const int nc = static_cast<int>(sys.x_calc.size());
   x = xd = xdd = Eigen::VectorXd::Zero(nx);
   e = ed = edd = sigma = conv = Eigen::VectorXd::Zero(ne);
@@ -31,7 +31,7 @@ Data::Data(const System& sys) {
   step = Eigen::VectorXd::Zero(std::max(nc, std::max(nP, nV)));
   rhs_V = Eigen::VectorXd::Zero(nV);
   sol_V = Eigen::VectorXd::Zero(nc);
-  h = f = g = reaction = acc_known = residual_load = Eigen::VectorXd::Zero(nx);
+  h = f = inertia_residual = reaction = acc_known = residual_load = Eigen::VectorXd::Zero(nx);
   sigma_equilibrium = Eigen::VectorXd::Zero(ne);
   rhs = qdd = Eigen::VectorXd::Zero(nd);
   body_M.assign(sys.bodies.size(), Eigen::Matrix4d::Zero());
@@ -42,8 +42,8 @@ Data::Data(const System& sys) {
 
 void Data::build_constraint_blocks(const System& sys) {
   const int nc = static_cast<int>(sys.x_calc.size());
-  AP.reset(static_cast<int>(sys.rows_P.size()), nc);
-  AV.reset(static_cast<int>(sys.rows_V.size()), nc);
+  AP.reset(static_cast<int>(sys.defs_P.size()), nc);
+  AV.reset(static_cast<int>(sys.defs_V.size()), nc);
   for (const SystemElement& se : sys.elements) {
     std::vector<int> rp(se.nd), rv(se.nd), cols(se.coords.size());
     for (int a = 0; a < se.nd; ++a) {
@@ -65,7 +65,7 @@ void Data::build_equations_of_motion(const System& sys) {
   for (int g : sys.x_calc) free_index[g] = n_free++;
   for (int g : sys.x_dyn) free_index[g] = n_free++;
   c_row.assign(sys.ne, -1);
-  for (int k : sys.rows_V)
+  for (int k : sys.defs_V)
     if (sys.def_class[k] != DefClass::Dynamic) c_row[k] = n_c_rows++;
   const int n = n_free + n_c_rows;
   KKT.reset(n, n);
@@ -101,7 +101,7 @@ void Data::ensure_dense(const System& sys) {
                      " nodal coordinates and " + std::to_string(sys.ne) + " deformations",
                  "the linearization uses dense matrices, spacar.simulate does not");
   const int nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
-  rhs_DF = Eigen::MatrixXd::Zero(static_cast<int>(sys.rows_V.size()), nq);
+  rhs_DF = Eigen::MatrixXd::Zero(static_cast<int>(sys.defs_V.size()), nq);
   DF = Eigen::MatrixXd::Zero(nx, nq);
   DFe = Eigen::MatrixXd::Zero(ne, nq);
   M = Eigen::MatrixXd::Zero(nx, nx);
@@ -124,7 +124,7 @@ double Data::estimate_bytes(const System& sys) {
 
 double Data::estimate_dense_bytes(const System& sys) {
   const double nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
-  const double nV = static_cast<double>(sys.rows_V.size()), nc = static_cast<double>(sys.x_calc.size());
+  const double nV = static_cast<double>(sys.defs_V.size()), nc = static_cast<double>(sys.x_calc.size());
   const double doubles = nx * nx                  // M
                          + ne * ne                // global constitutive matrices of the linearization
                          + nV * nq + nc * nq      // rhs_DF and the solution of the transfer functions

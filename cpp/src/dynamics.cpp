@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "spacar/diagnosis.hpp"
 #include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
@@ -16,35 +17,6 @@ namespace {
 
 bool constitutive_class(DefClass c) {
   return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
-}
-
-// The DOFs with the largest components of the null vector of M̄: those that move no mass.
-[[noreturn]] void throw_singular_mass(const System& sys, const Data& data, const Eigen::MatrixXd& Mbar) {
-  const int nd = sys.n_dof();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Mbar);
-  const Eigen::VectorXd lam = eig.eigenvalues();
-  const double tol = 1e-10 * std::max(lam.cwiseAbs().maxCoeff(), 1e-300);
-  std::vector<bool> named(nd, false);
-  for (int m = 0; m < nd && (m == 0 || lam[m] <= tol); ++m) {
-    const Eigen::VectorXd v = eig.eigenvectors().col(m);
-    const double vmax = v.cwiseAbs().maxCoeff();
-    for (int j = 0; j < nd; ++j) named[j] = named[j] || std::abs(v[j]) >= 0.1 * vmax;
-  }
-  std::ostringstream os;
-  os << "the reduced mass matrix is singular at t = " << data.t << " (smallest eigenvalue " << lam[0]
-     << "): the degrees of freedom";
-  for (int j = 0; j < nd; ++j) {
-    if (!named[j]) continue;
-    const int col = sys.dof_cols[j];
-    os << " [";
-    for (int g = 0; g < sys.nx; ++g)
-      if (sys.qhat_col_x[g] == col) os << "DYNX " << sys.coord_name(g);
-    for (int k = 0; k < sys.ne; ++k)
-      if (sys.qhat_col_e[k] == col) os << "DYNE " << sys.def_name(k);
-    os << "]";
-  }
-  os << " move no mass; add MASS or EMASS to the nodes or elements they move";
-  throw SingularMassError(os.str());
 }
 
 // out = M acc, element by element (point masses, element masses, rigid bodies).
@@ -116,8 +88,8 @@ void compute_inertia_and_loads(const System& sys, Data& data) {
 }
 
 void inertia_force(const System& sys, Data& data) {
-  inertia_times(sys, data, data.xdd, data.g);
-  data.g += data.h - data.f;
+  inertia_times(sys, data, data.xdd, data.inertia_residual);
+  data.inertia_residual += data.h - data.f;
 }
 
 void assemble_mass_matrix(const System& sys, Data& data) {
@@ -142,7 +114,7 @@ void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R) {
   constitutive_stresses(sys, data);
   inertia_force(sys, data);
   for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
-  R.noalias() = data.DFq.transpose() * data.g;
+  R.noalias() = data.DFq.transpose() * data.inertia_residual;
   for (int j = 0; j < nd; ++j) R[j] += data.DFe.col(sys.dof_cols[j]).dot(data.sigma);
 }
 
@@ -168,7 +140,7 @@ void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R) 
   constitutive_stresses(sys, data);
   inertia_force(sys, data);
   // DFe = B DF element by element, so DF_qᵀ g + DFe_qᵀ σ = DF_qᵀ (g + Σ Bᵀ σ).
-  Eigen::VectorXd w = data.g, all;
+  Eigen::VectorXd w = data.inertia_residual, all;
   add_element_loads(sys, data, [](int) { return true; }, w);
   transfer_transposed(sys, data, w, all);
   const int nd = sys.n_dof();
@@ -206,11 +178,11 @@ void solve_dynamics_direct(const System& sys, Data& data) {
   const int nf = data.n_free;
   compute_inertia_and_loads(sys, data);
   constitutive_stresses(sys, data);
-  // Known accelerations: the inputs'. g = M ẍ_known + h − f + B_Wᵀ σ^W on every coordinate.
+  // Known accelerations: the inputs'. inertia_residual = M ẍ_known + h − f + B_Wᵀ σ^W on every coordinate.
   data.acc_known.setZero();
   for (int g : sys.x_input) data.acc_known[g] = data.qhat_dd[sys.qhat_col_x[g]];
-  inertia_times(sys, data, data.acc_known, data.g);
-  data.g += data.h - data.f;
+  inertia_times(sys, data, data.acc_known, data.inertia_residual);
+  data.inertia_residual += data.h - data.f;
   data.KKT.set_zero();
   data.kkt_rhs.setZero();
   for (size_t i = 0; i < sys.elements.size(); ++i) {
@@ -220,7 +192,7 @@ void solve_dynamics_direct(const System& sys, Data& data) {
     for (int a = 0; a < se.nd; ++a) {
       const int k = se.def_offset + a;
       if (data.sigma[k] != 0.0)
-        for (size_t j = 0; j < se.coords.size(); ++j) data.g[se.coords[j]] += w.B(a, j) * data.sigma[k];
+        for (size_t j = 0; j < se.coords.size(); ++j) data.inertia_residual[se.coords[j]] += w.B(a, j) * data.sigma[k];
     }
     if (data.KKT_B[i] < 0) continue;
     data.KKT.add(data.KKT_B[i], w.B);
@@ -238,7 +210,7 @@ void solve_dynamics_direct(const System& sys, Data& data) {
     if (data.KKT_point[g] >= 0) data.KKT.add_value(data.KKT_point[g], 0, 0, sys.point_mass[g]);
   for (size_t b = 0; b < sys.bodies.size(); ++b) data.KKT.add(data.KKT_body[b], data.body_M[b]);
   for (int g = 0; g < sys.nx; ++g)
-    if (data.free_index[g] >= 0) data.kkt_rhs[data.free_index[g]] = -data.g[g];
+    if (data.free_index[g] >= 0) data.kkt_rhs[data.free_index[g]] = -data.inertia_residual[g];
   // Values beyond double precision (an enormous stiffness, load or mass) overflow here or in the
   // solution: that is not a singular mass matrix, and no smaller step can help.
   const Eigen::SparseMatrix<double>& K = data.KKT.matrix();
@@ -253,11 +225,7 @@ void solve_dynamics_direct(const System& sys, Data& data) {
   if (!data.kkt_rhs.allFinite()) throw overflow();
   if (!data.luK.factorize(K)) {
     if (!K_values.allFinite()) throw overflow();
-    // Name the degrees of freedom without inertia through the reduced equations.
-    solve_transfer(sys, data);
-    solve_velocities(sys, data);
-    solve_dynamics(sys, data);
-    throw SingularMassError("the equations of motion are singular at t = " + std::to_string(data.t));
+    explain_singular_equations(sys, data);
   }
   data.luK.solve(data.kkt_rhs, data.kkt_sol);
   data.xdd = data.acc_known;
@@ -284,18 +252,18 @@ void nodal_reactions(const System& sys, Data& data) {
   // Consistency (formulation.md §6): σ of every velocity row from (6.1) with only the released
   // and kinematic stresses known, A_Vᵀ σ^V = −[g + B_Wᵀ σ^W]_c; its DOF rows equal the
   // constitutive stresses iff q̈ satisfies the equations of motion.
-  data.residual_load = data.g;
+  data.residual_load = data.inertia_residual;
   add_element_loads(sys, data, [&](int k) {
     return sys.def_class[k] == DefClass::Released || sys.def_class[k] == DefClass::Kinematic; }, data.residual_load);
   data.sigma_equilibrium.setZero();
   const int nc = static_cast<int>(sys.x_calc.size());
-  if (nc > 0 && static_cast<int>(sys.rows_V.size()) == nc) {
+  if (nc > 0 && static_cast<int>(sys.defs_V.size()) == nc) {
     Eigen::VectorXd rhs(nc), sV(nc);
     for (int j = 0; j < nc; ++j) rhs[j] = -data.residual_load[sys.x_calc[j]];
     data.luV.solve_transposed(rhs, sV);
-    for (int r = 0; r < nc; ++r) data.sigma_equilibrium[sys.rows_V[r]] = sV[r];
+    for (int r = 0; r < nc; ++r) data.sigma_equilibrium[sys.defs_V[r]] = sV[r];
   }
-  data.residual_load = data.g;
+  data.residual_load = data.inertia_residual;
   add_element_loads(sys, data, [](int) { return true; }, data.residual_load);
   data.reaction = data.residual_load;
   for (int g = 0; g < sys.nx; ++g) {

@@ -11,7 +11,16 @@
 #include <sstream>
 #include <string>
 
+#include "spacar/errors.hpp"
+
 namespace spacar {
+
+Method parse_method(const std::string& name) {
+  if (name == "dop853") return Method::DOP853;
+  if (name == "dopri5") return Method::DOPRI5;
+  throw InputError("unknown integration method '" + name + "' (dop853, dopri5)");
+}
+
 namespace {
 
 using Row = std::array<double, 16>;

@@ -6,8 +6,8 @@
 #include <limits>
 #include <sstream>
 
+#include "spacar/diagnosis.hpp"
 #include "spacar/errors.hpp"
-#include "spacar/limits.hpp"
 
 namespace spacar {
 
@@ -39,8 +39,8 @@ namespace {
 
 // Targets of the position rows: fixed/LINE/kinematic from the system, inputs and DOFs from q̂.
 void set_targets(const System& sys, Data& data) {
-  for (size_t r = 0; r < sys.rows_P.size(); ++r) {
-    const int k = sys.rows_P[r];
+  for (size_t r = 0; r < sys.defs_P.size(); ++r) {
+    const int k = sys.defs_P[r];
     const int col = sys.qhat_col_e[k];
     if (col >= 0) data.target[r] = data.qhat[col];
     else if (sys.def_class[k] == DefClass::Kinematic) data.target[r] = data.e_integrated[k];
@@ -49,13 +49,7 @@ void set_targets(const System& sys, Data& data) {
 }
 
 void compute_residual(const System& sys, Data& data) {
-  for (size_t r = 0; r < sys.rows_P.size(); ++r) data.residual[r] = data.e[sys.rows_P[r]] - data.target[r];
-}
-
-// A block of rows (AP: positions, AV: velocities) from the element derivatives B.
-void assemble_block(const System& sys, Data& data, BlockMatrix& A, const std::vector<int>& block) {
-  A.set_zero();
-  for (size_t i = 0; i < sys.elements.size(); ++i) A.add(block[i], data.work[i].B);
+  for (size_t r = 0; r < sys.defs_P.size(); ++r) data.residual[r] = data.e[sys.defs_P[r]] - data.target[r];
 }
 
 // A number for a message: non-finite values are named as such, never printed as "nan".
@@ -77,7 +71,7 @@ std::string worst_rows(const System& sys, const Data& data, int count) {
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return size(a) > size(b); });
   std::ostringstream os;
   for (int i = 0; i < count && i < static_cast<int>(order.size()); ++i)
-    os << (i ? "; " : "") << sys.def_name(sys.rows_P[order[i]]) << " residual " << number(data.residual[order[i]]);
+    os << (i ? "; " : "") << sys.def_name(sys.defs_P[order[i]]) << " residual " << number(data.residual[order[i]]);
   return os.str();
 }
 
@@ -104,10 +98,15 @@ void factorize_velocity_block(const System& sys, Data& data) {
   factorize(sys, data, data.AV, data.luV, "velocity");
   // Without nonholonomic rows the velocity block is the position block: a Jacobian for the
   // next position solve.
-  data.jacobian_reusable = sys.rows_P == sys.rows_V;
+  data.jacobian_reusable = sys.defs_P == sys.defs_V;
 }
 
 }  // namespace
+
+void assemble_block(const System& sys, Data& data, BlockMatrix& A, const std::vector<int>& block) {
+  A.set_zero();
+  for (size_t i = 0; i < sys.elements.size(); ++i) A.add(block[i], data.work[i].B);
+}
 
 void evaluate_elements(const System& sys, Data& data) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
@@ -131,10 +130,10 @@ void evaluate_elements(const System& sys, Data& data) {
 
 void check_constraint_counts(const System& sys, Data& data) {
   const size_t nc = sys.x_calc.size();
-  if (sys.rows_P.size() != nc || sys.rows_V.size() != nc) {
+  if (sys.defs_P.size() != nc || sys.defs_V.size() != nc) {
     std::ostringstream os;
     os << "the kinematic constraints do not determine the calculable coordinates:\n"
-       << diagnose_constraints(sys, data, sys.rows_P.size() == nc);
+       << diagnose_constraints(sys, data, sys.defs_P.size() == nc);
     throw KinematicsError(os.str());
   }
 }
@@ -279,7 +278,7 @@ void solve_velocities(const System& sys, Data& data) {
   data.acc0.setZero();
   const int nc = static_cast<int>(sys.x_calc.size());
   if (nc > 0) {
-    for (size_t r = 0; r < sys.rows_V.size(); ++r) data.rhs_V[r] = -data.conv[sys.rows_V[r]];
+    for (size_t r = 0; r < sys.defs_V.size(); ++r) data.rhs_V[r] = -data.conv[sys.defs_V[r]];
     data.luV.solve(data.rhs_V, data.sol_V);
     for (int j = 0; j < nc; ++j) data.acc0[sys.x_calc[j]] = data.sol_V[j];
   }
@@ -309,8 +308,8 @@ void calculable_rates(const System& sys, Data& data, const Eigen::VectorXd& qhat
   for (int g : sys.x_dyn) y[g] = qhat_rate[sys.qhat_col_x[g]];
   const int nc = static_cast<int>(sys.x_calc.size());
   if (nc == 0) return;
-  for (size_t r = 0; r < sys.rows_V.size(); ++r) {
-    const int k = sys.rows_V[r];
+  for (size_t r = 0; r < sys.defs_V.size(); ++r) {
+    const int k = sys.defs_V[r];
     const int col = sys.qhat_col_e[k];
     data.rhs_V[r] = (col >= 0 ? qhat_rate[col] : 0.0) - (convective ? data.conv[k] : 0.0);
   }
@@ -376,180 +375,6 @@ void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w
       if (ecol >= 0) out[ecol] += mu;
     }
   }
-}
-
-namespace {
-
-// Greedy selection in the given order: vectors (columns of V) that add rank are kept, the others
-// are dependent on those before them. Returns the dependent ones. Gram-Schmidt with
-// reorthogonalisation against the kept vectors, held as the columns of one matrix so that each
-// projection is a matrix-vector product (large models: thousands of columns).
-std::vector<int> dependent_columns(const Eigen::MatrixXd& V, const std::vector<int>& order) {
-  const Eigen::Index m = V.rows();
-  Eigen::MatrixXd basis(m, std::min<Eigen::Index>(m, static_cast<Eigen::Index>(order.size())));
-  Eigen::Index k = 0;
-  Eigen::VectorXd v(m), c;
-  std::vector<int> dependent;
-  for (int j : order) {
-    v = V.col(j);
-    const double norm0 = v.norm();
-    for (int pass = 0; pass < 2 && k > 0; ++pass) {  // twice: Gram-Schmidt with reorthogonalisation
-      c.noalias() = basis.leftCols(k).transpose() * v;
-      v.noalias() -= basis.leftCols(k) * c;
-    }
-    if (norm0 == 0.0 || k == basis.cols() || v.norm() <= 1e-8 * norm0) {
-      dependent.push_back(j);
-    } else {
-      basis.col(k++) = v / v.norm();
-    }
-  }
-  return dependent;
-}
-
-}  // namespace
-
-ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
-  ConstraintDiagnosis d;
-  const std::vector<int>& rows = velocity ? sys.rows_V : sys.rows_P;
-  BlockMatrix& block = velocity ? data.AV : data.AP;
-  const int nP = static_cast<int>(rows.size());
-  const int nc = static_cast<int>(sys.x_calc.size());
-  d.n_constraints = nP;
-  d.n_calculable = nc;
-  const bool too_large = nP > kMaxDiagnosisSize || nc > kMaxDiagnosisSize;
-  if (too_large) {
-    d.rank = -1;
-  } else if (nP > 0 && nc > 0) {
-    // Full SVD: U (nP x nP), V (nc x nc), the block and its work copy.
-    require_memory(8.0 * (static_cast<double>(nP) * nP + static_cast<double>(nc) * nc + 3.0 * nP * nc),
-                   "the constraint diagnosis of " + std::to_string(nP) + " constraints on " + std::to_string(nc) +
-                       " calculable coordinates",
-                   "");
-    evaluate_elements(sys, data);
-    assemble_block(sys, data, block, velocity ? data.AV_block : data.AP_block);
-    const Eigen::MatrixXd A = Eigen::MatrixXd(block.matrix());
-    Eigen::BDCSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    const Eigen::VectorXd& s = svd.singularValues();
-    const double tol = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(s[0], 1e-300);
-    for (int i = 0; i < s.size(); ++i) d.rank += s[i] > tol;
-    for (int i = d.rank; i < nP; ++i) {  // left null vectors: combinations of redundant rows
-      const Eigen::VectorXd u = svd.matrixU().col(i);
-      const double umax = u.cwiseAbs().maxCoeff();
-      std::vector<std::pair<int, double>> group;
-      for (int r = 0; r < nP; ++r)
-        if (std::abs(u[r]) > 0.1 * umax) group.push_back({rows[r], u[r] / umax});
-      d.redundant_groups.push_back(group);
-    }
-    for (int i = d.rank; i < nc; ++i) {  // right null vectors: undetermined motions
-      const Eigen::VectorXd v = svd.matrixV().col(i);
-      const double vmax = v.cwiseAbs().maxCoeff();
-      std::vector<std::pair<int, double>> group;
-      for (int j = 0; j < nc; ++j)
-        if (std::abs(v[j]) > 0.1 * vmax) group.push_back({sys.x_calc[j], v[j] / vmax});
-      d.undetermined_groups.push_back(group);
-    }
-    // A concrete set to release: keep prescribed rows (inputs, DOFs) first, then fixed ones in
-    // ascending order; each row dependent on the kept ones is redundant.
-    std::vector<int> order;
-    for (int pass = 0; pass < 2; ++pass)
-      for (int r = 0; r < nP; ++r) {
-        const DefClass c = sys.def_class[rows[r]];
-        const bool fixed = c == DefClass::Fixed || c == DefClass::Nonholonomic;
-        if ((pass == 1) == fixed) order.push_back(r);
-      }
-    // (The selections cost O(n^3): skipped when the SVD shows full rank.)
-    if (d.rank < nP)
-      for (int r : dependent_columns(A.transpose(), order)) d.redundant.push_back(rows[r]);
-    std::sort(d.redundant.begin(), d.redundant.end());
-    std::vector<int> cols(nc);
-    for (int j = 0; j < nc; ++j) cols[j] = j;
-    if (d.rank < nc)
-      for (int j : dependent_columns(A, cols)) d.undetermined.push_back(sys.x_calc[j]);
-  } else if (nc > 0) {
-    d.undetermined = sys.x_calc;
-  } else {
-    d.redundant = rows;
-  }
-
-  std::ostringstream os;
-  if (velocity)
-    os << "  " << nP << " velocity constraint equations (fixed, input, dynamic, nonholonomic deformations) for " << nc
-       << " calculable coordinate rates";
-  else
-    os << "  " << nP << " constraint equations (fixed, input, dynamic deformations) for " << nc
-       << " calculable coordinates";
-  if (nP > nc) os << ": over-constrained by " << nP - nc;
-  if (nP < nc) os << ": under-constrained by " << nc - nP;
-  if (too_large) {
-    os << "; the block is too large for a detailed diagnosis (at most " << kMaxDiagnosisSize
-       << " constraints and calculable coordinates).";
-    d.text = os.str();
-    return d;
-  }
-  os << "; rank " << d.rank << ".";
-  if (velocity && (!d.redundant.empty() || !d.undetermined.empty()))
-    os << "\n  the nonholonomic constraints (ENHC) do not determine these rates: pair each nonholonomic"
-          "\n  deformation with a kinematic coordinate whose rate it determines (formulation.md §5).";
-  // Long lists are cut (the structured fields keep everything): an error message stays readable.
-  constexpr size_t kItems = 20, kGroups = 5, kTerms = 12;
-  auto more = [&os](size_t shown, size_t total, const char* what) {
-    if (total > shown) os << "\n   ... and " << total - shown << " more " << what;
-  };
-  if (!d.redundant.empty()) {
-    os << "\n  redundant constraints; release these (RLSE) to remove the redundancy:";
-    for (size_t i = 0; i < d.redundant.size() && i < kItems; ++i) {
-      const int k = d.redundant[i];
-      os << "\n   - RLSE " << sys.def_label[k][0] << " " << sys.def_label[k][1] << "   (" << sys.def_name(k) << ")";
-    }
-    more(kItems, d.redundant.size(), "redundant constraints");
-    for (size_t i = 0; i < d.redundant_groups.size() && i < kGroups; ++i) {
-      const auto& group = d.redundant_groups[i];
-      os << "\n  dependent combination:";
-      for (size_t t = 0; t < group.size() && t < kTerms; ++t)
-        os << " " << sys.def_name(group[t].first) << " (weight " << group[t].second << ")";
-      if (group.size() > kTerms) os << " ... (" << group.size() - kTerms << " more terms)";
-    }
-    more(kGroups, d.redundant_groups.size(), "dependent combinations");
-  }
-  if (!d.undetermined.empty()) {
-    os << "\n  undetermined coordinates; fix them (FIX), make them degrees of freedom (DYNX) or add elements:";
-    for (size_t i = 0; i < d.undetermined.size() && i < kItems; ++i) os << "\n   - " << sys.coord_name(d.undetermined[i]);
-    more(kItems, d.undetermined.size(), "undetermined coordinates");
-    for (size_t i = 0; i < d.undetermined_groups.size() && i < kGroups; ++i) {
-      const auto& group = d.undetermined_groups[i];
-      os << "\n  free motion:";
-      for (size_t t = 0; t < group.size() && t < kTerms; ++t)
-        os << " " << sys.coord_name(group[t].first) << " (weight " << group[t].second << ")";
-      if (group.size() > kTerms) os << " ... (" << group.size() - kTerms << " more terms)";
-    }
-    more(kGroups, d.undetermined_groups.size(), "free motions");
-  }
-  d.text = os.str();
-  return d;
-}
-
-std::string diagnose_constraints(const System& sys, Data& data, bool velocity) {
-  return diagnose(sys, data, velocity).text;
-}
-
-std::string weakest_constraint(const System& sys, Data& data) {
-  const int nV = static_cast<int>(sys.rows_V.size()), nc = static_cast<int>(sys.x_calc.size());
-  if (nV != nc || nc == 0 || nc > kMaxDiagnosisSize) return "";
-  assemble_block(sys, data, data.AV, data.AV_block);
-  Eigen::BDCSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(data.AV.matrix()), Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::VectorXd& s = svd.singularValues();
-  const double ratio = s[nc - 1] / s[0];
-  if (!(ratio < 1e-6)) return "";
-  std::ostringstream os;
-  os << "  the velocity constraint block is nearly singular (smallest/largest singular value " << ratio
-     << ");\n  constraints that lose their independence:";
-  const Eigen::VectorXd u = svd.matrixU().col(nc - 1), v = svd.matrixV().col(nc - 1);
-  for (int r = 0; r < nV; ++r)
-    if (std::abs(u[r]) > 0.1 * u.cwiseAbs().maxCoeff()) os << " " << sys.def_name(sys.rows_V[r]);
-  os << "\n  coordinates of the singular motion:";
-  for (int j = 0; j < nc; ++j)
-    if (std::abs(v[j]) > 0.1 * v.cwiseAbs().maxCoeff()) os << " " << sys.coord_name(sys.x_calc[j]);
-  return os.str();
 }
 
 }  // namespace spacar

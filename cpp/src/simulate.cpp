@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "spacar/diagnosis.hpp"
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
@@ -273,12 +274,13 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   dY.tail(nd) = data_->qdd;
 }
 
-bool Simulation::recursive_state(const double* q, const double* qd, Eigen::VectorXd& qdd, Eigen::VectorXd& x,
-                                 Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
+bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
+                                 Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
+  require_dof_sizes("recursive_state", q, qd);
   if (!tree_) tree_ = PlanarTree::detect(*sys_, *data_);
   if (!tree_) return false;
   Eigen::VectorXd x1 = data_->x, xd1 = Eigen::VectorXd::Zero(sys_->nx), xdd1 = xd1, qdd1(sys_->n_dof());
-  if (!tree_->solve(q, qd, x1, xd1, xdd1, qdd1.data())) return false;
+  if (!tree_->solve(q.data(), qd.data(), x1, xd1, xdd1, qdd1.data())) return false;
   qdd = qdd1;
   x = x1;
   xd = xd1;
@@ -286,16 +288,43 @@ bool Simulation::recursive_state(const double* q, const double* qd, Eigen::Vecto
   return true;
 }
 
+Eigen::VectorXd Simulation::reduced_accelerations() {
+  Data& d = *data_;
+  const Eigen::VectorXd qdd = d.qdd, xdd = d.xdd, edd = d.edd, qhat_dd = d.qhat_dd;
+  solve_transfer(*sys_, d);
+  solve_velocities(*sys_, d);
+  solve_dynamics(*sys_, d);
+  Eigen::VectorXd reduced = d.qdd;
+  d.qdd = qdd;
+  d.xdd = xdd;
+  d.edd = edd;
+  d.qhat_dd = qhat_dd;
+  return reduced;
+}
+
+void Simulation::require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const {
+  if (q.size() != sys_->n_dof() || qd.size() != sys_->n_dof())
+    throw InputError(std::string(what) + "(): q and qd must have one value per degree of freedom");
+}
+
+void Simulation::solve_state(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  require_dof_sizes("solve_state", q, qd);
+  solve_state(t, q.data(), qd.data());
+}
+
+void Simulation::evaluate(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  require_dof_sizes("evaluate", q, qd);
+  evaluate(t, q.data(), qd.data());
+}
+
+void Simulation::move_to(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  require_dof_sizes("move_to", q, qd);
+  move_to(t, q.data(), qd.data());
+}
+
 void Simulation::record(BlockResults& res, int k) {
   res.t[k] = data_->t;
-  res.x.row(k) = data_->x;
-  res.xd.row(k) = data_->xd;
-  res.xdd.row(k) = data_->xdd;
-  res.e.row(k) = data_->e;
-  res.ed.row(k) = data_->ed;
-  res.edd.row(k) = data_->edd;
-  res.sigma.row(k) = data_->sigma;
-  res.reaction.row(k) = data_->reaction;
+  for (const OutputArray& a : kOutputArrays) (res.*a.rows).row(k) = (*data_).*a.now;
 }
 
 BlockResults Simulation::run(const RunOptions& options) {
@@ -307,14 +336,10 @@ BlockResults Simulation::run(const RunOptions& options) {
 void Simulation::require_finite_state(double t) const {
   // Values beyond double precision (e.g. FORCE 8 1e308 on a support) must not reach the results
   // as infinities or NaNs: the run stops here and keeps the output times before.
-  const std::pair<const char*, const Eigen::VectorXd*> parts[] = {
-      {"coordinates", &data_->x}, {"velocities", &data_->xd}, {"accelerations", &data_->xdd},
-      {"deformations", &data_->e}, {"deformation rates", &data_->ed}, {"deformation accelerations", &data_->edd},
-      {"stresses", &data_->sigma}, {"reactions", &data_->reaction}};
-  for (const auto& [name, v] : parts)
-    if (!v->allFinite()) {
+  for (const OutputArray& a : kOutputArrays)
+    if (!((*data_).*a.now).allFinite()) {
       std::ostringstream os;
-      os << "the " << name << " at t = " << t
+      os << "the " << a.what << " at t = " << t
          << " are not finite: the model's values exceed double precision (check the magnitudes of loads, "
             "masses, stiffnesses and rates)";
       throw Error(os.str());
@@ -341,39 +366,57 @@ std::string num(double v) {
 // Keep the first `rows` rows of every time-indexed array (a run that failed midway).
 void cut_rows(BlockResults& res, int rows) {
   res.t.conservativeResize(rows);
-  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd, &res.reaction, &res.e, &res.ed, &res.edd, &res.sigma})
-    m->conservativeResize(rows, m->cols());
+  for (const OutputArray& a : kOutputArrays) (res.*a.rows).conservativeResize(rows, (res.*a.rows).cols());
 }
 
 }  // namespace
 
 void Simulation::run(BlockResults& res, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  if (!(options.time_limit >= 0.0)) throw InputError("the time limit must not be negative");
-  if (options.max_steps < 1) throw InputError("the step limit must be positive");
-  has_deadline_ = options.time_limit > 0.0 && std::isfinite(options.time_limit);
-  time_limit_ = options.time_limit;
-  if (has_deadline_)
-    deadline_ = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(options.time_limit));
-  // The system may be recompiled during the run (repartition): keep copies, not references.
-  Settings st = sys_->settings;
-  const int n_out = st.timestep_n;
-  const double t0 = sys_->t0, t_end = t0 + st.timestep_tp;
   res = BlockResults();
   res.warnings = sys_->warnings;
-  const int nd0 = sys_->n_dof(), ny0 = static_cast<int>(sys_->y_defs.size());
-  const bool linear = !sys_->e_line.empty() || st.linear.value_or(0) >= 1;
+  const BlockPlan plan = plan_block(options, res.warnings);
+  start_clock(options, start);
+  allocate_results(res, plan);
+  int k_out = 0;
+  auto finish = [&]() {
+    res.newton_iterations = data_->total_newton_iterations;
+    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    has_deadline_ = false;
+    tree_.reset();
+  };
+  try {
+    integrate_block(res, options, plan, k_out);
+  } catch (...) {
+    cut_rows(res, k_out);
+    finish();
+    throw;
+  }
+  finish();
+  store_state();
+}
 
-  // Requests that cannot be carried out are refused before any work (formulation.md §8.1).
+// Requests that cannot be carried out are refused before any work (formulation.md §8.1).
+Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vector<std::string>& warnings) const {
+  if (!(options.time_limit >= 0.0)) throw InputError("the time limit must not be negative");
+  if (options.max_steps < 1) throw InputError("the step limit must be positive");
+  // The system may be recompiled during the run (repartition): keep copies, not references.
+  BlockPlan plan;
+  plan.st = sys_->settings;
+  Settings& st = plan.st;
+  const int n_out = st.timestep_n;
+  const double t0 = sys_->t0, t_end = t0 + st.timestep_tp;
+  plan.t0 = t0;
+  plan.t_end = t_end;
+  plan.linear = !sys_->e_line.empty() || st.linear.value_or(0) >= 1;
   if (!std::isfinite(t_end))
     throw InputError("TIMESTEP: the end time TIME + Tp = " + num(t0) + " + " + num(st.timestep_tp) +
                      " is not a finite number");
   if (n_out > 0 && st.timestep_tp > 0.0 && !(t0 + st.timestep_tp / n_out > t0))
     throw InputError("TIMESTEP: the output interval Tp/n = " + num(st.timestep_tp / n_out) +
                      " is lost in the rounding of the time t = " + num(t0) + " (TIME)");
-  const bool integrate = (nd0 > 0 || ny0 > 0) && n_out > 0 && t_end > t0;
-  if (integrate) {
+  plan.integrate = (sys_->n_dof() > 0 || !sys_->y_defs.empty()) && n_out > 0 && t_end > t0;
+  if (plan.integrate) {
     const double h_min = Integrator::min_step(t_end);
     if (st.timestep_tp < h_min)
       throw InputError("TIMESTEP: the period Tp = " + num(st.timestep_tp) +
@@ -386,122 +429,126 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
                        " steps, more than the limit of " + std::to_string(options.max_steps) + " steps per block");
     for (auto [eps, name] : {std::pair<double*, const char*>{&st.epsint, "EPSINT"}, {&st.epsind, "EPSIND"}})
       if (*eps < kMinTolerance) {
-        res.warnings.push_back(std::string(name) + " " + num(*eps) +
-                               " is below the attainable accuracy in double precision: " + num(kMinTolerance) +
-                               " (100 machine epsilons) is used");
+        warnings.push_back(std::string(name) + " " + num(*eps) +
+                           " is below the attainable accuracy in double precision: " + num(kMinTolerance) +
+                           " (100 machine epsilons) is used");
         *eps = kMinTolerance;
       }
   }
   const int nt = n_out + 1;
-  {
-    const double nx = sys_->nx, ne = sys_->ne, nz = nd0 + static_cast<double>(sys_->e_line.size());
-    double per_time = 8.0 * (1.0 + 4.0 * nx + 4.0 * ne);
-    if (linear) per_time += 8.0 * (6.0 * nz * nz + nz + (nx + ne) * nz);
-    require_memory(per_time * nt,
-                   "the results of " + std::to_string(nt) + " output times (" + std::to_string(sys_->nx) +
-                       " coordinates, " + std::to_string(sys_->ne) + " deformations" +
-                       (linear ? ", linearized equations" : "") + ")",
-                   "use fewer output intervals (TIMESTEP n) or split the period into blocks");
-  }
-  res.t.resize(nt);
-  for (RowMatrix* m : {&res.x, &res.xd, &res.xdd, &res.reaction}) m->resize(nt, sys_->nx);
-  res.reaction.setZero();
-  for (RowMatrix* m : {&res.e, &res.ed, &res.edd, &res.sigma}) m->resize(nt, sys_->ne);
-  std::vector<double> times(nt);
-  for (int k = 0; k < nt; ++k) times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
-  times.back() = t_end;  // exactly the end of the block, whatever the rounding
+  plan.times.resize(nt);
+  for (int k = 0; k < nt; ++k) plan.times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
+  plan.times.back() = t_end;  // exactly the end of the block, whatever the rounding
+  return plan;
+}
 
-  int k_out = 0;
-  auto finish = [&]() {
-    res.newton_iterations = data_->total_newton_iterations;
-    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+void Simulation::start_clock(const RunOptions& options, std::chrono::steady_clock::time_point start) {
+  has_deadline_ = options.time_limit > 0.0 && std::isfinite(options.time_limit);
+  time_limit_ = options.time_limit;
+  if (has_deadline_)
+    deadline_ = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(options.time_limit));
+}
+
+void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) const {
+  const int nt = static_cast<int>(plan.times.size());
+  const double nx = sys_->nx, ne = sys_->ne, nz = sys_->n_dof() + static_cast<double>(sys_->e_line.size());
+  double per_time = 8.0 * (1.0 + 4.0 * nx + 4.0 * ne);
+  if (plan.linear) per_time += 8.0 * (6.0 * nz * nz + nz + (nx + ne) * nz);
+  require_memory(per_time * nt,
+                 "the results of " + std::to_string(nt) + " output times (" + std::to_string(sys_->nx) +
+                     " coordinates, " + std::to_string(sys_->ne) + " deformations" +
+                     (plan.linear ? ", linearized equations" : "") + ")",
+                 "use fewer output intervals (TIMESTEP n) or split the period into blocks");
+  res.t.resize(nt);
+  for (const OutputArray& a : kOutputArrays) (res.*a.rows).resize(nt, a.per_deformation ? sys_->ne : sys_->nx);
+  res.reaction.setZero();
+}
+
+void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out) {
+  assemble();
+  tree_ = plan.integrate && options.recursive ? PlanarTree::detect(*sys_, *data_) : nullptr;
+  res.recursive = tree_ != nullptr;
+  if (tree_) {
+    base_.xd = base_.xdd = Eigen::VectorXd::Zero(sys_->nx);
+    base_.t = plan.t0;
+  }
+  const Settings& st = plan.st;
+  auto output = [&](double t, const Eigen::VectorXd& Y) {
+    check_time(t);
+    evaluate_state(t, Y);
+    if (st.forcemode >= 1 || plan.linear) forces();
+    else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
+    require_finite_state(t);
+    if (plan.linear) res.linearizations.push_back(linearize());
+    record(res, k_out);
+    if (options.on_output) options.on_output(k_out, *data_, plan.linear ? &res.linearizations.back() : nullptr);
+    ++k_out;
   };
+  // State Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
+  Eigen::VectorXd Y(2 * sys_->n_dof() + static_cast<int>(sys_->y_defs.size()));
+  Y << sys_->q0, sys_->y0, sys_->qd0;
+  if (!plan.integrate) {
+    // Kinematic analysis (or a single analysis at the current time).
+    for (double t : plan.times) output(t, Y);
+    return;
+  }
+  double t = plan.t0, h = options.initial_step;
+  kinematic_failure_.clear();
+  for (;;) {
+    // One segment: integrate until the end, or until a free rotation must be repartitioned.
+    // The step limit holds for the block, whatever the number of segments.
+    if (res.steps >= options.max_steps)
+      throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
+                             " steps in the block at t = " + num(t));
+    const std::vector<double> remaining(plan.times.begin() + k_out, plan.times.end());
+    const double t_reached = integrate_segment(res, options, st, t, plan.t_end, h, Y, remaining, output);
+    h = res.last_step;
+    if (t_reached >= plan.t_end) break;
+    t = t_reached;
+    repartition(rotation_to_repartition(Y), t, Y);
+  }
+}
+
+double Simulation::integrate_segment(BlockResults& res, const RunOptions& options, const Settings& st, double t,
+                                     double t_end, double h, Eigen::VectorXd& Y, const std::vector<double>& times,
+                                     const Integrator::Output& output) {
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  Integrator integ(static_cast<int>(Y.size()), options.method);
+  Eigen::VectorXd rtol(Y.size());
+  rtol.head(nd + ny).setConstant(st.epsint);
+  rtol.tail(nd).setConstant(st.epsind);
+  integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
+  integ.set_max_step(st.hmax);
+  integ.set_max_steps(options.max_steps - res.steps);
+  if (h > 0.0) integ.set_initial_step(h);
+  // Stop to repartition a free rotation whose dependent Euler parameter became small.
+  if (!sys_->free_rotations.empty())
+    integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+  integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
+  anchor_.valid = false;
+  auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
+  auto add_stats = [&]() {
+    const IntegratorStats& s = integ.stats();
+    res.rhs_evaluations += s.nfev;
+    res.steps += s.nsteps;
+    res.accepted += s.naccept;
+    res.rejected += s.nreject;
+  };
+  double t_reached = t;
   try {
-    assemble();
-    tree_ = integrate && options.recursive ? PlanarTree::detect(*sys_, *data_) : nullptr;
-    res.recursive = tree_ != nullptr;
-    if (tree_) {
-      base_.xd = base_.xdd = Eigen::VectorXd::Zero(sys_->nx);
-      base_.t = t0;
-    }
-    const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
-    auto output = [&](double t, const Eigen::VectorXd& Y) {
-      check_time(t);
-      evaluate_state(t, Y);
-      if (st.forcemode >= 1 || linear) forces();
-      else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
-      require_finite_state(t);
-      if (linear) res.linearizations.push_back(linearize());
-      record(res, k_out);
-      if (options.on_output) options.on_output(k_out, *data_, linear ? &res.linearizations.back() : nullptr);
-      ++k_out;
-    };
-    // State Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
-    Eigen::VectorXd Y(2 * nd + ny);
-    Y << sys_->q0, sys_->y0, sys_->qd0;
-    if (!integrate) {
-      // Kinematic analysis (or a single analysis at the current time).
-      for (double t : times) output(t, Y);
-    } else {
-      double t = t0, h = options.initial_step;
-      kinematic_failure_.clear();
-      for (;;) {
-        // One segment: integrate until the end, or until a free rotation must be repartitioned.
-        // The step limit holds for the block, whatever the number of segments.
-        if (res.steps >= options.max_steps)
-          throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
-                                 " steps in the block at t = " + num(t));
-        Integrator integ(static_cast<int>(Y.size()), options.method);
-        Eigen::VectorXd rtol(Y.size());
-        rtol.head(nd + ny).setConstant(st.epsint);
-        rtol.tail(nd).setConstant(st.epsind);
-        integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
-        integ.set_max_step(st.hmax);
-        integ.set_max_steps(options.max_steps - res.steps);
-        if (h > 0.0) integ.set_initial_step(h);
-        // Stop to repartition a free rotation whose dependent Euler parameter became small.
-        if (!sys_->free_rotations.empty())
-          integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
-        integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
-        anchor_.valid = false;
-        const std::vector<double> remaining(times.begin() + k_out, times.end());
-        auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
-        auto add_stats = [&]() {
-          const IntegratorStats& s = integ.stats();
-          res.rhs_evaluations += s.nfev;
-          res.steps += s.nsteps;
-          res.accepted += s.naccept;
-          res.rejected += s.nreject;
-        };
-        double t_reached = t;
-        try {
-          t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
-        } catch (const IntegrationError& err) {
-          add_stats();
-          explain_collapse(err, Y);
-          throw;
-        } catch (...) {
-          add_stats();
-          throw;
-        }
-        add_stats();
-        h = res.last_step = integ.last_step();
-        if (t_reached >= t_end) break;
-        t = t_reached;
-        repartition(rotation_to_repartition(Y), t, Y);
-      }
-    }
+    t_reached = integ.integrate(f, t, t_end, Y, times, output);
+  } catch (const IntegrationError& err) {
+    add_stats();
+    explain_collapse(err, Y);
+    throw;
   } catch (...) {
-    cut_rows(res, k_out);
-    finish();
-    has_deadline_ = false;
-    tree_.reset();
+    add_stats();
     throw;
   }
-  has_deadline_ = false;
-  tree_.reset();
-  finish();
-  store_state();
+  add_stats();
+  res.last_step = integ.last_step();
+  return t_reached;
 }
 
 void Simulation::explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y) {

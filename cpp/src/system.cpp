@@ -147,12 +147,12 @@ void partition(System& sys) {
       }
     }
     if (c != DefClass::Nonholonomic) {
-      sys.row_P[k] = static_cast<int>(sys.rows_P.size());
-      sys.rows_P.push_back(k);
+      sys.row_P[k] = static_cast<int>(sys.defs_P.size());
+      sys.defs_P.push_back(k);
     }
     if (c != DefClass::Kinematic) {
-      sys.row_V[k] = static_cast<int>(sys.rows_V.size());
-      sys.rows_V.push_back(k);
+      sys.row_V[k] = static_cast<int>(sys.defs_V.size());
+      sys.defs_V.push_back(k);
     }
   }
 

@@ -128,6 +128,8 @@ def _write_animation(res, path) -> None:
         return
     try:
         path = save_animation(res, path)
+    except SpacarError:  # e.g. an unknown suffix: an error, not a warning (InputError is also a ValueError)
+        raise
     except (RuntimeError, ValueError) as err:
         _comment(f"warning: no animation written: {err}")
         return

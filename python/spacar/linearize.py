@@ -156,8 +156,7 @@ def linearize(model, state=None) -> Linearization:
     DYNE deformations ascending). The mechanism is assembled at the model's current state first
     and then moved continuously to ``state`` (the inputs at time t), so that the calculable
     coordinates stay on the branch of the assembled mechanism."""
-    model.prepare()
-    sim = _core.Simulation(model.core)
+    sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
     sim.assemble()
     system = sim.system
     if state is None:

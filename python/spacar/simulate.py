@@ -64,8 +64,7 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
         raise InputError(f"method must be 'dop853' or 'dopri5', got {show(method)}")
     if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
-    model.prepare()
-    sim = _core.Simulation(model.core)
+    sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
     system = sim.system
     settings = model.core.settings
     callbacks = []

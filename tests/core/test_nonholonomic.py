@@ -32,7 +32,7 @@ from scipy.integrate import cumulative_simpson, solve_ivp
 from scipy.optimize import brentq
 
 import spacar
-from spacar import _core
+from spacar import _testing
 from support.spatial_models import R_, body_angular_velocity
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -152,8 +152,8 @@ def belt_drive(rigid, n=50, T=0.5, mass=True):
 
 def belt_kernel(model):
     el = model.elements[1]
-    return _core.element_kernel("PLBELT", params=list(el.params), l0=el.l0, lgeomy=list(el.lgeomy),
-                                emass=list(el.emass))
+    return _testing.element_kernel("PLBELT", params=list(el.params), l0=el.l0, lgeomy=list(el.lgeomy),
+                                   emass=list(el.emass))
 
 
 def test_rigid_belt_speed_ratio_is_exact():

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from spacar import _core
+from spacar import _testing
 
 
 def random_sparse(n, density, rng, diagonal=True):
@@ -48,7 +48,7 @@ def relative_residual(A, x, b):
 def test_solves_match_dense_solves(n, density):
     rng = np.random.default_rng(n)
     A = random_sparse(n, density, rng)
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert lu.factorize(A)
     dense = A.toarray()
     for _ in range(3):
@@ -63,7 +63,7 @@ def test_new_values_replay_the_pivot_sequence():
     """Values that change by a few percent keep the pivots: no new pivot choice, exact solves."""
     rng = np.random.default_rng(7)
     A = random_sparse(200, 0.02, rng)
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert lu.factorize(A)
     chosen = lu.pivotings
     factorize_perturbed(lu, A, rng, 20)
@@ -74,7 +74,7 @@ def test_a_poor_replayed_pivot_chooses_pivots_again():
     """Diagonally dominant values first (diagonal pivots), then a zero diagonal: the replay
     meets a zero pivot, the factorization pivots again and still solves exactly."""
     A = sp.csc_matrix(np.array([[10.0, 1.0, 1.0], [1.0, 10.0, 1.0], [1.0, 1.0, 10.0]]))
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert lu.factorize(A)
     chosen = lu.pivotings
     B = same_pattern(A, A.data)
@@ -96,7 +96,7 @@ def test_saddle_point_matrix_with_zero_block():
     B = sp.random(m, n, density=0.08, random_state=rng) + sp.eye(m, n)
     K = sp.bmat([[M, B.T], [B, None]], format="csc")
     K.sort_indices()
-    lu = _core.SparseLU(K)
+    lu = _testing.SparseLU(K)
     assert lu.factorize(K)
     b = rng.normal(size=n + m)
     assert relative_residual(K, lu.solve(b), b) < 1e-14
@@ -106,7 +106,7 @@ def test_saddle_point_matrix_with_zero_block():
 def test_singular_and_non_finite_matrices_are_refused():
     rng = np.random.default_rng(11)
     A = random_sparse(30, 0.1, rng)
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert lu.factorize(A)
     dense = A.toarray()
     dense[:, 4] = 0.0  # a zero column, kept in the pattern
@@ -114,7 +114,7 @@ def test_singular_and_non_finite_matrices_are_refused():
     near = A.toarray()
     near[:, 7] = near[:, 3] * (1.0 + 1e-16)  # numerically dependent columns
     pattern = sp.csc_matrix((near != 0) | (A.toarray() != 0), dtype=float)
-    lu2 = _core.SparseLU(pattern)
+    lu2 = _testing.SparseLU(pattern)
     assert not lu2.factorize(_with_values(pattern, near))
     assert lu.factorize(A)  # and a good matrix again afterwards
     for bad in (np.nan, np.inf):
@@ -140,7 +140,7 @@ def _with_values(pattern, dense):
 
 def test_pattern_must_not_change():
     A = sp.csc_matrix(np.eye(3))
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     with pytest.raises(ValueError, match="pattern"):
         lu.factorize(sp.csc_matrix(np.ones((3, 3))))
 
@@ -165,7 +165,7 @@ def test_fill_of_a_chain_grows_linearly():
     fill = {}
     for links in (100, 1000):
         A = chain(links, rng)
-        lu = _core.SparseLU(A)
+        lu = _testing.SparseLU(A)
         assert lu.factorize(A)
         b = rng.normal(size=A.shape[0])
         assert relative_residual(A, lu.solve(b), b) < 1e-13
@@ -177,7 +177,7 @@ def test_solves_without_valid_factors_are_nan():
     """Before any factorization and after a failed one the factors are incomplete: the solution
     is NaN (never a read outside the work space)."""
     A = sp.csc_matrix(np.array([[2.0, 1.0], [1.0, 3.0]]))
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert np.isnan(lu.solve(np.ones(2))).all()
     assert lu.factorize(A)
     assert not lu.factorize(same_pattern(A, [1.0, 1.0, 1.0, 1.0]))  # singular
@@ -190,7 +190,7 @@ def test_overflow_in_a_replay_chooses_pivots_again():
     """Values near the largest double: the replayed elimination overflows (an infinite pivot),
     a new pivot choice does not, and the solution is exact."""
     A = sp.csc_matrix(np.array([[1.0, 1.0], [0.5, 1.0]]))
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert lu.factorize(A)
     B = sp.csc_matrix(np.array([[1e305, 1e308], [-9e307, 1e308]]))
     assert lu.factorize(B)
@@ -203,7 +203,7 @@ def test_a_preferred_diagonal_pivot_respects_the_singularity_threshold():
     """The diagonal is kept as pivot only above 1e-13 of the largest entry: otherwise the
     larger candidate, whose replay then holds (no new pivot choice at every factorization)."""
     A = sp.csc_matrix(np.array([[0.6e-13, 1.0], [5e-13, 1.0]]))
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert lu.factorize(A)
     chosen = lu.pivotings
     for _ in range(3):
@@ -216,7 +216,7 @@ def test_a_preferred_diagonal_pivot_respects_the_singularity_threshold():
 def test_binding_refuses_another_shape():
     """A 3×2 matrix whose stored entries match the first columns of a 3×3 pattern with an
     empty last column."""
-    lu = _core.SparseLU(sp.csc_matrix(np.diag([1.0, 1.0, 0.0])))
+    lu = _testing.SparseLU(sp.csc_matrix(np.diag([1.0, 1.0, 0.0])))
     with pytest.raises(ValueError, match="pattern"):
         lu.factorize(sp.csc_matrix(np.eye(3)[:, :2]))
 
@@ -227,7 +227,7 @@ def test_amd_ordering_is_tried_after_enough_replays():
     k = 20
     T = sp.diags([-1.0, 4.0, -1.0], [-1, 0, 1], shape=(k, k))
     A = (sp.kron(sp.eye(k), T) + sp.kron(sp.diags([-1.0, -1.0], [-1, 1], shape=(k, k)), sp.eye(k))).tocsc()
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert lu.factorize(A)
     colamd_fill, chosen = lu.factor_nonzeros, lu.pivotings
     rng = np.random.default_rng(0)
@@ -246,7 +246,7 @@ def test_amd_trial_keeps_exact_factors_either_way(seed):
     are never fuller than COLAMD's and every solve stays exact."""
     rng = np.random.default_rng(seed)
     A = random_sparse(150, 0.03, rng)
-    lu = _core.SparseLU(A)
+    lu = _testing.SparseLU(A)
     assert lu.factorize(A)
     colamd_fill = lu.factor_nonzeros
     factorize_perturbed(lu, A, rng, 40, tol=1e-13)

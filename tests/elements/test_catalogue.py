@@ -115,7 +115,7 @@ def kernel_of_a_prepared_element(t):
             m.x(n, *[float(n), 0.5 * n, 0.25][: NODE_SIZE[kind.name]])
     m.prepare()
     el = m.elements[1]
-    return spacar._core.element_kernel(t.name, params=list(el.params), l0=el.l0 or 1.0, lgeomy=list(el.lgeomy))
+    return spacar._testing.element_kernel(t.name, params=list(el.params), l0=el.l0 or 1.0, lgeomy=list(el.lgeomy))
 
 
 @pytest.mark.parametrize("t", spacar.element_catalogue(), ids=lambda t: t.name)

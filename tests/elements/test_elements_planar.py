@@ -1,5 +1,5 @@
 """Element-level verification of the planar elements PLTRUSS, PLBEAM, PLBEAMNL, PLHINGE
-(issue #3; formulation.md §4.1–4.4, §10.1) through `spacar._core.element_kernel`.
+(issue #3; formulation.md §4.1–4.4, §10.1) through `spacar._testing.element_kernel`.
 
 The generic finite-difference and invariance checks live in support/element_checks.py (one line per
 element type below); this module adds closed-form and independent physical references:
@@ -25,7 +25,7 @@ from support.element_checks import (  # noqa: F401  (record: fixture used by the
     random_configuration,
     record,
 )
-from spacar import _core
+from spacar import _testing
 
 PLANAR_CASES = [
     ElementCase("PLTRUSS", chord),
@@ -118,7 +118,7 @@ def test_constant_curvature_bending(type_):
     rng = np.random.default_rng(7)
     for _ in range(N_CONFIGS):
         l0, alpha0, kappa = rng.uniform(0.5, 2), rng.uniform(-math.pi, math.pi), rng.uniform(-2, 2)
-        k = _core.element_kernel(type_, l0=l0, lgeomy=[alpha0])
+        k = _testing.element_kernel(type_, l0=l0, lgeomy=[alpha0])
         e = k.deformations(arc(rng.uniform(-1, 1, 2), alpha0, l0, kappa * l0 / 2))
         expected = -l0 * math.sin(kappa * l0 / 2)
         np.testing.assert_allclose(e[1:], [expected, expected], rtol=0, atol=1e-14)
@@ -132,7 +132,7 @@ def test_plbeamnl_circular_arc_elongation():
     rng = np.random.default_rng(11)
     for _ in range(5):
         l0, alpha0 = rng.uniform(0.5, 2), rng.uniform(-math.pi, math.pi)
-        k = _core.element_kernel("PLBEAMNL", l0=l0, lgeomy=[alpha0])
+        k = _testing.element_kernel("PLBEAMNL", l0=l0, lgeomy=[alpha0])
         deviation = {}
         for theta in (0.02, 0.01):
             e = k.deformations(arc(rng.uniform(-1, 1, 2), alpha0, l0, theta))
@@ -152,8 +152,8 @@ def test_plbeam_nonlinear_correction_is_arc_excess():
     for _ in range(N_CONFIGS):
         ref = CASES["PLBEAM"].reference(CASES["PLBEAM"], rng)
         x = random_configuration(rng, CASES["PLBEAM"].kinds, ref)
-        lin = _core.element_kernel("PLBEAM", l0=ref.l0, lgeomy=list(ref.lgeomy)).deformations(x)
-        nl = _core.element_kernel("PLBEAMNL", l0=ref.l0, lgeomy=list(ref.lgeomy)).deformations(x)
+        lin = _testing.element_kernel("PLBEAM", l0=ref.l0, lgeomy=list(ref.lgeomy)).deformations(x)
+        nl = _testing.element_kernel("PLBEAMNL", l0=ref.l0, lgeomy=list(ref.lgeomy)).deformations(x)
         e2, e3 = lin[1:]
         np.testing.assert_allclose(nl[1:], lin[1:], rtol=0, atol=0)
         np.testing.assert_allclose(nl[0] - lin[0], (2 * e2**2 + e2 * e3 + 2 * e3**2) / (30 * ref.l0),
@@ -169,7 +169,7 @@ def test_constitutive_matrix(type_):
     rng = np.random.default_rng(3)
     for _ in range(5):
         l0, a, b = rng.uniform(0.5, 2), rng.uniform(1, 1e4), rng.uniform(1, 1e2)
-        k = _core.element_kernel(type_, l0=l0)
+        k = _testing.element_kernel(type_, l0=l0)
         if type_ in BEAMS:  # ESTIFF EA EI
             expected = np.zeros((3, 3))
             expected[0, 0] = a / l0
@@ -192,7 +192,7 @@ def test_bending_strain_energy_of_constant_curvature(type_):
         l0, alpha0 = rng.uniform(0.5, 2), rng.uniform(-math.pi, math.pi)
         EI = rng.uniform(1, 10)
         EA = EI * rng.uniform(10, 1000) / l0**2
-        k = _core.element_kernel(type_, l0=l0, lgeomy=[alpha0])
+        k = _testing.element_kernel(type_, l0=l0, lgeomy=[alpha0])
         S = k.constitutive([EA, EI])
         for kappa in (1e-2, 1e-3, 1e-4):
             theta = kappa * l0 / 2
@@ -218,11 +218,11 @@ def straight_rigid(type_, rng):
         return u + omega * np.array([-r[1], r[0]])
 
     if type_ == "PLTRUSS":
-        k = _core.element_kernel(type_, l0=l0, emass=[rhoA])
+        k = _testing.element_kernel(type_, l0=l0, emass=[rhoA])
         x = np.concatenate([c + rp, c + rq])
         xd = np.concatenate([vel(rp), vel(rq)])
     else:  # material tangents along the chord: φ = α0 + β = α, β̇ = ω
-        k = _core.element_kernel(type_, l0=l0, lgeomy=[alpha0], emass=[rhoA])
+        k = _testing.element_kernel(type_, l0=l0, lgeomy=[alpha0], emass=[rhoA])
         beta = alpha - alpha0
         x = np.concatenate([c + rp, [beta], c + rq, [beta]])
         xd = np.concatenate([vel(rp), [omega], vel(rq), [omega]])

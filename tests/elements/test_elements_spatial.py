@@ -1,5 +1,5 @@
 """Element-level verification of the spatial elements TRUSS, BEAM, BEAMNL, HINGE, L2MIN1
-(issue #4; formulation.md §0, §4.1, §4.8–4.10, §4.13, §10.1) through `spacar._core.element_kernel`.
+(issue #4; formulation.md §0, §4.1, §4.8–4.10, §4.13, §10.1) through `spacar._testing.element_kernel`.
 
 The generic finite-difference and invariance checks live in support/element_checks.py (one line per
 case below; for element types with LAMBDA nodes the derivative checks run at unit Euler
@@ -39,7 +39,7 @@ from support.element_checks import (  # noqa: F401  (record: fixture used by the
     wrap_to_pi,
 )
 from support.spatial_models import E_ as E_of, G_ as G_of, hinge_frame, unit
-from spacar import _core
+from spacar import _core, _testing
 
 TOL = 1e-14  # closed forms: round-off of a few operations on O(1) numbers
 
@@ -198,7 +198,7 @@ def test_beamnl_correction():
     c = CASES["BEAM"]
     for _, ref, k, x in samples_on_and_off_sphere(c, "nl"):
         lin = k.deformations(x)
-        nl = _core.element_kernel("BEAMNL", l0=ref.l0, lgeomy=list(ref.lgeomy)).deformations(x)
+        nl = _testing.element_kernel("BEAMNL", l0=ref.l0, lgeomy=list(ref.lgeomy)).deformations(x)
         e3, e4, e5, e6 = lin[2:]
         np.testing.assert_array_equal(nl[1:], lin[1:])
         np.testing.assert_allclose(nl[0] - lin[0], (2 * e3**2 + e3 * e4 + 2 * e4**2 + 2 * e5**2 + e5 * e6
@@ -228,8 +228,8 @@ def planar_beam_pair(type_, rng):
     """BEAM(NL) with e_x0 = t(α0), e_y0 = n(α0), e_z0 = z and the PLBEAM(NL) with LGEOMY α0."""
     l0, alpha0, rhoA = rng.uniform(0.5, 2), rng.uniform(-math.pi, math.pi), rng.uniform(0.5, 3)
     C0 = np.array([[math.cos(alpha0), -math.sin(alpha0), 0], [math.sin(alpha0), math.cos(alpha0), 0], [0, 0, 1]])
-    k3 = _core.element_kernel(type_, l0=l0, lgeomy=list(lgeomy_of(C0)), emass=[rhoA])
-    k2 = _core.element_kernel("PL" + type_, l0=l0, lgeomy=[alpha0], emass=[rhoA])
+    k3 = _testing.element_kernel(type_, l0=l0, lgeomy=list(lgeomy_of(C0)), emass=[rhoA])
+    k2 = _testing.element_kernel("PL" + type_, l0=l0, lgeomy=[alpha0], emass=[rhoA])
     p = rng.uniform(-2, 2, 2)
     xp = np.array([*p, 0.0, *(p + l0 * np.array([math.cos(alpha0), math.sin(alpha0)])), 0.0])
     xp[[0, 1, 3, 4]] += rng.uniform(-0.2, 0.2, 4) * l0
@@ -278,8 +278,8 @@ def test_planar_reduction_with_flipped_section_axis():
         l0, alpha0 = rng.uniform(0.5, 2), rng.uniform(-math.pi, math.pi)
         t0, n0 = np.array([math.cos(alpha0), math.sin(alpha0), 0]), np.array([-math.sin(alpha0), math.cos(alpha0), 0])
         C0 = np.column_stack([t0, -n0, [0, 0, -1]])  # = [t0, −n0, t0 × (−n0)]
-        k3 = _core.element_kernel("BEAM", l0=l0, lgeomy=list(lgeomy_of(C0)))
-        k2 = _core.element_kernel("PLBEAM", l0=l0, lgeomy=[alpha0])
+        k3 = _testing.element_kernel("BEAM", l0=l0, lgeomy=list(lgeomy_of(C0)))
+        k2 = _testing.element_kernel("PLBEAM", l0=l0, lgeomy=[alpha0])
         xp = np.concatenate([[0, 0], rng.uniform(-math.pi, math.pi, 1), l0 * t0[:2] + rng.uniform(-0.2, 0.2, 2) * l0,
                              rng.uniform(-math.pi, math.pi, 1)])
         x, _ = embed_planar(xp)
@@ -298,7 +298,7 @@ def straight_beam(type_, rng):
     l0 = rng.uniform(0.5, 2)
     C0 = section_frame(rng, unit(rng.normal(size=3)))
     p = rng.uniform(-2, 2, 3)
-    k = _core.element_kernel(type_, l0=l0, lgeomy=list(lgeomy_of(C0)))
+    k = _testing.element_kernel(type_, l0=l0, lgeomy=list(lgeomy_of(C0)))
     return k, l0, C0, p
 
 
@@ -402,7 +402,7 @@ def test_beam_constitutive_matrix(type_):
     for _ in range(5):
         l0 = rng.uniform(0.5, 2)
         values = list(rng.uniform(1, 1e4, 4))
-        k = _core.element_kernel(type_, l0=l0, lgeomy=[1, 0, 0, 0, 1, 0, 0, 0, 1])
+        k = _testing.element_kernel(type_, l0=l0, lgeomy=[1, 0, 0, 0, 1, 0, 0, 0, 1])
         np.testing.assert_allclose(k.constitutive(values), beam_stiffness(l0, *values), rtol=1e-15, atol=0)
         for n in range(4):
             np.testing.assert_allclose(k.constitutive(values[:n]), beam_stiffness(l0, *(values[:n] + [0] * (4 - n))),
@@ -493,8 +493,8 @@ def test_rotary_inertia_adds_section_energy():
             Op = C0.T @ (2 * G_of(x[3:7]) @ xd[3:7])
             Oq = C0.T @ (2 * G_of(x[10:14]) @ xd[10:14])
             T_rot = ref.l0 / 6 * (Op @ J @ Op + Op @ J @ Oq + Oq @ J @ Oq)
-            full = _core.element_kernel("BEAM", l0=ref.l0, lgeomy=list(ref.lgeomy), emass=list(emass))
-            plain = _core.element_kernel("BEAM", l0=ref.l0, lgeomy=list(ref.lgeomy), emass=[emass[0]])
+            full = _testing.element_kernel("BEAM", l0=ref.l0, lgeomy=list(ref.lgeomy), emass=list(emass))
+            plain = _testing.element_kernel("BEAM", l0=ref.l0, lgeomy=list(ref.lgeomy), emass=[emass[0]])
             np.testing.assert_allclose(full.kinetic_energy(x, xd) - plain.kinetic_energy(x, xd), T_rot,
                                        rtol=1e-12, atol=1e-14)
 
@@ -596,8 +596,8 @@ def test_truss_in_plane_equals_pltruss():
     rng = np.random.default_rng(47)
     for _ in range(N_CONFIGS):
         l0, rhoA = rng.uniform(0.5, 2), rng.uniform(0.5, 3)
-        k3 = _core.element_kernel("TRUSS", l0=l0, emass=[rhoA])
-        k2 = _core.element_kernel("PLTRUSS", l0=l0, emass=[rhoA])
+        k3 = _testing.element_kernel("TRUSS", l0=l0, emass=[rhoA])
+        k2 = _testing.element_kernel("PLTRUSS", l0=l0, emass=[rhoA])
         x2, v2, g = rng.uniform(-2, 2, 4), rng.normal(size=4), rng.normal(size=3)
         x2[2:] = x2[:2] + l0 * (unit(rng.normal(size=2)) + rng.uniform(-0.2, 0.2, 2))
         J = np.zeros((6, 4))
@@ -632,7 +632,7 @@ def test_hinge_rotation_angle_frame_rule_and_misalignment_signs(axis):
     R̂ = Rx(φ)Ry(θ) ⇒ e = (φ, sin θ, 0); R̂ = Rx(φ)Rz(θ) ⇒ e = (φ, 0, sin θ) — exactly, with
     e1 = φ on (−π, π] (no wrapping in the interior) and the hinge frame of §4.10 (a different
     e_y0 would mix e2 and e3). Small θ: e2 = R̂13 ≈ θ about local y, e3 = −R̂12 ≈ θ about local z."""
-    k = _core.element_kernel("HINGE", params=list(axis))
+    k = _testing.element_kernel("HINGE", params=list(axis))
     C0 = hinge_frame(axis)
     rng = np.random.default_rng(59)
     phis = list(np.linspace(-math.pi, math.pi, 25)[1:-1]) + [math.pi - 1e-9, -math.pi + 1e-9, 0.0, math.pi]
@@ -650,7 +650,7 @@ def test_hinge_rotation_angle_frame_rule_and_misalignment_signs(axis):
     # the branch at an exactly representable half turn is +π: (−π, π]
     for i in range(3):
         x = np.concatenate([IDENTITY, axis_angle(np.eye(3)[i], math.pi)])
-        assert _core.element_kernel("HINGE", params=list(np.eye(3)[i])).deformations(x)[0] == math.pi
+        assert _testing.element_kernel("HINGE", params=list(np.eye(3)[i])).deformations(x)[0] == math.pi
     np.testing.assert_allclose(k.constitutive([3.5]), np.diag([3.5, 0.0, 0.0]), rtol=0, atol=0)
     assert not k.constitutive([]).any()
 
@@ -674,8 +674,8 @@ def test_hinge_rotation_is_right_handed_about_the_given_axis():
     for axis in ((0, 0, 1), (1, 2, 3)):
         lam2 = axis_angle(axis, 0.4)
         x = np.concatenate([IDENTITY, lam2])
-        assert abs(_core.element_kernel("HINGE", params=list(axis)).deformations(x)[0] - 0.4) < 1e-15
-        assert abs(_core.element_kernel("HINGE", params=[-a for a in axis]).deformations(x)[0] + 0.4) < 1e-15
+        assert abs(_testing.element_kernel("HINGE", params=list(axis)).deformations(x)[0] - 0.4) < 1e-15
+        assert abs(_testing.element_kernel("HINGE", params=[-a for a in axis]).deformations(x)[0] + 0.4) < 1e-15
 
 
 def relative_rotation_jacobian(k, x):
@@ -694,7 +694,7 @@ def test_hinge_regular_at_half_turn(axis):
     increment of o2 to (e1, e2, e3) is orthogonal (singular values 1), with a misalignment
     ≤ 0.1 rad all singular values stay ≥ 0.8. A common rotation of both nodes changes nothing.
     Contrast: the antisymmetric misalignments (R̂13 − R̂31)/2, (R̂21 − R̂12)/2 lose rank there."""
-    k = _core.element_kernel("HINGE", params=list(axis))
+    k = _testing.element_kernel("HINGE", params=list(axis))
     C0 = hinge_frame(axis)
     rng = np.random.default_rng(61)
     for deg in (179.9, 180.0, -179.9, -180.0):
@@ -748,4 +748,4 @@ def test_l2min1_exact():
 def test_kernel_rejects_missing_geometry(type_, kwargs):
     """Missing or incomplete LGEOMY / axis: an InputError, not an out-of-range read."""
     with pytest.raises(_core.InputError):
-        _core.element_kernel(type_, **kwargs)
+        _testing.element_kernel(type_, **kwargs)

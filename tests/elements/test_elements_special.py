@@ -1,6 +1,6 @@
 """Element-level verification of the special elements PLBEAR, BEARING, SURFACE, PLWHEEL, WHEEL
 and PLBELT (issue #6; formulation.md §4.5–4.7, §4.11, §4.12, §4.14, §10.1) through
-`spacar._core.element_kernel`.
+`spacar._testing.element_kernel`.
 
 Generic checks (support/element_checks.py, at N_CONFIGS random configurations, unit and non-unit Euler
 parameters): B, the convective term c, Σσ_iΓ_i, mass and gravity against differences. Wheel slips
@@ -57,7 +57,7 @@ from support.element_checks import (  # noqa: F401  (record: fixture used by the
     skew,
 )
 from support.spatial_models import E_ as E_of, hinge_frame, unit
-from spacar import _core
+from spacar import _core, _testing
 
 TOL = 1e-13  # closed forms: round-off of a few operations on O(1) numbers
 
@@ -366,7 +366,7 @@ def test_plbear_closed_form_and_stiffness():
 
 def test_plbear_revolute_joint_use():
     """Rigid e1, e2 with e3 free: p2 coincides with p1 + R(β_o1)d0 whatever the rotations."""
-    k = _core.element_kernel("PLBEAR", lgeomy=[0.0, 0.0])
+    k = _testing.element_kernel("PLBEAR", lgeomy=[0.0, 0.0])
     x = np.array([0.3, -0.2, 1.1, 0.3, -0.2, -2.0])
     np.testing.assert_allclose(k.deformations(x), [0, 0, -3.1], atol=TOL)
 
@@ -381,7 +381,7 @@ def test_bearing_closed_form():
             C0 = hinge_frame(axis)
             # R as the quadratic form of §0 (also off the sphere): e_j^{o1} = R(λ_o1) C0 e_j
             pos = (rotation_matrix(x[3:7]) @ C0).T @ (x[7:10] - x[0:3]) - np.array(ref.lgeomy)
-            hinge = _core.element_kernel("HINGE", params=list(axis)).deformations(np.concatenate([x[3:7], x[10:14]]))
+            hinge = _testing.element_kernel("HINGE", params=list(axis)).deformations(np.concatenate([x[3:7], x[10:14]]))
             e = k.deformations(x)
             np.testing.assert_allclose(e[:3], pos, atol=TOL * 10)
             np.testing.assert_allclose(e[3:], hinge, atol=TOL)
@@ -392,7 +392,7 @@ def test_bearing_vertical_axis_gives_ground_position_and_yaw():
     """The vehicle use of §4.11/§10.6: a BEARING from the ground (at the origin, λ = 1) with a
     vertical axis has the frame C0 = (z, x, y): e1 = height, e2 = x, e3 = y (minus d0), e4 = yaw ψ
     exactly, e5 = sin φ for a lean φ about the heading, e6 = 0 (no pitch)."""
-    k = _core.element_kernel("BEARING", params=[0, 0, 1], lgeomy=[0.5, 0.0, 0.0])
+    k = _testing.element_kernel("BEARING", params=[0, 0, 1], lgeomy=[0.5, 0.0, 0.0])
     for psi, phi in [(0.3, 0.2), (-2.5, -0.7), (3.0, 1.2)]:
         qz = np.array([math.cos(psi / 2), 0, 0, math.sin(psi / 2)])
         qx = np.array([math.cos(phi / 2), math.sin(phi / 2), 0, 0])
@@ -430,8 +430,8 @@ def test_surface_closed_form():
 
 def test_surface_sphere_and_plane():
     """Points on the sphere x² + y² + z² = 4 and on the plane x + 2y − z = 3 give e1 = 0."""
-    sphere = _core.element_kernel("SURFACE", params=[1, 1, 1, 0, 0, 0, 0, 0, 0, -4])
-    plane = _core.element_kernel("SURFACE", params=[0, 0, 0, 0, 0, 0, 1, 2, -1, -3])
+    sphere = _testing.element_kernel("SURFACE", params=[1, 1, 1, 0, 0, 0, 0, 0, 0, -4])
+    plane = _testing.element_kernel("SURFACE", params=[0, 0, 0, 0, 0, 0, 1, 2, -1, -3])
     rng = np.random.default_rng(3)
     for _ in range(10):
         u = unit(rng.normal(size=3))
@@ -468,7 +468,7 @@ def test_plwheel_slips_are_the_contact_point_velocity():
 
 def test_plwheel_creep_damping_matrix():
     """EDAMPP d1 d2: σ = diag(d1, d2) ė (released slips, linear creep model)."""
-    k = _core.element_kernel("PLWHEEL", params=[0.3, 0, 1])
+    k = _testing.element_kernel("PLWHEEL", params=[0.3, 0, 1])
     np.testing.assert_array_equal(k.constitutive([40.0, 25.0]), np.diag([40.0, 25.0]))
     assert not k.has_mass
 
@@ -590,8 +590,8 @@ def test_wheel_on_a_plane_given_as_a_quadric_is_the_plane_wheel():
     count = 0
     while count < 20:
         axis, r, n = rng.normal(size=3), rng.uniform(0.2, 1.0), unit(rng.normal(size=3))
-        plane = _core.element_kernel("WHEEL", params=[*axis, r, *n])
-        quadric = _core.element_kernel("WHEEL", params=[*axis, r, 0, 0, 0, 0, 0, 0, *n, 0])
+        plane = _testing.element_kernel("WHEEL", params=[*axis, r, *n])
+        quadric = _testing.element_kernel("WHEEL", params=[*axis, r, 0, 0, 0, 0, 0, 0, *n, 0])
         lam = unit(rng.normal(size=4))
         if 1 - (n @ rotation_matrix(lam) @ unit(axis)) ** 2 < 0.09:
             continue
@@ -617,7 +617,7 @@ def test_wheel_on_a_large_sphere_steeply_tilted():
     contact directions and spins: e1 ≈ 0 and all derivatives finite."""
     rng = np.random.default_rng(3)
     for R in (100.0, 1e4):
-        k = _core.element_kernel("WHEEL", params=[1, 0, 0, 1.0, 1, 1, 1, 0, 0, 0, 0, 0, 0, -R * R])
+        k = _testing.element_kernel("WHEEL", params=[1, 0, 0, 1.0, 1, 1, 1, 0, 0, 0, 0, 0, 0, -R * R])
         for _ in range(300):
             n = unit(rng.normal(size=3))
             tilt = rng.uniform(1.3, 1.54)
@@ -640,9 +640,9 @@ def test_wheel_on_a_large_sphere_steeply_tilted():
 
 def test_wheel_surface_input_errors():
     with pytest.raises(spacar.InputError, match="c1 .. c9 are all zero"):
-        _core.element_kernel("WHEEL", params=[0, 1, 0, 0.3] + [0.0] * 9 + [1.0])
+        _testing.element_kernel("WHEEL", params=[0, 1, 0, 0.3] + [0.0] * 9 + [1.0])
     with pytest.raises(spacar.InputError, match="quadratic surface"):
-        _core.element_kernel("WHEEL", params=[0, 1, 0, 0.3, 1, 1])
+        _testing.element_kernel("WHEEL", params=[0, 1, 0, 0.3, 1, 1])
     with pytest.raises(spacar.InputError, match=r"^wheel.dat, line 2, keyword WHEEL: WHEEL 1 takes 4, 7 or 14 "
                                                 r"numbers after its nodes .* got 10$"):
         spacar.read_string("* a wheel\nWHEEL 1 1 2 0 1 0 0.3 1 1 1 1 1 1\nEND\n", file="wheel.dat")
@@ -654,7 +654,7 @@ def test_wheel_rolling_direction():
     ẋ = +rω x: both slips vanish; a unit velocity along x (y) is a unit longitudinal (lateral)
     slip."""
     r = 0.35
-    k = _core.element_kernel("WHEEL", params=[0, 1, 0, r])
+    k = _testing.element_kernel("WHEEL", params=[0, 1, 0, r])
     x = np.array([0, 0, r, 1, 0, 0, 0])
     om = 2.0
     lamd = 0.5 * np.array([0, 0, om, 0])  # ω = 2 E(1,0,0,0) λ̇ = (0, ω, 0)
@@ -808,7 +808,7 @@ def test_plbelt_kinetic_energy_and_gravity_by_quadrature(label):
 
 
 def test_plbelt_without_emass_has_no_mass():
-    k = _core.element_kernel("PLBELT", params=[0.1, 0.2], l0=1.0, lgeomy=[0.0])
+    k = _testing.element_kernel("PLBELT", params=[0.1, 0.2], l0=1.0, lgeomy=[0.0])
     assert not k.has_mass
     assert k.kinetic_energy(np.array([0, 0, 0.3, 1, 0, 0.2]), np.ones(6)) == 0.0
 

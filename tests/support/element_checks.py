@@ -46,7 +46,7 @@ from typing import Callable, Sequence
 import numpy as np
 import pytest
 
-from spacar import _core
+from spacar import _core, _testing
 
 NodeKind = _core.NodeKind
 
@@ -215,8 +215,8 @@ class ElementCase:
         return self.info.n_emass > 0
 
     def kernel(self, ref: Reference):
-        return _core.element_kernel(self.type, params=list(ref.params), l0=ref.l0,
-                                    lgeomy=list(ref.lgeomy), emass=list(ref.emass))
+        return _testing.element_kernel(self.type, params=list(ref.params), l0=ref.l0,
+                                       lgeomy=list(ref.lgeomy), emass=list(ref.emass))
 
     @property
     def has_lambda(self):

@@ -85,9 +85,10 @@ struct Data {
   Eigen::VectorXd rhs;          // reduced force (n_dof)
   Eigen::LLT<Eigen::MatrixXd> llt;
   Eigen::VectorXd qdd;          // DOF accelerations (n_dof)
-  Eigen::VectorXd g;            // M ẍ + h − f (nx)
+  // M ẍ + h − f (nx): the inertia and applied loads the stresses must balance (not gravity g).
+  Eigen::VectorXd inertia_residual;
   Eigen::VectorXd reaction;     // loads of supports and drivers on fixed and input coordinates (nx)
-  // Consistency of the reactions with the motion (formulation.md §6): g + DDᵀσ on every
+  // Consistency of the reactions with the motion (formulation.md §6): M ẍ + h − f + DDᵀσ on every
   // coordinate (the reactions on fixed and input rows, ≈ 0 on the others) and σ of every
   // velocity row from (6.1), degree-of-freedom rows included (0 on the other rows).
   Eigen::VectorXd residual_load;      // (nx)

@@ -14,7 +14,7 @@ void constitutive_stresses(const System& sys, Data& data);
 // Element mass matrices and convective forces, rigid-body inertias, and the global h and f at
 // the current x, ẋ (the element work vectors must hold x and v).
 void compute_inertia_and_loads(const System& sys, Data& data);
-// g = M ẍ + h − f (after compute_inertia_and_loads).
+// inertia_residual = M ẍ + h − f (after compute_inertia_and_loads).
 void inertia_force(const System& sys, Data& data);
 // The dense global mass matrix (full path).
 void assemble_mass_matrix(const System& sys, Data& data);

@@ -33,9 +33,4 @@ struct TimeLimitError : Error {
   using Error::Error;
 };
 
-// A feature that is specified but whose physics has not been implemented yet.
-struct NotImplementedError : Error {
-  using Error::Error;
-};
-
 }  // namespace spacar

@@ -26,6 +26,9 @@ struct IntegrationError : std::runtime_error {
 };
 
 enum class Method { DOP853, DOPRI5 };
+// The method of its name ("dop853", "dopri5"), the one parser of every entry point;
+// InputError for any other name.
+Method parse_method(const std::string& name);
 
 struct IntegratorStats {
   long nfev = 0, nsteps = 0, naccept = 0, nreject = 0;

@@ -3,8 +3,6 @@
 // (convective) terms that give accelerations.
 #pragma once
 
-#include <string>
-#include <utility>
 #include <vector>
 
 #include "spacar/data.hpp"
@@ -48,27 +46,9 @@ void solve_accelerations_direct(const System& sys, Data& data);
 // velocity block (after solve_velocities_direct). Uses the rhs_V/sol_V work vectors.
 void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out);
 
-// Diagnosis of the position constraint block A_P (or, velocity = true, of the velocity block A_V,
-// whose rows hold the nonholonomic deformations instead of their kinematic coordinates) at the
-// current positions (formulation.md §2.3, §5).
-// Above this many constraints or calculable coordinates the diagnosis gives the counts only
-// (rank = -1): the SVD and the selections are cubic in the size and would take minutes.
-constexpr int kMaxDiagnosisSize = 1500;
-
-struct ConstraintDiagnosis {
-  int n_constraints = 0, n_calculable = 0, rank = 0;  // rank -1: not computed (too large)
-  std::vector<int> redundant;     // deformations whose release removes the redundancy
-  std::vector<int> undetermined;  // calculable coordinates left undetermined
-  // From the SVD: dependent combinations of rows and free motions, (index, weight).
-  std::vector<std::vector<std::pair<int, double>>> redundant_groups, undetermined_groups;
-  std::string text;               // readable report naming elements and nodes
-};
-// velocity: the velocity block (rows V) instead of the position block (rows P).
-ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity = false);
-std::string diagnose_constraints(const System& sys, Data& data, bool velocity = false);
-// If the velocity constraint block is nearly singular (a dead point): which constraints lose
-// their independence and which coordinates move; "" otherwise.
-std::string weakest_constraint(const System& sys, Data& data);
+// Assemble the constraint block A (AP or AV, `block`: its element block ids) at the current
+// element derivatives.
+void assemble_block(const System& sys, Data& data, BlockMatrix& A, const std::vector<int>& block);
 
 // Check that the constraint block is square; throws KinematicsError with the diagnosis.
 void check_constraint_counts(const System& sys, Data& data);

@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "spacar/catalogue.hpp"
@@ -69,6 +70,77 @@ struct Settings {
   int restart = 0;
   std::optional<int> linear;      // extension LINEAR 0/1/2
 };
+
+// --- The fields of Node, Element and Settings, each listed once: the Python properties
+// (bindings/bind_model.cpp) and the pickled records (serialize.hpp) are generated from these
+// tables, in this order (the order is the pickle format: append new fields at the end and raise
+// kModelStateVersion). A field is (name, member, doc); `Codec` says how it is stored when it is
+// not stored as it is (the element type by name, so that a pickle does not depend on the order
+// of the catalogue).
+
+struct AsStored;           // the value itself; enums as their integer
+struct ElementTypeByName;  // an index into element_catalogue() stored as the type's name
+
+template <class S, class T, class Codec = AsStored>
+struct Field {
+  const char* name;
+  T S::*member;
+  const char* doc;
+};
+
+template <class Codec = AsStored, class S, class T>
+constexpr Field<S, T, Codec> field(const char* name, T S::*member, const char* doc) {
+  return {name, member, doc};
+}
+
+inline constexpr auto kNodeFields = std::make_tuple(
+    field("id", &Node::id, "node number"),
+    field("kind", &Node::kind, "node kind (X: given by X only, not yet used by an element)"),
+    field("x", &Node::x, "current coordinates"),
+    field("cls", &Node::cls, "class of every coordinate"),
+    field("xd", &Node::xd, "current velocities"),
+    field("xdd", &Node::xdd, "current accelerations"),
+    field("force", &Node::force, "FORCE values (empty: none)"),
+    field("mass", &Node::mass, "MASS values as given (empty: none)"),
+    field("torquel", &Node::torquel, "TORQUEL values (empty: none)"),
+    field("used", &Node::used, "referenced by an element"),
+    field("x_given", &Node::x_given, "number of coordinates given explicitly (X/XY/...)"),
+    field("origin", &Node::origin, "where the node was first defined (for messages)"));
+
+inline constexpr auto kElementFields = std::make_tuple(
+    field("id", &Element::id, "element number"),
+    field<ElementTypeByName>("type", &Element::type, "index into the element catalogue"),
+    field("nodes", &Element::nodes, "node numbers in the order of the definition line"),
+    field("params", &Element::params, "numbers of the definition line, as given"),
+    field("l0", &Element::l0, "LENGTHO (set by the user or at the first END)"),
+    field("lgeomy", &Element::lgeomy, "LGEOMY (set by the user or at the first END)"),
+    field("estiff", &Element::estiff, "ESTIFF values"),
+    field("edampp", &Element::edampp, "EDAMPP values"),
+    field("emass", &Element::emass, "EMASS values"),
+    field("cls", &Element::cls, "class of every deformation"),
+    field("e", &Element::e, "current deformations"),
+    field("ed", &Element::ed, "current deformation rates"),
+    field("edd", &Element::edd, "current deformation accelerations"),
+    field("e_given", &Element::e_given, "E was given (targets of fixed deformations, initial DOF values)"),
+    field("kinematic_of", &Element::kinematic_of,
+          "nonholonomic deformations: (element, index) of the kinematic coordinate; (0, 0) if none"),
+    field("automatic", &Element::automatic, "L2MIN1 created automatically for a LAMBDA node"),
+    field("origin", &Element::origin, "where the element was defined (file, line, keyword)"));
+
+inline constexpr auto kSettingsFields = std::make_tuple(
+    field("timestep_n", &Settings::timestep_n, "TIMESTEP n: output intervals (0: no integration)"),
+    field("timestep_tp", &Settings::timestep_tp, "TIMESTEP Tp: period of the block"),
+    field("hmax", &Settings::hmax, "HMAX: largest integration step"),
+    field("maxiterat", &Settings::maxiterat, "MAXITERAT: Newton iterations"),
+    field("epskin", &Settings::epskin, "EPSKIN: tolerance of the kinematics"),
+    field("epsint", &Settings::epsint, "EPSINT: tolerance of the integration (positions)"),
+    field("epsind", &Settings::epsind, "EPSIND: tolerance of the integration (velocities)"),
+    field("forcemode", &Settings::forcemode, "FORCEMODE"),
+    field("animate", &Settings::animate, "ANIMATE"),
+    field("matasc", &Settings::matasc, "MATASC"),
+    field("jobid", &Settings::jobid, "JOBID (None: not given)"),
+    field("restart", &Settings::restart, "RESTART"),
+    field("linear", &Settings::linear, "LINEAR 0/1/2 (None: not given)"));
 
 class Model {
  public:

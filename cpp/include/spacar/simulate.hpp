@@ -56,6 +56,28 @@ struct BlockResults {
   std::vector<std::string> warnings;
 };
 
+// The arrays recorded at every output time, listed once (recording, allocation, the results
+// handed to Python and the state given to RunOptions::on_output): Data holds the value at the
+// current time, BlockResults one row per output time.
+struct OutputArray {
+  const char* name;
+  const char* what;       // in messages: "the <what> at t = ... are not finite"
+  bool per_deformation;   // ne columns (else nx)
+  Eigen::VectorXd Data::*now;
+  RowMatrix BlockResults::*rows;
+};
+
+inline constexpr OutputArray kOutputArrays[] = {
+    {"x", "coordinates", false, &Data::x, &BlockResults::x},
+    {"xd", "velocities", false, &Data::xd, &BlockResults::xd},
+    {"xdd", "accelerations", false, &Data::xdd, &BlockResults::xdd},
+    {"e", "deformations", true, &Data::e, &BlockResults::e},
+    {"ed", "deformation rates", true, &Data::ed, &BlockResults::ed},
+    {"edd", "deformation accelerations", true, &Data::edd, &BlockResults::edd},
+    {"sigma", "stresses", true, &Data::sigma, &BlockResults::sigma},
+    {"reaction", "reactions", false, &Data::reaction, &BlockResults::reaction},
+};
+
 class Simulation {
  public:
   // Prepares (first END) and compiles the model; the model must outlive the simulation.
@@ -90,8 +112,17 @@ class Simulation {
   // accelerations; false (nothing written) if the system is not a planar tree of rigid bodies or
   // a body moves no mass. The tree is taken at the solved state of the first call (after
   // assemble(): the assembled state) and kept until the next run.
-  bool recursive_state(const double* q, const double* qd, Eigen::VectorXd& qdd, Eigen::VectorXd& x,
-                       Eigen::VectorXd& xd, Eigen::VectorXd& xdd);
+  bool recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
+                       Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd);
+  // q̈ of the reduced equations (3.1) with transfer functions at the last evaluated state, the
+  // state left as it was: an independent check of the integration path's sparse solve.
+  Eigen::VectorXd reduced_accelerations();
+
+  // The entry points of users and the bindings: q and q̇ are checked to have one value per
+  // degree of freedom (InputError), then the versions above run (recursive_state checks too).
+  void solve_state(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  void evaluate(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  void move_to(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
 
   BlockResults run(const RunOptions& options = {});
   // The same, into `res`. If the run fails (an exception), `res` holds what was computed up to
@@ -102,7 +133,29 @@ class Simulation {
   void store_state();
 
  private:
+  // A block's run in three stages: plan (the requests checked before any work, the output
+  // times), allocate (the result arrays, within the memory limit), integrate (assemble, then
+  // the output times reached by integration or, without degrees of freedom, by kinematics).
+  struct BlockPlan {
+    Settings st;                 // the system's settings, tolerances raised to kMinTolerance
+    double t0 = 0.0, t_end = 0.0;
+    bool integrate = false;      // degrees of freedom or integrated deformations, and a period
+    bool linear = false;         // linearized equations at every output time
+    std::vector<double> times;   // the output times, the last exactly t_end
+  };
+  BlockPlan plan_block(const RunOptions& options, std::vector<std::string>& warnings) const;
+  void start_clock(const RunOptions& options, std::chrono::steady_clock::time_point start);
+  void allocate_results(BlockResults& res, const BlockPlan& plan) const;
+  // k_out: the output times recorded (also when it throws).
+  void integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out);
+  // One integrator run from t towards t_end through `times`, until the end or a repartition of a
+  // free rotation; the time reached. Counters and the last step go to res.
+  double integrate_segment(BlockResults& res, const RunOptions& options, const Settings& st, double t, double t_end,
+                           double h, Eigen::VectorXd& Y, const std::vector<double>& times,
+                           const Integrator::Output& output);
   void record(BlockResults& res, int k);
+  // InputError unless q and q̇ have one value per degree of freedom (`what`: the entry point).
+  void require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;
   // After the integrator gave up: rethrow as a KinematicsError if the kinematics is the cause.
   void explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y);
   // A free rotation whose dependent Euler parameter has become small, or −1.

@@ -61,8 +61,10 @@ struct System {
   // Index lists (global indices, ascending) per class.
   std::vector<int> x_fixed, x_calc, x_input, x_dyn;
   std::vector<int> e_fixed, e_released, e_input, e_dyn, e_line, e_nonholonomic, e_kinematic;
-  std::vector<int> rows_P;      // deformations with known values: position constraint rows
-  std::vector<int> rows_V;      // deformations with known rates: velocity constraint rows
+  // The deformation of each row of the constraint blocks (row → deformation; row_P and row_V
+  // below are the inverse maps).
+  std::vector<int> defs_P;      // deformations with known values: position constraint rows
+  std::vector<int> defs_V;      // deformations with known rates: velocity constraint rows
   std::vector<int> auto_released;  // fixed rows with no calculable coordinate, checked instead
   std::vector<int> e_element;   // element (index into elements) of each deformation
   // Deformations defined up to a period (angles), unwrapped to continuous values: (index, period).

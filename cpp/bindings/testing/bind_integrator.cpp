@@ -1,4 +1,4 @@
-// Test-only binding of the Runge-Kutta integrator: integrates a Python rhs so that the tests can
+// Binding of the Runge-Kutta integrator (spacar._testing): integrates a Python rhs so that the tests can
 // check accuracy, dense output and failure handling against exact solutions.
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
@@ -14,18 +14,11 @@ namespace py = pybind11;
 
 namespace {
 
-spacar::Method parse_method(const std::string& name) {
-  if (name == "dop853") return spacar::Method::DOP853;
-  if (name == "dopri5") return spacar::Method::DOPRI5;
-  throw std::invalid_argument("dop853_solve: method must be 'dop853' or 'dopri5', not '" + name +
-                              "'");
-}
-
 py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, double t_end,
                const std::vector<double>& touts, double rtol, double atol,
                const std::string& method, double hmax) {
   const int n = static_cast<int>(y0.size());
-  spacar::Integrator integrator(n, parse_method(method));
+  spacar::Integrator integrator(n, spacar::parse_method(method));
   integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol),
                             Eigen::VectorXd::Constant(n, atol));
   integrator.set_max_step(hmax);
@@ -55,7 +48,7 @@ py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, doub
 }  // namespace
 
 void bind_integrator(py::module_& m) {
-  m.def("dop853_solve", &solve, py::arg("f"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
+  m.def("explicit_rk_solve", &solve, py::arg("f"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
         py::arg("touts"), py::arg("rtol"), py::arg("atol"), py::arg("method") = "dop853",
         py::arg("hmax") = std::numeric_limits<double>::infinity(),
         "Test helper: integrate dy/dt = f(t, y) from t0 to t_end with the embedded Runge-Kutta "

@@ -1,0 +1,164 @@
+// The analysis of a block (simulate.hpp): the compiled system, its data, and the simulation
+// with its stages and its run.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "spacar/diagnosis.hpp"
+#include "spacar/simulate.hpp"
+
+namespace spacar::bindings {
+
+namespace {
+
+py::dict block_results_to_dict(BlockResults&& r) {
+  py::dict d;
+  d["t"] = std::move(r.t);
+  for (const OutputArray& a : kOutputArrays) d[a.name] = std::move(r.*a.rows);
+  py::list lins;
+  for (const Linearization& l : r.linearizations) lins.append(linearization_to_dict(l));
+  d["linearizations"] = lins;
+  d["rhs_evaluations"] = r.rhs_evaluations;
+  d["steps"] = r.steps;
+  d["accepted"] = r.accepted;
+  d["rejected"] = r.rejected;
+  d["newton_iterations"] = r.newton_iterations;
+  d["last_step"] = r.last_step;
+  d["wall_time"] = r.wall_time;
+  d["recursive"] = r.recursive;
+  d["warnings"] = r.warnings;
+  return d;
+}
+
+}  // namespace
+
+void bind_simulation(py::module_& m) {
+  py::class_<System>(m, "System")
+      .def_readonly("nx", &System::nx)
+      .def_readonly("ne", &System::ne)
+      .def_readonly("coord_label", &System::coord_label)
+      .def_readonly("def_label", &System::def_label)
+      .def_readonly("coord_class", &System::coord_class)
+      .def_readonly("def_class", &System::def_class)
+      .def_readonly("x_calc", &System::x_calc)
+      .def_readonly("x_input", &System::x_input)
+      .def_readonly("x_dyn", &System::x_dyn)
+      .def_readonly("x_fixed", &System::x_fixed)
+      .def_readonly("e_input", &System::e_input)
+      .def_readonly("e_dyn", &System::e_dyn)
+      .def_readonly("defs_P", &System::defs_P)
+      .def_readonly("defs_V", &System::defs_V)
+      .def_readonly("dof_cols", &System::dof_cols)
+      .def_readonly("input_cols", &System::input_cols)
+      .def_readonly("q0", &System::q0)
+      .def_readonly("qd0", &System::qd0)
+      .def_readonly("warnings", &System::warnings)
+      .def_property_readonly("n_dof", &System::n_dof)
+      .def_property_readonly("n_qhat", &System::n_qhat);
+
+  py::class_<Data>(m, "Data")
+      .def_readonly("t", &Data::t)
+      .def_readonly("x", &Data::x)
+      .def_readonly("xd", &Data::xd)
+      .def_readonly("xdd", &Data::xdd)
+      .def_readonly("e", &Data::e)
+      .def_readonly("ed", &Data::ed)
+      .def_readonly("edd", &Data::edd)
+      .def_readonly("sigma", &Data::sigma)
+      .def_readonly("qhat", &Data::qhat)
+      .def_readonly("qhat_d", &Data::qhat_d)
+      .def_readonly("qhat_dd", &Data::qhat_dd)
+      .def_readonly("DF", &Data::DF)
+      .def_readonly("DFe", &Data::DFe)
+      .def_readonly("acc0", &Data::acc0)
+      .def_readonly("M", &Data::M)
+      .def_readonly("Mbar", &Data::Mbar)
+      .def_readonly("qdd", &Data::qdd)
+      .def_readonly("reaction", &Data::reaction)
+      .def_readonly("residual_load", &Data::residual_load)
+      .def_readonly("sigma_equilibrium", &Data::sigma_equilibrium)
+      .def_readonly("newton_iterations", &Data::newton_iterations);
+
+  py::class_<Simulation>(m, "Simulation")
+      .def(py::init<Model&>(), py::keep_alive<1, 2>())
+      .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
+      .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
+      .def("assemble", &Simulation::assemble)
+      .def("forces", &Simulation::forces)
+      .def("reduced_accelerations", &Simulation::reduced_accelerations)
+      .def("linearize", [](Simulation& s) { return linearization_to_dict(s.linearize()); })
+      .def("diagnose",
+           [](Simulation& s) {
+             const ConstraintDiagnosis d = diagnose(s.system(), s.data());
+             const System& sys = s.system();
+             py::dict out;
+             out["n_constraints"] = d.n_constraints;
+             out["n_calculable"] = d.n_calculable;
+             out["rank"] = d.rank;
+             py::list red, und;
+             for (int k : d.redundant) red.append(py::make_tuple(sys.def_label[k][0], sys.def_label[k][1]));
+             for (int g : d.undetermined) und.append(py::make_tuple(sys.coord_label[g][0], sys.coord_label[g][1]));
+             out["redundant"] = red;
+             out["undetermined"] = und;
+             out["text"] = d.text;
+             return out;
+           })
+      .def("evaluate", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::evaluate))
+      .def("solve_state",
+           py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::solve_state),
+           "The integration path: positions, velocities, q̈ and stresses without DF.")
+      .def(
+          "recursive_state",
+          [](Simulation& s, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) -> py::object {
+            Eigen::VectorXd qdd, x, xd, xdd;
+            if (!s.recursive_state(q, qd, qdd, x, xd, xdd)) return py::none();
+            py::dict out;
+            out["qdd"] = qdd;
+            out["x"] = x;
+            out["xd"] = xd;
+            out["xdd"] = xdd;
+            return out;
+          },
+          "The recursive path of planar rigid trees at (q, q̇), its tree taken at the solved state of the first "
+          "call: a dict of qdd, x, xd, xdd (None for other systems); a check of it against solve_state() and "
+          "move_to().")
+      .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))
+      .def(
+          "run",
+          [](Simulation& s, py::object on_output, double initial_step, const std::string& method,
+             double time_limit, bool recursive) {
+            RunOptions opt;
+            opt.recursive = recursive;
+            opt.initial_step = initial_step;
+            opt.method = parse_method(method);
+            if (!on_output.is_none()) {
+              opt.on_output = [on_output](int k, const Data& d, const Linearization* lin) {
+                py::gil_scoped_acquire gil;
+                py::dict state;
+                state["t"] = d.t;
+                for (const OutputArray& a : kOutputArrays) state[a.name] = d.*a.now;
+                if (lin) state["linearization"] = linearization_to_dict(*lin);
+                on_output(k, state);
+              };
+            }
+            opt.time_limit = time_limit;
+            BlockResults r;
+            std::exception_ptr failure;
+            {
+              py::gil_scoped_release release;
+              try {
+                s.run(r, opt);
+              } catch (...) {
+                failure = std::current_exception();
+              }
+            }
+            if (failure) raise_with_results(failure, block_results_to_dict(std::move(r)));
+            return block_results_to_dict(std::move(r));
+          },
+          py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
+          py::arg("time_limit") = 0.0, py::arg("recursive") = true,
+          "Run the block; on failure the exception has the results up to the failure as `results`.");
+}
+
+}  // namespace spacar::bindings

@@ -1,0 +1,19 @@
+// spacar._testing: direct access to pieces of the core that the shipped API does not expose, for
+// the tests and the peer comparisons (spacar.compare): one element kernel, the Runge-Kutta
+// integrator on a Python right-hand side, the sparse LU. Kept out of spacar._core.
+#include <pybind11/pybind11.h>
+
+namespace py = pybind11;
+
+void bind_kernels(py::module_& m);
+void bind_integrator(py::module_& m);
+void bind_sparse(py::module_& m);
+
+PYBIND11_MODULE(_testing, m) {
+  m.doc() = "spacar core internals for tests and peer comparisons";
+  // The core's exception types and their translation are registered by spacar._core.
+  py::module_::import("spacar._core");
+  bind_kernels(m);
+  bind_integrator(m);
+  bind_sparse(m);
+}
