@@ -74,7 +74,7 @@ def test_local_processes_and_threads_match_serial_runs(serial_grid):
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         in_threads = spacar.sweep(base, GRID, executor=pool, progress=False)
     assert_same_as_serial(in_threads, serial_grid)
-    assert base.current_time == 0.0 and not base._core.frozen  # the sweep works on copies
+    assert base.current_time == 0.0 and not base.core.frozen  # the sweep works on copies
 
 
 def test_failed_cases_are_reported_with_their_parameters():

@@ -264,4 +264,4 @@ def test_check_does_not_change_the_model():
     model = fourbar(rocker_rotation=7)
     before = model.dump(digits=17)
     model.check()
-    assert model.dump(digits=17) == before and not model._core.frozen
+    assert model.dump(digits=17) == before and not model.core.frozen

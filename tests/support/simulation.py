@@ -10,6 +10,6 @@ def assembled(model):
     assembled initial state. The simulation works on the model itself: pass ``model.copy()`` to
     keep the model as it was."""
     model.prepare()
-    sim = _core.Simulation(model._core)
+    sim = _core.Simulation(model.core)
     sim.assemble()
     return sim
