@@ -6,7 +6,6 @@ come back exactly, and the copy computes bit-identical results.
 from __future__ import annotations
 
 import pickle
-from pathlib import Path
 
 import cloudpickle
 import numpy as np
@@ -14,9 +13,9 @@ import pytest
 
 import spacar
 from spacar import InputError
+from support.paths import EXAMPLES
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 SPATIAL = """\
 BEAM 1 1 2 3 4 0 1 0

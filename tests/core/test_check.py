@@ -13,15 +13,15 @@ formulation.md §2.3).
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import spacar
 from spacar.cli import main
+from support.paths import EXAMPLES
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 # Four-bar: ground pivots (0, 0) and (2, 0), crank (0, 0)–(0, 1), coupler (0, 1)–(2, 1.2),
 # rocker (2, 0)–(2, 1.2); the crank turns at 1 rad/s from β2 = 0.

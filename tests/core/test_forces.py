@@ -18,16 +18,16 @@ and `spacar._core.Simulation` (evaluate/move_to, forces and the Data arrays) are
 """
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import spacar
 from support.equilibrium import static_equilibrium
+from support.paths import EXAMPLES
 from support.simulation import assembled
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 G = 9.81
 
 

@@ -21,7 +21,6 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -33,9 +32,10 @@ from numpy.polynomial import legendre as gauss_legendre
 import spacar
 from spacar.cli import main
 from support.equilibrium import static_equilibrium
+from support.paths import EXAMPLES
 from support.simulation import assembled
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 
 def omegas(lin):

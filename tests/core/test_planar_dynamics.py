@@ -17,7 +17,6 @@ import math
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -26,10 +25,10 @@ import scipy.optimize
 import scipy.special
 
 import spacar
+from support.paths import EXAMPLES
 from support.simulation import assembled
 
 G = 9.81
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def assert_finite(res):

@@ -5,16 +5,14 @@ equation, the BEAM cantilever and its numerical linearization.
 """
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 import spacar
+from support.paths import EXAMPLES
 from support.simulation import assembled
 
-ROOT = Path(__file__).resolve().parents[2]
-PLANAR_EXAMPLE = ROOT / "examples" / "slidercrank.dat"
-SPATIAL_EXAMPLE = ROOT / "examples" / "slidercrank3d.dat"
+PLANAR_EXAMPLE = EXAMPLES / "slidercrank.dat"
+SPATIAL_EXAMPLE = EXAMPLES / "slidercrank3d.dat"
 
 
 # ---------------------------------------------------------------------------------------------
