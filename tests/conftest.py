@@ -1,10 +1,9 @@
 """Shared paths and texts of the input/output tests."""
-from pathlib import Path
-
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+from support.paths import EXAMPLES
+
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 
 @pytest.fixture

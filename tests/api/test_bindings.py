@@ -3,12 +3,11 @@ the pickled records and the properties list the same fields in the same order, a
 points that take an integration method refuse an unknown one alike."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import spacar
 from spacar import _core, _testing
+from support.paths import EXAMPLES
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 
 def properties(cls):
@@ -44,7 +43,7 @@ def test_the_pickled_records_hold_the_properties_in_their_order():
 def test_both_entry_points_refuse_an_unknown_integration_method_alike():
     """One parser (integrator.hpp parse_method): the simulation and the integrator raise
     the same InputError, which is also a ValueError."""
-    sim = _core.Simulation(spacar.read(EXAMPLE)._core)
+    sim = _core.Simulation(spacar.read(EXAMPLE).core)
     errors = []
     for call in (lambda: sim.run(method="rk4"),
                  lambda: _testing.explicit_rk_solve(lambda t, y: y, 0.0, [1.0], 1.0, [1.0], 1e-6, 1e-6, method="rk4")):
@@ -63,7 +62,7 @@ def test_every_state_entry_point_checks_the_sizes_of_q_and_qd():
     import numpy as np
     import pytest
 
-    sim = _core.Simulation(spacar.read(EXAMPLE)._core)
+    sim = _core.Simulation(spacar.read(EXAMPLE).core)
     sim.assemble()
     n = sim.system.n_dof
     good, bad = np.zeros(n), np.zeros(n + 1)

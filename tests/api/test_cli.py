@@ -16,8 +16,9 @@ import pytest
 
 import spacar
 from spacar.keywords import LOOKUP
+from support.paths import EXAMPLES
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 SCRIPT = Path(sys.executable).parent / ("spacar.exe" if os.name == "nt" else "spacar")
 

@@ -6,7 +6,6 @@ come back exactly, and the copy computes bit-identical results.
 from __future__ import annotations
 
 import pickle
-from pathlib import Path
 
 import cloudpickle
 import numpy as np
@@ -14,9 +13,9 @@ import pytest
 
 import spacar
 from spacar import InputError
+from support.paths import EXAMPLES
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 SPATIAL = """\
 BEAM 1 1 2 3 4 0 1 0
@@ -56,7 +55,7 @@ END
 
 def snapshot(model: spacar.Model):
     """Every field of the model that pickling must keep, as plain data."""
-    core = model._core
+    core = model.core
     nodes = {nid: (n.id, n.kind.name, n.x, [c.name for c in n.cls], n.xd, n.xdd, n.force, n.mass, n.torquel,
                    n.used, n.origin) for nid, n in core.nodes.items()}
     elements = {eid: (el.id, el.type_name, el.nodes, el.params, el.l0, el.lgeomy, el.estiff, el.edampp, el.emass,
@@ -94,7 +93,7 @@ def test_the_manual_example_round_trips_exactly_before_and_after_a_run(dumps):
     copy = roundtrip(model, dumps)
     assert same(snapshot(copy), snapshot(model))
     assert copy.dump(digits=17) == model.dump(digits=17)
-    assert not copy._core.frozen
+    assert not copy.core.frozen
     # The same results, bit for bit, and the same state afterwards.
     res_a, res_b = spacar.simulate(model), spacar.simulate(copy)
     for name in ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction"):
@@ -102,7 +101,7 @@ def test_the_manual_example_round_trips_exactly_before_and_after_a_run(dumps):
     assert same(snapshot(copy), snapshot(model))
     # After the run: state at t = 5, prepared, with the continuation step of RESTART 0.
     after = roundtrip(model, dumps)
-    assert after._core.frozen and after.current_time == 5.0 and after._continue_step == model._continue_step > 0
+    assert after.core.frozen and after.current_time == 5.0 and after._continue_step == model._continue_step > 0
     assert same(snapshot(after), snapshot(model))
     res_c, res_d = spacar.simulate(model), spacar.simulate(after)
     np.testing.assert_array_equal(res_c.x, res_d.x)
@@ -125,8 +124,8 @@ def test_a_spatial_model_with_every_kind_of_field_round_trips_exactly():
     model = spacar.read_string(SPATIAL)
     for value in (0.1 + 0.2, -0.0, 5e-324, 1.7976931348623157e308, np.nextafter(1.0, 2.0)):
         model.xd(6, 3, value)
-        assert roundtrip(model)._core.nodes[6].xd[2] == value
-        assert str(roundtrip(model)._core.nodes[6].xd[2]) == str(value)
+        assert roundtrip(model).core.nodes[6].xd[2] == value
+        assert str(roundtrip(model).core.nodes[6].xd[2]) == str(value)
 
 
 def test_an_unprepared_copy_still_takes_new_geometry():
@@ -140,7 +139,7 @@ def test_an_unprepared_copy_still_takes_new_geometry():
 
 def test_a_corrupt_state_is_an_input_error():
     state = spacar._core.Model().__getstate__()
-    good = spacar.read(EXAMPLE)._core.__getstate__()
+    good = spacar.read(EXAMPLE).core.__getstate__()
     bad_version = (99,) + tuple(good[1:])
     bad_node = list(good)
     bad_node[1] = [tuple(good[1][0][:2]) + ([0.0],) + tuple(good[1][0][3:])]  # node with 1 coordinate

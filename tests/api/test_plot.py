@@ -11,7 +11,6 @@ import math
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,11 +22,11 @@ from matplotlib import animation as mpl_animation  # noqa: E402
 
 import spacar  # noqa: E402
 from spacar.geometry import ElementGeometry, Geometry, shapes  # noqa: E402
+from support.paths import EXAMPLES  # noqa: E402
 
 Image = pytest.importorskip("PIL.Image")
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 
 @pytest.fixture(autouse=True)

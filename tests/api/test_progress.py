@@ -1,14 +1,14 @@
 """The progress bar over simulated time (issue #7): tqdm, optional, advanced at the output times
 only; off when not interactive or when asked."""
 import sys
-from pathlib import Path
 
 import pytest
 
 import spacar
 import spacar.progress
+from support.paths import EXAMPLES
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 
 def run(**kwargs):

@@ -1,14 +1,13 @@
 """The Python layer's shared pieces (issue 18): the public handle to the core model, the one
 keyword-argument grouping, the one tqdm detection and the one R(λ)."""
 import re
-from pathlib import Path
 
 import spacar
 from spacar import _core
 from spacar.geometry import Geometry
+from support.paths import EXAMPLES, ROOT
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 
 def test_model_core_is_the_core_model_itself():

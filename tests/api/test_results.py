@@ -8,16 +8,15 @@ References are independent of the lookup code: the states passed to the on_outpu
 import pickle
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import spacar
+from support.paths import EXAMPLES
 from support.planar_models import compressed_cantilever
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 # Nodes of the manual's slider-crank and their kinds (manual §5.7): XY 1, 3, 6, 8; BETA 2, 4, 5, 7, 9.
 NODE_SIZES = {1: 2, 2: 1, 3: 2, 4: 1, 5: 1, 6: 2, 7: 1, 8: 2, 9: 1}
@@ -287,7 +286,7 @@ def test_save_and_load_keep_the_kinematic_coordinates_of_a_linearization(tmp_pat
     # linearization (the bicycle: LINEAR 1, one output time) had no eigenvalues or state matrix.
     from spacar.linearize import MATRICES
 
-    res = spacar.simulate(spacar.read(ROOT / "examples" / "bicycle.dat"), progress=False)
+    res = spacar.simulate(spacar.read(EXAMPLES / "bicycle.dat"), progress=False)
     res.save(tmp_path / "bicycle.npz")
     a, b = res.linearizations[0], spacar.Results.load(tmp_path / "bicycle.npz").linearizations[0]
     assert len(a.y_labels) == 4 and b.y_labels == a.y_labels

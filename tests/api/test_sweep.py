@@ -6,16 +6,15 @@ from __future__ import annotations
 import concurrent.futures
 import os
 import pickle
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import spacar
 from spacar import InputError
+from support.paths import EXAMPLES
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 SPEEDS = np.linspace(1.0, 2.0, 8)            # crank speed XD 2 1 [rad/s]; the manual: 1.5
 ROD_EI = np.linspace(0.8e-3, 1.6e-3, 8)      # bending stiffness of the rod (ESTIFF 2 and 3); 1.2723e-3
@@ -74,7 +73,7 @@ def test_local_processes_and_threads_match_serial_runs(serial_grid):
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         in_threads = spacar.sweep(base, GRID, executor=pool, progress=False)
     assert_same_as_serial(in_threads, serial_grid)
-    assert base.current_time == 0.0 and not base._core.frozen  # the sweep works on copies
+    assert base.current_time == 0.0 and not base.core.frozen  # the sweep works on copies
 
 
 def test_failed_cases_are_reported_with_their_parameters():

@@ -7,16 +7,14 @@ import numpy as np
 import pytest
 
 import spacar
-from spacar import _core
+from support.simulation import assembled
 
 EXAMPLES = ["examples/slidercrank.dat", "examples/slidercrank3d.dat", "examples/bicycle.dat"]
 
 
 def states(model, count, seed):
     """The model's assembled state and random perturbations of its DOF values and rates."""
-    model.prepare()
-    sim = _core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model)
     q0, qd0 = np.array(sim.system.q0), np.array(sim.system.qd0)
     rng = np.random.default_rng(seed)
     out = [(0.0, q0, qd0)]

@@ -18,16 +18,16 @@ and `spacar._core.Simulation` (evaluate/move_to, forces and the Data arrays) are
 """
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import spacar
-from spacar import _core
 from support.equilibrium import static_equilibrium
+from support.paths import EXAMPLES
+from support.simulation import assembled
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 G = 9.81
 
 
@@ -259,9 +259,7 @@ def test_flexible_slider_crank_power_balance():
     model.epsind(1e-10)
     copy = model.copy()
     res = model.run()
-    copy.prepare()
-    sim = _core.Simulation(copy._core)
-    sim.assemble()
+    sim = assembled(copy)
     s = sim.system
     EI, l0 = 0.0012723, 0.15
     S = EI / l0**3 * np.array([[4.0, -2.0], [-2.0, 4.0]])
@@ -403,9 +401,7 @@ def consistency(sim, t, q, qd):
 
 def test_reactions_consistent_with_the_motion_flexible_slider_crank():
     model = spacar.read_string(EXAMPLE.read_text())
-    model.prepare()
-    sim = _core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model)
     rng = np.random.default_rng(5)
     for t in (0.0, 0.4, 1.3, 3.1):
         q = 1e-3 * rng.normal(size=4)
@@ -435,8 +431,6 @@ def test_reactions_consistent_with_the_motion_dynx_pendulum():
     m.emass(2, 0.5)
     m.mass(5, 0.3)
     m.gravity(0.0, -G)
-    m.prepare()
-    sim = _core.Simulation(m._core)
-    sim.assemble()
+    sim = assembled(m)
     dof_stress, dof_rows, calc_rows, _ = consistency(sim, 0.0, np.array([0.3, 0.02, -0.01]), np.array([1.2, 0.1, 0.3]))
     assert dof_stress <= 1e-12 and dof_rows <= 1e-12 and calc_rows <= 1e-12

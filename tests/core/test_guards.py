@@ -8,7 +8,6 @@ from __future__ import annotations
 import re
 import time
 from fractions import Fraction
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,9 +15,9 @@ import pytest
 import spacar
 from spacar import InputError, KinematicsError, SpacarError, TimeLimitError
 from spacar.keywords import INT, KEYWORDS, REAL
+from support.paths import EXAMPLES
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 TEXT = EXAMPLE.read_text()
 BODY = TEXT.replace("END\n", "")
 

@@ -21,7 +21,6 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -31,11 +30,12 @@ from numpy.polynomial import Legendre
 from numpy.polynomial import legendre as gauss_legendre
 
 import spacar
-from spacar import _core
 from spacar.cli import main
 from support.equilibrium import static_equilibrium
+from support.paths import EXAMPLES
+from support.simulation import assembled
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 
 def omegas(lin):
@@ -562,10 +562,7 @@ def reduced_residual_jacobian(model, t, z0, zd0, zdd0, h=1e-5):
     """∂R/∂z and ∂R/∂ż of R(z, ż) = M̄(z)(z̈0 − q̈(z, ż)) — the reduced residual of
     formulation.md §7.2 written with the public evaluation of q̈ and M̄ — by central
     differences (the model's LINE parameters, if any, must be DYNE here)."""
-    model = model.copy()
-    model.prepare()
-    sim = _core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model.copy())
 
     def R(z, zd):
         sim.move_to(t, z, zd)
@@ -608,10 +605,7 @@ def test_analytic_and_difference_parts_reproduce_the_full_jacobian():
 
 def nominal_accelerations(model, t, z0, zd0):
     """q̈ of the degrees of freedom at (t, z0, ż0)."""
-    model = model.copy()
-    model.prepare()
-    sim = _core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model.copy())
     sim.move_to(t, z0, zd0)
     return np.array(sim.data.qdd)
 
@@ -633,9 +627,7 @@ def test_line_parameters_along_the_slider_crank_motion():
     assert np.abs(res.e[:, rows]).max() <= 1e-12  # LINE parameters are fixed in the motion
     dyne = spacar.read_string(EXAMPLE.read_text().replace("Timestep 100 5.0", ""))
     dyne.epskin(1e-12)
-    dyne.prepare()
-    sim = _core.Simulation(dyne._core)
-    sim.assemble()
+    sim = assembled(dyne)
     first, zero, h = [], np.zeros(4), 1e-5
 
     def mbar(t, z):

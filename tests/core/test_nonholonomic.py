@@ -24,7 +24,6 @@ import math
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -33,10 +32,10 @@ from scipy.optimize import brentq
 
 import spacar
 from spacar import _testing
+from support.paths import EXAMPLES
 from support.spatial_models import R_, body_angular_velocity
 
-ROOT = Path(__file__).resolve().parents[2]
-BICYCLE = ROOT / "examples" / "bicycle.dat"
+BICYCLE = EXAMPLES / "bicycle.dat"
 
 TIGHT = dict(epsint=1e-12, epsind=1e-12, epskin=1e-12)
 

@@ -17,7 +17,6 @@ import math
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -26,10 +25,10 @@ import scipy.optimize
 import scipy.special
 
 import spacar
-from spacar import _core
+from support.paths import EXAMPLES
+from support.simulation import assembled
 
 G = 9.81
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def assert_finite(res):
@@ -197,8 +196,7 @@ def energies(model, res, elements, l0, rho_a, ei, point_masses, gravity):
     §3.2-§4.2: T = 1/2 xd' M xd (M from Simulation.evaluate), V_e = 1/2 e' S e with the PLBEAM
     bending stiffness (EI/l0^3)[[4, -2], [-2, 4]] (axial deformations rigid), V_g = -sum m g.x
     - sum rhoA l0 g.(x_p/2 + (l0/12) t_p + x_q/2 - (l0/12) t_q), t = (cos, sin)(alpha0 + beta)."""
-    sim = _core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model)
     labels = [tuple(lbl) for lbl in sim.system.coord_label]
     dlabels = [tuple(lbl) for lbl in sim.system.def_label]
     g = np.asarray(gravity, dtype=float)
@@ -233,8 +231,7 @@ def lowest_elastic_frequency():
     """Frequencies of the linearized double pendulum about the hanging equilibrium; the two
     lowest are the swinging modes, the third is the lowest elastic mode."""
     model = double_pendulum(hanging=True)
-    sim = _core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model)
     K, Mbar = stiffness_by_differences(sim, np.zeros(sim.system.n_dof))
     w2 = np.sort(scipy.linalg.eigvals(K, Mbar).real)
     assert np.all(w2 > 0)
@@ -313,8 +310,7 @@ def cantilever(n, ei=1.0, rho_a=1.0, L=1.0):
 
 def cantilever_modes(n):
     model = cantilever(n)
-    sim = _core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model)
     K, Mbar = stiffness_by_differences(sim, np.zeros(sim.system.n_dof))
     assert np.abs(K - K.T).max() < 1e-9 * np.abs(K).max()
     w2, V = scipy.linalg.eigh(0.5 * (K + K.T), Mbar)

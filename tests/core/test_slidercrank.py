@@ -11,14 +11,13 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 from support.manual import OUTPUT, parse_dump, values
+from support.paths import EXAMPLES, ROOT
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 # The state after 5 s as printed in the manual (§5.7), line for line (tests/data/manual_output.dat).
 MANUAL_DUMP = OUTPUT.read_text()

@@ -25,6 +25,7 @@ from scipy.special import ellipk
 import spacar
 from spacar import cli
 from support.manual import printed_state, values
+from support.simulation import assembled
 from support.spatial_models import (
     PLANAR_EXAMPLE,
     RSSR,
@@ -587,9 +588,7 @@ def four_bar_energy(initial, res):
     a copy of the model taken before the run); V of gravity for the rigid straight beams and
     truss (½ρA l0 g at each end node, exact when t_p = t_q) and the point mass at C."""
     model = initial.copy()
-    model.prepare()
-    sim = spacar._core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model)
     T = np.empty(len(res.t))
     for k, t in enumerate(res.t):
         sim.evaluate(t, res.element(5).e[k, :1], res.element(5).ed[k, :1])

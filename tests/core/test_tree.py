@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import spacar
-from spacar import _core
 from spacar.compare import models
+from support.simulation import assembled
 
 G = 9.81
 
@@ -88,13 +88,6 @@ TREES = {
     "branched spring": lambda: branched_tree(spring=True),
     "PLBEAMNL, DYNX": plbeamnl_chain,
 }
-
-
-def assembled(model):
-    model.prepare()
-    sim = _core.Simulation(model._core)
-    sim.assemble()
-    return sim
 
 
 @pytest.mark.parametrize("name", list(TREES))

@@ -21,8 +21,8 @@ from support.element_checks import (  # noqa: F401  (record: fixture used by the
     chord,
     record,
 )
+from support.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "adding-an-element.md"
 ELEMENT_FILE = "cpp/src/elements/truss.cpp"
 LIST_FILE = "cpp/include/spacar/elements/list.hpp"

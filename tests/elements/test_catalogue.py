@@ -3,12 +3,12 @@
 The expected tables are transcribed from those documents in support/manual.py, not taken from the code.
 """
 import re
-from pathlib import Path
 
 import pytest
 
 import spacar
 from support.manual import ELEMENTS, KEYWORDS
+from support.paths import ROOT
 
 # Manual §5.1 (the element types) and every keyword of §5.1-5.6.
 MANUAL_KEYWORDS = list(ELEMENTS) + KEYWORDS
@@ -171,9 +171,8 @@ def _code_without_comments(path):
 def test_type_names_are_written_only_in_their_element_files():
     """Code outside an element's own file does not compare element type names: it asks the
     catalogue (flags, family). Checked for the C++ core and the drawing and docs code."""
-    root = Path(__file__).resolve().parents[2]
-    files = [p for p in (root / "cpp").rglob("*.[ch]pp") if "elements" not in p.relative_to(root / "cpp").parts]
-    files += [root / "python" / "spacar" / name for name in ("geometry.py", "docgen.py", "plotting.py")]
+    files = [p for p in (ROOT / "cpp").rglob("*.[ch]pp") if "elements" not in p.relative_to(ROOT / "cpp").parts]
+    files += [ROOT / "python" / "spacar" / name for name in ("geometry.py", "docgen.py", "plotting.py")]
     names = [t.name for t in spacar.element_catalogue()]
     found = [(p.name, n) for p in files for n in names
              if re.search(rf"[\"']{n}[\"']", _code_without_comments(p))]

@@ -7,7 +7,6 @@ found at the first END (zero length, unused node) are provoked with ``model.summ
 name the line that defined the element or node.
 """
 import re
-from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -16,8 +15,9 @@ from hypothesis import strategies as st
 import spacar
 from spacar import InputError
 from support.fuzzing import LINE_EDITS, mutated_lines
+from support.paths import EXAMPLES
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 
 BASE = EXAMPLE.read_text().splitlines()  # 23 lines, END on line 23
 

@@ -7,7 +7,6 @@ import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import pytest
 
@@ -15,8 +14,8 @@ import spacar
 import spacar.docgen
 from spacar.io.matasc import STATE_FILES
 from support.manual import ELEMENTS, KEYWORDS
+from support.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 
 # Manual §5.1: the element types with their deformation counts (formulation.md §4).

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 import spacar
+from support.paths import EXAMPLES
 from support.planar_models import compressed_cantilever
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 STATE = {"x": "x", "xd": "xd", "xdd": "xdd", "e": "e", "ed": "ed", "edd": "edd"}
 NUMBER = re.compile(r"^-?\d\.\d{15}E[+-]\d{2,3}$")
 

@@ -8,14 +8,14 @@ the number format are checked, and that dumps are restartable input.
 """
 import math
 import re
-from pathlib import Path
 
 import pytest
 
 import spacar
 from support.manual import OUTPUT
+from support.paths import EXAMPLES
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+EXAMPLE = EXAMPLES / "slidercrank.dat"
 MANUAL_OUTPUT = OUTPUT
 
 INT_FIELD = re.compile(r"[+-]?\d+")

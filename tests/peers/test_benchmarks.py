@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+
+from support.paths import ROOT
 
 pytest.importorskip("pinocchio")
 pytest.importorskip("exudyn")
 
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_run_all_quick(tmp_path):

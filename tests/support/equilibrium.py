@@ -3,17 +3,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from spacar import _core
+from support.simulation import assembled
 
 
 def static_equilibrium(model, tol=1e-13):
     """The DOF values at rest in equilibrium: Newton on the reduced force R(q) = −M̄ q̈ (at
     q̇ = 0) with a central-difference Jacobian (R, unlike q̈, is well conditioned). Returns the
     simulation moved to that state and q."""
-    model = model.copy()
-    model.prepare()
-    sim = _core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model.copy())
     nd = sim.system.n_dof
     q, zero = np.zeros(nd), np.zeros(nd)
 

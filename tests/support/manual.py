@@ -8,10 +8,10 @@ printed state after 5 s is ``OUTPUT``, tests/data/manual_output.dat (verbatim), 
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-OUTPUT = ROOT / "tests" / "data" / "manual_output.dat"
+from support.paths import DATA
+
+OUTPUT = DATA / "manual_output.dat"
 
 XY, BETA, XYZ, LAMBDA = "XY", "BETA", "XYZ", "LAMBDA"
 

@@ -5,15 +5,14 @@ equation, the BEAM cantilever and its numerical linearization.
 """
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 import spacar
+from support.paths import EXAMPLES
+from support.simulation import assembled
 
-ROOT = Path(__file__).resolve().parents[2]
-PLANAR_EXAMPLE = ROOT / "examples" / "slidercrank.dat"
-SPATIAL_EXAMPLE = ROOT / "examples" / "slidercrank3d.dat"
+PLANAR_EXAMPLE = EXAMPLES / "slidercrank.dat"
+SPATIAL_EXAMPLE = EXAMPLES / "slidercrank3d.dat"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -189,9 +188,7 @@ def linearize(model, h=1e-9):
     """M̄ = data.Mbar and K = −M̄ ∂q̈/∂q by central differences of Simulation.evaluate at the
     assembled state with q̇ = 0. Returns (M̄, K, labels) with labels[j] = (element, deformation)
     of DOF j."""
-    model.prepare()
-    sim = spacar._core.Simulation(model._core)
-    sim.assemble()
+    sim = assembled(model)
     system = sim.system
     nd = system.n_dof
     q0 = np.array(system.q0)
