@@ -6,25 +6,23 @@
 
 namespace spacar::bindings {
 
+// The arrays by the names of Linearization::for_each_array (the one list of them), with the
+// labels and the time.
 py::dict linearization_to_dict(const Linearization& l) {
   py::dict d;
   d["t"] = l.t;
   d["z_label"] = l.z_label;
   d["n_line"] = l.n_line;
-  d["M0"] = l.M0;
-  d["C0"] = l.C0;
-  d["D0"] = l.D0;
-  d["K0"] = l.K0;
-  d["N0"] = l.N0;
-  d["G0"] = l.G0;
-  d["r0"] = l.r0;
-  d["DFz"] = l.DFz;
-  d["DFez"] = l.DFez;
   d["y_label"] = l.y_label;
-  d["Kk"] = l.Kk;
-  d["AK0"] = l.AK0;
-  d["BK0"] = l.BK0;
+  l.for_each_array([&d](const char* name, const auto& array) { d[name] = array; });
   return d;
+}
+
+// The names of the arrays, in the order of for_each_array (spacar.linearize.MATRICES).
+py::tuple linearization_arrays() {
+  py::list names;
+  Linearization().for_each_array([&names](const char* name, const auto&) { names.append(name); });
+  return py::tuple(names);
 }
 
 }  // namespace spacar::bindings

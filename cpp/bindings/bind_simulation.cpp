@@ -34,6 +34,7 @@ py::dict block_results_to_dict(BlockResults&& r) {
 }  // namespace
 
 void bind_simulation(py::module_& m) {
+  m.attr("linearization_arrays") = linearization_arrays();
   py::class_<System>(m, "System")
       .def_readonly("nx", &System::nx)
       .def_readonly("ne", &System::ne)

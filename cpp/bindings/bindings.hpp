@@ -24,5 +24,6 @@ void bind_topology(py::module_& m);
 [[noreturn]] void raise_with_results(const std::exception_ptr& p, py::object results);
 
 py::dict linearization_to_dict(const Linearization& l);
+py::tuple linearization_arrays();
 
 }  // namespace spacar::bindings

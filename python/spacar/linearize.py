@@ -19,11 +19,10 @@ from . import _core
 from .errors import InputError
 
 
-# The arrays of a linearization, by the names of its attributes (formulation.md §7). The core
-# (Linearization::for_each_array, in the same order), the constructors below and
-# Results.save/load all go by this one list.
-MATRICES = ("M0", "C0", "D0", "K0", "N0", "G0", "Kk", "AK0", "BK0", "DF", "DFe", "r0")
-_CORE_KEY = {"DF": "DFz", "DFe": "DFez"}  # the core's names of ∂x/∂z and ∂e/∂z
+# The arrays of a linearization, by the names of its attributes (formulation.md §7): the core's
+# one list (Linearization::for_each_array), which the constructors below and Results.save/load
+# go by.
+MATRICES = tuple(_core.linearization_arrays)
 
 
 class Linearization:
@@ -39,7 +38,7 @@ class Linearization:
         """From the dictionary of the core (``Simulation.linearize()``, the on_output state)."""
         self._fill(d["t"], [("x" if k == 0 else "e", a, b) for k, a, b in d["z_label"]], d["n_line"],
                    [("e", a, b) for _, a, b in d["y_label"]],
-                   {name: d[_CORE_KEY.get(name, name)] for name in MATRICES},
+                   {name: d[name] for name in MATRICES},
                    coordinate_labels, deformation_labels)
 
     @classmethod
