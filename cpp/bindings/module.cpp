@@ -20,6 +20,7 @@ using namespace spacar;
 void bind_kernels(py::module_& m);
 void bind_integrator(py::module_& m);
 void bind_sparse(py::module_& m);
+void bind_statics(py::module_& m);
 
 namespace {
 
@@ -615,4 +616,5 @@ PYBIND11_MODULE(_core, m) {
   bind_kernels(m);
   bind_integrator(m);
   bind_sparse(m);
+  bind_statics(m);
 }
