@@ -18,12 +18,15 @@ py::handle& static_error_type() {
 
 py::dict static_results_to_dict(StaticResults&& r) {
   py::dict d;
+  d["coord_label"] = r.coord_label;
+  d["def_label"] = r.def_label;
   d["load"] = std::move(r.load);
   d["x"] = std::move(r.x);
   d["e"] = std::move(r.e);
   d["sigma"] = std::move(r.sigma);
   d["reaction"] = std::move(r.reaction);
   d["iterations"] = r.iterations;
+  d["load_reached"] = r.load_reached;
   d["newton_iterations"] = r.newton_iterations;
   d["step_cuts"] = r.step_cuts;
   d["kinematic_iterations"] = r.kinematic_iterations;

@@ -246,18 +246,20 @@ class EquilibriumPath {
     have_DF_ = true;   // static_forces follows at once
   }
 
-  // The DOFs that make up the directions V (columns) of q: components ≥ 10% of the largest.
+  // The DOFs that make up the directions V (columns) of q: components ≥ 10% of the largest,
+  // the largest first, at most four named.
   std::string directions(const Eigen::MatrixXd& V) const {
+    std::vector<std::pair<double, int>> part;
+    for (int j = 0; j < nd_; ++j) {
+      double w = 0.0;
+      for (int c = 0; c < V.cols(); ++c) w = std::max(w, std::abs(V(j, c)) / V.col(c).cwiseAbs().maxCoeff());
+      if (w >= 0.1) part.push_back({-w, j});
+    }
+    std::sort(part.begin(), part.end());
     std::ostringstream os;
     os << "the direction of";
-    const char* sep = " ";
-    for (int j = 0; j < nd_; ++j) {
-      bool named = false;
-      for (int c = 0; c < V.cols(); ++c) named = named || std::abs(V(j, c)) >= 0.1 * V.col(c).cwiseAbs().maxCoeff();
-      if (!named) continue;
-      os << sep << dof_name(sys_, j);
-      sep = ", ";
-    }
+    for (size_t i = 0; i < part.size() && i < 4; ++i) os << (i ? ", " : " ") << dof_name(sys_, part[i].second);
+    if (part.size() > 4) os << " and " << part.size() - 4 << " more";
     return os.str();
   }
 
@@ -299,6 +301,8 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
   const System& sys = sim.system();
   Data& data = sim.data();
   res.warnings = sys.warnings;
+  res.coord_label = sys.coord_label;
+  res.def_label = sys.def_label;
   const int n = opt.steps;
   require_memory(Data::estimate_dense_bytes(sys) + 8.0 * n * (2.0 * sys.nx + 2.0 * sys.ne + 2.0),
                  "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
@@ -351,7 +355,7 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
         step *= 0.5;
         continue;
       }
-      lambda = next;
+      lambda = res.load_reached = next;
       if (std::isnan(res.indefinite_at)) {
         const std::string dir = path.indefinite();
         if (!dir.empty()) {

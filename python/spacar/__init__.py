@@ -35,6 +35,7 @@ from .model import Model
 from .geometry import Geometry
 from .results import Results
 from .simulate import simulate
+from .statics import StaticError, static
 from .sweep import SweepError, SweepResult, sweep
 
 __version__ = "0.1.0"
@@ -98,6 +99,8 @@ __all__ = [
     "parse",
     "dump",
     "simulate",
+    "static",
+    "StaticError",
     "sweep",
     "SweepResult",
     "SweepError",

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <limits>
 #include <string>
 #include <vector>
@@ -36,9 +37,11 @@ struct StaticOptions {
 };
 
 struct StaticResults {
+  std::vector<std::array<int, 2>> coord_label, def_label;  // (node, component), (element, deformation)
   Eigen::VectorXd load;            // load factor λ of each row (k / steps)
   RowMatrix x, e, sigma, reaction; // rows x nx / ne: sigma complete (reaction stresses included)
   std::vector<int> iterations;     // Newton iterations from the previous row (cut sub-steps included)
+  double load_reached = 0.0;       // the last converged load factor (1 unless StaticError)
   long newton_iterations = 0;      // all Newton iterations, failed attempts included
   long step_cuts = 0;              // load steps halved because Newton failed
   long kinematic_iterations = 0;   // iterations of the position solves
