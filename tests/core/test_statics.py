@@ -272,3 +272,42 @@ def test_cli_static(tmp_path, capsys):
     assert float(tips[0][3]) == pytest.approx(1e-6 / 3, rel=1e-6)
     assert float(tips[1][3]) == pytest.approx(2e-6 / 3, rel=1e-6)
     assert "block 2: static equilibrium in 2 load steps" in out
+
+
+def test_prescribed_deformation_is_applied_with_the_loads():
+    """An actuator (PLTRUSS 1, INPUTE elongation +0.1 over the block) and a spring (PLTRUSS 2,
+    RLSE with EA) hold the apex 3 under a load F. Reference here: apex and the two axial forces
+    from |x3 − x1| = l1 + 0.1 and N1 u1 + N2 u2 = F, N2 = EA (l2 − l2₀)/l2₀."""
+    from scipy.optimize import fsolve
+
+    EA, F = 2.0, np.array([0.3, -0.4])
+    m = spacar.Model()
+    m.pltruss(1, 1, 3)
+    m.pltruss(2, 2, 3)
+    m.x(1, 0.0, 0.0)
+    m.x(2, 1.0, 0.0)
+    m.x(3, 0.4, 0.6)
+    m.fix(1)
+    m.fix(2)
+    m.dynx(3, 2)  # x3 calculable from the actuator's length
+    m.apply("INPUTE", 1, 1)
+    m.ed(1, 1, 0.1)
+    m.timestep(1, 1.0)
+    m.rlse(2, 1)
+    m.estiff(2, EA)
+    m.force(3, *F)
+    res = spacar.static(m, steps=4)
+    x1, x2, x30 = np.zeros(2), np.array([1.0, 0.0]), np.array([0.4, 0.6])
+    l1, l20 = np.linalg.norm(x30 - x1) + 0.1, np.linalg.norm(x30 - x2)
+
+    def equations(v):
+        x3, N1 = v[:2], v[2]
+        u1, u2 = (x3 - x1) / np.linalg.norm(x3 - x1), (x3 - x2) / np.linalg.norm(x3 - x2)
+        N2 = EA * (np.linalg.norm(x3 - x2) - l20) / l20
+        return [*(N1 * u1 + N2 * u2 - F), np.linalg.norm(x3 - x1) - l1]
+
+    ref = fsolve(equations, [0.45, 0.65, 0.0], xtol=1e-14)
+    np.testing.assert_allclose(res.node(3).x[-1], ref[:2], atol=1e-10)
+    assert res.deformation(1, 1)[-1] == pytest.approx(0.1, abs=1e-12)
+    assert res.stress(1, 1)[-1] == pytest.approx(ref[2], abs=1e-9)  # the actuator's force
+    np.testing.assert_allclose(res.deformation(1, 1), 0.1 * res.t, atol=1e-12)
