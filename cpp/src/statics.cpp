@@ -134,6 +134,15 @@ class EquilibriumPath {
     bool singular_at_start = false;
   };
 
+  // At the starting state (assembled, λ = 0): the generalized forces R0 that hold it there, zero
+  // for an unloaded stress-free start, the equilibrium of the block before otherwise. The path
+  // solves R(q, λ) − (1 − λ) R0 = 0: it begins exactly at the current state, and from one block
+  // to the next the loads change gradually instead of being released and applied again.
+  void start() {
+    static_forces(sys_, data_, 0.0, R0_, nullptr);
+    have_DF_ = true;
+  }
+
   // Equilibrium at load factor λ, starting from the current state. The sign of det K must stay
   // that of the start: a change during the iterations means that the step crosses a limit or
   // bifurcation point, and Newton may land on a distant branch (a snap-through). Such a step
@@ -156,6 +165,7 @@ class EquilibriumPath {
         return a;
       }
       const double force = static_forces(sys_, data_, lambda, R, &K_);
+      R -= (1.0 - lambda) * R0_;
       const Eigen::VectorXd Rs = scale_.cwiseProduct(R);
       if (!Rs.allFinite() || !K_.allFinite()) {
         a.why = "the forces or the stiffness are not finite";
@@ -277,6 +287,7 @@ class EquilibriumPath {
   const int nd_;
   Eigen::VectorXd scale_;        // characteristic size of each DOF: lengths vs angles
   Eigen::VectorXd p0_, p1_;
+  Eigen::VectorXd R0_;           // generalized forces at the start (see start())
   Eigen::MatrixXd K_;
   bool have_DF_ = false;
 };
@@ -321,6 +332,7 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
   sim.assemble();
   data.t = sys.t0;
   EquilibriumPath path(sys, data, opt, res);
+  path.start();
   const double nominal = 1.0 / n, smallest = nominal * std::ldexp(1.0, -opt.max_cuts);
   double lambda = 0.0, step = nominal;
   int iterations = 0;

@@ -62,7 +62,10 @@ def static(model, steps: int = 10, *, max_iterations: int = 30, max_cuts: int = 
     GRAVITY, and the prestress of deformations given with E), with the inputs (INPUTX, INPUTE)
     moved to their values at the end of the block (their XD, XDD over the TIMESTEP period).
 
-    Loads and inputs are applied together in ``steps`` equal steps of the load factor λ; at each
+    The path starts at the model's current state (the generalized forces R0 that hold it, zero
+    from an unloaded stress-free assembly, are released as (1 − λ) R0), so that a block that
+    continues from the equilibrium of the one before moves gradually from the old loads to the
+    new ones. Loads and inputs are applied together in ``steps`` equal steps of λ; at each
     step Newton's method with the exact tangent stiffness (structural plus geometric, K0 + G0 of
     :func:`spacar.linearize`) solves the reduced equations. A step in which Newton fails (or in
     which the stiffness changes the sign of its determinant: a limit or bifurcation point) is

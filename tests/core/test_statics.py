@@ -311,3 +311,19 @@ def test_prescribed_deformation_is_applied_with_the_loads():
     assert res.deformation(1, 1)[-1] == pytest.approx(0.1, abs=1e-12)
     assert res.stress(1, 1)[-1] == pytest.approx(ref[2], abs=1e-9)  # the actuator's force
     np.testing.assert_allclose(res.deformation(1, 1), 0.1 * res.t, atol=1e-12)
+
+
+def test_path_starts_at_the_current_state():
+    """A second analysis with the same loads starts at the equilibrium and stays there; a block
+    with other loads ends where a fresh analysis ends."""
+    m = plbeam_cantilever(10, force=(0.0, 3.0))
+    first = spacar.static(m, steps=5)
+    again = spacar.static(m, steps=5)
+    np.testing.assert_allclose(again.x, np.tile(first.x[-1], (5, 1)), atol=1e-12)
+    assert again.stats["newton_iterations"] == 0
+    m.force(21, 0.0, 6.0)
+    more = spacar.static(m, steps=5)
+    fresh = spacar.static(plbeam_cantilever(10, force=(0.0, 6.0)), steps=5)
+    np.testing.assert_allclose(more.x[-1], fresh.x[-1], atol=1e-10)
+    tip_y = more.node(21).x[:, 1]
+    assert np.all(np.diff(tip_y) > 0) and tip_y[0] > first.node(21).x[-1, 1]  # from 3 to 6 gradually

@@ -4,6 +4,9 @@
 // the equations of motion (formulation.md §3.1) at zero velocity and acceleration, under the
 // block's loads (FORCE, TORQUEL, GRAVITY) scaled by the load factor λ and with the inputs moved
 // from their values at the block start to their values at the block end in proportion to λ.
+// The path starts at the current state: R(q, λ) − (1 − λ) R(q_start, 0) = 0 is followed, the
+// second term being zero from an unloaded, stress-free start (and the previous block's loads in
+// generalized form when a block continues from an equilibrium).
 // Full Newton with the exact tangent stiffness ∂R/∂q = K0 + G0 of the linearization (structural
 // plus geometric, formulation.md §7.2; C0 = N0 = 0 at rest), λ from 0 to 1 in equal load steps,
 // a step halved when Newton fails there. No mass is needed.
