@@ -171,9 +171,18 @@ class EquilibriumPath {
         a.why = "the forces or the stiffness are not finite";
         return a;
       }
-      Eigen::FullPivLU<Eigen::MatrixXd> lu(scale_.asDiagonal() * K_ * scale_.asDiagonal());
-      lu.setThreshold(1e-13);
-      const bool singular = nd_ > 0 && !lu.isInvertible();
+      const Eigen::MatrixXd Ks = scale_.asDiagonal() * K_ * scale_.asDiagonal();
+      const Eigen::PartialPivLU<Eigen::MatrixXd> lu(Ks);
+      // A tiny pivot: the stiffness may be singular; full pivoting confirms it and finds the null
+      // directions.
+      Eigen::MatrixXd null_space;
+      const Eigen::VectorXd pivots = lu.matrixLU().diagonal().cwiseAbs();
+      if (nd_ > 0 && !(pivots.minCoeff() > 1e-13 * pivots.maxCoeff())) {
+        Eigen::FullPivLU<Eigen::MatrixXd> full(Ks);
+        full.setThreshold(1e-13);
+        if (!full.isInvertible()) null_space = full.kernel();
+      }
+      const bool singular = null_space.cols() > 0;
       const int sign = singular || nd_ == 0 ? 0 : determinant_sign(lu);
       if (it == 0) start_sign = sign;
       else if (sign != start_sign) crossed = true;
@@ -202,7 +211,7 @@ class EquilibriumPath {
         return a;
       }
       if (singular) {
-        a.why = "the tangent stiffness is singular: no stiffness in " + directions(lu.kernel());
+        a.why = "the tangent stiffness is singular: no stiffness in " + directions(null_space);
         a.singular_at_start = it == 0;
         return a;
       }
@@ -214,18 +223,29 @@ class EquilibriumPath {
     }
   }
 
-  // The scaled tangent stiffness of the last evaluation: positive definite at a stable equilibrium.
-  // Returns "" or the description of its most negative direction.
+  // The scaled tangent stiffness of the last evaluation has an eigenvalue with a negative real
+  // part: the equilibrium is unstable (for a symmetric stiffness, i.e. conservative loads: not
+  // positive definite). Follower loads (TORQUEL) make it unsymmetric; its symmetric part may then
+  // be indefinite at a stable equilibrium, so the eigenvalues of the matrix itself decide.
+  // Returns "" or the description of the direction of the most negative eigenvalue.
   std::string indefinite() const {
     if (nd_ == 0) return "";
     const Eigen::MatrixXd Ks = scale_.asDiagonal() * K_ * scale_.asDiagonal();
-    const Eigen::MatrixXd sym = 0.5 * (Ks + Ks.transpose());
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(sym);
-    const Eigen::VectorXd& lam = eig.eigenvalues();
-    const double big = lam.cwiseAbs().maxCoeff();
-    if (!(lam[0] < -1e-9 * big)) return "";
-    return directions(eig.eigenvectors().col(0)) + " (smallest eigenvalue " + num(lam[0] / big) +
-           " of the largest)";
+    const double big = Ks.cwiseAbs().maxCoeff();
+    double lowest = 0.0;
+    Eigen::VectorXd direction;
+    if ((Ks - Ks.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * big) {
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (Ks + Ks.transpose()));
+      lowest = eig.eigenvalues()[0];
+      direction = eig.eigenvectors().col(0);
+    } else {
+      Eigen::EigenSolver<Eigen::MatrixXd> eig(Ks);
+      Eigen::Index k = 0;
+      lowest = eig.eigenvalues().real().minCoeff(&k);
+      direction = eig.eigenvectors().col(k).cwiseAbs();
+    }
+    if (!(lowest < -1e-9 * big)) return "";
+    return directions(direction) + " (eigenvalue " + num(lowest / big) + " of the largest entry)";
   }
 
   struct Snapshot {
@@ -251,6 +271,9 @@ class EquilibriumPath {
     for (int g : sys_.x_input) data_.x[g] = qhat[sys_.qhat_col_x[g]];
     for (int g : sys_.x_dyn) data_.x[g] = qhat[sys_.qhat_col_x[g]];
     have_DF_ = false;  // until static_forces has evaluated it here
+    // Full Newton on the positions: the steps between static iterates are large, and the chord
+    // iteration with the last velocity block (meant for small time steps) would crawl.
+    data_.jacobian_reusable = false;
     solve_positions(sys_, data_, std::max(sys_.settings.maxiterat, 50), std::min(sys_.settings.epskin, 1e-10), false);
     res_.kinematic_iterations += data_.newton_iterations;
     have_DF_ = true;   // static_forces follows at once
@@ -273,8 +296,8 @@ class EquilibriumPath {
     return os.str();
   }
 
-  static int determinant_sign(const Eigen::FullPivLU<Eigen::MatrixXd>& lu) {
-    int sign = static_cast<int>(lu.permutationP().determinant() * lu.permutationQ().determinant());
+  static int determinant_sign(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu) {
+    int sign = static_cast<int>(lu.permutationP().determinant());
     for (int i = 0; i < lu.matrixLU().rows(); ++i)
       if (lu.matrixLU()(i, i) < 0.0) sign = -sign;
     return sign;

@@ -327,3 +327,19 @@ def test_path_starts_at_the_current_state():
     np.testing.assert_allclose(more.x[-1], fresh.x[-1], atol=1e-10)
     tip_y = more.node(21).x[:, 1]
     assert np.all(np.diff(tip_y) > 0) and tip_y[0] > first.node(21).x[-1, 1]  # from 3 to 6 gradually
+
+
+def test_follower_torque_rolls_a_spatial_beam_like_the_planar_one():
+    """TORQUEL about the body z axis of the tip of a BEAM cantilever bending in its x-y plane is the
+    dead moment of the PLBEAM cantilever: the same circle, node for node; its load stiffness is
+    unsymmetric, yet the equilibrium is stable (not reported indefinite), and Newton converges
+    quadratically."""
+    n = 30
+    m = beam_cantilever(n, EIy=1.0, EIz=1.0, GIp=1.0, rhoA=0.0)
+    m.torquel(101 + n, 0.0, 0.0, 2 * np.pi)
+    res = spacar.static(m, steps=8)
+    planar = spacar.static(plbeam_cantilever(n, moment=2 * np.pi), steps=8)
+    for k in range(n + 1):
+        np.testing.assert_allclose(res.node(k + 1).x[:, :2], planar.node(2 * k + 1).x, atol=1e-9)
+    assert res.stats["indefinite_at"] is None
+    assert max(res.stats["iterations"]) <= 3
