@@ -192,13 +192,18 @@ class EquilibriumPath {
         return a;
       }
       double res_max = 0.0;
+      Eigen::VectorXd dy;
       if (nd_ > 0) {
         res_max = Rs.cwiseAbs().maxCoeff(&a.worst);
         a.worst_residual = R[a.worst];
+        if (!singular) dy = lu.solve(-Rs);
       }
-      // Converged: the residual is small against the forces it balances, or the corrections
-      // have reached round-off with a residual near it.
-      if (res_max <= opt_.tolerance * force || (last_correction <= 1e-12 && res_max <= 1e-6 * force)) {
+      // Converged: the residual is small against the forces it balances; or it would move the
+      // DOFs by less than round-off (nothing is loaded: a mechanism moved by its inputs); or the
+      // corrections have reached round-off with a residual near it.
+      const double correction = dy.size() ? dy.cwiseAbs().maxCoeff() : 0.0;
+      if (res_max <= opt_.tolerance * force || (!singular && correction <= 1e-13) ||
+          (last_correction <= 1e-12 && res_max <= 1e-6 * force)) {
         if (crossed && sign == start_sign) {
           a.why = "past a limit point: the only equilibrium found lies on a distant branch (a snap-through)";
           return a;
@@ -217,8 +222,7 @@ class EquilibriumPath {
       }
       ++a.iterations;
       ++res_.newton_iterations;
-      const Eigen::VectorXd dy = lu.solve(-Rs);
-      last_correction = dy.cwiseAbs().maxCoeff();
+      last_correction = correction;
       for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += scale_[j] * dy[j];
     }
   }
