@@ -32,7 +32,7 @@ void add_stress_loads(const System& sys, const Data& data, Eigen::VectorXd& out)
 }
 
 // DF_q^eᵀ S DF_q^e over the constitutive deformations: the structural stiffness K0.
-void add_structural_stiffness(const System& sys, const Data& data, const Eigen::MatrixXd& DFeq, Eigen::MatrixXd& K) {
+void add_structural_stiffness(const System& sys, const Eigen::MatrixXd& DFeq, Eigen::MatrixXd& K) {
   for (const SystemElement& se : sys.elements) {
     if (!se.has_constitutive) continue;
     Eigen::MatrixXd S = se.S;
@@ -74,8 +74,10 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
   Eigen::VectorXd w = Eigen::VectorXd::Zero(sys.nx);
   add_stress_loads(sys, data, w);
   double scale = 0.0;  // the largest applied or elastic load on a coordinate, in units of energy
-  for (int g = 0; g < sys.nx; ++g)
-    scale = std::max(scale, std::max(std::abs(w[g]), std::abs(data.f[g])) * (sys.coord_is_length[g] ? sys.length_scale : 1.0));
+  for (int g = 0; g < sys.nx; ++g) {
+    const double size = sys.coord_is_length[g] ? sys.length_scale : 1.0;
+    scale = std::max(scale, std::max(std::abs(w[g]), std::abs(data.f[g])) * size);
+  }
   w -= data.f;
   for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
   R.noalias() = data.DFq.transpose() * w;
@@ -104,7 +106,7 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
   K->noalias() = data.DFq.transpose() * Kx * data.DFq;
   Eigen::MatrixXd DFeq(sys.ne, nd);
   for (int j = 0; j < nd; ++j) DFeq.col(j) = data.DFe.col(sys.dof_cols[j]);
-  add_structural_stiffness(sys, data, DFeq, *K);
+  add_structural_stiffness(sys, DFeq, *K);
   return scale;
 }
 
@@ -320,7 +322,8 @@ class EquilibriumPath {
 };
 
 void check_options(const StaticOptions& o) {
-  if (o.steps < 1) throw InputError("static: the number of load steps must be at least 1, got " + std::to_string(o.steps));
+  if (o.steps < 1)
+    throw InputError("static: the number of load steps must be at least 1, got " + std::to_string(o.steps));
   if (o.max_iterations < 1)
     throw InputError("static: max_iterations must be at least 1, got " + std::to_string(o.max_iterations));
   if (o.max_cuts < 0 || o.max_cuts > 50)

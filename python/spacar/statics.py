@@ -78,8 +78,8 @@ def static(model, steps: int = 10, *, max_iterations: int = 30, max_cuts: int = 
     ``iterations`` (per row), ``step_cuts``, ``load_reached`` (the last converged load factor),
     ``kinematic_iterations``, ``wall_time`` and ``indefinite_at`` (the first load factor at
     which the tangent stiffness is indefinite, i.e. the equilibrium is unstable because a
-    buckling load was passed; None if never, with a warning in ``model.warnings`` otherwise). The model's state is left at the equilibrium, at
-    rest, at the block's start time.
+    buckling load was passed; None if never, with a warning in ``model.warnings`` otherwise).
+    The model's state is left at the equilibrium, at rest, at the block's start time.
 
     Raises :class:`spacar.StaticError` if no equilibrium is found (loads beyond a limit point,
     a degree of freedom without stiffness), with the converged steps as ``err.results``; the
