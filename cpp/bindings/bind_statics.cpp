@@ -79,4 +79,15 @@ void bind_statics(py::module_& m) {
       py::arg("tolerance") = 1e-10,
       "Static equilibrium of the model's block in load steps; StaticError (with `results`, the converged "
       "steps) if Newton fails beyond the smallest step.");
+  m.def(
+      "static_forces",
+      [](Simulation& sim, double lambda) {
+        Eigen::VectorXd R;
+        Eigen::MatrixXd K;
+        static_forces(sim.system(), sim.data(), lambda, R, &K);
+        return py::make_tuple(R, K);
+      },
+      py::arg("simulation"), py::arg("load_factor"),
+      "(R, K) at the simulation's solved positions, at rest, under λ times the loads: the reduced "
+      "generalized forces and the tangent stiffness K0 + G0 (for tests against differences).");
 }

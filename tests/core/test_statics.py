@@ -361,3 +361,57 @@ def test_mechanism_moved_by_its_input_without_loads():
     np.testing.assert_allclose(r, 0.15, atol=1e-9)
     np.testing.assert_allclose(res.node(8).x[:, 0], slider, atol=1e-9)
     assert np.abs(res.sigma).max() < 1e-12
+
+
+def _tangent_models():
+    planar = plbeam_cantilever(4, force=(0.3, 1.0), moment=0.2, mass=2.0)
+    planar.gravity(0.5, -3.0)
+    spatial = beam_cantilever(3, EIy=1.0, EIz=2.0, GIp=0.5, rhoA=1.5)
+    spatial.torquel(104, 0.3, -0.2, 0.5)
+    spatial.force(4, 0.2, 0.4, -0.3)
+    spatial.gravity(0.0, -1.0, -2.0)
+    # Coordinates as DOFs with released, stiff deformations, and a support moved by an input.
+    frame = spacar.Model()
+    frame.plbeam(1, 1, 2, 3, 4)
+    frame.plbeam(2, 3, 4, 5, 6)
+    frame.x(3, 0.6, 0.1)
+    frame.x(5, 1.0, 0.5)
+    frame.fix(1, 2)
+    frame.fix(2)
+    frame.apply("INPUTX", 1, 1)
+    frame.dynx(3)
+    frame.dynx(4)
+    frame.dynx(5)
+    frame.dynx(6)
+    for e in (1, 2):
+        frame.rlse(e)
+        frame.estiff(e, 50.0, 1.5)
+        frame.emass(e, 1.0)
+    frame.force(5, 0.4, -0.7)
+    frame.gravity(0.0, -2.0)
+    return {"planar DYNE": planar, "spatial TORQUEL": spatial, "planar DYNX RLSE": frame}
+
+
+@pytest.mark.parametrize("name", list(_tangent_models()))
+def test_tangent_stiffness_is_the_derivative_of_the_residual(name):
+    """K0 + G0 against central differences of R(q) at a state out of equilibrium, at λ = 0.7 (the
+    load stiffness of beam gravity and TORQUEL scaled with the loads). The simulation moves to
+    each q (it needs the mass that these models have); static_forces evaluates there."""
+    model = _tangent_models()[name]
+    model.prepare()
+    sim = _core.Simulation(model._core)
+    sim.assemble()
+    nd = sim.system.n_dof
+    q0 = np.array(sim.system.q0) + 0.05 * np.sin(np.arange(nd) + 1.0)
+    rest = np.zeros(nd)
+
+    def forces(q):
+        sim.move_to(0.0, q, rest)
+        R, K = _core.static_forces(sim, 0.7)
+        return np.array(R), np.array(K)
+
+    R, K = forces(q0)
+    h = 1e-6
+    K_fd = np.column_stack([(forces(q0 + h * d)[0] - forces(q0 - h * d)[0]) / (2 * h) for d in np.eye(nd)])
+    assert np.abs(R).max() > 1e-2  # out of equilibrium: the stresses' reaction terms matter
+    assert np.abs(K - K_fd).max() < 1e-8 * np.abs(K).max()
