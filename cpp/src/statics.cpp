@@ -241,9 +241,11 @@ class EquilibriumPath {
     double lowest = 0.0;
     Eigen::VectorXd direction;
     if ((Ks - Ks.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * big) {
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (Ks + Ks.transpose()));
-      lowest = eig.eigenvalues()[0];
-      direction = eig.eigenvectors().col(0);
+      const Eigen::MatrixXd sym = 0.5 * (Ks + Ks.transpose());
+      // Eigenvalues only at every step; the vector once an equilibrium is unstable.
+      lowest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(sym, Eigen::EigenvaluesOnly).eigenvalues()[0];
+      if (!(lowest < -1e-9 * big)) return "";
+      direction = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(sym).eigenvectors().col(0);
     } else {
       Eigen::EigenSolver<Eigen::MatrixXd> eig(Ks);
       Eigen::Index k = 0;
