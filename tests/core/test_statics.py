@@ -415,3 +415,13 @@ def test_tangent_stiffness_is_the_derivative_of_the_residual(name):
     K_fd = np.column_stack([(forces(q0 + h * d)[0] - forces(q0 - h * d)[0]) / (2 * h) for d in np.eye(nd)])
     assert np.abs(R).max() > 1e-2  # out of equilibrium: the stresses' reaction terms matter
     assert np.abs(K - K_fd).max() < 1e-8 * np.abs(K).max()
+
+
+def test_results_save_load_and_draw(tmp_path):
+    res = spacar.static(plbeam_cantilever(4, force=(0.0, 1.0)), steps=3)
+    path = tmp_path / "static.npz"
+    res.save(path)
+    back = spacar.Results.load(path)
+    np.testing.assert_array_equal(back.x, res.x)
+    assert back.stats == res.stats  # per-row iterations and indefinite_at None included
+    assert res.geometry is not None
