@@ -12,7 +12,7 @@ namespace {
 
 // The Python exception types, created once; the C++ exception of the same name maps to each.
 struct PyErrors {
-  py::handle base, input, kinematics, mass, integration, time_limit;
+  py::handle base, input, kinematics, mass, integration, time_limit, statics;
 };
 
 PyErrors& py_errors() {
@@ -35,6 +35,9 @@ py::handle python_type(const std::exception_ptr& p, std::string& message) {
   } catch (const SingularMassError& x) {
     message = x.what();
     return e.mass;
+  } catch (const StaticError& x) {
+    message = x.what();
+    return e.statics;
   } catch (const TimeLimitError& x) {
     message = x.what();
     return e.time_limit;
@@ -64,6 +67,7 @@ void bind_errors(py::module_& m) {
   e.mass = py::exception<SingularMassError>(m, "SingularMassError", e.base).release();
   e.integration = py::exception<IntegrationError>(m, "IntegrationError", e.base).release();
   e.time_limit = py::exception<TimeLimitError>(m, "TimeLimitError", e.base).release();
+  e.statics = py::exception<StaticError>(m, "StaticError", e.base).release();
   py::register_exception_translator([](std::exception_ptr p) {
     if (!p) return;
     std::string message;

@@ -14,4 +14,5 @@ PYBIND11_MODULE(_core, m) {
   bind_model(m);
   bind_simulation(m);
   bind_topology(m);
+  bind_statics(m);
 }

@@ -34,6 +34,7 @@ from .model import Model
 from .geometry import Geometry
 from .results import Results
 from .simulate import simulate
+from .statics import StaticError, static
 from .sweep import SweepError, SweepResult, sweep
 
 __version__ = "0.1.0"
@@ -97,6 +98,8 @@ __all__ = [
     "parse",
     "dump",
     "simulate",
+    "static",
+    "StaticError",
     "sweep",
     "SweepResult",
     "SweepError",

@@ -6,6 +6,8 @@
                        proceeds; with ANIMATE 1 the animation of those blocks is written to
                        ``<stem>.gif`` (``--animation`` for another file or format), where
                        ``<stem>`` is the input file name without extension.
+``spacar static FILE`` the static equilibrium of every block under its loads (docs/statics.md),
+                       in load steps, with the state dump after every END.
 ``spacar check FILE``  summary of the model of the first block: nodes and elements by type,
                        coordinates and deformations per class, degrees of freedom.
 
@@ -136,6 +138,33 @@ def _write_animation(res, path) -> None:
     _comment(f"animation: {os.fspath(Path(path))} ({len(res.t)} output times)")
 
 
+def _static(args) -> int:
+    from .statics import static_blocks
+
+    model = read(args.file)
+    _comment(f"spacar {__version__} static: {args.file}")
+    for w in model.warnings:
+        _comment(f"warning: {w}")
+    if not model.blocks:
+        _comment("no input block ended with END: nothing to analyse")
+        return 0
+    n_warn = len(model.warnings)
+    blocks = static_blocks(model, steps=args.steps, max_cuts=args.max_cuts, tolerance=args.tolerance)
+    for k, res in enumerate(blocks):
+        for w in model.warnings[n_warn:]:
+            _comment(f"warning: {w}")
+        n_warn = len(model.warnings)
+        s = res.stats
+        _comment(f"block {k + 1}: static equilibrium in {len(res.t)} load steps, {s['newton_iterations']} Newton "
+                 f"iterations ({s['step_cuts']} step cuts), {s['wall_time'] * 1e3:.1f} ms")
+        if s["indefinite_at"] is not None:
+            _comment(f"the tangent stiffness is indefinite from load factor {s['indefinite_at']:g}: unstable")
+        _print_forces(res, model, args.dump_digits)
+        sys.stdout.write(dump(model, digits=args.dump_digits))
+        sys.stdout.flush()
+    return 0
+
+
 def _check(args) -> int:
     model = read(args.file)
     _comment(f"spacar check: {args.file}")
@@ -181,6 +210,16 @@ def main(argv=None) -> int:
     run.add_argument("--time-limit", type=_seconds, default=None, metavar="SECONDS",
                      help="wall-clock limit per block (default: none); beyond it the run stops with an error")
     run.set_defaults(func=_run)
+    static = sub.add_parser("static", help="static equilibrium of every block under its loads; print the state dumps")
+    static.add_argument("file")
+    static.add_argument("--steps", type=int, default=10, metavar="N", help="equal load steps per block (default 10)")
+    static.add_argument("--max-cuts", type=int, default=12, metavar="N",
+                        help="halvings of a load step in which Newton fails before giving up (default 12)")
+    static.add_argument("--tolerance", type=float, default=1e-10,
+                        help="residual relative to the largest load balanced (default 1e-10)")
+    static.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
+                        help="significant digits of the dump (default 4; 17 for a lossless restart)")
+    static.set_defaults(func=_static)
     check = sub.add_parser("check", help="summarise the model: nodes, elements, classes, degrees of freedom")
     check.add_argument("file")
     check.set_defaults(func=_check)

@@ -14,6 +14,8 @@ one (an earlier ``spacar.NotImplementedError`` shadowed Python's builtin of that
 - :class:`SingularMassError` — a degree of freedom without inertia.
 - :class:`IntegrationError` — the integrator cannot continue.
 - :class:`TimeLimitError` — the analysis did not finish within its ``time_limit``.
+- :class:`StaticError` — no static equilibrium was found (:func:`spacar.static`); ``err.results``
+  holds the load steps converged before the failure.
 """
 from ._core import (  # noqa: F401
     InputError,
@@ -21,6 +23,7 @@ from ._core import (  # noqa: F401
     KinematicsError,
     SingularMassError,
     SpacarError,
+    StaticError,
     TimeLimitError,
 )
 
@@ -31,4 +34,5 @@ __all__ = [
     "SingularMassError",
     "IntegrationError",
     "TimeLimitError",
+    "StaticError",
 ]

@@ -308,7 +308,8 @@ class Results:
         meta = {
             "format": "spacar.Results",
             "version": 2,  # 2: with the kinematic coordinates of the linearizations
-            "stats": {k: (v if isinstance(v, (int, float, str)) else float(v)) for k, v in self.stats.items()},
+            "stats": {k: (v if v is None or isinstance(v, (int, float, str, list)) else float(v))
+                      for k, v in self.stats.items()},
             "settings_linear": self.settings_linear,
             "geometry": None if self.geometry is None else self.geometry.to_dict(),
             "linearizations": lin_meta,

@@ -33,4 +33,10 @@ struct TimeLimitError : Error {
   using Error::Error;
 };
 
+// No static equilibrium was found (statics.hpp): the load factor reached, the worst residual and
+// its degree of freedom are in the message; the bindings attach the converged load steps.
+struct StaticError : Error {
+  using Error::Error;
+};
+
 }  // namespace spacar

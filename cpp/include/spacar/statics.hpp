@@ -1,0 +1,68 @@
+// Static equilibrium (issue 19, docs/statics.md): the configuration in which the reduced
+// generalized forces of the degrees of freedom vanish at rest,
+//   R(q, λ) = DF_qᵀ (−λ f) + DFe_qᵀ σ(e) = 0,
+// the equations of motion (formulation.md §3.1) at zero velocity and acceleration, under the
+// block's loads (FORCE, TORQUEL, GRAVITY) scaled by the load factor λ and with the inputs moved
+// from their values at the block start to their values at the block end in proportion to λ.
+// The path starts at the current state: R(q, λ) − (1 − λ) R(q_start, 0) = 0 is followed, the
+// second term being zero from an unloaded, stress-free start (and the previous block's loads in
+// generalized form when a block continues from an equilibrium).
+// Full Newton with the exact tangent stiffness ∂R/∂q = K0 + G0 of the linearization (structural
+// plus geometric, formulation.md §7.2; C0 = N0 = 0 at rest), λ from 0 to 1 in equal load steps,
+// a step halved when Newton fails there. No mass is needed.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "spacar/data.hpp"
+#include "spacar/errors.hpp"
+#include "spacar/model.hpp"
+#include "spacar/simulate.hpp"
+#include "spacar/system.hpp"
+
+namespace spacar {
+
+struct StaticOptions {
+  int steps = 10;            // equal load steps from λ = 0 to 1; one result row each
+  int max_iterations = 30;   // Newton iterations per (sub)step
+  int max_cuts = 12;         // halvings of a load step before giving up
+  double tolerance = 1e-10;  // residual relative to the largest generalized force balanced
+};
+
+struct StaticResults {
+  std::vector<std::array<int, 2>> coord_label, def_label;  // (node, component), (element, deformation)
+  Eigen::VectorXd load;            // load factor λ of each row (k / steps)
+  RowMatrix x, e, sigma, reaction; // rows x nx / ne: sigma complete (reaction stresses included)
+  std::vector<int> iterations;     // Newton iterations from the previous row (cut sub-steps included)
+  double load_reached = 0.0;       // the last converged load factor (1 unless StaticError)
+  long newton_iterations = 0;      // all Newton iterations, failed attempts included
+  long step_cuts = 0;              // load steps halved because Newton failed
+  long kinematic_iterations = 0;   // iterations of the position solves
+  // First converged load factor at which the tangent stiffness is indefinite (an equilibrium
+  // past a buckling or limit point: unstable), NaN if it never was.
+  double indefinite_at = std::numeric_limits<double>::quiet_NaN();
+  double wall_time = 0.0;
+  std::vector<std::string> warnings;
+};
+
+// The static state at load factor λ with the positions solved: the reduced generalized forces
+// R (n_dof) and, if K is not null, the tangent stiffness ∂R/∂q (n_dof x n_dof). Leaves in data
+// the transfer functions, the rates at zero, data.f = λ f, the complete stresses σ (reaction
+// stresses of the velocity rows from the equilibrium of the calculable coordinates) and the
+// reactions on the fixed and input coordinates. Returns the scale of R: the largest applied or
+// elastic load on a coordinate (loads on lengths times the mean element length).
+double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K);
+
+// "DYNX node 3 component 2" / "DYNE element 2 (PLBEAM) deformation 3" of degree of freedom j.
+std::string dof_name(const System& sys, int j);
+
+// The static analysis of the model's current block: assemble at λ = 0, follow the equilibrium to
+// λ = 1 and store it in the model (at rest, at the block's start time). On failure StaticError
+// with `res` holding the rows converged before it; the model is then not changed.
+void solve_static(Model& model, StaticResults& res, const StaticOptions& options = {});
+
+}  // namespace spacar

@@ -1,0 +1,431 @@
+#include "spacar/statics.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "spacar/dynamics.hpp"
+#include "spacar/kinematics.hpp"
+#include "spacar/limits.hpp"
+
+namespace spacar {
+
+namespace {
+
+bool constitutive_class(DefClass c) {
+  return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
+}
+
+// Σ_k B_kᵀ σ_k over all deformations, added to out.
+void add_stress_loads(const System& sys, const Data& data, Eigen::VectorXd& out) {
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const ElementWork& w = data.work[i];
+    for (int a = 0; a < se.nd; ++a) {
+      const double s = data.sigma[se.def_offset + a];
+      if (s == 0.0) continue;
+      for (size_t j = 0; j < se.coords.size(); ++j) out[se.coords[j]] += w.B(a, j) * s;
+    }
+  }
+}
+
+// DF_q^eᵀ S DF_q^e over the constitutive deformations: the structural stiffness K0.
+void add_structural_stiffness(const System& sys, const Eigen::MatrixXd& DFeq, Eigen::MatrixXd& K) {
+  for (const SystemElement& se : sys.elements) {
+    if (!se.has_constitutive) continue;
+    Eigen::MatrixXd S = se.S;
+    for (int a = 0; a < se.nd; ++a)
+      if (!constitutive_class(sys.def_class[se.def_offset + a])) S.row(a).setZero();
+    const auto De = DFeq.middleRows(se.def_offset, se.nd);
+    K.noalias() += De.transpose() * S * De;
+  }
+}
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+std::string dof_name(const System& sys, int j) {
+  const int nxd = static_cast<int>(sys.x_dyn.size());
+  if (j < nxd) return "DYNX " + sys.coord_name(sys.x_dyn[j]);
+  return "DYNE " + sys.def_name(sys.e_dyn[j - nxd]);
+}
+
+double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K) {
+  const int nd = sys.n_dof();
+  // At rest: no rates, no accelerations, hence no inertia or convective forces.
+  data.qhat_d.setZero();
+  data.qhat_dd.setZero();
+  solve_transfer(sys, data);
+  solve_velocities(sys, data);
+  data.xdd.setZero();
+  data.edd.setZero();
+  compute_inertia_and_loads(sys, data);
+  data.f *= lambda;
+  constitutive_stresses(sys, data);
+  // The unbalanced load w = −λf + Σ Bᵀσ on every coordinate; R = DF_qᵀ w.
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(sys.nx);
+  add_stress_loads(sys, data, w);
+  double scale = 0.0;  // the largest applied or elastic load on a coordinate, in units of energy
+  for (int g = 0; g < sys.nx; ++g) {
+    const double size = sys.coord_is_length[g] ? sys.length_scale : 1.0;
+    scale = std::max(scale, std::max(std::abs(w[g]), std::abs(data.f[g])) * size);
+  }
+  w -= data.f;
+  for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
+  R.noalias() = data.DFq.transpose() * w;
+  // Reaction stresses of the velocity rows from the equilibrium of the calculable coordinates,
+  // A_Vᵀ y = −w_c (formulation.md §6); on DOF deformation rows y → 0 at equilibrium. With them
+  // Σ σ_k H_k is exactly the derivative of DF_q (the second-order transfer) contracted with w.
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc > 0) {
+    Eigen::VectorXd rhs(nc), y(nc);
+    for (int j = 0; j < nc; ++j) rhs[j] = -w[sys.x_calc[j]];
+    data.luV.solve_transposed(rhs, y);
+    for (int r = 0; r < nc; ++r) data.sigma[sys.defs_V[r]] += y[r];
+  }
+  data.reaction = -data.f;
+  add_stress_loads(sys, data, data.reaction);
+  for (int g = 0; g < sys.nx; ++g) {
+    const CoordClass c = sys.coord_class[g];
+    if (c != CoordClass::Fixed && c != CoordClass::Input) data.reaction[g] = 0.0;
+  }
+  if (!K) return scale;
+  // Tangent stiffness K0 + G0: G0 with the complete stresses and the stiffness of the
+  // position-dependent loads (beam gravity, TORQUEL), which scale with λ.
+  Eigen::MatrixXd Kx = geometric_stiffness(sys, data, data.sigma);
+  if (lambda != 1.0 && (sys.gravity.squaredNorm() > 0.0 || !sys.torquel.empty()))
+    Kx -= (1.0 - lambda) * geometric_stiffness(sys, data, Eigen::VectorXd::Zero(sys.ne));
+  K->noalias() = data.DFq.transpose() * Kx * data.DFq;
+  Eigen::MatrixXd DFeq(sys.ne, nd);
+  for (int j = 0; j < nd; ++j) DFeq.col(j) = data.DFe.col(sys.dof_cols[j]);
+  add_structural_stiffness(sys, DFeq, *K);
+  return scale;
+}
+
+namespace {
+
+// Newton's iterations for one load factor from the current state, and the state to go back to.
+class EquilibriumPath {
+ public:
+  EquilibriumPath(const System& sys, Data& data, const StaticOptions& opt, StaticResults& res)
+      : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()) {
+    scale_.resize(nd_);
+    int j = 0;
+    for (int g : sys.x_dyn) scale_[j++] = sys.coord_is_length[g] ? sys.length_scale : 1.0;
+    for (int k : sys.e_dyn) scale_[j++] = sys.def_is_length[k] ? sys.length_scale : 1.0;
+    // Inputs at the block start (λ = 0) and end (λ = 1), ordered as input_cols.
+    const double tp = sys.settings.timestep_tp;
+    p0_ = sys.p0;
+    p1_ = sys.p0 + tp * sys.pd0 + 0.5 * tp * tp * sys.pdd0;
+  }
+
+  struct Attempt {
+    bool converged = false;
+    int iterations = 0;
+    std::string why;            // why Newton failed
+    int worst = -1;             // DOF of the largest (scaled) residual
+    double worst_residual = 0.0;
+    bool singular_at_start = false;
+  };
+
+  // At the starting state (assembled, λ = 0): the generalized forces R0 that hold it there, zero
+  // for an unloaded stress-free start, the equilibrium of the block before otherwise. The path
+  // solves R(q, λ) − (1 − λ) R0 = 0: it begins exactly at the current state, and from one block
+  // to the next the loads change gradually instead of being released and applied again.
+  void start() {
+    static_forces(sys_, data_, 0.0, R0_, nullptr);
+    have_DF_ = true;
+  }
+
+  // Equilibrium at load factor λ, starting from the current state. The sign of det K must stay
+  // that of the start: a change during the iterations means that the step crosses a limit or
+  // bifurcation point, and Newton may land on a distant branch (a snap-through). Such a step
+  // fails unless `last_chance` (the smallest step): then an end beyond a bifurcation, where the
+  // sign has changed, is accepted (an unstable equilibrium, reported as indefinite), while a
+  // return to the start's sign (the jump past a limit point) fails.
+  Attempt solve(double lambda, bool last_chance) {
+    Attempt a;
+    Eigen::VectorXd qhat = data_.qhat;
+    for (int i = 0; i < sys_.n_input(); ++i) qhat[sys_.input_cols[i]] = p0_[i] + lambda * (p1_[i] - p0_[i]);
+    Eigen::VectorXd R;
+    double last_correction = std::numeric_limits<double>::infinity();
+    int start_sign = 0;
+    bool crossed = false;
+    for (int it = 0;; ++it) {
+      try {
+        place(qhat);
+      } catch (const KinematicsError& err) {
+        a.why = std::string("the kinematics has no solution there (") + err.what() + ")";
+        return a;
+      }
+      const double force = static_forces(sys_, data_, lambda, R, &K_);
+      R -= (1.0 - lambda) * R0_;
+      const Eigen::VectorXd Rs = scale_.cwiseProduct(R);
+      if (!Rs.allFinite() || !K_.allFinite()) {
+        a.why = "the forces or the stiffness are not finite";
+        return a;
+      }
+      const Eigen::MatrixXd Ks = scale_.asDiagonal() * K_ * scale_.asDiagonal();
+      const Eigen::PartialPivLU<Eigen::MatrixXd> lu(Ks);
+      // A tiny pivot: the stiffness may be singular; full pivoting confirms it and finds the null
+      // directions.
+      Eigen::MatrixXd null_space;
+      const Eigen::VectorXd pivots = lu.matrixLU().diagonal().cwiseAbs();
+      if (nd_ > 0 && !(pivots.minCoeff() > 1e-13 * pivots.maxCoeff())) {
+        Eigen::FullPivLU<Eigen::MatrixXd> full(Ks);
+        full.setThreshold(1e-13);
+        if (!full.isInvertible()) null_space = full.kernel();
+      }
+      const bool singular = null_space.cols() > 0;
+      const int sign = singular || nd_ == 0 ? 0 : determinant_sign(lu);
+      if (it == 0) start_sign = sign;
+      else if (sign != start_sign) crossed = true;
+      if (crossed && !last_chance) {
+        a.why = "the tangent stiffness changes the sign of its determinant within the step (a limit or "
+                "bifurcation point)";
+        return a;
+      }
+      double res_max = 0.0;
+      Eigen::VectorXd dy;
+      if (nd_ > 0) {
+        res_max = Rs.cwiseAbs().maxCoeff(&a.worst);
+        a.worst_residual = R[a.worst];
+        if (!singular) dy = lu.solve(-Rs);
+      }
+      // Converged: the residual is small against the forces it balances; or it would move the
+      // DOFs by less than round-off (nothing is loaded: a mechanism moved by its inputs); or the
+      // corrections have reached round-off with a residual near it.
+      const double correction = dy.size() ? dy.cwiseAbs().maxCoeff() : 0.0;
+      if (res_max <= opt_.tolerance * force || (!singular && correction <= 1e-13) ||
+          (last_correction <= 1e-12 && res_max <= 1e-6 * force)) {
+        if (crossed && sign == start_sign) {
+          a.why = "past a limit point: the only equilibrium found lies on a distant branch (a snap-through)";
+          return a;
+        }
+        a.converged = true;
+        return a;
+      }
+      if (it == opt_.max_iterations) {
+        a.why = "Newton's method did not converge in " + std::to_string(opt_.max_iterations) + " iterations";
+        return a;
+      }
+      if (singular) {
+        a.why = "the tangent stiffness is singular: no stiffness in " + directions(null_space);
+        a.singular_at_start = it == 0;
+        return a;
+      }
+      ++a.iterations;
+      ++res_.newton_iterations;
+      last_correction = correction;
+      for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += scale_[j] * dy[j];
+    }
+  }
+
+  // The scaled tangent stiffness of the last evaluation has an eigenvalue with a negative real
+  // part: the equilibrium is unstable (for a symmetric stiffness, i.e. conservative loads: not
+  // positive definite). Follower loads (TORQUEL) make it unsymmetric; its symmetric part may then
+  // be indefinite at a stable equilibrium, so the eigenvalues of the matrix itself decide.
+  // Returns "" or the description of the direction of the most negative eigenvalue.
+  std::string indefinite() const {
+    if (nd_ == 0) return "";
+    const Eigen::MatrixXd Ks = scale_.asDiagonal() * K_ * scale_.asDiagonal();
+    const double big = Ks.cwiseAbs().maxCoeff();
+    double lowest = 0.0;
+    Eigen::VectorXd direction;
+    if ((Ks - Ks.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * big) {
+      const Eigen::MatrixXd sym = 0.5 * (Ks + Ks.transpose());
+      // Eigenvalues only at every step; the vector once an equilibrium is unstable.
+      lowest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(sym, Eigen::EigenvaluesOnly).eigenvalues()[0];
+      if (!(lowest < -1e-9 * big)) return "";
+      direction = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(sym).eigenvectors().col(0);
+    } else {
+      Eigen::EigenSolver<Eigen::MatrixXd> eig(Ks);
+      Eigen::Index k = 0;
+      lowest = eig.eigenvalues().real().minCoeff(&k);
+      direction = eig.eigenvectors().col(k).cwiseAbs();
+    }
+    if (!(lowest < -1e-9 * big)) return "";
+    return directions(direction) + " (eigenvalue " + num(lowest / big) + " of the largest entry)";
+  }
+
+  struct Snapshot {
+    Eigen::VectorXd x, qhat, angle_ref;
+    Eigen::MatrixXd DF;
+    bool have_DF = false;
+  };
+  Snapshot save() const { return {data_.x, data_.qhat, data_.angle_ref, data_.DF, have_DF_}; }
+  void restore(const Snapshot& s) {
+    data_.x = s.x;
+    data_.qhat = s.qhat;
+    data_.angle_ref = s.angle_ref;
+    data_.DF = s.DF;
+    have_DF_ = s.have_DF;
+  }
+
+ private:
+  // Positions for q̂: the calculable coordinates predicted along DF from the last state, then
+  // solved by Newton on the constraints.
+  void place(const Eigen::VectorXd& qhat) {
+    if (have_DF_) data_.x.noalias() += data_.DF * (qhat - data_.qhat);
+    data_.qhat = qhat;
+    for (int g : sys_.x_input) data_.x[g] = qhat[sys_.qhat_col_x[g]];
+    for (int g : sys_.x_dyn) data_.x[g] = qhat[sys_.qhat_col_x[g]];
+    have_DF_ = false;  // until static_forces has evaluated it here
+    // Full Newton on the positions: the steps between static iterates are large, and the chord
+    // iteration with the last velocity block (meant for small time steps) would crawl.
+    data_.jacobian_reusable = false;
+    solve_positions(sys_, data_, std::max(sys_.settings.maxiterat, 50), std::min(sys_.settings.epskin, 1e-10), false);
+    res_.kinematic_iterations += data_.newton_iterations;
+    have_DF_ = true;   // static_forces follows at once
+  }
+
+  // The DOFs that make up the directions V (columns) of q: components ≥ 10% of the largest,
+  // the largest first, at most four named.
+  std::string directions(const Eigen::MatrixXd& V) const {
+    std::vector<std::pair<double, int>> part;
+    for (int j = 0; j < nd_; ++j) {
+      double w = 0.0;
+      for (int c = 0; c < V.cols(); ++c) w = std::max(w, std::abs(V(j, c)) / V.col(c).cwiseAbs().maxCoeff());
+      if (w >= 0.1) part.push_back({-w, j});
+    }
+    std::sort(part.begin(), part.end());
+    std::ostringstream os;
+    os << "the direction of";
+    for (size_t i = 0; i < part.size() && i < 4; ++i) os << (i ? ", " : " ") << dof_name(sys_, part[i].second);
+    if (part.size() > 4) os << " and " << part.size() - 4 << " more";
+    return os.str();
+  }
+
+  static int determinant_sign(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu) {
+    int sign = static_cast<int>(lu.permutationP().determinant());
+    for (int i = 0; i < lu.matrixLU().rows(); ++i)
+      if (lu.matrixLU()(i, i) < 0.0) sign = -sign;
+    return sign;
+  }
+
+  const System& sys_;
+  Data& data_;
+  const StaticOptions& opt_;
+  StaticResults& res_;
+  const int nd_;
+  Eigen::VectorXd scale_;        // characteristic size of each DOF: lengths vs angles
+  Eigen::VectorXd p0_, p1_;
+  Eigen::VectorXd R0_;           // generalized forces at the start (see start())
+  Eigen::MatrixXd K_;
+  bool have_DF_ = false;
+};
+
+void check_options(const StaticOptions& o) {
+  if (o.steps < 1)
+    throw InputError("static: the number of load steps must be at least 1, got " + std::to_string(o.steps));
+  if (o.max_iterations < 1)
+    throw InputError("static: max_iterations must be at least 1, got " + std::to_string(o.max_iterations));
+  if (o.max_cuts < 0 || o.max_cuts > 50)
+    throw InputError("static: max_cuts must be between 0 and 50, got " + std::to_string(o.max_cuts));
+  if (!(o.tolerance > 0.0 && o.tolerance < 1.0))
+    throw InputError("static: the tolerance must be between 0 and 1, got " + num(o.tolerance));
+}
+
+}  // namespace
+
+void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  check_options(opt);
+  res = StaticResults();
+  Simulation sim(model);
+  const System& sys = sim.system();
+  Data& data = sim.data();
+  res.warnings = sys.warnings;
+  res.coord_label = sys.coord_label;
+  res.def_label = sys.def_label;
+  const int n = opt.steps;
+  require_memory(Data::estimate_dense_bytes(sys) + 8.0 * n * (2.0 * sys.nx + 2.0 * sys.ne + 2.0),
+                 "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
+                     std::to_string(sys.ne) + " deformations in " + std::to_string(n) + " load steps",
+                 "use fewer load steps");
+  res.load.resize(n);
+  for (RowMatrix* m : {&res.x, &res.reaction}) m->resize(n, sys.nx);
+  for (RowMatrix* m : {&res.e, &res.sigma}) m->resize(n, sys.ne);
+  int rows = 0;
+  auto finish = [&]() {
+    res.load.conservativeResize(rows);
+    for (RowMatrix* m : {&res.x, &res.reaction, &res.e, &res.sigma}) m->conservativeResize(rows, m->cols());
+    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+
+  sim.assemble();
+  data.t = sys.t0;
+  EquilibriumPath path(sys, data, opt, res);
+  path.start();
+  const double nominal = 1.0 / n, smallest = nominal * std::ldexp(1.0, -opt.max_cuts);
+  double lambda = 0.0, step = nominal;
+  int iterations = 0;
+  try {
+    while (rows < n) {
+      const double target = static_cast<double>(rows + 1) / n;
+      // Land exactly on the load factor of the next row.
+      const double next = lambda + step >= target - 1e-12 * nominal ? target : lambda + step;
+      const EquilibriumPath::Snapshot before = path.save();
+      const bool last_chance = step <= smallest * (1.0 + 1e-9);
+      const EquilibriumPath::Attempt a = path.solve(next, last_chance);
+      iterations += a.iterations;
+      if (!a.converged) {
+        const bool hopeless = a.singular_at_start || last_chance;
+        if (hopeless) {
+          std::ostringstream os;
+          os << "no static equilibrium found beyond load factor " << num(lambda) << " (of 1; tried " << num(next)
+             << "): " << a.why;
+          if (a.worst >= 0)
+            os << "; worst residual " << num(a.worst_residual) << " on " << dof_name(sys, a.worst);
+          if (!a.singular_at_start) {
+            os << " (load step cut " << res.step_cuts << " times, down to " << num(step)
+               << "). The load may exceed a limit point (snap-through or collapse), which needs an arc-length "
+                  "method; or the model has a degree of freedom without stiffness";
+          } else {
+            os << ". Give that degree of freedom stiffness (ESTIFF) or a support (FIX)";
+          }
+          throw StaticError(os.str());
+        }
+        path.restore(before);
+        ++res.step_cuts;
+        step *= 0.5;
+        continue;
+      }
+      lambda = res.load_reached = next;
+      if (std::isnan(res.indefinite_at)) {
+        const std::string dir = path.indefinite();
+        if (!dir.empty()) {
+          res.indefinite_at = lambda;
+          res.warnings.push_back("the tangent stiffness is indefinite at load factor " + num(lambda) + " in " + dir +
+                                 ": the equilibrium is unstable (a buckling or limit load was passed)");
+        }
+      }
+      if (lambda == target) {
+        res.load[rows] = lambda;
+        res.x.row(rows) = data.x;
+        res.e.row(rows) = data.e;
+        res.sigma.row(rows) = data.sigma;
+        res.reaction.row(rows) = data.reaction;
+        res.iterations.push_back(iterations);
+        iterations = 0;
+        ++rows;
+      }
+      step = std::min(2.0 * step, nominal);  // back towards the nominal step after a cut
+    }
+  } catch (const Error&) {
+    finish();
+    throw;
+  }
+  finish();
+  sim.store_state();
+}
+
+}  // namespace spacar

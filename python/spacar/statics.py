@@ -1,0 +1,108 @@
+"""Static equilibrium of a model's block (docs/statics.md)::
+
+    res = spacar.static(model, steps=10)   # λ = 0.1, 0.2, ..., 1
+    res.t                                   # the load factors of the rows
+    res.node(21).x[-1]                      # tip position at the full load
+    res.stats["indefinite_at"]              # None, or where the equilibrium became unstable
+
+The solve runs in C++ (cpp/src/statics.cpp): full Newton on the reduced equations at rest with
+the exact tangent stiffness K0 + G0, the load factor λ raised from 0 to 1 in equal steps, a step
+halved when Newton fails in it.
+"""
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from . import _core
+from ._util import show
+from .errors import InputError, SpacarError, StaticError  # noqa: F401  (StaticError: spacar.statics.StaticError)
+from .results import Results
+
+
+def _results(arrays: dict, model) -> Results:
+    load = np.asarray(arrays["load"], dtype=float)
+    x, e = arrays["x"], arrays["e"]
+    rest_x, rest_e = np.zeros_like(x), np.zeros_like(e)
+    table = {"t": load, "x": x, "xd": rest_x, "xdd": rest_x.copy(), "e": e, "ed": rest_e,
+             "edd": rest_e.copy(), "sigma": arrays["sigma"], "reaction": arrays["reaction"]}
+    indefinite = float(arrays["indefinite_at"])
+    stats = {
+        "analysis": "static",
+        "load_reached": float(arrays["load_reached"]),
+        "newton_iterations": int(arrays["newton_iterations"]),
+        "iterations": list(arrays["iterations"]),
+        "step_cuts": int(arrays["step_cuts"]),
+        "kinematic_iterations": int(arrays["kinematic_iterations"]),
+        "indefinite_at": None if np.isnan(indefinite) else indefinite,
+        "wall_time": float(arrays["wall_time"]),
+    }
+    res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
+    res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
+    return res
+
+
+def _count(value, name: str, low: int, high: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not low <= value <= high:
+        raise InputError(f"{name} must be an integer from {low} to {high}, got {show(value)}")
+    return int(value)
+
+
+def static(model, steps: int = 10, *, max_iterations: int = 30, max_cuts: int = 12,
+           tolerance: float = 1e-10) -> Results:
+    """Static equilibrium of the model's current block: the configuration in which the degrees of
+    freedom (DYNX, DYNE) are in equilibrium at rest under the block's loads (FORCE, TORQUEL,
+    GRAVITY, and the prestress of deformations given with E), with the inputs (INPUTX, INPUTE)
+    moved to their values at the end of the block (their XD, XDD over the TIMESTEP period).
+
+    The path starts at the model's current state (the generalized forces R0 that hold it, zero
+    from an unloaded stress-free assembly, are released as (1 − λ) R0), so that a block that
+    continues from the equilibrium of the one before moves gradually from the old loads to the
+    new ones. Loads and inputs are applied together in ``steps`` equal steps of λ; at each
+    step Newton's method with the exact tangent stiffness (structural plus geometric, K0 + G0 of
+    :func:`spacar.linearize`) solves the reduced equations. A step in which Newton fails (or in
+    which the stiffness changes the sign of its determinant: a limit or bifurcation point) is
+    halved, up to ``max_cuts`` times. ``tolerance``: the residual relative to the largest load
+    balanced. No mass is needed.
+
+    Returns :class:`spacar.Results` with one row per load step (``res.t`` holds λ; the last row
+    is the full load): x, e, the complete stresses σ (reaction stresses included) and the
+    reactions, rates and accelerations zero; ``res.stats`` has ``newton_iterations``,
+    ``iterations`` (per row), ``step_cuts``, ``load_reached`` (the last converged load factor),
+    ``kinematic_iterations``, ``wall_time`` and ``indefinite_at`` (the first load factor at
+    which the tangent stiffness is indefinite, i.e. the equilibrium is unstable because a
+    buckling load was passed; None if never, with a warning in ``model.warnings`` otherwise).
+    The model's state is left at the equilibrium, at rest, at the block's start time.
+
+    Raises :class:`spacar.StaticError` if no equilibrium is found (loads beyond a limit point,
+    a degree of freedom without stiffness), with the converged steps as ``err.results``; the
+    model is then not changed.
+    """
+    steps = _count(steps, "steps", 1, 10**7)
+    max_iterations = _count(max_iterations, "max_iterations", 1, 1000)
+    max_cuts = _count(max_cuts, "max_cuts", 0, 50)
+    if isinstance(tolerance, bool) or not isinstance(tolerance, numbers.Real) or not 0 < tolerance < 1:
+        raise InputError(f"tolerance must be a number between 0 and 1, got {show(tolerance)}")
+    try:  # the core prepares the model (the first END) as a simulation does
+        arrays = _core.solve_static(model.core, steps, max_iterations, max_cuts, float(tolerance))
+    except SpacarError as err:
+        partial = getattr(err, "results", None)
+        if isinstance(partial, dict):
+            model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
+            err.results = _results(partial, model)
+        raise
+    model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
+    return _results(arrays, model)
+
+
+def static_blocks(model, **kwargs):
+    """The static equilibrium of every block of the input in order, as ``spacar static`` does:
+    the current block first, then each later block applied to the equilibrium reached (a load
+    history). Yields one :class:`spacar.Results` per block (``kwargs`` go to :func:`static`)."""
+    from .io.reader import apply_block
+
+    for k, block in enumerate(model.blocks or [None]):
+        if k > 0:
+            apply_block(model, block)
+        yield static(model, **kwargs)
