@@ -20,6 +20,7 @@ using namespace spacar;
 void bind_kernels(py::module_& m);
 void bind_integrator(py::module_& m);
 void bind_sparse(py::module_& m);
+void bind_radau(py::module_& m);  // test-only: the Radau IIA integrator
 
 namespace {
 
@@ -619,4 +620,5 @@ PYBIND11_MODULE(_core, m) {
   bind_kernels(m);
   bind_integrator(m);
   bind_sparse(m);
+  bind_radau(m);
 }
