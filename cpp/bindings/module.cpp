@@ -432,6 +432,8 @@ py::dict block_results_to_dict(BlockResults&& r) {
   d["accepted"] = r.accepted;
   d["rejected"] = r.rejected;
   d["newton_iterations"] = r.newton_iterations;
+  d["jacobians"] = r.jacobians;
+  d["decompositions"] = r.decompositions;
   d["last_step"] = r.last_step;
   d["wall_time"] = r.wall_time;
   d["recursive"] = r.recursive;
@@ -570,7 +572,8 @@ void bind_simulation(py::module_& m) {
             opt.initial_step = initial_step;
             if (method == "dop853") opt.method = Method::DOP853;
             else if (method == "dopri5") opt.method = Method::DOPRI5;
-            else throw InputError("unknown integration method '" + method + "' (dop853, dopri5)");
+            else if (method == "radau5") opt.method = Method::RADAU5;
+            else throw InputError("unknown integration method '" + method + "' (dop853, dopri5, radau5)");
             if (!on_output.is_none()) {
               opt.on_output = [on_output](int k, const Data& d, const Linearization* lin) {
                 py::gil_scoped_acquire gil;

@@ -4,11 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
 #include "spacar/limits.hpp"
+#include "spacar/radau5.hpp"
 
 namespace spacar {
 
@@ -451,41 +453,61 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
         if (res.steps >= options.max_steps)
           throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
                                  " steps in the block at t = " + num(t));
-        Integrator integ(static_cast<int>(Y.size()), options.method);
-        Eigen::VectorXd rtol(Y.size());
-        rtol.head(nd + ny).setConstant(st.epsint);
-        rtol.tail(nd).setConstant(st.epsind);
-        integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
-        integ.set_max_step(st.hmax);
-        integ.set_max_steps(options.max_steps - res.steps);
-        if (h > 0.0) integ.set_initial_step(h);
-        // Stop to repartition a free rotation whose dependent Euler parameter became small.
-        if (!sys_->free_rotations.empty())
-          integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
-        integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
-        anchor_.valid = false;
-        const std::vector<double> remaining(times.begin() + k_out, times.end());
-        auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
-        auto add_stats = [&]() {
-          const IntegratorStats& s = integ.stats();
-          res.rhs_evaluations += s.nfev;
-          res.steps += s.nsteps;
-          res.accepted += s.naccept;
-          res.rejected += s.nreject;
+        // One segment with either integrator: the explicit Integrator or the implicit Radau5,
+        // which also needs the Jacobian of the right-hand side (simulate_jacobian.cpp).
+        auto segment = [&](auto& integ) {
+          Eigen::VectorXd rtol(Y.size());
+          rtol.head(nd + ny).setConstant(st.epsint);
+          rtol.tail(nd).setConstant(st.epsind);
+          integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
+          integ.set_max_step(st.hmax);
+          integ.set_max_steps(options.max_steps - res.steps);
+          if (h > 0.0) integ.set_initial_step(h);
+          // Stop to repartition a free rotation whose dependent Euler parameter became small.
+          if (!sys_->free_rotations.empty())
+            integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+          integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
+          anchor_.valid = false;
+          const std::vector<double> remaining(times.begin() + k_out, times.end());
+          auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
+          auto add_stats = [&]() {
+            const auto& s = integ.stats();
+            res.rhs_evaluations += s.nfev;
+            res.steps += s.nsteps;
+            res.accepted += s.naccept;
+            res.rejected += s.nreject;
+            if constexpr (std::is_same_v<std::decay_t<decltype(s)>, Radau5Stats>) {
+              res.jacobians += s.njev;
+              res.decompositions += s.ndec;
+            }
+          };
+          double t_reached = t;
+          try {
+            t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
+          } catch (const IntegrationError& err) {
+            add_stats();
+            explain_collapse(err, Y);
+            throw;
+          } catch (...) {
+            add_stats();
+            throw;
+          }
+          add_stats();
+          res.last_step = integ.last_step();
+          return t_reached;
         };
         double t_reached = t;
-        try {
-          t_reached = integ.integrate(f, t, t_end, Y, remaining, output);
-        } catch (const IntegrationError& err) {
-          add_stats();
-          explain_collapse(err, Y);
-          throw;
-        } catch (...) {
-          add_stats();
-          throw;
+        if (options.method == Method::RADAU5) {
+          Radau5 integ(static_cast<int>(Y.size()));
+          integ.set_jacobian([this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) { jacobian(tt, y, J); });
+          // The Jacobian (a linearization) costs several right-hand sides per DOF: keep it longer.
+          integ.set_jacobian_reuse(0.1);
+          t_reached = segment(integ);
+        } else {
+          Integrator integ(static_cast<int>(Y.size()), options.method);
+          t_reached = segment(integ);
         }
-        add_stats();
-        h = res.last_step = integ.last_step();
+        h = res.last_step;
         if (t_reached >= t_end) break;
         t = t_reached;
         repartition(rotation_to_repartition(Y), t, Y);

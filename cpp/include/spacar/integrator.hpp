@@ -25,7 +25,8 @@ struct IntegrationError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Method { DOP853, DOPRI5 };
+// RADAU5 is the implicit Radau IIA method of radau5.hpp (its own class, not Integrator's).
+enum class Method { DOP853, DOPRI5, RADAU5 };
 
 struct IntegratorStats {
   long nfev = 0, nsteps = 0, naccept = 0, nreject = 0;
