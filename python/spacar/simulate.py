@@ -42,6 +42,10 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     (docs/matasc.md), line by line as the run proceeds; the stem is ``output_stem``, else
     ``model.output_stem``, else the input file name without extension, else ``spacar``.
 
+    ``method``: ``"dop853"`` (default), ``"dopri5"`` or ``"radau5"`` (implicit Radau IIA for stiff
+    systems, its Newton matrix from the linearized equations; ``res.stats`` then also holds
+    ``jacobians`` and ``decompositions``; docs/stiff-integration.md).
+
     ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
     :class:`spacar.TimeLimitError`.
 
