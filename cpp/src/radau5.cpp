@@ -86,7 +86,7 @@ Radau5::Radau5(int n)
   E2_.setZero(n, n);
   lu_real_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n);
   lu_complex_ = Eigen::PartialPivLU<Eigen::MatrixXcd>(n);
-  for (Eigen::VectorXd* v : {&f0_, &scale_, &y_stage_, &y_new_, &y_out_, &err_v_, &tmp_}) v->setZero(n);
+  for (Eigen::VectorXd* v : {&f0_, &scale_, &y_stage_, &y_new_, &y_out_, &err_v_, &dz_, &tmp_}) v->setZero(n);
   ctmp_.setZero(n);
   for (int i = 0; i < 3; ++i)
     for (Eigen::VectorXd* v : {&z_[i], &w_[i], &fz_[i], &poly_[i]}) v->setZero(n);
@@ -225,10 +225,10 @@ Radau5::Attempt Radau5::newton(const Rhs& f, double t, double h, const Eigen::Ve
     // Right-hand sides of the transformed system, T^-1 F(Z) - Λ W / h; the increments of W
     // then overwrite fz_.
     tmp_ = tb.TI(0, 0) * fz_[0] + tb.TI(0, 1) * fz_[1] + tb.TI(0, 2) * fz_[2] - (tb.L(0, 0) / h) * w_[0];
-    const Eigen::VectorXd g1 = tb.TI(1, 0) * fz_[0] + tb.TI(1, 1) * fz_[1] + tb.TI(1, 2) * fz_[2];
-    const Eigen::VectorXd g2 = tb.TI(2, 0) * fz_[0] + tb.TI(2, 1) * fz_[1] + tb.TI(2, 2) * fz_[2];
-    ctmp_.real() = g1 - (tb.L(1, 1) * w_[1] + tb.L(1, 2) * w_[2]) / h;
-    ctmp_.imag() = g2 - (tb.L(2, 1) * w_[1] + tb.L(2, 2) * w_[2]) / h;
+    ctmp_.real() = tb.TI(1, 0) * fz_[0] + tb.TI(1, 1) * fz_[1] + tb.TI(1, 2) * fz_[2] -
+                   (tb.L(1, 1) * w_[1] + tb.L(1, 2) * w_[2]) / h;
+    ctmp_.imag() = tb.TI(2, 0) * fz_[0] + tb.TI(2, 1) * fz_[1] + tb.TI(2, 2) * fz_[2] -
+                   (tb.L(2, 1) * w_[1] + tb.L(2, 2) * w_[2]) / h;
     fz_[0] = lu_real_.solve(tmp_);
     ctmp_ = lu_complex_.solve(ctmp_);
     fz_[1] = ctmp_.real();
@@ -273,14 +273,14 @@ bool Radau5::estimate_error(const Rhs& f, double t, double h, const Eigen::Vecto
   const Tableau& tb = tableau();
   y_new_ = y + z_[2];
   scale_ = atol_.array() + rtol_.array() * y.array().abs().max(y_new_.array().abs());
-  const Eigen::VectorXd dz = (tb.d[0] * z_[0] + tb.d[1] * z_[1] + tb.d[2] * z_[2]) / h;
-  tmp_ = f0_ + dz;
+  dz_ = (tb.d[0] * z_[0] + tb.d[1] * z_[1] + tb.d[2] * z_[2]) / h;
+  tmp_ = f0_ + dz_;
   err_v_ = lu_real_.solve(tmp_);
   err_ = std::max(scaled_rms(err_v_, scale_), kMinError);
   if (err_ >= 1.0 && refine) {
     y_stage_ = y + err_v_;
     if (!eval(f, t, y_stage_, tmp_)) return false;
-    tmp_ += dz;
+    tmp_ += dz_;
     err_v_ = lu_real_.solve(tmp_);
     err_ = std::max(scaled_rms(err_v_, scale_), kMinError);
   }
@@ -307,11 +307,13 @@ Radau5::Attempt Radau5::attempt_step(const Rhs& f, double t, double h, const Eig
 void Radau5::build_polynomial() {
   const Tableau& tb = tableau();
   const double c1 = tb.c[0], c2 = tb.c[1];
-  poly_[0] = (z_[1] - z_[2]) / (c2 - 1.0);                        // u[0, c2-1]
-  const Eigen::VectorXd d21 = (z_[0] - z_[1]) / (c1 - c2);        // u[c2-1, c1-1]
-  const Eigen::VectorXd d10 = z_[0] / c1;                         // u[c1-1, -1]
-  poly_[1] = (poly_[0] - d21) / (1.0 - c1);                       // u[0, c2-1, c1-1]
-  poly_[2] = poly_[1] - (d21 - d10) / c2;                         // u[0, c2-1, c1-1, -1]
+  Eigen::VectorXd& d21 = y_stage_;  // work space
+  Eigen::VectorXd& d10 = err_v_;
+  poly_[0] = (z_[1] - z_[2]) / (c2 - 1.0);   // u[0, c2-1]
+  d21 = (z_[0] - z_[1]) / (c1 - c2);         // u[c2-1, c1-1]
+  d10 = z_[0] / c1;                          // u[c1-1, -1]
+  poly_[1] = (poly_[0] - d21) / (1.0 - c1);  // u[0, c2-1, c1-1]
+  poly_[2] = poly_[1] - (d21 - d10) / c2;    // u[0, c2-1, c1-1, -1]
 }
 
 void Radau5::polynomial_value(double s) {

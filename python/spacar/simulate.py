@@ -67,7 +67,7 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     if on_output is not None and not callable(on_output):
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
     if not isinstance(method, str):
-        raise InputError(f"method must be 'dop853', 'dopri5' or 'radau5', got {show(method)}")
+        raise InputError(f"method must be 'dop853' or 'dopri5' (explicit) or 'radau5' (implicit), got {show(method)}")
     if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
     model.prepare()

@@ -9,6 +9,7 @@ import pytest
 
 import spacar
 from spacar.compare import models
+from support.spatial_models import G_, tighten
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
 
@@ -92,3 +93,63 @@ def test_cli_and_sweep_accept_radau5(capsys):
                        outputs={"jacobians": lambda res: res.stats["jacobians"]}, workers=1, progress=False)
     assert not out.errors
     assert (out["jacobians"] > 0).all()
+
+
+def incline_wheel(eps):
+    """A wheel (PLWHEEL 2, spin DYNX 5) rolling down an incline, its centre held by PLBEAR 1 from
+    the ground whose e1, e2 are the kinematic coordinates of the slips (ENHC), heading fixed."""
+    m = spacar.Model()
+    m.plbear(1, 1, 2, 3, 4)
+    m.plwheel(2, 3, 4, 5, 0.4, 0.0, 1.0)
+    m.xy(3, 0.0, 0.0)
+    m.fix(1)
+    m.fix(2)
+    m.e(1, 3, 0.3)
+    m.enhc(2, 1, 1, 1)
+    m.enhc(2, 2, 1, 2)
+    m.dynx(5)
+    m.mass(3, 2.0)
+    m.mass(5, 0.11)
+    m.gravity(3.0, -1.0)
+    m.timestep(10, 2.0)
+    m.forcemode(1)  # complete stresses (the contact forces of the wheel) at the output times
+    for set_eps in (m.epsint, m.epsind):
+        set_eps(eps)
+    m.epskin(1e-12)
+    return m
+
+
+def test_nonholonomic_wheel_agrees_with_dop853():
+    # ENHC: the kinematic coordinates of the slips are states; their rows and columns of the
+    # Jacobian come from Kk, AK0 and BK0.
+    ref = spacar.simulate(incline_wheel(1e-10), progress=False)
+    res = spacar.simulate(incline_wheel(1e-8), method="radau5", progress=False)
+    assert np.abs(res.x - ref.x).max() < 1e-9
+    assert np.abs(res.e - ref.e).max() < 1e-9
+    assert np.abs(ref.sigma).max() > 0
+    assert np.abs(res.sigma - ref.sigma).max() < 1e-8 * np.abs(ref.sigma).max()
+
+
+def free_body(period, n_out):
+    """A rigid body on LAMBDA node 1 (full inertia tensor, body-fixed torque), tumbling: every
+    Euler parameter changes sign, so the dependent one is re-partitioned during the run."""
+    lam0 = np.array([0.6, -0.2, 0.5, 0.4]) / np.linalg.norm([0.6, -0.2, 0.5, 0.4])
+    w0 = np.array([0.5, -1.0, 2.0])
+    m = spacar.Model()
+    m.lambda_(1, *lam0)
+    m.mass(1, 2.0, 0.1, -0.2, 3.0, 0.3, 4.0)
+    m.dynx(1)
+    m.torquel(1, 0.3, -0.2, 0.5)
+    for i, v in enumerate(0.5 * G_(lam0).T @ w0):
+        m.xd(1, i + 1, v)
+    m.timestep(n_out, period)
+    return tighten(m)
+
+
+def test_free_rotation_with_repartitions_agrees_with_dop853():
+    # Every re-partition ends a segment and starts a new Radau integration.
+    ref = spacar.simulate(free_body(10.0, 50), progress=False)
+    res = spacar.simulate(free_body(10.0, 50), method="radau5", progress=False)
+    signs = np.sign(res.node(1).x)
+    assert all(np.count_nonzero(np.diff(signs[:, i])) >= 2 for i in range(4))
+    assert np.abs(res.x - ref.x).max() < 1e-7

@@ -98,7 +98,7 @@ class Radau5 {
   Eigen::MatrixXcd E2_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_real_;
   Eigen::PartialPivLU<Eigen::MatrixXcd> lu_complex_;
-  Eigen::VectorXd f0_, scale_, y_stage_, y_new_, y_out_, err_v_, tmp_;
+  Eigen::VectorXd f0_, scale_, y_stage_, y_new_, y_out_, err_v_, dz_, tmp_;
   Eigen::VectorXcd ctmp_;
   Eigen::VectorXd z_[3], w_[3], fz_[3], poly_[3];
 };
