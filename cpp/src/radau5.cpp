@@ -409,8 +409,10 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
       if (result == Attempt::ErrorTooLarge) h = first ? 0.1 * h_try : h_try / quot;
       else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
       else h = 0.5 * h_try;
-      // A Jacobian from an earlier state may be the reason: take it afresh at this state.
-      need_jacobian = !jacobian_fresh;
+      // A Jacobian from an earlier state may be why Newton failed: take it afresh at this state.
+      // (Hairer's code renews it after any rejection; a step rejected for its error had converged,
+      // and here a Jacobian is a linearization costing several right-hand sides per DOF.)
+      need_jacobian = !jacobian_fresh && result != Attempt::ErrorTooLarge;
       continue;
     }
 
