@@ -27,6 +27,8 @@ py::dict block_results_to_dict(BlockResults&& r) {
   d["last_step"] = r.last_step;
   d["wall_time"] = r.wall_time;
   d["recursive"] = r.recursive;
+  d["jacobians"] = r.jacobians;
+  d["decompositions"] = r.decompositions;
   d["warnings"] = r.warnings;
   return d;
 }

@@ -18,7 +18,8 @@ namespace spacar {
 Method parse_method(const std::string& name) {
   if (name == "dop853") return Method::DOP853;
   if (name == "dopri5") return Method::DOPRI5;
-  throw InputError("unknown integration method '" + name + "' (dop853, dopri5)");
+  if (name == "radau5") return Method::RADAU5;
+  throw InputError("unknown integration method '" + name + "' (dop853, dopri5, radau5)");
 }
 
 namespace {
@@ -209,6 +210,7 @@ Integrator::Integrator(int n, Method method)
       atol_(Eigen::VectorXd::Constant(std::max(n, 0), 1e-6)),
       hmax_(std::numeric_limits<double>::infinity()) {
   if (n < 1) throw std::invalid_argument("Integrator: the system needs at least one state");
+  if (method == Method::RADAU5) throw std::invalid_argument("Integrator: RADAU5 is the class Radau5");
   const Scheme& sc = scheme(method);
   k_.assign(sc.total, Eigen::VectorXd::Zero(n));
   dense_.assign(3 + sc.dense_rows, Eigen::VectorXd::Zero(n));

@@ -4,12 +4,14 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include "spacar/diagnosis.hpp"
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
 #include "spacar/limits.hpp"
+#include "spacar/radau5.hpp"
 
 namespace spacar {
 
@@ -513,8 +515,24 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
 double Simulation::integrate_segment(BlockResults& res, const RunOptions& options, const Settings& st, double t,
                                      double t_end, double h, Eigen::VectorXd& Y, const std::vector<double>& times,
                                      const Integrator::Output& output) {
-  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  if (options.method == Method::RADAU5) {
+    Radau5 integ(static_cast<int>(Y.size()));
+    integ.set_jacobian([this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) { jacobian(tt, y, J); });
+    // The Jacobian (a linearization) costs several right-hand sides per DOF: keep it longer.
+    integ.set_jacobian_reuse(0.1);
+    return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
+  }
   Integrator integ(static_cast<int>(Y.size()), options.method);
+  return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
+}
+
+// One segment with either integrator (the explicit Integrator or the implicit Radau5, which have
+// the same interface).
+template <class Integ>
+double Simulation::run_segment(Integ& integ, BlockResults& res, const RunOptions& options, const Settings& st,
+                               double t, double t_end, double h, Eigen::VectorXd& Y,
+                               const std::vector<double>& times, const Integrator::Output& output) {
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   Eigen::VectorXd rtol(Y.size());
   rtol.head(nd + ny).setConstant(st.epsint);
   rtol.tail(nd).setConstant(st.epsind);
@@ -529,11 +547,15 @@ double Simulation::integrate_segment(BlockResults& res, const RunOptions& option
   anchor_.valid = false;
   auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
   auto add_stats = [&]() {
-    const IntegratorStats& s = integ.stats();
+    const auto& s = integ.stats();
     res.rhs_evaluations += s.nfev;
     res.steps += s.nsteps;
     res.accepted += s.naccept;
     res.rejected += s.nreject;
+    if constexpr (std::is_same_v<Integ, Radau5>) {
+      res.jacobians += s.njev;
+      res.decompositions += s.ndec;
+    }
   };
   double t_reached = t;
   try {

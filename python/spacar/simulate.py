@@ -11,9 +11,11 @@ from .linearize import Linearization
 from .results import Results
 
 
-def _results(arrays: dict, system, model) -> Results:
+def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
                                     "newton_iterations", "wall_time", "recursive")}
+    if method == "radau5":  # the implicit method's work: Jacobians (linearizations), LU factorizations
+        stats.update(jacobians=arrays["jacobians"], decompositions=arrays["decompositions"])
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
     res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear)
     res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
@@ -40,6 +42,10 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     (docs/matasc.md), line by line as the run proceeds; the stem is ``output_stem``, else
     ``model.output_stem``, else the input file name without extension, else ``spacar``.
 
+    ``method``: ``"dop853"`` (default), ``"dopri5"`` or ``"radau5"`` (implicit Radau IIA for stiff
+    systems, its Newton matrix from the linearized equations; ``res.stats`` then also holds
+    ``jacobians`` and ``decompositions``; docs/stiff-integration.md).
+
     ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
     :class:`spacar.TimeLimitError`.
 
@@ -61,7 +67,7 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     if on_output is not None and not callable(on_output):
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
     if not isinstance(method, str):
-        raise InputError(f"method must be 'dop853' or 'dopri5', got {show(method)}")
+        raise InputError(f"method must be 'dop853' or 'dopri5' (explicit) or 'radau5' (implicit), got {show(method)}")
     if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
     sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
@@ -104,7 +110,7 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):
             model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
-            err.results = _results(partial, sim.system, model)
+            err.results = _results(partial, sim.system, model, method)
         raise
     finally:
         if writer is not None:
@@ -113,4 +119,4 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
             bar.close()
     model._continue_step = arrays["last_step"]
     model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    return _results(arrays, sim.system, model)
+    return _results(arrays, sim.system, model, method)

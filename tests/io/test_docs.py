@@ -23,7 +23,7 @@ MANUAL_ELEMENTS = {name: n_deformations for name, (_, n_deformations, _) in ELEM
 # Manual §5.2-5.6: every other keyword.
 MANUAL_KEYWORDS = KEYWORDS
 HAND_WRITTEN = ["index.md", "getting-started.md", "input-format.md", "python-api.md", "formulation.md",
-                "matasc.md", "performance.md"]
+                "matasc.md", "performance.md", "stiff-integration.md"]
 README_COMMANDS = [
     'python3 -m venv .venv && . .venv/bin/activate && pip install . && spacar run examples/slidercrank.dat',
     'python3 -m venv .venv && . .venv/bin/activate && pip install ".[test]" && pytest',

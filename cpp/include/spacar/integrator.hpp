@@ -25,8 +25,9 @@ struct IntegrationError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Method { DOP853, DOPRI5 };
-// The method of its name ("dop853", "dopri5"), the one parser of every entry point;
+// RADAU5 is the implicit Radau IIA method of radau5.hpp (its own class, not Integrator's).
+enum class Method { DOP853, DOPRI5, RADAU5 };
+// The method of its name ("dop853", "dopri5", "radau5"), the one parser of every entry point;
 // InputError for any other name.
 Method parse_method(const std::string& name);
 

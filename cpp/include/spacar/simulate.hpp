@@ -50,6 +50,7 @@ struct BlockResults {
   RowMatrix reaction;          // nt x nx: reactions on fixed and input coordinates (FORCEMODE ≥ 1)
   std::vector<Linearization> linearizations;  // at every output time if LINE or LINEAR ≥ 1
   long rhs_evaluations = 0, steps = 0, accepted = 0, rejected = 0, newton_iterations = 0;
+  long jacobians = 0, decompositions = 0;  // implicit method (RADAU5) only
   double last_step = 0.0;
   double wall_time = 0.0;      // seconds spent in the block
   bool recursive = false;      // the right-hand sides took the recursive path (tree.hpp)
@@ -108,6 +109,8 @@ class Simulation {
   void evaluate_state(double t, const Eigen::VectorXd& Y);
   // Right-hand side of the first-order system Y = (q, y, q̇).
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
+  // Its Jacobian ∂(q̇, ẏ, q̈)/∂(q, y, q̇) at (t, Y) from the linearized equations (simulate_jacobian.cpp).
+  void jacobian(double t, const Eigen::VectorXd& Y, Eigen::MatrixXd& J);
   // The state at (q, q̇) by the recursive path: q̈ and the coordinates' positions, velocities and
   // accelerations; false (nothing written) if the system is not a planar tree of rigid bodies or
   // a body moves no mass. The tree is taken at the solved state of the first call (after
@@ -153,6 +156,10 @@ class Simulation {
   double integrate_segment(BlockResults& res, const RunOptions& options, const Settings& st, double t, double t_end,
                            double h, Eigen::VectorXd& Y, const std::vector<double>& times,
                            const Integrator::Output& output);
+  template <class Integ>
+  double run_segment(Integ& integ, BlockResults& res, const RunOptions& options, const Settings& st, double t,
+                     double t_end, double h, Eigen::VectorXd& Y, const std::vector<double>& times,
+                     const Integrator::Output& output);
   void record(BlockResults& res, int k);
   // InputError unless q and q̇ have one value per degree of freedom (`what`: the entry point).
   void require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;

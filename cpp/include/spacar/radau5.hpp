@@ -1,0 +1,106 @@
+// Implicit Runge-Kutta integration for stiff systems: Radau IIA of order 5 (three stages) with
+// step-size control, simplified Newton iterations and dense output in the manner of Hairer's
+// RADAU5 (E. Hairer, G. Wanner, "Solving Ordinary Differential Equations II", Sec. IV.8).
+//
+// The interface has the shape of Integrator (integrator.hpp), so that the analysis can drive
+// either: tolerances per component, maximum step, step limit, initial step, stop condition and
+// step-start callback, integrate() with dense output at the output times. In addition the
+// Jacobian ∂f/∂y comes from a user callback (dense), evaluated at accepted states only and reused
+// over steps while the Newton iterations converge well; the factorizations of the Newton matrix
+// are reused while the step size stays put.
+#pragma once
+
+#include <Eigen/Dense>
+#include <complex>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "spacar/integrator.hpp"
+
+namespace spacar {
+
+struct Radau5Stats {
+  long nfev = 0, nsteps = 0, naccept = 0, nreject = 0;
+  long njev = 0;      // Jacobian evaluations
+  long ndec = 0;      // factorizations of the Newton matrix (one real and one complex each)
+  long nnewton = 0;   // simplified Newton iterations (three rhs and two solves each)
+};
+
+class Radau5 {
+ public:
+  using Rhs = Integrator::Rhs;
+  using Output = Integrator::Output;
+  using StopCondition = Integrator::StopCondition;
+  using StepStart = Integrator::StepStart;
+  // J = ∂f/∂y at (t, y), n x n. May throw StepRejected like the rhs.
+  using Jacobian = std::function<void(double t, const Eigen::VectorXd& y, Eigen::MatrixXd& J)>;
+
+  explicit Radau5(int n);
+
+  // Per component, as for Integrator. Internally the tolerances are mapped as in Hairer's code,
+  // rtol' = 0.1 rtol^(2/3), atol' = atol rtol'/rtol: the error estimate is that of an embedded
+  // third-order formula, and this mapping makes the global error about rtol.
+  void set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol);
+  void set_max_step(double hmax);
+  void set_max_steps(long n);
+  void set_initial_step(double h);  // 0 = automatic
+  double last_step() const;
+  void set_stop_condition(StopCondition stop);
+  void set_step_start(StepStart start);
+  void set_jacobian(Jacobian jac);  // required before integrate()
+  // The Jacobian is kept for the next step when the Newton contraction rate of the step was at
+  // most this (Hairer's default 0.001; about 0.1 when the Jacobian is expensive).
+  void set_jacobian_reuse(double theta);
+
+  // As Integrator::integrate: y(t0) -> y(t_end) with out(t_k, y(t_k)) at the output times from
+  // the collocation polynomial of the step containing t_k.
+  double integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
+                   const std::vector<double>& touts, const Output& out);
+
+  const Radau5Stats& stats() const;  // cumulative over all integrate calls
+
+ private:
+  enum class Attempt { Accepted, ErrorTooLarge, SlowNewton, Failed };
+
+  bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
+  double initial_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y);
+  void factorize(double h);
+  void starting_values(double h);
+  Attempt newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y);
+  bool estimate_error(const Rhs& f, double t, double h, const Eigen::VectorXd& y, bool refine);
+  Attempt attempt_step(const Rhs& f, double t, double h, const Eigen::VectorXd& y, bool refine);
+  void build_polynomial();
+  void polynomial_value(double s);  // y_out_ = u(t_new + s h_old), s in [-1, 0]
+  size_t emit_outputs(const std::vector<double>& touts, size_t next, double t_new, const Output& out);
+
+  int n_;
+  Eigen::VectorXd rtol_, atol_;   // mapped tolerances
+  double fnewt_ = 0.03;           // Newton stopping criterion (scaled norm of the increment)
+  double theta_reuse_ = 0.001;
+  double hmax_;
+  long max_steps_ = Integrator::kMaxSteps;
+  double h_initial_ = 0.0, h_last_ = 0.0;
+  StopCondition stop_;
+  StepStart step_start_;
+  Jacobian jac_;
+  Radau5Stats stats_;
+  std::string failure_;
+
+  // Newton state carried between steps (Hairer's FACCON and THETA).
+  double faccon_ = 1.0, theta_ = 0.0, err_ = 0.0, slow_factor_ = 0.5;
+  int newton_its_ = 0;
+  bool have_polynomial_ = false;  // a previous step's collocation polynomial predicts Z
+  double h_old_ = 0.0, t_new_ = 0.0;
+
+  // Work space, allocated once.
+  Eigen::MatrixXd J_, E1_;
+  Eigen::MatrixXcd E2_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_real_;
+  Eigen::PartialPivLU<Eigen::MatrixXcd> lu_complex_;
+  Eigen::VectorXd f0_, scale_, y_stage_, y_new_, y_out_, err_v_, dz_, tmp_;
+  Eigen::VectorXcd ctmp_;
+  Eigen::VectorXd z_[3], w_[3], fz_[3], poly_[3];
+};
+
+}  // namespace spacar

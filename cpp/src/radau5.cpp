@@ -1,0 +1,453 @@
+// Radau IIA of order 5 (see radau5.hpp). The stage equations Z - h (A ⊗ I) F(Z) = 0 for the stage
+// increments Z = (z1, z2, z3) are solved by simplified Newton iterations with the Jacobian J of the
+// step start. Multiplied by (h A)^-1 and transformed with the eigenvectors T of A^-1
+// (T^-1 A^-1 T = Λ: one real eigenvalue γ and a complex pair α ± iβ) the Newton system falls
+// apart into one real system (γ/h - J) and one complex system ((α + iβ)/h - J) of size n.
+// Step-size control: Hairer's error estimate (the embedded third-order formula filtered by
+// (γ/h - J)^-1, which keeps it bounded for stiff components) with the predictive (Gustafsson)
+// controller; the Newton iterations also reject steps whose convergence is too slow.
+#include "spacar/radau5.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace spacar {
+namespace {
+
+// Radau IIA nodes, the transformation T, its inverse and Λ = T^-1 A^-1 T.
+struct Tableau {
+  double c[3];
+  Eigen::Matrix3d T, TI, L;
+  // Error estimate: y_embedded - y_new = (h/γ) f(t, y) + Σ e_i z_i with e = d/γ below, i.e.
+  // err = (γ/h - J)^-1 (f(t, y) + Σ d_i z_i / h) (Hairer & Wanner IV.8, (8.19)-(8.20)).
+  double d[3];
+};
+
+Tableau make_tableau() {
+  Tableau tb;
+  const double s6 = std::sqrt(6.0);
+  tb.c[0] = (4.0 - s6) / 10.0;
+  tb.c[1] = (4.0 + s6) / 10.0;
+  tb.c[2] = 1.0;
+  Eigen::Matrix3d A;
+  A << (88.0 - 7.0 * s6) / 360.0, (296.0 - 169.0 * s6) / 1800.0, (-2.0 + 3.0 * s6) / 225.0,
+      (296.0 + 169.0 * s6) / 1800.0, (88.0 + 7.0 * s6) / 360.0, (-2.0 - 3.0 * s6) / 225.0,
+      (16.0 - s6) / 36.0, (16.0 + s6) / 36.0, 1.0 / 9.0;
+  const Eigen::Matrix3d Ainv = A.inverse();
+  const Eigen::EigenSolver<Eigen::Matrix3d> es(Ainv);
+  int real = 0, complex = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(es.eigenvalues()[i].imag()) < 1e-12) real = i;
+    else if (es.eigenvalues()[i].imag() > 0) complex = i;
+  }
+  tb.T.col(0) = es.eigenvectors().col(real).real();
+  tb.T.col(1) = es.eigenvectors().col(complex).real();
+  tb.T.col(2) = es.eigenvectors().col(complex).imag();
+  tb.TI = tb.T.inverse();
+  tb.L = tb.TI * Ainv * tb.T;  // [[γ, 0, 0], [0, α, β], [0, -β, α]] up to round-off
+  tb.d[0] = -(13.0 + 7.0 * s6) / 3.0;
+  tb.d[1] = (-13.0 + 7.0 * s6) / 3.0;
+  tb.d[2] = -1.0 / 3.0;
+  return tb;
+}
+
+const Tableau& tableau() {
+  static const Tableau tb = make_tableau();
+  return tb;
+}
+
+constexpr int kMaxNewton = 7;       // Hairer's NIT
+constexpr double kSafety = 0.9;
+constexpr double kMinError = 1e-10;
+const double kRound = std::numeric_limits<double>::epsilon();
+
+std::string describe(double t, double h) {
+  std::ostringstream s;
+  s.precision(12);
+  s << "t = " << t << ", step size h = " << h;
+  return s.str();
+}
+
+double scaled_rms(const Eigen::VectorXd& v, const Eigen::VectorXd& scale) {
+  return std::sqrt((v.array() / scale.array()).square().sum() / static_cast<double>(v.size()));
+}
+
+}  // namespace
+
+Radau5::Radau5(int n)
+    : n_(n), hmax_(std::numeric_limits<double>::infinity()) {
+  if (n < 1) throw std::invalid_argument("Radau5: the system needs at least one state");
+  set_tolerances(Eigen::VectorXd::Constant(n, 1e-6), Eigen::VectorXd::Constant(n, 1e-6));
+  J_.setZero(n, n);
+  E1_.setZero(n, n);
+  E2_.setZero(n, n);
+  lu_real_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n);
+  lu_complex_ = Eigen::PartialPivLU<Eigen::MatrixXcd>(n);
+  for (Eigen::VectorXd* v : {&f0_, &scale_, &y_stage_, &y_new_, &y_out_, &err_v_, &dz_, &tmp_}) v->setZero(n);
+  ctmp_.setZero(n);
+  for (int i = 0; i < 3; ++i)
+    for (Eigen::VectorXd* v : {&z_[i], &w_[i], &fz_[i], &poly_[i]}) v->setZero(n);
+  failure_.reserve(256);
+}
+
+void Radau5::set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
+  if (rtol.size() != n_ || atol.size() != n_)
+    throw std::invalid_argument("Radau5: tolerances need one entry per state");
+  Eigen::VectorXd r(n_), a(n_);
+  double rmin = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n_; ++i) {
+    const bool valid = std::isfinite(rtol[i]) && std::isfinite(atol[i]) && rtol[i] >= 0 &&
+                       atol[i] >= 0 && rtol[i] + atol[i] > 0;
+    if (!valid)
+      throw std::invalid_argument(
+          "Radau5: tolerances must be finite, non-negative and not both zero (state " +
+          std::to_string(i) + ")");
+    if (rtol[i] > 0) {
+      r[i] = 0.1 * std::pow(rtol[i], 2.0 / 3.0);
+      a[i] = atol[i] * r[i] / rtol[i];
+      rmin = std::min(rmin, r[i]);
+    } else {
+      r[i] = 0.0;
+      a[i] = atol[i];
+    }
+  }
+  rtol_ = r;
+  atol_ = a;
+  // Hairer's default stopping criterion of the Newton iterations.
+  const double tol = std::isfinite(rmin) ? rmin : 1e-6;
+  fnewt_ = std::max(10.0 * kRound / tol, std::min(0.03, std::sqrt(tol)));
+}
+
+void Radau5::set_max_step(double hmax) {
+  if (!(hmax > 0)) throw std::invalid_argument("Radau5: the maximum step must be positive");
+  hmax_ = hmax;
+}
+
+void Radau5::set_max_steps(long n) {
+  if (n < 1) throw std::invalid_argument("Radau5: the step limit must be positive");
+  max_steps_ = n;
+}
+
+void Radau5::set_initial_step(double h) {
+  if (!(h >= 0) || !std::isfinite(h))
+    throw std::invalid_argument("Radau5: the initial step must be finite and >= 0");
+  h_initial_ = h;
+}
+
+double Radau5::last_step() const { return h_last_; }
+void Radau5::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
+void Radau5::set_step_start(StepStart start) { step_start_ = std::move(start); }
+void Radau5::set_jacobian(Jacobian jac) { jac_ = std::move(jac); }
+
+void Radau5::set_jacobian_reuse(double theta) {
+  if (!(theta > 0 && theta < 1)) throw std::invalid_argument("Radau5: the reuse threshold must be in (0, 1)");
+  theta_reuse_ = theta;
+}
+
+const Radau5Stats& Radau5::stats() const { return stats_; }
+
+bool Radau5::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
+  ++stats_.nfev;
+  f(t, y, dy);
+  if (dy.size() != n_)
+    throw std::invalid_argument("Radau5: the rhs returned " + std::to_string(dy.size()) + " derivatives for " +
+                                std::to_string(n_) + " states");
+  if (dy.allFinite()) return true;
+  failure_ = "non-finite rhs value";
+  return false;
+}
+
+// Hairer's starting step estimate (as Integrator's) for a method of order 5; uses f0_.
+double Radau5::initial_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y) {
+  const double span = std::min(hmax_, t_end - t0);
+  scale_ = atol_.array() + rtol_.array() * y.array().abs();
+  const double d0 = scaled_rms(y, scale_), d1 = scaled_rms(f0_, scale_);
+  const double h0 = std::min((d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1, span);
+  y_stage_ = y + h0 * f0_;
+  try {
+    if (!eval(f, t0 + h0, y_stage_, tmp_)) return h0;
+  } catch (const StepRejected&) {
+    return h0;
+  }
+  const double d2 = scaled_rms(tmp_ - f0_, scale_) / h0;
+  const double dmax = std::max(d1, d2);
+  const double h1 = dmax <= 1e-15 ? std::max(1e-6, 1e-3 * h0) : std::pow(0.01 / dmax, 1.0 / 6.0);
+  return std::min({100.0 * h0, h1, span});
+}
+
+// The real matrix γ/h - J and the complex one (α + iβ)/h - J, factorized.
+void Radau5::factorize(double h) {
+  const Tableau& tb = tableau();
+  E1_ = -J_;
+  E1_.diagonal().array() += tb.L(0, 0) / h;
+  lu_real_.compute(E1_);
+  E2_ = -J_.cast<std::complex<double>>();
+  E2_.diagonal().array() += std::complex<double>(tb.L(1, 1), tb.L(2, 1)) / h;
+  lu_complex_.compute(E2_);
+  ++stats_.ndec;
+}
+
+// Starting values of the Newton iterations: zero, or the previous step's collocation polynomial
+// extrapolated to the new stage times (Hairer's STARTN = false).
+void Radau5::starting_values(double h) {
+  const Tableau& tb = tableau();
+  for (int i = 0; i < 3; ++i) {
+    if (!have_polynomial_) {
+      z_[i].setZero();
+      continue;
+    }
+    const double s = tb.c[i] * h / h_old_;
+    z_[i] = s * (poly_[0] + (s - (tb.c[1] - 1.0)) * (poly_[1] + (s - (tb.c[0] - 1.0)) * poly_[2]));
+  }
+  for (int j = 0; j < 3; ++j) w_[j] = tb.TI(j, 0) * z_[0] + tb.TI(j, 1) * z_[1] + tb.TI(j, 2) * z_[2];
+}
+
+// Simplified Newton iterations for Z at (t, y) with step h (factorizations for h in place):
+// Accepted when converged, SlowNewton when the convergence is too slow for the step
+// (slow_factor_ proposes the reduction), Failed when diverging or failing.
+Radau5::Attempt Radau5::newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y) {
+  const Tableau& tb = tableau();
+  scale_ = atol_.array() + rtol_.array() * y.array().abs();
+  starting_values(h);
+  faccon_ = std::pow(std::max(faccon_, kRound), 0.8);
+  theta_ = theta_reuse_;
+  double dyno_old = 0.0, thq_old = 0.0;
+  for (int it = 1; it <= kMaxNewton; ++it) {
+    ++stats_.nnewton;
+    newton_its_ = it;
+    for (int i = 0; i < 3; ++i) {
+      y_stage_ = y + z_[i];
+      if (!eval(f, t + tb.c[i] * h, y_stage_, fz_[i])) return Attempt::Failed;
+    }
+    // Right-hand sides of the transformed system, T^-1 F(Z) - Λ W / h; the increments of W
+    // then overwrite fz_.
+    tmp_ = tb.TI(0, 0) * fz_[0] + tb.TI(0, 1) * fz_[1] + tb.TI(0, 2) * fz_[2] - (tb.L(0, 0) / h) * w_[0];
+    ctmp_.real() = tb.TI(1, 0) * fz_[0] + tb.TI(1, 1) * fz_[1] + tb.TI(1, 2) * fz_[2] -
+                   (tb.L(1, 1) * w_[1] + tb.L(1, 2) * w_[2]) / h;
+    ctmp_.imag() = tb.TI(2, 0) * fz_[0] + tb.TI(2, 1) * fz_[1] + tb.TI(2, 2) * fz_[2] -
+                   (tb.L(2, 1) * w_[1] + tb.L(2, 2) * w_[2]) / h;
+    fz_[0] = lu_real_.solve(tmp_);
+    ctmp_ = lu_complex_.solve(ctmp_);
+    fz_[1] = ctmp_.real();
+    fz_[2] = ctmp_.imag();
+    if (!(fz_[0].allFinite() && fz_[1].allFinite() && fz_[2].allFinite())) {
+      failure_ = "singular Newton matrix";
+      return Attempt::Failed;
+    }
+    double sum = 0.0;
+    for (int j = 0; j < 3; ++j) sum += (fz_[j].array() / scale_.array()).square().sum();
+    const double dyno = std::sqrt(sum / (3.0 * n_));
+    if (it > 1 && it < kMaxNewton) {
+      const double thq = dyno / dyno_old;
+      theta_ = it == 2 ? thq : std::sqrt(thq * thq_old);
+      thq_old = thq;
+      if (!(theta_ < 0.99)) {
+        failure_ = "Newton iterations diverge";
+        return Attempt::Failed;
+      }
+      faccon_ = theta_ / (1.0 - theta_);
+      const double predicted = faccon_ * dyno * std::pow(theta_, kMaxNewton - 1 - it) / fnewt_;
+      if (predicted >= 1.0) {
+        // Not converged within the allowed iterations: a smaller step converges faster.
+        const double q = std::clamp(predicted, 1e-4, 20.0);
+        slow_factor_ = 0.8 * std::pow(q, -1.0 / (4.0 + kMaxNewton - 1 - it));
+        failure_ = "Newton iterations converge too slowly";
+        return Attempt::SlowNewton;
+      }
+    }
+    dyno_old = std::max(dyno, kRound);
+    for (int j = 0; j < 3; ++j) w_[j] += fz_[j];
+    for (int i = 0; i < 3; ++i) z_[i] = tb.T(i, 0) * w_[0] + tb.T(i, 1) * w_[1] + tb.T(i, 2) * w_[2];
+    if (faccon_ * dyno <= fnewt_) return Attempt::Accepted;
+  }
+  failure_ = "Newton iterations did not converge";
+  return Attempt::Failed;
+}
+
+// err_ = scaled norm of the filtered error estimate; with `refine` (first step, or after a
+// rejection) a large estimate is improved once by one more filtering through f (Hairer).
+bool Radau5::estimate_error(const Rhs& f, double t, double h, const Eigen::VectorXd& y, bool refine) {
+  const Tableau& tb = tableau();
+  y_new_ = y + z_[2];
+  scale_ = atol_.array() + rtol_.array() * y.array().abs().max(y_new_.array().abs());
+  dz_ = (tb.d[0] * z_[0] + tb.d[1] * z_[1] + tb.d[2] * z_[2]) / h;
+  tmp_ = f0_ + dz_;
+  err_v_ = lu_real_.solve(tmp_);
+  err_ = std::max(scaled_rms(err_v_, scale_), kMinError);
+  if (err_ >= 1.0 && refine) {
+    y_stage_ = y + err_v_;
+    if (!eval(f, t, y_stage_, tmp_)) return false;
+    tmp_ += dz_;
+    err_v_ = lu_real_.solve(tmp_);
+    err_ = std::max(scaled_rms(err_v_, scale_), kMinError);
+  }
+  if (std::isfinite(err_)) return true;
+  failure_ = "non-finite error estimate";
+  return false;
+}
+
+Radau5::Attempt Radau5::attempt_step(const Rhs& f, double t, double h, const Eigen::VectorXd& y, bool refine) {
+  const Attempt converged = newton(f, t, h, y);
+  if (converged != Attempt::Accepted) return converged;
+  if (!estimate_error(f, t, h, y, refine)) return Attempt::Failed;
+  if (err_ >= 1.0) {
+    failure_ = "local error above tolerance";
+    return Attempt::ErrorTooLarge;
+  }
+  // f at the new state starts the next step's error estimate; a failure there rejects the step.
+  if (!eval(f, t + h, y_new_, tmp_)) return Attempt::Failed;
+  return Attempt::Accepted;
+}
+
+// Newton form of the collocation polynomial u through (t, y) and the stages, in
+// s = (t' - t_new) / h on [-1, 0]: u(s) = y_new + s (p0 + (s - c2 + 1) (p1 + (s - c1 + 1) p2)).
+void Radau5::build_polynomial() {
+  const Tableau& tb = tableau();
+  const double c1 = tb.c[0], c2 = tb.c[1];
+  Eigen::VectorXd& d21 = y_stage_;  // work space
+  Eigen::VectorXd& d10 = err_v_;
+  poly_[0] = (z_[1] - z_[2]) / (c2 - 1.0);   // u[0, c2-1]
+  d21 = (z_[0] - z_[1]) / (c1 - c2);         // u[c2-1, c1-1]
+  d10 = z_[0] / c1;                          // u[c1-1, -1]
+  poly_[1] = (poly_[0] - d21) / (1.0 - c1);  // u[0, c2-1, c1-1]
+  poly_[2] = poly_[1] - (d21 - d10) / c2;    // u[0, c2-1, c1-1, -1]
+}
+
+void Radau5::polynomial_value(double s) {
+  const Tableau& tb = tableau();
+  y_out_ = y_new_ + s * (poly_[0] + (s - (tb.c[1] - 1.0)) * (poly_[1] + (s - (tb.c[0] - 1.0)) * poly_[2]));
+}
+
+size_t Radau5::emit_outputs(const std::vector<double>& touts, size_t next, double t_new, const Output& out) {
+  for (; next < touts.size() && touts[next] <= t_new; ++next) {
+    if (touts[next] == t_new) {
+      out(t_new, y_new_);
+    } else {
+      polynomial_value((touts[next] - t_new) / h_old_);
+      out(touts[next], y_out_);
+    }
+  }
+  return next;
+}
+
+double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
+                         const std::vector<double>& touts, const Output& out) {
+  if (y.size() != n_) throw std::invalid_argument("Radau5: the state has the wrong size");
+  if (!(t_end >= t0)) throw std::invalid_argument("Radau5: t_end must not be before t0");
+  if (!jac_) throw std::invalid_argument("Radau5: no Jacobian callback set");
+  for (size_t i = 0; i < touts.size(); ++i)
+    if (!(touts[i] >= t0 && touts[i] <= t_end) || (i > 0 && touts[i] < touts[i - 1]))
+      throw std::invalid_argument("Radau5: output times must be sorted and within [t0, t_end]");
+  if (!y.allFinite()) throw IntegrationError("Radau5: non-finite initial state at " + describe(t0, 0.0));
+
+  failure_ = "none";
+  size_t next = 0;
+  for (; next < touts.size() && touts[next] == t0; ++next) out(t0, y);
+  if (t_end == t0) return t0;
+
+  bool ok = false;
+  try {
+    ok = eval(f, t0, y, f0_);
+  } catch (const StepRejected& e) {
+    failure_ = e.what();
+  }
+  if (!ok)
+    throw IntegrationError("Radau5: cannot start, rhs failed at the initial state (" + failure_ + ") at " +
+                           describe(t0, 0.0));
+
+  double h = std::min(h_initial_ > 0 ? h_initial_ : initial_step(f, t0, t_end, y), hmax_);
+  bool first = true, rejected = false;
+  bool need_jacobian = true, jacobian_fresh = false;  // fresh: taken at the current step start
+  double h_factorized = 0.0;                           // step of the factorizations in place
+  double h_acc = 0.0, err_acc = 0.0;                   // last accepted step, for the predictive controller
+  long accepted_here = 0;
+  have_polynomial_ = false;
+  faccon_ = 1.0;
+  double t = t0;
+  for (long steps = 0; t < t_end; ++steps) {
+    if (steps >= max_steps_)
+      throw IntegrationError("Radau5: more than " + std::to_string(max_steps_) + " steps at " + describe(t, h));
+    if (!(h >= Integrator::min_step(t)))
+      throw IntegrationError("Radau5: step size underflow at " + describe(t, h) + " (last rejection: " +
+                             failure_ + ")");
+    const bool last = t + std::min(1.01 * h, hmax_) >= t_end;
+    const double h_try = last ? t_end - t : h;
+
+    ++stats_.nsteps;
+    if (step_start_) step_start_(t, y);
+    Attempt result = Attempt::Failed;
+    try {
+      if (need_jacobian) {
+        ++stats_.njev;
+        jac_(t, y, J_);
+        if (J_.rows() != n_ || J_.cols() != n_)
+          throw std::invalid_argument("Radau5: the Jacobian has the wrong size");
+        if (!J_.allFinite()) throw IntegrationError("Radau5: non-finite Jacobian at " + describe(t, h_try));
+        need_jacobian = false;
+        jacobian_fresh = true;
+        h_factorized = 0.0;
+      }
+      if (h_try != h_factorized) {
+        factorize(h_try);
+        h_factorized = h_try;
+      }
+      result = attempt_step(f, t, h_try, y, first || rejected);
+    } catch (const StepRejected& e) {
+      failure_ = e.what();
+      result = Attempt::Failed;
+    }
+
+    // Hairer's step-size proposal: the error behaves as h^4; fewer Newton iterations, more trust.
+    const double fac = std::min(kSafety, kSafety * (1 + 2 * kMaxNewton) / (newton_its_ + 2 * kMaxNewton));
+    double quot = std::clamp(std::pow(err_, 0.25) / fac, 0.125, 5.0);
+    if (result != Attempt::Accepted) {
+      ++stats_.nreject;
+      rejected = true;
+      if (result == Attempt::ErrorTooLarge) h = first ? 0.1 * h_try : h_try / quot;
+      else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
+      else h = 0.5 * h_try;
+      // A Jacobian from an earlier state may be why Newton failed: take it afresh at this state.
+      // (Hairer's code renews it after any rejection; a step rejected for its error had converged,
+      // and here a Jacobian is a linearization costing several right-hand sides per DOF.)
+      need_jacobian = !jacobian_fresh && result != Attempt::ErrorTooLarge;
+      continue;
+    }
+
+    ++stats_.naccept;
+    ++accepted_here;
+    if (accepted_here > 1) {
+      // Predictive controller (Gustafsson): use the trend of the last two errors.
+      const double gus = std::clamp((h_acc / h_try) * std::pow(err_ * err_ / err_acc, 0.25) / kSafety, 0.125, 5.0);
+      quot = std::max(quot, gus);
+    }
+    h_acc = h_try;
+    err_acc = std::max(1e-2, err_);
+    double h_new = std::min(h_try / quot, hmax_);
+    if (rejected) h_new = std::min(h_new, h_try);
+
+    const double t_new = last ? t_end : t + h_try;
+    h_old_ = h_try;
+    build_polynomial();
+    have_polynomial_ = true;
+    next = emit_outputs(touts, next, t_new, out);
+    t = t_new;
+    y = y_new_;
+    f0_ = tmp_;  // f(t_new, y_new) from attempt_step
+    first = rejected = false;
+    jacobian_fresh = false;
+    // Keep the Jacobian if Newton contracted fast; keep the step (and the factorizations) too
+    // if the proposal is only a little larger.
+    need_jacobian = theta_ > theta_reuse_;
+    if (!need_jacobian && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;
+    // A last step shortened to reach t_end says little about the step the solution allows.
+    h = last ? std::max(h_new, std::min(h, hmax_)) : h_new;
+    if (stop_ && t < t_end && stop_(t, y)) break;
+  }
+  h_last_ = h;
+  return t;
+}
+
+}  // namespace spacar
