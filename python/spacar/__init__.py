@@ -17,6 +17,7 @@ progress bar).
 """
 from . import _core
 from ._util import show as _show
+from . import section
 from .check import Check, Diagnosis, Summary, check, summary
 from .errors import (
     InputError,
@@ -100,6 +101,7 @@ __all__ = [
     "simulate",
     "static",
     "StaticError",
+    "section",
     "sweep",
     "SweepResult",
     "SweepError",
