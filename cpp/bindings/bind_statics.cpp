@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "spacar/simulate.hpp"
 #include "spacar/statics.hpp"
 
 namespace spacar::bindings {
@@ -58,6 +59,33 @@ void bind_statics(py::module_& m) {
       py::arg("tolerance") = 1e-10,
       "Static equilibrium of the model's block in load steps; StaticError (with `results`, the converged "
       "steps) if Newton fails beyond the smallest step.");
+
+  // The tangent of the static solve at the model's current state, for spacar.compliance: the
+  // model is assembled as a simulation does, then R, K0 + G0 (λ = 1: the block's full loads) and
+  // DF restricted to the degrees of freedom (∂x/∂q) are evaluated there.
+  m.def(
+      "static_tangent",
+      [](Model& model) {
+        Simulation sim(model);
+        sim.assemble();
+        const System& sys = sim.system();
+        Eigen::VectorXd R;
+        Eigen::MatrixXd K;
+        static_forces(sys, sim.data(), 1.0, R, &K);
+        std::vector<std::string> dofs;
+        for (int j = 0; j < sys.n_dof(); ++j) dofs.push_back(dof_name(sys, j));
+        py::dict d;
+        d["K"] = K;
+        d["R"] = R;
+        d["DF"] = Eigen::MatrixXd(sim.data().DFq);
+        d["x"] = Eigen::VectorXd(sim.data().x);
+        d["coord_label"] = sys.coord_label;
+        d["dof_names"] = dofs;
+        return d;
+      },
+      py::arg("model"),
+      "At the model's current state (assembled): the reduced forces R and tangent stiffness K0 + G0 of "
+      "the static solve under the block's full loads, DF of the degrees of freedom, x and the labels.");
 }
 
 }  // namespace spacar::bindings

@@ -19,6 +19,7 @@ from . import _core
 from ._util import show as _show
 from . import section
 from .check import Check, Diagnosis, Summary, check, summary
+from .compliance import compliance
 from .errors import (
     InputError,
     IntegrationError,
@@ -101,6 +102,7 @@ __all__ = [
     "simulate",
     "static",
     "StaticError",
+    "compliance",
     "section",
     "sweep",
     "SweepResult",

@@ -1,0 +1,87 @@
+"""Static compliance at a node (docs/statics.md, "Compliance")::
+
+    res = spacar.static(model)                     # the equilibrium (skip for an unloaded model)
+    C = spacar.compliance(model, 21, rotation=22)  # planar: 3 x 3 in (x, y, β) per (Fx, Fy, M)
+    K = np.linalg.inv(C)                           # the stiffness at the node
+
+The compliance is that of the tangent stiffness of the static solve (K0 + G0 at the model's
+current state under the block's full loads) seen through the transfer function of the node:
+
+    C = T K⁻¹ Tᵀ,   T = DF_node (∂x_node/∂q)
+
+so C_ij is the displacement i of the node per unit load j on it (a small load added to the
+block's loads). For a LAMBDA node the rows of T are the small rotation vector in global axes,
+δθ = 2 E(λ) δλ (formulation §0): the rotations are compliant to moments in global axes.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+from ._util import show
+from .errors import InputError, StaticError
+
+# The coordinates of a node kind that describe its displacement.
+_SIZE = {"XY": 2, "BETA": 1, "XYZ": 3}
+
+
+def _E(lam) -> np.ndarray:
+    """E(λ) of formulation §0: ω = 2 E(λ) λ̇ in global axes."""
+    l0, l1, l2, l3 = lam
+    return np.array([[-l1, l0, -l3, l2],
+                     [-l2, l3, l0, -l1],
+                     [-l3, -l2, l1, l0]])
+
+
+def _rows(tangent: dict, nodes: dict, n, what: str) -> np.ndarray:
+    """The rows of T for node n: DF of its coordinates (a LAMBDA node: 2 E(λ) DF_λ)."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or int(n) not in nodes:
+        raise InputError(f"{what} {show(n)} is not a node of the model")
+    kind = nodes[int(n)].kind.name
+    rows = [i for i, (node, _) in enumerate(tangent["coord_label"]) if node == int(n)]
+    DF = np.asarray(tangent["DF"])[rows]
+    if kind == "LAMBDA":
+        lam = np.asarray(tangent["x"])[rows]
+        return 2.0 * _E(lam / np.linalg.norm(lam)) @ DF
+    if kind not in _SIZE:
+        raise InputError(f"{what} {int(n)} has no coordinates used by an element")
+    return DF
+
+
+def compliance(model, node, rotation=None) -> np.ndarray:
+    """The static compliance at ``node`` at the model's current state (an equilibrium: after
+    :func:`spacar.static`, which leaves the model there, or an unloaded model).
+
+    ``node``: a position node (XY: rows x, y; XYZ: x, y, z) or a rotation node alone (BETA: β;
+    LAMBDA: the rotation vector in global axes); ``rotation``: the BETA or LAMBDA node of the
+    same point, appended (planar 3 × 3 in x, y, β; spatial 6 × 6 in x, y, z, θx, θy, θz).
+    Returns C (m × m): the displacements and rotations per unit force and moment at the node,
+    in global axes. The tangent includes the geometric stiffness of the current stresses and
+    loads (stress stiffening, a compressive load's softening). A direction that is fixed (a
+    support) has zero compliance.
+
+    Raises :class:`spacar.StaticError` when the tangent stiffness is singular (a mechanism: a
+    degree of freedom without stiffness), naming the direction."""
+    from .model import Model
+
+    if not isinstance(model, Model):
+        raise InputError(f"compliance needs a spacar.Model (at its equilibrium), got {show(model)}")
+    tangent = _core.static_tangent(model.core)
+    nodes = model.nodes
+    T = _rows(tangent, nodes, node, "node")
+    if rotation is not None:
+        is_number = isinstance(rotation, (int, np.integer)) and not isinstance(rotation, bool)
+        if not is_number or int(rotation) not in nodes or nodes[int(rotation)].kind.name not in ("BETA", "LAMBDA"):
+            raise InputError(f"rotation {show(rotation)} must be a BETA or LAMBDA node of the model")
+        T = np.vstack([T, _rows(tangent, nodes, rotation, "rotation node")])
+    K = np.asarray(tangent["K"])
+    if K.size == 0:
+        return np.zeros((T.shape[0], T.shape[0]))
+    scale = np.abs(K).max()
+    u, s, vt = np.linalg.svd(K)
+    if not s[-1] > 1e-13 * s[0]:
+        weights = np.abs(vt[-1])
+        names = [tangent["dof_names"][j] for j in np.argsort(-weights) if weights[j] >= 0.1 * weights.max()]
+        raise StaticError(f"the tangent stiffness is singular (largest entry {scale:.3g}): no stiffness in "
+                          f"the direction of {', '.join(names[:4])}; the compliance is unbounded")
+    return T @ np.linalg.solve(K, T.T)
