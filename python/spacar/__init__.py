@@ -19,7 +19,7 @@ from . import _core
 from ._util import show as _show
 from . import section
 from .check import Check, Diagnosis, Summary, check, summary
-from .compliance import compliance
+from .compliance import compliance, support_stiffness
 from .errors import (
     InputError,
     IntegrationError,
@@ -103,6 +103,7 @@ __all__ = [
     "static",
     "StaticError",
     "compliance",
+    "support_stiffness",
     "section",
     "sweep",
     "SweepResult",

@@ -85,3 +85,46 @@ def compliance(model, node, rotation=None) -> np.ndarray:
         raise StaticError(f"the tangent stiffness is singular (largest entry {scale:.3g}): no stiffness in "
                           f"the direction of {', '.join(names[:4])}; the compliance is unbounded")
     return T @ np.linalg.solve(K, T.T)
+
+
+def support_stiffness(model, node, components=None) -> np.ndarray:
+    """The stiffness of a support or drive: the response of the reactions on the prescribed
+    (FIX or INPUTX) coordinates ``components`` of ``node`` (1-based; default: all of its
+    prescribed ones) to a unit prescribed displacement of each, the rest of the model in
+    equilibrium, at the model's current state: K_s = ∂r_p/∂x_p (m × m, e.g. a flexure's drive
+    stiffness, or the stiffness of a guide in its supported directions).
+
+    Computed exactly as the Schur complement of the tangent stiffness: on a copy of the model the
+    coordinates become degrees of freedom (DYNX), the DYNE deformations that this makes
+    redundant (named by the constraint diagnosis) become RLSE (their stiffness stays), and
+    K_s = C_pp⁻¹ with C_pp their compliance (:func:`compliance`). Position (XY, XYZ) and BETA
+    nodes."""
+    from .model import Model
+
+    if not isinstance(model, Model):
+        raise InputError(f"support_stiffness needs a spacar.Model (at its equilibrium), got {show(model)}")
+    nodes = model.nodes
+    if isinstance(node, bool) or not isinstance(node, (int, np.integer)) or int(node) not in nodes:
+        raise InputError(f"node {show(node)} is not a node of the model")
+    n = int(node)
+    if nodes[n].kind.name not in _SIZE:
+        raise InputError(f"node {n} ({nodes[n].kind.name}): the support stiffness is for XY, XYZ and BETA nodes")
+    classes = [c.name for c in nodes[n].cls]
+    prescribed = [i + 1 for i, c in enumerate(classes) if c in ("fixed", "input")]
+    if components is None:
+        components = prescribed
+    components = [int(i) for i in np.atleast_1d(components)]
+    if not components or any(i not in prescribed for i in components):
+        raise InputError(f"components {show(components)} must be prescribed (FIX, INPUTX) components of node {n}; "
+                         f"its prescribed ones: {prescribed}")
+    free = model.copy()
+    free.dynx(n, *components)
+    for e, i in free.check().diagnosis.redundant:
+        if free.elements[e].cls[i - 1].name != "dynamic":
+            raise InputError(f"freeing node {n} components {components} makes the rigid deformation {i} of element "
+                             f"{e} redundant; the support stiffness needs a model whose prescribed coordinates "
+                             "are supported by elastic (DYNE) deformations")
+        free.rlse(e, i)
+    C = compliance(free, n)
+    rows = [i - 1 for i in components]
+    return np.linalg.inv(C[np.ix_(rows, rows)])

@@ -115,3 +115,32 @@ def test_mechanism_and_bad_nodes():
         spacar.compliance(ok, 5, rotation=5)
     with pytest.raises(InputError, match="spacar.Model"):
         spacar.compliance("model", 5)
+
+
+# ------------------------------------------------------------------------------------------------
+# support stiffness
+# ------------------------------------------------------------------------------------------------
+
+def test_propped_and_guided_cantilever_support_stiffness():
+    n, L, EI = 3, 1.5, 2.0
+    propped = planar_cantilever(n, L, 0.0, EI, rigid_axis=True)
+    propped.fix(2 * n + 1, 2)   # the tip's y supported
+    K = spacar.support_stiffness(propped, 2 * n + 1)
+    np.testing.assert_allclose(K, [[3 * EI / L**3]], rtol=1e-10)
+    assert [c.name for c in propped.nodes[2 * n + 1].cls] == ["calculable", "fixed"]  # the model is not changed
+    guided = planar_cantilever(n, L, 0.0, EI, rigid_axis=True)
+    guided.fix(2 * n + 1, 2)
+    guided.fix(2 * n + 2)       # and its rotation
+    K = spacar.support_stiffness(guided, 2 * n + 1)
+    np.testing.assert_allclose(K, [[12 * EI / L**3]], rtol=1e-10)  # y, the rotation held
+    K = spacar.support_stiffness(guided, 2 * n + 2)
+    np.testing.assert_allclose(K, [[4 * EI / L]], rtol=1e-10)      # β, y held
+
+
+def test_driven_parallel_leaf_guide_drive_stiffness():
+    L, d, EI = 0.05, 0.03, 0.35
+    m = parallel_leaf_guide(L, d, EI)
+    m.apply("INPUTX", 3, 1)     # the stage driven in x instead of free
+    assert spacar.support_stiffness(m, 3, 1)[0, 0] == pytest.approx(24 * EI / L**3, rel=1e-10)
+    with pytest.raises(InputError, match="prescribed"):
+        spacar.support_stiffness(m, 3, 2)  # y is calculable
