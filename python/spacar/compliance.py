@@ -77,13 +77,16 @@ def compliance(model, node, rotation=None) -> np.ndarray:
     K = np.asarray(tangent["K"])
     if K.size == 0:
         return np.zeros((T.shape[0], T.shape[0]))
-    scale = np.abs(K).max()
-    u, s, vt = np.linalg.svd(K)
+    # Singular? Judged on the stiffness scaled to a unit diagonal, so that lengths and angles,
+    # stiff and soft parts compare (a zero diagonal is left as it is: a direction without stiffness).
+    diag = np.abs(np.diag(K))
+    d = 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0))
+    _, s, vt = np.linalg.svd(d[:, None] * K * d[None, :])
     if not s[-1] > 1e-13 * s[0]:
-        weights = np.abs(vt[-1])
+        weights = np.abs(d * vt[-1])
         names = [tangent["dof_names"][j] for j in np.argsort(-weights) if weights[j] >= 0.1 * weights.max()]
-        raise StaticError(f"the tangent stiffness is singular (largest entry {scale:.3g}): no stiffness in "
-                          f"the direction of {', '.join(names[:4])}; the compliance is unbounded")
+        raise StaticError(f"the tangent stiffness is singular: no stiffness in the direction of "
+                          f"{', '.join(names[:4])}{' and more' if len(names) > 4 else ''}; the compliance is unbounded")
     return T @ np.linalg.solve(K, T.T)
 
 

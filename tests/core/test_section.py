@@ -137,10 +137,10 @@ def test_cantilever_tip_load_bending_and_shear_stress():
     root = np.arange(n) * L / n
     np.testing.assert_allclose(s.normal[-1], P * (L - root) / sec.Wz, rtol=1e-5)
     np.testing.assert_allclose(s.shear[-1], 1.5 * P / sec.A, rtol=1e-5)
-    value, element, row = s.max()["normal"]
+    value, element, _ = s.max()["normal"]
     assert element == 1 and value == pytest.approx(P * L / sec.Wz, rel=1e-5)
     normal, shear = s.element(3)
-    assert normal[-1] == s.normal[-1, 2]
+    assert normal[-1] == s.normal[-1, 2] and shear[-1] == s.shear[-1, 2]
     # The same from a dict naming one element only.
     only = section.stresses(res, {2: sec})
     assert only.elements == [2] and only.normal[-1, 0] == s.normal[-1, 1]
