@@ -48,9 +48,12 @@ def _rows(tangent: dict, nodes: dict, n, what: str) -> np.ndarray:
     return DF
 
 
-def compliance(model, node, rotation=None) -> np.ndarray:
+def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.ndarray:
     """The static compliance at ``node`` at the model's current state (an equilibrium: after
-    :func:`spacar.static`, which leaves the model there, or an unloaded model).
+    :func:`spacar.static`, which leaves the model there, or an unloaded model), or at row ``k``
+    of ``results`` of :func:`spacar.static` of this model (its load factor λ = ``results.t[k]``
+    and its degrees of freedom; e.g. the drive stiffness along a load path; loads reached from
+    an unloaded start, inputs not moving).
 
     ``node``: a position node (XY: rows x, y; XYZ: x, y, z) or a rotation node alone (BETA: β;
     LAMBDA: the rotation vector in global axes); ``rotation``: the BETA or LAMBDA node of the
@@ -66,7 +69,14 @@ def compliance(model, node, rotation=None) -> np.ndarray:
 
     if not isinstance(model, Model):
         raise InputError(f"compliance needs a spacar.Model (at its equilibrium), got {show(model)}")
-    tangent = _core.static_tangent(model.core)
+    if results is None:
+        tangent = _core.static_tangent(model.core)
+    else:
+        if getattr(results, "stats", {}).get("analysis") != "static":
+            raise InputError("results must come from spacar.static (the rows are equilibria at load factors)")
+        k = range(len(results.t))[k]
+        tangent = _core.static_tangent(model.core, float(results.t[k]), np.asarray(results.x[k], dtype=float),
+                                       np.asarray(results.e[k], dtype=float))
     nodes = model.nodes
     T = _rows(tangent, nodes, node, "node")
     if rotation is not None:

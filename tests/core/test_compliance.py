@@ -144,3 +144,17 @@ def test_driven_parallel_leaf_guide_drive_stiffness():
     assert spacar.support_stiffness(m, 3, 1)[0, 0] == pytest.approx(24 * EI / L**3, rel=1e-10)
     with pytest.raises(InputError, match="prescribed"):
         spacar.support_stiffness(m, 3, 2)  # y is calculable
+
+
+def test_compliance_along_a_static_load_path():
+    n, P = 8, 3.0
+    model = planar_cantilever(n, 1.0, 1e3, 1.0, force=(0.0, P))
+    res = spacar.static(model, steps=4)
+    along = [spacar.compliance(model, 2 * n + 1, results=res, k=k) for k in range(4)]
+    np.testing.assert_allclose(along[-1], spacar.compliance(model, 2 * n + 1), rtol=1e-12, atol=1e-15)
+    half = planar_cantilever(n, 1.0, 1e3, 1.0, force=(0.0, P / 2))
+    spacar.static(half, steps=2)
+    np.testing.assert_allclose(along[1], spacar.compliance(half, 2 * n + 1), rtol=1e-7, atol=1e-12)
+    assert along[0][1, 1] > along[1][1, 1] > along[3][1, 1]  # the elastica stiffens with the load
+    with pytest.raises(InputError, match="spacar.static"):
+        spacar.compliance(model, 2 * n + 1, results=object())
