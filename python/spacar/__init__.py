@@ -17,7 +17,9 @@ progress bar).
 """
 from . import _core
 from ._util import show as _show
+from . import section
 from .check import Check, Diagnosis, Summary, check, summary
+from .compliance import compliance, support_stiffness
 from .errors import (
     InputError,
     IntegrationError,
@@ -100,6 +102,9 @@ __all__ = [
     "simulate",
     "static",
     "StaticError",
+    "compliance",
+    "support_stiffness",
+    "section",
     "sweep",
     "SweepResult",
     "SweepError",

@@ -130,6 +130,23 @@ class Linearization:
         mu = np.real_if_close(mu, tol=1e6)
         return np.real(mu[np.argsort(np.abs(mu))]) if np.isrealobj(mu) else mu[np.argsort(np.abs(mu))]
 
+    def buckling_modes(self):
+        """(μ, shapes in z (nz x n), shapes in the nodal coordinates (nx x n)) of
+        (K0 + μ G0) v = 0: the real, finite buckling factors sorted by |μ| (as
+        :meth:`buckling_factors`, complex ones left out) with their mode shapes, each normalised
+        to unit largest component in z (sign arbitrary); the nodal shapes are DF v, drawable with
+        ``spacar.draw(res, mode=shapes_x[:, i])``."""
+        import scipy.linalg
+
+        mu, v = scipy.linalg.eig(-self.K0, self.G0)
+        keep = np.isfinite(mu) & (np.abs(np.imag(mu)) <= 1e-6 * np.maximum(np.abs(mu), 1.0))
+        mu, v = np.real(mu[keep]), np.real(v[:, keep])
+        order = np.argsort(np.abs(mu))
+        mu, v = mu[order], v[:, order]
+        if v.size:
+            v = v / np.abs(v).max(axis=0)
+        return mu, v, self.DF @ v
+
     def state_space(self, outputs: str = "z"):
         """(A, B, C, D) of the linearized system in the state [δz; δy^k; δż] with generalized
         forces on z as inputs and, as outputs, δz (``outputs="z"``) or the nodal coordinates

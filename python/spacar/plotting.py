@@ -226,13 +226,46 @@ class Scene:
         return [ln for ln in self.lines if ln.get_gid() == f"element-{element}"]
 
 
+def _displaced(res: Results, k: int, mode, scale) -> Results:
+    """One-row results at row k displaced by ``scale`` times the nodal shape ``mode`` (nx); by
+    default scaled so that the largest displacement of a position is a tenth of the model's
+    extent. Euler parameters are normalised again."""
+    dx = np.real(np.asarray(mode)).astype(float).reshape(-1)
+    if dx.shape != res.x[k].shape or not np.isfinite(dx).all():
+        raise InputError(f"mode must hold {res.x.shape[1]} finite numbers (one per nodal coordinate, as "
+                         f"Linearization.buckling_modes()[2][:, i]), got shape {np.shape(mode)}")
+    kinds = res.geometry.node_kinds
+    cols = res.node_columns
+    positions = [c for n, c in cols.items() if kinds.get(n) in ("XY", "XYZ")]
+    rows = np.concatenate(positions) if positions else np.arange(len(dx))
+    if scale is None:
+        xy = np.vstack([res.x[k][c] for c in positions]) if positions else np.zeros((1, 1))
+        extent = max(np.ptp(xy, axis=0).max(), 1e-300)
+        largest = np.abs(dx[rows]).max() if rows.size else 0.0
+        scale = 0.1 * extent / largest if largest > 0 else 1.0
+    x = res.x[k] + float(scale) * dx
+    for n, c in cols.items():
+        if kinds.get(n) == "LAMBDA":
+            x[c] /= np.linalg.norm(x[c])
+    one = lambda a: np.asarray(a)[k:k + 1]  # noqa: E731
+    arrays = {"t": one(res.t), "x": x[None, :], "xd": one(res.xd), "xdd": one(res.xdd), "e": one(res.e),
+              "ed": one(res.ed), "edd": one(res.edd), "sigma": one(res.sigma), "reaction": one(res.reaction)}
+    return Results(arrays, res.coordinate_labels, res.deformation_labels, res.stats, geometry=res.geometry)
+
+
 def draw(res: Results, k: int = -1, *, time: float | None = None, ax=None, labels: bool = False,
-         trace=(), beam_points: int = 21, figsize=None):
+         trace=(), beam_points: int = 21, figsize=None, mode=None, scale: float | None = None):
     """Draw the mechanism at output index ``k`` (default the last) or at the output time nearest
     to ``time``. ``labels`` writes the node numbers; ``trace`` lists position nodes whose paths
-    over the whole run are drawn (e.g. a coupler curve). Returns the :class:`Scene` (its ``ax``
-    is the axes)."""
+    over the whole run are drawn (e.g. a coupler curve). ``mode``: a shape in the nodal
+    coordinates (e.g. a buckling mode, ``Linearization.buckling_modes()[2][:, 0]``, or a
+    vibration mode) added to that state, times ``scale`` (default: its largest displacement a
+    tenth of the model's size). Returns the :class:`Scene` (its ``ax`` is the axes)."""
     if time is not None:
         k = res.time_index(time)
     k = range(len(res.t))[k]
+    if mode is not None:
+        if res.geometry is None:
+            raise InputError("these results have no geometry to draw (results of spacar.simulate have)")
+        res, k = _displaced(res, k, mode, scale), 0
     return Scene(res, ax, k, labels=labels, trace=trace, beam_points=beam_points, figsize=figsize)

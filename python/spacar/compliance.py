@@ -1,0 +1,143 @@
+"""Static compliance at a node (docs/statics.md, "Compliance")::
+
+    res = spacar.static(model)                     # the equilibrium (skip for an unloaded model)
+    C = spacar.compliance(model, 21, rotation=22)  # planar: 3 x 3 in (x, y, β) per (Fx, Fy, M)
+    K = np.linalg.inv(C)                           # the stiffness at the node
+
+The compliance is that of the tangent stiffness of the static solve (K0 + G0 at the model's
+current state under the block's full loads) seen through the transfer function of the node:
+
+    C = T K⁻¹ Tᵀ,   T = DF_node (∂x_node/∂q)
+
+so C_ij is the displacement i of the node per unit load j on it (a small load added to the
+block's loads). For a LAMBDA node the rows of T are the small rotation vector in global axes,
+δθ = 2 E(λ) δλ (formulation §0): the rotations are compliant to moments in global axes.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+from ._util import show
+from .errors import InputError, StaticError
+
+# The coordinates of a node kind that describe its displacement.
+_SIZE = {"XY": 2, "BETA": 1, "XYZ": 3}
+
+
+def _E(lam) -> np.ndarray:
+    """E(λ) of formulation §0: ω = 2 E(λ) λ̇ in global axes."""
+    l0, l1, l2, l3 = lam
+    return np.array([[-l1, l0, -l3, l2],
+                     [-l2, l3, l0, -l1],
+                     [-l3, -l2, l1, l0]])
+
+
+def _rows(tangent: dict, nodes: dict, n, what: str) -> np.ndarray:
+    """The rows of T for node n: DF of its coordinates (a LAMBDA node: 2 E(λ) DF_λ)."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or int(n) not in nodes:
+        raise InputError(f"{what} {show(n)} is not a node of the model")
+    kind = nodes[int(n)].kind.name
+    rows = [i for i, (node, _) in enumerate(tangent["coord_label"]) if node == int(n)]
+    DF = np.asarray(tangent["DF"])[rows]
+    if kind == "LAMBDA":
+        lam = np.asarray(tangent["x"])[rows]
+        return 2.0 * _E(lam / np.linalg.norm(lam)) @ DF
+    if kind not in _SIZE:
+        raise InputError(f"{what} {int(n)} has no coordinates used by an element")
+    return DF
+
+
+def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.ndarray:
+    """The static compliance at ``node`` at the model's current state (an equilibrium: after
+    :func:`spacar.static`, which leaves the model there, or an unloaded model), or at row ``k``
+    of ``results`` of :func:`spacar.static` of this model (its load factor λ = ``results.t[k]``
+    and its degrees of freedom; e.g. the drive stiffness along a load path; loads reached from
+    an unloaded start, inputs not moving).
+
+    ``node``: a position node (XY: rows x, y; XYZ: x, y, z) or a rotation node alone (BETA: β;
+    LAMBDA: the rotation vector in global axes); ``rotation``: the BETA or LAMBDA node of the
+    same point, appended (planar 3 × 3 in x, y, β; spatial 6 × 6 in x, y, z, θx, θy, θz).
+    Returns C (m × m): the displacements and rotations per unit force and moment at the node,
+    in global axes. The tangent includes the geometric stiffness of the current stresses and
+    loads (stress stiffening, a compressive load's softening). A direction that is fixed (a
+    support) has zero compliance.
+
+    Raises :class:`spacar.StaticError` when the tangent stiffness is singular (a mechanism: a
+    degree of freedom without stiffness), naming the direction."""
+    from .model import Model
+
+    if not isinstance(model, Model):
+        raise InputError(f"compliance needs a spacar.Model (at its equilibrium), got {show(model)}")
+    if results is None:
+        tangent = _core.static_tangent(model.core)
+    else:
+        if getattr(results, "stats", {}).get("analysis") != "static":
+            raise InputError("results must come from spacar.static (the rows are equilibria at load factors)")
+        k = range(len(results.t))[k]
+        tangent = _core.static_tangent(model.core, float(results.t[k]), np.asarray(results.x[k], dtype=float),
+                                       np.asarray(results.e[k], dtype=float))
+    nodes = model.nodes
+    T = _rows(tangent, nodes, node, "node")
+    if rotation is not None:
+        is_number = isinstance(rotation, (int, np.integer)) and not isinstance(rotation, bool)
+        if not is_number or int(rotation) not in nodes or nodes[int(rotation)].kind.name not in ("BETA", "LAMBDA"):
+            raise InputError(f"rotation {show(rotation)} must be a BETA or LAMBDA node of the model")
+        T = np.vstack([T, _rows(tangent, nodes, rotation, "rotation node")])
+    K = np.asarray(tangent["K"])
+    if K.size == 0:
+        return np.zeros((T.shape[0], T.shape[0]))
+    # Singular? Judged on the stiffness scaled to a unit diagonal, so that lengths and angles,
+    # stiff and soft parts compare (a zero diagonal is left as it is: a direction without stiffness).
+    diag = np.abs(np.diag(K))
+    d = 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0))
+    _, s, vt = np.linalg.svd(d[:, None] * K * d[None, :])
+    if not s[-1] > 1e-13 * s[0]:
+        weights = np.abs(d * vt[-1])
+        names = [tangent["dof_names"][j] for j in np.argsort(-weights) if weights[j] >= 0.1 * weights.max()]
+        raise StaticError(f"the tangent stiffness is singular: no stiffness in the direction of "
+                          f"{', '.join(names[:4])}{' and more' if len(names) > 4 else ''}; the compliance is unbounded")
+    return T @ np.linalg.solve(K, T.T)
+
+
+def support_stiffness(model, node, components=None) -> np.ndarray:
+    """The stiffness of a support or drive: the response of the reactions on the prescribed
+    (FIX or INPUTX) coordinates ``components`` of ``node`` (1-based; default: all of its
+    prescribed ones) to a unit prescribed displacement of each, the rest of the model in
+    equilibrium, at the model's current state: K_s = ∂r_p/∂x_p (m × m, e.g. a flexure's drive
+    stiffness, or the stiffness of a guide in its supported directions).
+
+    Computed exactly as the Schur complement of the tangent stiffness: on a copy of the model the
+    coordinates become degrees of freedom (DYNX), the DYNE deformations that this makes
+    redundant (named by the constraint diagnosis) become RLSE (their stiffness stays), and
+    K_s = C_pp⁻¹ with C_pp their compliance (:func:`compliance`). Position (XY, XYZ) and BETA
+    nodes."""
+    from .model import Model
+
+    if not isinstance(model, Model):
+        raise InputError(f"support_stiffness needs a spacar.Model (at its equilibrium), got {show(model)}")
+    nodes = model.nodes
+    if isinstance(node, bool) or not isinstance(node, (int, np.integer)) or int(node) not in nodes:
+        raise InputError(f"node {show(node)} is not a node of the model")
+    n = int(node)
+    if nodes[n].kind.name not in _SIZE:
+        raise InputError(f"node {n} ({nodes[n].kind.name}): the support stiffness is for XY, XYZ and BETA nodes")
+    classes = [c.name for c in nodes[n].cls]
+    prescribed = [i + 1 for i, c in enumerate(classes) if c in ("fixed", "input")]
+    if components is None:
+        components = prescribed
+    components = [int(i) for i in np.atleast_1d(components)]
+    if not components or any(i not in prescribed for i in components):
+        raise InputError(f"components {show(components)} must be prescribed (FIX, INPUTX) components of node {n}; "
+                         f"its prescribed ones: {prescribed}")
+    free = model.copy()
+    free.dynx(n, *components)
+    for e, i in free.check().diagnosis.redundant:
+        if free.elements[e].cls[i - 1].name != "dynamic":
+            raise InputError(f"freeing node {n} components {components} makes the rigid deformation {i} of element "
+                             f"{e} redundant; the support stiffness needs a model whose prescribed coordinates "
+                             "are supported by elastic (DYNE) deformations")
+        free.rlse(e, i)
+    C = compliance(free, n)
+    rows = [i - 1 for i in components]
+    return np.linalg.inv(C[np.ix_(rows, rows)])

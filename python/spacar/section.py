@@ -1,0 +1,297 @@
+"""Cross-sections of beams and trusses: the ESTIFF and EMASS values from the dimensions and the
+material, the section moduli, and the largest stresses of a solution (docs/statics.md,
+"Cross-sections and stresses")::
+
+    steel = spacar.section.STEEL                      # E = 210 GPa, ν = 0.3, ρ = 7850 kg/m³
+    leaf = spacar.section.rectangle(b=0.02, h=0.0005, material=steel)
+    leaf.apply(model, 1, 2, 3)                        # ESTIFF (and EMASS if ρ > 0) of elements 1–3
+    leaf.plbeam_estiff()                              # (EA, EI)
+    s = spacar.section.stresses(res, leaf)            # largest normal and shear stress per element
+    s.normal.max(), s.element(2).normal
+
+Axes (those of the beam elements, formulation §4.2, §4.8): x along the beam, y the first
+principal axis of the cross-section (BEAM: the LGEOMY/definition-line vector; PLBEAM: the
+in-plane normal), z = x × y (PLBEAM: out of the plane). ``Iz = ∫y² dA`` resists bending about z,
+which is the in-plane bending of PLBEAM (its EI) and the BEAM's ``EIz``; ``Iy = ∫z² dA`` goes
+with the BEAM's ``EIy``. Units are the user's (SI in the named materials).
+"""
+from __future__ import annotations
+
+import math
+import numbers
+
+import numpy as np
+
+from ._util import show
+from .errors import InputError
+
+
+def _positive(value, name: str, zero: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) or \
+            not (value >= 0 if zero else value > 0):
+        raise InputError(f"{name} must be a {'non-negative' if zero else 'positive'} number, got {show(value)}")
+    return float(value)
+
+
+class Material:
+    """A linear elastic isotropic material: Young's modulus ``E``, the shear modulus ``G`` given
+    directly or by Poisson's ratio ``nu`` (G = E / 2(1 + ν)), and the density ``rho`` (0: no
+    mass)."""
+
+    def __init__(self, E, *, nu=None, G=None, rho=0.0, name: str = ""):
+        self.E = _positive(E, "E")
+        if (nu is None) == (G is None):
+            raise InputError("give the material either Poisson's ratio nu or the shear modulus G")
+        if G is None:
+            if isinstance(nu, bool) or not isinstance(nu, numbers.Real) or not -1.0 < nu < 0.5:
+                raise InputError(f"Poisson's ratio nu must be a number between -1 and 0.5, got {show(nu)}")
+            G = self.E / (2.0 * (1.0 + nu))
+        self.G = _positive(G, "G")
+        self.nu = self.E / (2.0 * self.G) - 1.0
+        self.rho = _positive(rho, "rho", zero=True)
+        self.name = str(name)
+
+    def __repr__(self):
+        return f"<spacar.section.Material {self.name or ''}: E = {self.E:g}, G = {self.G:g}, rho = {self.rho:g}>"
+
+
+STEEL = Material(210e9, nu=0.3, rho=7850.0, name="steel")
+ALUMINIUM = Material(70e9, nu=0.33, rho=2700.0, name="aluminium")
+TITANIUM = Material(114e9, nu=0.34, rho=4430.0, name="titanium (Ti-6Al-4V)")
+
+
+class Section:
+    """The properties of one cross-section (made by :func:`rectangle`, :func:`circle`,
+    :func:`tube`): area ``A``, second moments ``Iy``, ``Iz`` and polar ``Ip = Iy + Iz``, the
+    torsion constant ``J`` (Saint-Venant; ``Ip`` for round sections), the section moduli ``Wy``,
+    ``Wz`` (bending stress |M|/W) and ``Wt`` (torsion: τ = |T|/Wt), the transverse shear factor
+    ``shear_factor`` (largest shear stress k V / A), and the ``material`` (None: geometry only)."""
+
+    def __init__(self, shape: str, dims: dict, material, *, A, Iy, Iz, J, Wy, Wz, Wt, shear_factor, round_: bool):
+        if material is not None and not isinstance(material, Material):
+            raise InputError(f"material must be a spacar.section.Material, got {show(material)}")
+        self.shape, self.dims, self.material = shape, dims, material
+        self.A, self.Iy, self.Iz, self.Ip, self.J = A, Iy, Iz, Iy + Iz, J
+        self.Wy, self.Wz, self.Wt = Wy, Wz, Wt
+        self.shear_factor = shear_factor
+        self._round = round_  # bending about any axis has the same modulus: |M| = hypot(My, Mz)
+
+    # --- the element data ---------------------------------------------------------------------
+
+    def _mat(self) -> Material:
+        if self.material is None:
+            raise InputError(f"the {self.shape} section has no material: give material=... to know E, G, rho")
+        return self.material
+
+    def truss_estiff(self) -> tuple:
+        """ESTIFF of PLTRUSS/TRUSS: (EA,)."""
+        return (self._mat().E * self.A,)
+
+    def plbeam_estiff(self) -> tuple:
+        """ESTIFF of PLBEAM/PLBEAMNL: (EA, EI) with I = Iz (bending in the plane)."""
+        m = self._mat()
+        return (m.E * self.A, m.E * self.Iz)
+
+    def beam_estiff(self) -> tuple:
+        """ESTIFF of BEAM/BEAMNL: (EA, GIp, EIy, EIz), the torsional stiffness being G J (the
+        catalogue's "GIp"; J = Ip only for round sections)."""
+        m = self._mat()
+        return (m.E * self.A, m.G * self.J, m.E * self.Iy, m.E * self.Iz)
+
+    def emass(self, rotary: bool = False) -> tuple:
+        """EMASS: (ρA,), or for BEAM with ``rotary=True`` (ρA, ρIp, ρIy, ρIz), the rotary inertia
+        of the cross-section per unit length (an extension of the manual's EMASS)."""
+        rho = self._mat().rho
+        if rotary:
+            return (rho * self.A, rho * self.Ip, rho * self.Iy, rho * self.Iz)
+        return (rho * self.A,)
+
+    def apply(self, model, *elements, rotary: bool = False):
+        """Give the elements (numbers; none: every beam and truss of the model) the ESTIFF of
+        this section and, if the material has a density, its EMASS (BEAM with ``rotary=True``:
+        with the rotary inertia). Returns ``model``."""
+        table = model.elements
+        if not elements:
+            elements = [e for e, el in table.items() if el.type_name in _ESTIFF]
+        for e in elements:
+            if e not in table:
+                raise InputError(f"element {show(e)} is not defined")
+            kind = table[e].type_name
+            if kind not in _ESTIFF:
+                raise InputError(f"a cross-section gives the data of beams and trusses, not of element {e} ({kind})")
+            model.estiff(e, *getattr(self, _ESTIFF[kind])())
+            if self._mat().rho > 0.0:
+                model.emass(e, *self.emass(rotary and kind in ("BEAM", "BEAMNL")))
+        return model
+
+    # --- stresses ----------------------------------------------------------------------------
+
+    def normal_stress(self, N, My, Mz):
+        """Largest |normal stress| over the section under the axial force N and the bending
+        moments My, Mz (arrays broadcast): |N|/A + hypot(My, Mz)/W for round sections, |N|/A +
+        |My|/Wy + |Mz|/Wz (a corner) for the rectangle."""
+        N, My, Mz = (np.abs(np.asarray(v, dtype=float)) for v in (N, My, Mz))
+        if self._round:
+            return N / self.A + np.hypot(My, Mz) / self.Wz
+        return N / self.A + My / self.Wy + Mz / self.Wz
+
+    def shear_stress(self, T, Vy, Vz):
+        """Largest shear stress under the twisting moment T and the shear forces Vy, Vz:
+        |T|/Wt + k hypot(Vy, Vz)/A (elementary theory; the sum of torsional and transverse
+        shear is exact where both peak together, e.g. the surface of a round section on the
+        neutral axis, and an upper bound otherwise)."""
+        T, Vy, Vz = (np.abs(np.asarray(v, dtype=float)) for v in (T, Vy, Vz))
+        return T / self.Wt + self.shear_factor * np.hypot(Vy, Vz) / self.A
+
+    def __repr__(self):
+        dims = ", ".join(f"{k} = {v:g}" for k, v in self.dims.items())
+        mat = f" of {self.material.name or 'material'}" if self.material is not None else ""
+        return f"<spacar.section {self.shape}({dims}){mat}: A = {self.A:.6g}, Iy = {self.Iy:.6g}, Iz = {self.Iz:.6g}>"
+
+
+# The ESTIFF method of each element type a section describes.
+_ESTIFF = {"PLBEAM": "plbeam_estiff", "PLBEAMNL": "plbeam_estiff", "BEAM": "beam_estiff",
+           "BEAMNL": "beam_estiff", "PLTRUSS": "truss_estiff", "TRUSS": "truss_estiff"}
+
+
+def _rectangle_torsion(a: float, c: float) -> tuple:
+    """Saint-Venant torsion of an a × c rectangle, a ≥ c: (J, Wt) from the series of the
+    Prandtl stress function (Timoshenko & Goodier §109), summed over odd n until converged:
+    J = (a c³/3) [1 − (192 c / π⁵ a) Σ tanh(nπa/2c)/n⁵], τmax = Gθ c [1 − (8/π²) Σ 1/(n² cosh(nπa/2c))]
+    at the middle of the long sides, so Wt = J / (c [...])."""
+    s_j = s_t = 0.0
+    for n in range(1, 2001, 2):
+        s_j += math.tanh(n * math.pi * a / (2 * c)) / n**5
+        arg = n * math.pi * a / (2 * c)
+        s_t += 0.0 if arg > 700 else 1.0 / (n * n * math.cosh(arg))
+    J = a * c**3 / 3.0 * (1.0 - 192.0 * c / (math.pi**5 * a) * s_j)
+    tau = c * (1.0 - 8.0 / math.pi**2 * s_t)
+    return J, J / tau
+
+
+def rectangle(b, h, material: Material | None = None) -> Section:
+    """A solid b × h rectangle: ``h`` along y (PLBEAM: the height in the plane of bending, e.g.
+    the thickness of a leaf spring), ``b`` along z (PLBEAM: the width out of the plane).
+
+    A = bh, Iz = b h³/12, Iy = h b³/12, Wz = b h²/6, Wy = h b²/6; J and Wt by the Saint-Venant
+    series (square: J = 0.1406 h⁴, Wt = 0.2082 h³; thin, b ≫ h: J → b h³/3); shear factor 3/2."""
+    b, h = _positive(b, "b"), _positive(h, "h")
+    J, Wt = _rectangle_torsion(max(b, h), min(b, h))
+    return Section("rectangle", {"b": b, "h": h}, material, A=b * h, Iy=h * b**3 / 12, Iz=b * h**3 / 12, J=J,
+                   Wy=h * b**2 / 6, Wz=b * h**2 / 6, Wt=Wt, shear_factor=1.5, round_=False)
+
+
+def circle(d, material: Material | None = None) -> Section:
+    """A solid circle of diameter ``d``: A = πd²/4, I = πd⁴/64, J = Ip = πd⁴/32, W = πd³/32,
+    Wt = πd³/16; shear factor 4/3."""
+    d = _positive(d, "d")
+    I = math.pi * d**4 / 64
+    return Section("circle", {"d": d}, material, A=math.pi * d**2 / 4, Iy=I, Iz=I, J=2 * I, Wy=I / (d / 2),
+                   Wz=I / (d / 2), Wt=2 * I / (d / 2), shear_factor=4.0 / 3.0, round_=True)
+
+
+def tube(d, t, material: Material | None = None) -> Section:
+    """A round tube of outer diameter ``d`` and wall thickness ``t`` (t ≤ d/2; d/2: the solid
+    circle): with the inner diameter di = d − 2t, A = π(d² − di²)/4, I = π(d⁴ − di⁴)/64,
+    J = Ip = 2I, W = 2I/d, Wt = 4I/d; shear factor (4/3)(r² + r ri + ri²)/(r² + ri²) (4/3 for the
+    solid circle, → 2 for a thin wall)."""
+    d, t = _positive(d, "d"), _positive(t, "t")
+    if t > d / 2:
+        raise InputError(f"the wall thickness t = {t:g} of a tube exceeds its outer radius d/2 = {d / 2:g}")
+    di = d - 2 * t
+    I = math.pi * (d**4 - di**4) / 64
+    r, ri = d / 2, di / 2
+    k = 4.0 / 3.0 * (r * r + r * ri + ri * ri) / (r * r + ri * ri)
+    return Section("tube", {"d": d, "t": t}, material, A=math.pi * (d**2 - di**2) / 4, Iy=I, Iz=I, J=2 * I,
+                   Wy=2 * I / d, Wz=2 * I / d, Wt=4 * I / d, shear_factor=k, round_=True)
+
+
+# ------------------------------------------------------------------------------------------------
+# Stresses of a solution
+# ------------------------------------------------------------------------------------------------
+
+class Stresses:
+    """The largest stresses per element at each output (:func:`stresses`): ``t`` (nt), ``elements``
+    (the element numbers of the columns), ``normal`` and ``shear`` (nt × n_elements), and the
+    section forces they come from in ``forces[e]`` (a dict of arrays N, T, My, Mz at both ends
+    as (nt × 2), Vy, Vz)."""
+
+    def __init__(self, t, elements, normal, shear, forces):
+        self.t, self.elements, self.normal, self.shear, self.forces = t, elements, normal, shear, forces
+
+    def element(self, e: int):
+        """(normal, shear) of element e over the outputs."""
+        if e not in self.elements:
+            raise InputError(f"element {show(e)} has no stresses here (elements: {self.elements})")
+        k = self.elements.index(e)
+        return self.normal[:, k], self.shear[:, k]
+
+    def max(self) -> dict:
+        """The largest normal and shear stress over all outputs and elements, with where:
+        ``{"normal": (value, element, output index), "shear": (...)}``."""
+        out = {}
+        for name in ("normal", "shear"):
+            a = getattr(self, name)
+            if a.size == 0:
+                out[name] = (0.0, None, None)
+                continue
+            i, k = np.unravel_index(np.argmax(a), a.shape)
+            out[name] = (float(a[i, k]), self.elements[k], int(i))
+        return out
+
+    def __repr__(self):
+        return f"<spacar.section.Stresses: {len(self.t)} outputs x {len(self.elements)} elements>"
+
+
+def section_forces(results, e: int, type_name: str, l0: float) -> dict:
+    """The section forces of element e from its generalized stresses σ (formulation §4.2, §4.8):
+    axial force N = σ1; end moments M = l0 σ of the bending pairs (σ conjugate to the bending
+    deformations l0 sin θ: M = l0 σ cos θ, the element's end rotations θ relative to its chord
+    being small); shear force V = σp − σq of each pair ((Mp + Mq)/l0 in the beam's sign: zero
+    for constant curvature); twisting moment T = l0 σ2 (BEAM)."""
+    s = lambda i: results.sigma[:, results.deformation_index(e, i)]  # noqa: E731
+    zero = np.zeros(len(results.t))
+    if type_name in ("PLTRUSS", "TRUSS"):
+        ends = np.zeros((len(zero), 2))
+        return {"N": s(1), "T": zero, "My": ends, "Mz": ends, "Vy": zero, "Vz": zero}
+    if type_name in ("PLBEAM", "PLBEAMNL"):
+        return {"N": s(1), "T": zero, "My": np.zeros((len(zero), 2)), "Mz": l0 * np.column_stack([s(2), s(3)]),
+                "Vy": s(2) - s(3), "Vz": zero}
+    return {"N": s(1), "T": l0 * s(2), "My": l0 * np.column_stack([s(3), s(4)]),
+            "Mz": l0 * np.column_stack([s(5), s(6)]), "Vz": s(3) - s(4), "Vy": s(5) - s(6)}
+
+
+def stresses(results, sections) -> Stresses:
+    """The largest normal stress (|N|/A plus bending, the larger of both ends, both bending axes
+    of BEAM: :meth:`Section.normal_stress`) and the largest shear stress (torsion plus transverse
+    shear: :meth:`Section.shear_stress`) of beams and trusses at every output of ``results``.
+
+    ``sections``: one :class:`Section` for every beam and truss of the model, or a dict
+    ``{element: Section}`` for those elements only. The stresses σ must be complete: those of a
+    static analysis are; a simulation fills the reaction stresses of rigid deformations (e.g. an
+    axially rigid beam's N) only with ``FORCEMODE 2``."""
+    geometry = results.geometry
+    if geometry is None:
+        raise InputError("these results have no geometry (element types and lengths) to compute stresses with")
+    table = {el.id: el for el in geometry.elements}
+    if isinstance(sections, Section):
+        sections = {e: sections for e, el in table.items() if el.type in _ESTIFF}
+    elif not isinstance(sections, dict):
+        raise InputError(f"sections must be a Section or a dict {{element: Section}}, got {show(sections)}")
+    elements = sorted(sections)
+    nt = len(results.t)
+    normal, shear, forces = np.zeros((nt, len(elements))), np.zeros((nt, len(elements))), {}
+    for k, e in enumerate(elements):
+        sec = sections[e]
+        if not isinstance(sec, Section):
+            raise InputError(f"the section of element {e} must be a spacar.section.Section, got {show(sec)}")
+        if e not in table or table[e].type not in _ESTIFF:
+            kind = f" ({table[e].type})" if e in table else ""
+            raise InputError(f"element {show(e)}{kind} is not a beam or truss of these results")
+        el = table[e]
+        f = section_forces(results, e, el.type, el.l0)
+        forces[e] = f
+        normal[:, k] = np.maximum(sec.normal_stress(f["N"], f["My"][:, 0], f["Mz"][:, 0]),
+                                  sec.normal_stress(f["N"], f["My"][:, 1], f["Mz"][:, 1]))
+        shear[:, k] = sec.shear_stress(f["T"], f["Vy"], f["Vz"])
+    return Stresses(np.asarray(results.t), elements, normal, shear, forces)

@@ -1,0 +1,188 @@
+"""Cross-sections and stresses (issue 19, spacar.section): the section properties against values
+computed here by hand and against the published Saint-Venant torsion coefficients (Timoshenko &
+Goodier, table of k1, k2 for rectangles); the largest stresses of static solutions against
+beam theory: a cantilever with a tip load (σ = P (L − x)/W along it, τ = 1.5 P/A), an axial bar
+(σ = P/A), a spatial cantilever bent about both axes and twisted.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import spacar
+from spacar import section
+from spacar.errors import InputError
+from support.spatial_models import cantilever as beam_cantilever
+
+
+def test_material_from_nu_or_g():
+    m = section.Material(200e9, nu=0.25, rho=8000.0)
+    assert m.G == pytest.approx(80e9)
+    assert section.Material(200e9, G=80e9).nu == pytest.approx(0.25)
+    assert section.STEEL.E == 210e9 and section.STEEL.rho == 7850.0
+    assert section.STEEL.G == pytest.approx(210e9 / 2.6)
+    with pytest.raises(InputError, match="either"):
+        section.Material(1.0)
+    with pytest.raises(InputError, match="either"):
+        section.Material(1.0, nu=0.3, G=1.0)
+    with pytest.raises(InputError, match="nu"):
+        section.Material(1.0, nu=0.6)
+    with pytest.raises(InputError, match="E must"):
+        section.Material(-1.0, nu=0.3)
+
+
+def test_rectangle_leaf_spring():
+    b, h = 0.02, 0.001  # a 20 mm wide, 1 mm thick leaf
+    s = section.rectangle(b, h, section.STEEL)
+    assert s.A == pytest.approx(2e-5)
+    assert s.Iz == pytest.approx(0.02 * 1e-9 / 12)
+    assert s.Iy == pytest.approx(0.001 * 8e-6 / 12)
+    assert s.Wz == pytest.approx(0.02 * 1e-6 / 6)
+    assert s.Wy == pytest.approx(0.001 * 4e-4 / 6)
+    # Thin strip: J = (b h³/3)(1 − 0.630 h/b) up to (h/b)⁵ terms; τ = T h / J.
+    assert s.J == pytest.approx(b * h**3 / 3 * (1 - 0.63025 * h / b), rel=1e-5)
+    assert s.Wt == pytest.approx(s.J / h, rel=1e-9)
+    EA, EI = s.plbeam_estiff()
+    assert EA == pytest.approx(210e9 * 2e-5) and EI == pytest.approx(210e9 * 0.02e-9 / 12)
+    EA, GJ, EIy, EIz = s.beam_estiff()
+    assert GJ == pytest.approx(210e9 / 2.6 * s.J) and EIy == pytest.approx(210e9 * s.Iy)
+    assert EIz == pytest.approx(EI)
+    assert s.emass() == pytest.approx((7850 * 2e-5,))
+    assert s.emass(rotary=True) == pytest.approx((7850 * 2e-5, 7850 * (s.Iy + s.Iz), 7850 * s.Iy, 7850 * s.Iz))
+
+
+@pytest.mark.parametrize("ratio, k1, k2", [(1.0, 0.1406, 0.208), (2.0, 0.229, 0.246), (4.0, 0.281, 0.282),
+                                           (10.0, 0.312, 0.312)])
+def test_rectangle_torsion_coefficients(ratio, k1, k2):
+    # J = k1 a c³, τmax = T / (k2 a c²) for an a × c rectangle (a ≥ c), tabulated to 3 digits.
+    c = 0.01
+    for s in (section.rectangle(ratio * c, c), section.rectangle(c, ratio * c)):  # either orientation
+        assert s.J / (ratio * c * c**3) == pytest.approx(k1, abs=6e-4)
+        assert s.Wt / (ratio * c * c**2) == pytest.approx(k2, abs=6e-4)
+
+
+def test_circle_and_tube():
+    d = 0.01
+    s = section.circle(d, section.ALUMINIUM)
+    assert s.A == pytest.approx(math.pi * 1e-4 / 4)
+    assert s.Iy == s.Iz == pytest.approx(math.pi * 1e-8 / 64)
+    assert s.J == pytest.approx(math.pi * 1e-8 / 32)
+    assert s.Wz == pytest.approx(math.pi * 1e-6 / 32) and s.Wt == pytest.approx(math.pi * 1e-6 / 16)
+    assert s.shear_factor == pytest.approx(4 / 3)
+    solid = section.tube(d, d / 2)
+    for name in ("A", "Iy", "Iz", "J", "Wy", "Wz", "Wt", "shear_factor"):
+        assert getattr(solid, name) == pytest.approx(getattr(s, name), rel=1e-12)
+    t = section.tube(0.1, 0.001)
+    di = 0.098
+    assert t.Iz == pytest.approx(math.pi * (0.1**4 - di**4) / 64)
+    assert t.Wt == pytest.approx(math.pi * (0.1**4 - di**4) / 32 / 0.05)
+    assert t.shear_factor == pytest.approx(2.0, rel=0.01)  # thin wall: τ = 2V/A
+    with pytest.raises(InputError, match="exceeds"):
+        section.tube(0.01, 0.006)
+    with pytest.raises(InputError, match="no material"):
+        section.circle(d).plbeam_estiff()
+    with pytest.raises(InputError, match="positive"):
+        section.rectangle(0.0, 1.0)
+
+
+def test_apply_sets_estiff_and_emass_by_element_type():
+    m = spacar.Model()
+    m.plbeam(1, 1, 2, 3, 4)
+    m.pltruss(2, 3, 5)
+    m.x(3, 1.0, 0.0)
+    m.x(5, 1.0, 1.0)
+    s = section.circle(0.01, section.STEEL)
+    assert s.apply(m) is m
+    el = m.elements
+    np.testing.assert_allclose(el[1].estiff, s.plbeam_estiff())
+    np.testing.assert_allclose(el[2].estiff, s.truss_estiff())
+    np.testing.assert_allclose(el[1].emass, [7850 * s.A])
+    spatial = beam_cantilever(2)
+    section.rectangle(0.02, 0.01, section.Material(1e9, nu=0.3)).apply(spatial, 2)  # no density: no EMASS change
+    assert spatial.elements[2].estiff[3] == pytest.approx(1e9 * 0.02 * 1e-6 / 12)
+    assert list(spatial.elements[2].emass) == list(spatial.elements[1].emass)
+    s.apply(spatial, 1, rotary=True)
+    np.testing.assert_allclose(spatial.elements[1].emass, s.emass(rotary=True))
+    with pytest.raises(InputError, match="not defined"):
+        s.apply(m, 9)
+
+
+# ------------------------------------------------------------------------------------------------
+# stresses of solutions
+# ------------------------------------------------------------------------------------------------
+
+def plbeam_cantilever(n, L, sec, force):
+    """n PLBEAMs along x, clamped at nodes 1, 2, the section's stiffness, all deformations DYNE."""
+    m = spacar.Model()
+    for k in range(1, n + 1):
+        m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
+        m.x(2 * k + 1, k * L / n, 0.0)
+        m.dyne(k, 1, 2, 3)
+    sec.apply(m)
+    m.fix(1)
+    m.fix(2)
+    m.force(2 * n + 1, *force)
+    return m
+
+
+def test_cantilever_tip_load_bending_and_shear_stress():
+    n, L, P = 5, 0.1, 0.01  # small: linear to ~1e-7
+    sec = section.rectangle(0.02, 0.002, section.STEEL)
+    res = spacar.static(plbeam_cantilever(n, L, sec, (0.0, P)), steps=1)
+    s = section.stresses(res, sec)
+    assert s.elements == [1, 2, 3, 4, 5]
+    # The largest bending moment of element k is at its root end, x = (k − 1) L/n.
+    root = np.arange(n) * L / n
+    np.testing.assert_allclose(s.normal[-1], P * (L - root) / sec.Wz, rtol=1e-5)
+    np.testing.assert_allclose(s.shear[-1], 1.5 * P / sec.A, rtol=1e-5)
+    value, element, _ = s.max()["normal"]
+    assert element == 1 and value == pytest.approx(P * L / sec.Wz, rel=1e-5)
+    normal, shear = s.element(3)
+    assert normal[-1] == s.normal[-1, 2] and shear[-1] == s.shear[-1, 2]
+    # The same from a dict naming one element only.
+    only = section.stresses(res, {2: sec})
+    assert only.elements == [2] and only.normal[-1, 0] == s.normal[-1, 1]
+
+
+def test_axial_bar_stress():
+    sec = section.circle(0.004, section.ALUMINIUM)
+    P = 50.0
+    res = spacar.static(plbeam_cantilever(3, 0.5, sec, (P, 0.0)), steps=1)
+    s = section.stresses(res, sec)
+    np.testing.assert_allclose(s.normal[-1], P / sec.A, rtol=1e-9)
+    np.testing.assert_allclose(s.shear[-1], 0.0, atol=1e-9 * P / sec.A)
+
+
+def test_spatial_cantilever_bent_about_both_axes_and_twisted():
+    n, L = 4, 1.0
+    sec = section.rectangle(0.03, 0.02, section.STEEL)
+    m = beam_cantilever(n, L=L)
+    for e in range(1, n + 1):
+        m.dyne(e, 1)
+    sec.apply(m)
+    Py, Pz, T = 0.02, -0.03, 0.05  # small: the torque of the loads on the deflection is 1e-6 of T
+    m.force(n + 1, 0.0, Py, Pz)
+    m.apply("FORCE", 100 + n + 1, 0.0, 2.0 * T, 0.0, 0.0)  # r_λ = 2 E(λ)ᵀ m at λ = (1, 0, 0, 0)
+    res = spacar.static(m, steps=1)
+    assert res.node(n + 1).x[-1][1] > 0  # bends the way it is pushed
+    s = section.stresses(res, sec)
+    # The clamped end: |Mz| = Py L about z (the y-bending, h = 0.02 along y), |My| = Pz L.
+    assert s.normal[-1, 0] == pytest.approx(abs(Py) * L / sec.Wz + abs(Pz) * L / sec.Wy, rel=1e-4)
+    assert s.shear[-1, 0] == pytest.approx(abs(T) / sec.Wt + 1.5 * math.hypot(Py, Pz) / sec.A, rel=1e-4)
+    f = s.forces[1]
+    assert abs(f["T"][-1]) == pytest.approx(abs(T), rel=1e-4)
+    # A round section bends about the resultant axis.
+    disc = section.circle(0.02, section.STEEL)
+    r = section.stresses(res, disc)
+    assert r.normal[-1, 0] == pytest.approx(math.hypot(Py, Pz) * L / disc.Wz, rel=1e-4)
+
+
+def test_stresses_bad_input():
+    sec = section.circle(0.004, section.ALUMINIUM)
+    res = spacar.static(plbeam_cantilever(2, 0.5, sec, (1.0, 0.0)), steps=1)
+    with pytest.raises(InputError, match="not a beam or truss"):
+        section.stresses(res, {7: sec})
+    with pytest.raises(InputError, match="Section"):
+        section.stresses(res, 3.0)
