@@ -24,7 +24,8 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
                                     "newton_iterations", "wall_time", "recursive")}
     stats["method"] = _method_used(arrays)
     stats["switches"] = [tuple(s) for s in arrays["switches"]]
-    if method in ("radau5", "auto"):  # the implicit method's work: Jacobians (linearizations), LU factorizations
+    # The implicit method's work, where it ran: Jacobians (linearizations), LU factorizations.
+    if method == "radau5" or arrays["switches"]:
         stats.update(jacobians=arrays["jacobians"], decompositions=arrays["decompositions"])
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
     res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear)
@@ -32,7 +33,7 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     return res
 
 
-def simulate(model, *, method: str = "dop853", on_output=None, progress=None, output_stem=None,
+def simulate(model, *, method: str = "auto", on_output=None, progress=None, output_stem=None,
              time_limit=None, recursive: bool = True) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
@@ -52,12 +53,13 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     (docs/matasc.md), line by line as the run proceeds; the stem is ``output_stem``, else
     ``model.output_stem``, else the input file name without extension, else ``spacar``.
 
-    ``method``: ``"dop853"`` (default), ``"dopri5"``, ``"radau5"`` (implicit Radau IIA for stiff
-    systems, its Newton matrix from the linearized equations; ``res.stats`` then also holds
-    ``jacobians`` and ``decompositions``) or ``"auto"`` (DOP853 until it detects stiffness, then
-    radau5 until the stiffness goes; docs/stiff-integration.md). ``res.stats["method"]`` names
-    the integrator(s) used (``"dop853"``, ``"radau5"``, ``"auto: dop853→radau5 at t=0.0123"``),
-    ``res.stats["switches"]`` lists the changes as ``(t, from, to)``.
+    ``method``: ``"auto"`` (default: DOP853 until it detects stiffness, then radau5 until the
+    stiffness goes; docs/stiff-integration.md), ``"dop853"``, ``"dopri5"`` or ``"radau5"``
+    (implicit Radau IIA for stiff systems, its Newton matrix from the linearized equations;
+    ``res.stats`` then also holds ``jacobians`` and ``decompositions``, as after a switch).
+    ``res.stats["method"]`` names the integrator(s) used (``"dop853"``, ``"radau5"``,
+    ``"auto: dop853→radau5 at t=0.0123"``), ``res.stats["switches"]`` lists the changes as
+    ``(t, from, to)``.
 
     ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
     :class:`spacar.TimeLimitError`.

@@ -267,7 +267,7 @@ class _Task:
     lines: dict               # parameter name -> tuple of _Line (keyword-line parameters)
     analysis: Any             # "simulate", "linearize" or a function(model) -> result
     outputs: _Outputs
-    method: str = "dop853"
+    method: str = "auto"
     time_limit: float | None = None
 
 
@@ -538,7 +538,7 @@ def _parameter_arrays(names, cases):
 
 # --- the entry point -------------------------------------------------------------------------------
 
-def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str = "dop853",
+def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str = "auto",
           time_limit: float | None = None, workers: int | None = None, client=None, executor=None,
           chunksize: int | None = None, progress=None) -> SweepResult:
     """Run an analysis of ``model`` for every case of ``parameters`` and gather the outputs.

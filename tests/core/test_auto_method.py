@@ -79,7 +79,7 @@ def test_damped_cantilever_switches_to_radau_early():
 
 
 def test_slider_crank_stays_on_dop853_with_the_same_numbers():
-    dop = spacar.simulate(spacar.read(EXAMPLE), progress=False)
+    dop = spacar.simulate(spacar.read(EXAMPLE), method="dop853", progress=False)
     res = spacar.simulate(spacar.read(EXAMPLE), method="auto", progress=False)
     assert res.stats["switches"] == [] and res.stats["method"] == "dop853"
     assert dop.stats["method"] == "dop853" and dop.stats["switches"] == []
@@ -107,3 +107,12 @@ def test_cli_and_sweep_accept_auto(capsys):
                        outputs={"method": lambda res: res.stats["method"]}, workers=1, progress=False)
     assert not out.errors
     assert list(out["method"]) == ["dop853", "dop853"]
+
+
+def test_auto_is_the_default():
+    res = spacar.simulate(steel_cantilever(damping=1e-3, t_end=0.02), progress=False)
+    assert res.stats["switches"] and res.stats["method"].startswith("auto: dop853→radau5")
+    import inspect
+
+    assert inspect.signature(spacar.simulate).parameters["method"].default == "auto"
+    assert inspect.signature(spacar.sweep).parameters["method"].default == "auto"
