@@ -29,6 +29,11 @@ py::dict block_results_to_dict(BlockResults&& r) {
   d["recursive"] = r.recursive;
   d["jacobians"] = r.jacobians;
   d["decompositions"] = r.decompositions;
+  d["method"] = method_name(r.method);
+  py::list switches;
+  for (const MethodSwitch& w : r.switches)
+    switches.append(py::make_tuple(w.t, method_name(w.from), method_name(w.to)));
+  d["switches"] = switches;
   d["warnings"] = r.warnings;
   return d;
 }

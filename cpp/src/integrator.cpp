@@ -19,7 +19,18 @@ Method parse_method(const std::string& name) {
   if (name == "dop853") return Method::DOP853;
   if (name == "dopri5") return Method::DOPRI5;
   if (name == "radau5") return Method::RADAU5;
+  if (name == "auto") return Method::AUTO;
   throw InputError("unknown integration method '" + name + "' (dop853, dopri5, radau5)");
+}
+
+const char* method_name(Method m) {
+  switch (m) {
+    case Method::DOP853: return "dop853";
+    case Method::DOPRI5: return "dopri5";
+    case Method::RADAU5: return "radau5";
+    case Method::AUTO: return "auto";
+  }
+  return "?";
 }
 
 namespace {
@@ -36,6 +47,7 @@ struct Scheme {
   double q;           // order that sets the controller exponent -1/q and the initial-step formula
   double fac_min, fac_max;
   bool error_needs_last_stage;   // the error estimate uses f(t + h, y_new)
+  double stiff_bound;            // h|λ| beyond which a step counts as stiff (Hairer's codes)
   const double* c;
   const Row* a;
   const Row* d;
@@ -170,8 +182,8 @@ constexpr Row kD5[1] = {Row{-12715105075.0 / 11282082432, 0, 87487479700.0 / 327
                             -10690763975.0 / 1880347072, 701980252875.0 / 199316789632,
                             -1453857185.0 / 822651844, 69997945.0 / 29380423}};
 
-constexpr Scheme kDop853{12, 16, 4, 8.0, 0.333, 6.0, false, kC853, kA853, kD853};
-constexpr Scheme kDopri5{6, 7, 1, 5.0, 0.2, 10.0, true, kC5, kA5, kD5};
+constexpr Scheme kDop853{12, 16, 4, 8.0, 0.333, 6.0, false, 6.1, kC853, kA853, kD853};
+constexpr Scheme kDopri5{6, 7, 1, 5.0, 0.2, 10.0, true, 3.25, kC5, kA5, kD5};
 
 const Scheme& scheme(Method m) { return m == Method::DOP853 ? kDop853 : kDopri5; }
 
@@ -210,7 +222,8 @@ Integrator::Integrator(int n, Method method)
       atol_(Eigen::VectorXd::Constant(std::max(n, 0), 1e-6)),
       hmax_(std::numeric_limits<double>::infinity()) {
   if (n < 1) throw std::invalid_argument("Integrator: the system needs at least one state");
-  if (method == Method::RADAU5) throw std::invalid_argument("Integrator: RADAU5 is the class Radau5");
+  if (method == Method::RADAU5 || method == Method::AUTO)
+    throw std::invalid_argument("Integrator: only DOP853 and DOPRI5 (RADAU5 is the class Radau5)");
   const Scheme& sc = scheme(method);
   k_.assign(sc.total, Eigen::VectorXd::Zero(n));
   dense_.assign(3 + sc.dense_rows, Eigen::VectorXd::Zero(n));
@@ -256,6 +269,38 @@ double Integrator::last_step() const { return h_last_; }
 
 const IntegratorStats& Integrator::stats() const { return stats_; }
 
+void Integrator::set_stiffness_detection(bool on, double min_steps_ahead) {
+  if (!(min_steps_ahead >= 0)) throw std::invalid_argument("Integrator: min_steps_ahead must be >= 0");
+  detect_stiffness_ = on;
+  min_steps_ahead_ = min_steps_ahead;
+}
+bool Integrator::stiffness_detected() const { return stiff_; }
+double Integrator::stiffness_estimate() const { return hlamb_; }
+double Integrator::stiffness_bound(Method m) {
+  if (m != Method::DOP853 && m != Method::DOPRI5)
+    throw std::invalid_argument("Integrator: stiffness bounds are those of DOP853 and DOPRI5");
+  return scheme(m).stiff_bound;
+}
+
+// h|λ| from the two evaluations at t + h of the step just computed: k_[s] = f(t + h, y_new) and
+// k_[s-1] = f(t + h, Y) with Y = y_stage_, the argument of the last stage (c = 1 in both schemes).
+void Integrator::estimate_stiffness(double h) {
+  const Scheme& sc = scheme(method_);
+  const double num = (k_[sc.s] - k_[sc.s - 1]).squaredNorm();
+  const double den = (y_new_ - y_stage_).squaredNorm();
+  hlamb_ = den > 0.0 ? std::abs(h) * std::sqrt(num / den) : 0.0;
+}
+
+// Hairer's counting after an accepted step: true once kStiffSteps steps were stiff with no run of
+// kNonstiffSteps non-stiff ones between them.
+bool Integrator::stiff_after_step() {
+  if (hlamb_ > scheme(method_).stiff_bound) {
+    nonstiff_steps_ = 0;
+    return ++stiff_steps_ >= kStiffSteps;
+  }
+  if (++nonstiff_steps_ >= kNonstiffSteps) stiff_steps_ = 0;
+  return false;
+}
 // Calls the rhs; false if it produced a non-finite value.
 bool Integrator::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
   ++stats_.nfev;
@@ -346,6 +391,7 @@ Integrator::Attempt Integrator::attempt_step(const Rhs& f, double t, double h, d
   }
   // DOP853 needs f(t_new, y_new) only once the step is accepted (it starts the next step).
   if (!sc.error_needs_last_stage && !eval(f, t_new, y_new_, k_[sc.s])) return Attempt::Failed;
+  if (detect_stiffness_) estimate_stiffness(h);   // before the dense stages overwrite y_stage_
   if (dense && !build_dense(f, t, h, y)) return Attempt::Failed;
   return Attempt::Accepted;
 }
@@ -411,6 +457,9 @@ double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::Vecto
                                              describe(t0, 0.0));
 
   failure_ = "none";
+  stiff_ = false;
+  hlamb_ = 0.0;
+  stiff_steps_ = nonstiff_steps_ = 0;
   size_t next = 0;
   for (; next < touts.size() && touts[next] == t0; ++next) out(t0, y);
   if (t_end == t0) return t0;
@@ -471,6 +520,10 @@ double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::Vecto
     y = y_new_;
     std::swap(k_[0], k_[sc.s]);
     rejected = false;
+    if (detect_stiffness_ && stiff_after_step() && t_end - t > min_steps_ahead_ * h) {
+      stiff_ = true;
+      break;
+    }
     if (stop_ && t < t_end && stop_(t, y)) break;
   }
   h_last_ = h;

@@ -149,6 +149,13 @@ void Radau5::set_jacobian_reuse(double theta) {
 
 const Radau5Stats& Radau5::stats() const { return stats_; }
 
+void Radau5::set_nonstiffness_detection(double bound) {
+  if (!(bound >= 0) || !std::isfinite(bound))
+    throw std::invalid_argument("Radau5: the non-stiffness bound must be finite and >= 0");
+  nonstiff_bound_ = bound;
+}
+bool Radau5::nonstiffness_detected() const { return nonstiff_; }
+double Radau5::spectral_radius() const { return rho_; }
 bool Radau5::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
   ++stats_.nfev;
   f(t, y, dy);
@@ -366,6 +373,9 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
   long accepted_here = 0;
   have_polynomial_ = false;
   faccon_ = 1.0;
+  nonstiff_ = false;
+  nonstiff_steps_ = 0;
+  rho_ = 0.0;
   double t = t0;
   for (long steps = 0; t < t_end; ++steps) {
     if (steps >= max_steps_)
@@ -388,6 +398,12 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
         if (!J_.allFinite()) throw IntegrationError("Radau5: non-finite Jacobian at " + describe(t, h_try));
         need_jacobian = false;
         jacobian_fresh = true;
+        if (nonstiff_bound_ > 0) {
+          eigen_.compute(J_, false);
+          // No convergence of the eigenvalues: take the method for stiff (no return).
+          rho_ = eigen_.info() == Eigen::Success ? eigen_.eigenvalues().cwiseAbs().maxCoeff()
+                                                 : std::numeric_limits<double>::infinity();
+        }
         h_factorized = 0.0;
       }
       if (h_try != h_factorized) {
@@ -444,6 +460,13 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
     if (!need_jacobian && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;
     // A last step shortened to reach t_end says little about the step the solution allows.
     h = last ? std::max(h_new, std::min(h, hmax_)) : h_new;
+    if (nonstiff_bound_ > 0) {
+      nonstiff_steps_ = rho_ * h_try <= nonstiff_bound_ ? nonstiff_steps_ + 1 : 0;
+      if (nonstiff_steps_ >= kNonstiffSteps && t < t_end) {
+        nonstiff_ = true;
+        break;
+      }
+    }
     if (stop_ && t < t_end && stop_(t, y)) break;
   }
   h_last_ = h;

@@ -358,6 +358,15 @@ void Simulation::check_time(double t) {
 
 namespace {
 
+// Method AUTO returns from Radau to DOP853 only where DOP853 would be stable at this many times
+// Radau's step (LSODA's RATIO).
+constexpr double kExplicitGain = 5.0;
+// Method AUTO leaves DOP853 for Radau only when, at the stiffness detected, at least this many
+// steps of DOP853's current size remain in the block (Hairer's NSTIFF: his DOP853 looks for
+// stiffness only after 1000 steps). A short stiff stretch costs DOP853 little, and where the
+// stiff modes are excited (the manual's slider-crank) Radau's steps are no longer than DOP853's.
+constexpr double kStiffStepsAhead = 1000.0;
+
 std::string num(double v) {
   std::ostringstream os;
   os.precision(12);
@@ -497,41 +506,60 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   }
   double t = plan.t0, h = options.initial_step;
   kinematic_failure_.clear();
+  // AUTO starts explicit: most mechanisms are not stiff, and DOP853 tells when one is.
+  const bool auto_switch = options.method == Method::AUTO;
+  Method method = auto_switch ? Method::DOP853 : options.method;
+  res.method = method;
   for (;;) {
-    // One segment: integrate until the end, or until a free rotation must be repartitioned.
-    // The step limit holds for the block, whatever the number of segments.
+    // One segment: integrate until the end, until a free rotation must be repartitioned, or
+    // (AUTO) until the stiffness changes. The step limit holds for the block, whatever the
+    // number of segments.
     if (res.steps >= options.max_steps)
       throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
                              " steps in the block at t = " + num(t));
     const std::vector<double> remaining(plan.times.begin() + k_out, plan.times.end());
-    const double t_reached = integrate_segment(res, options, st, t, plan.t_end, h, Y, remaining, output);
-    h = res.last_step;
-    if (t_reached >= plan.t_end) break;
-    t = t_reached;
-    repartition(rotation_to_repartition(Y), t, Y);
+    const SegmentEnd end =
+        integrate_segment(res, options, method, auto_switch, st, t, plan.t_end, h, Y, remaining, output);
+    h = res.last_step;  // the other integrator continues with the step this one proposed
+    if (end.t >= plan.t_end) break;
+    t = end.t;
+    if (end.switch_method) {
+      const Method other = method == Method::DOP853 ? Method::RADAU5 : Method::DOP853;
+      res.switches.push_back({t, method, other});
+      method = other;
+    }
+    const int rotation = rotation_to_repartition(Y);
+    if (rotation >= 0) repartition(rotation, t, Y);
   }
 }
 
-double Simulation::integrate_segment(BlockResults& res, const RunOptions& options, const Settings& st, double t,
-                                     double t_end, double h, Eigen::VectorXd& Y, const std::vector<double>& times,
-                                     const Integrator::Output& output) {
-  if (options.method == Method::RADAU5) {
+Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const RunOptions& options, Method method,
+                                                     bool auto_switch, const Settings& st, double t, double t_end,
+                                                     double h, Eigen::VectorXd& Y, const std::vector<double>& times,
+                                                     const Integrator::Output& output) {
+  if (method == Method::RADAU5) {
     Radau5 integ(static_cast<int>(Y.size()));
     integ.set_jacobian([this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) { jacobian(tt, y, J); });
     // The Jacobian (a linearization) costs several right-hand sides per DOF: keep it longer.
     integ.set_jacobian_reuse(0.1);
+    // Back to DOP853 when its stability bound (|hλ| ≤ 6.1) would allow kExplicitGain times
+    // Radau's steps: LSODA's rule (Petzold 1983) with its factor, which pays for DOP853's 12
+    // right-hand sides per step against Radau's 4 to 10 and keeps the two from alternating.
+    if (auto_switch) integ.set_nonstiffness_detection(Integrator::stiffness_bound(Method::DOP853) / kExplicitGain);
     return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
   }
-  Integrator integ(static_cast<int>(Y.size()), options.method);
+  Integrator integ(static_cast<int>(Y.size()), method);
+  integ.set_stiffness_detection(auto_switch, kStiffStepsAhead);
   return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
 }
 
 // One segment with either integrator (the explicit Integrator or the implicit Radau5, which have
 // the same interface).
 template <class Integ>
-double Simulation::run_segment(Integ& integ, BlockResults& res, const RunOptions& options, const Settings& st,
-                               double t, double t_end, double h, Eigen::VectorXd& Y,
-                               const std::vector<double>& times, const Integrator::Output& output) {
+Simulation::SegmentEnd Simulation::run_segment(Integ& integ, BlockResults& res, const RunOptions& options,
+                                               const Settings& st, double t, double t_end, double h,
+                                               Eigen::VectorXd& Y, const std::vector<double>& times,
+                                               const Integrator::Output& output) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   Eigen::VectorXd rtol(Y.size());
   rtol.head(nd + ny).setConstant(st.epsint);
@@ -570,7 +598,8 @@ double Simulation::run_segment(Integ& integ, BlockResults& res, const RunOptions
   }
   add_stats();
   res.last_step = integ.last_step();
-  return t_reached;
+  if constexpr (std::is_same_v<Integ, Radau5>) return {t_reached, integ.nonstiffness_detected()};
+  else return {t_reached, integ.stiffness_detected()};
 }
 
 void Simulation::explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y) {

@@ -199,8 +199,9 @@ def main(argv=None) -> int:
     run.add_argument("file")
     run.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                      help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
-    run.add_argument("--method", choices=["dop853", "dopri5", "radau5"], default="dop853",
-                     help="integration method (radau5: implicit, for stiff flexible systems)")
+    run.add_argument("--method", choices=["dop853", "dopri5", "radau5", "auto"], default="auto",
+                     help="integration method (default auto: dop853, radau5 where it detects stiffness; "
+                          "radau5: implicit, for stiff flexible systems)")
     run.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                      help="progress bar over simulated time on standard error (default: in a terminal, "
                           "for runs longer than a second; needs tqdm)")

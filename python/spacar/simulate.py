@@ -11,10 +11,21 @@ from .linearize import Linearization
 from .results import Results
 
 
+def _method_used(arrays: dict) -> str:
+    """The integrator(s) of the block: "dop853", or with switches (method "auto") e.g.
+    "auto: dop853→radau5 at t=0.0123"."""
+    if not arrays["switches"]:
+        return arrays["method"]
+    return "auto: " + arrays["method"] + "".join(f"→{to} at t={t:.6g}" for t, _, to in arrays["switches"])
+
+
 def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
                                     "newton_iterations", "wall_time", "recursive")}
-    if method == "radau5":  # the implicit method's work: Jacobians (linearizations), LU factorizations
+    stats["method"] = _method_used(arrays)
+    stats["switches"] = [tuple(s) for s in arrays["switches"]]
+    # The implicit method's work, where it ran: Jacobians (linearizations), LU factorizations.
+    if method == "radau5" or arrays["switches"]:
         stats.update(jacobians=arrays["jacobians"], decompositions=arrays["decompositions"])
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
     res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear)
@@ -22,7 +33,7 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     return res
 
 
-def simulate(model, *, method: str = "dop853", on_output=None, progress=None, output_stem=None,
+def simulate(model, *, method: str = "auto", on_output=None, progress=None, output_stem=None,
              time_limit=None, recursive: bool = True) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
@@ -42,9 +53,13 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     (docs/matasc.md), line by line as the run proceeds; the stem is ``output_stem``, else
     ``model.output_stem``, else the input file name without extension, else ``spacar``.
 
-    ``method``: ``"dop853"`` (default), ``"dopri5"`` or ``"radau5"`` (implicit Radau IIA for stiff
-    systems, its Newton matrix from the linearized equations; ``res.stats`` then also holds
-    ``jacobians`` and ``decompositions``; docs/stiff-integration.md).
+    ``method``: ``"auto"`` (default: DOP853 until it detects stiffness, then radau5 until the
+    stiffness goes; docs/stiff-integration.md), ``"dop853"``, ``"dopri5"`` or ``"radau5"``
+    (implicit Radau IIA for stiff systems, its Newton matrix from the linearized equations;
+    ``res.stats`` then also holds ``jacobians`` and ``decompositions``, as after a switch).
+    ``res.stats["method"]`` names the integrator(s) used (``"dop853"``, ``"radau5"``,
+    ``"auto: dop853→radau5 at t=0.0123"``), ``res.stats["switches"]`` lists the changes as
+    ``(t, from, to)``.
 
     ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
     :class:`spacar.TimeLimitError`.
@@ -67,7 +82,8 @@ def simulate(model, *, method: str = "dop853", on_output=None, progress=None, ou
     if on_output is not None and not callable(on_output):
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
     if not isinstance(method, str):
-        raise InputError(f"method must be 'dop853' or 'dopri5' (explicit) or 'radau5' (implicit), got {show(method)}")
+        raise InputError(f"method must be 'dop853' or 'dopri5' (explicit), 'radau5' (implicit) or 'auto', "
+                         f"got {show(method)}")
     if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
     sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it

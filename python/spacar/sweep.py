@@ -267,7 +267,7 @@ class _Task:
     lines: dict               # parameter name -> tuple of _Line (keyword-line parameters)
     analysis: Any             # "simulate", "linearize" or a function(model) -> result
     outputs: _Outputs
-    method: str = "dop853"
+    method: str = "auto"
     time_limit: float | None = None
 
 
@@ -538,7 +538,7 @@ def _parameter_arrays(names, cases):
 
 # --- the entry point -------------------------------------------------------------------------------
 
-def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str = "dop853",
+def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str = "auto",
           time_limit: float | None = None, workers: int | None = None, client=None, executor=None,
           chunksize: int | None = None, progress=None) -> SweepResult:
     """Run an analysis of ``model`` for every case of ``parameters`` and gather the outputs.
@@ -590,8 +590,8 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     if not (analysis in ("simulate", "linearize") or callable(analysis)):
         raise InputError(f"sweep: analysis must be 'simulate', 'linearize' or a function, got {show(analysis)}")
     time_limit = seconds_or_none(time_limit, "sweep: time_limit")
-    if not isinstance(method, str) or method not in ("dop853", "dopri5", "radau5"):
-        raise InputError(f"sweep: unknown integration method {show(method)} (dop853, dopri5, radau5)")
+    if not isinstance(method, str) or method not in ("dop853", "dopri5", "radau5", "auto"):
+        raise InputError(f"sweep: unknown integration method {show(method)} (dop853, dopri5, radau5, auto)")
     names, cases, grid, lines = _cases(parameters, by_lines=isinstance(model, Model))
     task = _Task(model, lines, analysis, _Outputs(outputs, analysis), method, time_limit)
     n = len(cases)

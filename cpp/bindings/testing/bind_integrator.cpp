@@ -16,24 +16,25 @@ namespace {
 
 py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, double t_end,
                const std::vector<double>& touts, double rtol, double atol,
-               const std::string& method, double hmax) {
+               const std::string& method, double hmax, bool detect_stiffness) {
   const int n = static_cast<int>(y0.size());
   spacar::Integrator integrator(n, spacar::parse_method(method));
   integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol),
                             Eigen::VectorXd::Constant(n, atol));
   integrator.set_max_step(hmax);
+  integrator.set_stiffness_detection(detect_stiffness);
 
   const spacar::Integrator::Rhs rhs = [&f](double t, const Eigen::VectorXd& y,
                                            Eigen::VectorXd& dy) {
     dy = f(t, y).cast<Eigen::VectorXd>();
   };
-  Eigen::MatrixXd ys(touts.size(), n);
+  Eigen::MatrixXd ys = Eigen::MatrixXd::Constant(touts.size(), n, std::numeric_limits<double>::quiet_NaN());
   Eigen::Index row = 0;
   const spacar::Integrator::Output out = [&ys, &row](double, const Eigen::VectorXd& y) {
     ys.row(row++) = y.transpose();
   };
   Eigen::VectorXd y = y0;
-  integrator.integrate(rhs, t0, t_end, y, touts, out);
+  const double t_reached = integrator.integrate(rhs, t0, t_end, y, touts, out);
 
   const spacar::IntegratorStats& stats = integrator.stats();
   py::dict result;
@@ -42,6 +43,9 @@ py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, doub
   result["nfev"] = stats.nfev;
   result["naccept"] = stats.naccept;
   result["nreject"] = stats.nreject;
+  result["t_reached"] = t_reached;
+  result["stiff"] = integrator.stiffness_detected();
+  result["hlamb"] = integrator.stiffness_estimate();
   return result;
 }
 
@@ -50,8 +54,10 @@ py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, doub
 void bind_integrator(py::module_& m) {
   m.def("explicit_rk_solve", &solve, py::arg("f"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
         py::arg("touts"), py::arg("rtol"), py::arg("atol"), py::arg("method") = "dop853",
-        py::arg("hmax") = std::numeric_limits<double>::infinity(),
+        py::arg("hmax") = std::numeric_limits<double>::infinity(), py::arg("detect_stiffness") = false,
         "Test helper: integrate dy/dt = f(t, y) from t0 to t_end with the embedded Runge-Kutta "
         "method 'dop853' or 'dopri5' and return the dense output at touts as a dict with t, y "
-        "(len(touts) x n), nfev, naccept, nreject.");
+        "(len(touts) x n), nfev, naccept, nreject; with detect_stiffness the run stops where the "
+        "method detects stiffness: t_reached, stiff and hlamb (h|lambda| of the last step) say so "
+        "(the rows of later output times are NaN).");
 }

@@ -15,25 +15,26 @@ namespace {
 
 py::dict solve(const py::function& f, const py::function& jac, double t0, const Eigen::VectorXd& y0,
                double t_end, const std::vector<double>& touts, double rtol, double atol, double hmax,
-               double first_step) {
+               double first_step, double nonstiff_bound) {
   const int n = static_cast<int>(y0.size());
   spacar::Radau5 integrator(n);
   integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol), Eigen::VectorXd::Constant(n, atol));
   integrator.set_max_step(hmax);
   integrator.set_initial_step(first_step);
+  integrator.set_nonstiffness_detection(nonstiff_bound);
   integrator.set_jacobian([&jac](double t, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
     J = jac(t, y).cast<Eigen::MatrixXd>();
   });
   const spacar::Radau5::Rhs rhs = [&f](double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
     dy = f(t, y).cast<Eigen::VectorXd>();
   };
-  Eigen::MatrixXd ys(touts.size(), n);
+  Eigen::MatrixXd ys = Eigen::MatrixXd::Constant(touts.size(), n, std::numeric_limits<double>::quiet_NaN());
   Eigen::Index row = 0;
   const spacar::Radau5::Output out = [&ys, &row](double, const Eigen::VectorXd& y) {
     ys.row(row++) = y.transpose();
   };
   Eigen::VectorXd y = y0;
-  integrator.integrate(rhs, t0, t_end, y, touts, out);
+  const double t_reached = integrator.integrate(rhs, t0, t_end, y, touts, out);
 
   const spacar::Radau5Stats& s = integrator.stats();
   py::dict result;
@@ -46,6 +47,9 @@ py::dict solve(const py::function& f, const py::function& jac, double t0, const 
   result["nsteps"] = s.nsteps;
   result["naccept"] = s.naccept;
   result["nreject"] = s.nreject;
+  result["t_reached"] = t_reached;
+  result["nonstiff"] = integrator.nonstiffness_detected();
+  result["rho"] = integrator.spectral_radius();
   return result;
 }
 
@@ -55,7 +59,9 @@ void bind_radau(py::module_& m) {
   m.def("radau5_solve", &solve, py::arg("f"), py::arg("jac"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
         py::arg("touts"), py::arg("rtol"), py::arg("atol"),
         py::arg("hmax") = std::numeric_limits<double>::infinity(), py::arg("first_step") = 0.0,
+        py::arg("nonstiff_bound") = 0.0,
         "Test helper: integrate dy/dt = f(t, y) with jacobian jac(t, y) (n x n) by Radau IIA of order 5 "
         "from t0 to t_end; returns the dense output at touts as a dict with t, y (len(touts) x n) and the "
-        "counters nfev, njev, ndec, nnewton, nsteps, naccept, nreject.");
+        "counters nfev, njev, ndec, nnewton, nsteps, naccept, nreject; with nonstiff_bound > 0 the run stops "
+        "where rho(J) h stays below it (t_reached, nonstiff, rho; later output rows NaN).");
 }

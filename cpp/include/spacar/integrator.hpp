@@ -25,11 +25,15 @@ struct IntegrationError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// RADAU5 is the implicit Radau IIA method of radau5.hpp (its own class, not Integrator's).
-enum class Method { DOP853, DOPRI5, RADAU5 };
-// The method of its name ("dop853", "dopri5", "radau5"), the one parser of every entry point;
-// InputError for any other name.
+// RADAU5 is the implicit Radau IIA method of radau5.hpp (its own class, not Integrator's). AUTO is
+// a choice of the analysis, not an integrator: DOP853 until it detects stiffness, then RADAU5
+// until the stiffness goes (simulate.cpp, Simulation::integrate_block).
+enum class Method { DOP853, DOPRI5, RADAU5, AUTO };
+// The method of its name ("dop853", "dopri5", "radau5", "auto"), the one parser of every entry
+// point; InputError for any other name.
 Method parse_method(const std::string& name);
+// The name parse_method reads.
+const char* method_name(Method m);
 
 struct IntegratorStats {
   long nfev = 0, nsteps = 0, naccept = 0, nreject = 0;
@@ -76,6 +80,26 @@ class Integrator {
 
   const IntegratorStats& stats() const;   // cumulative over all integrate calls
 
+  // Stiffness detection (Hairer's test in his codes DOP853 and DOPRI5): after every accepted
+  // step, h|λ| is estimated as h ‖f(t+h, y_new) − f(t+h, Y)‖ / ‖y_new − Y‖ from the last two
+  // evaluations at t + h (Y: the argument of the last stage, at c = 1), which differ by a
+  // small perturbation of the solution: the quotient is a Rayleigh-like estimate of the
+  // dominant eigenvalue of ∂f/∂y along it. A step with h|λ| above the method's bound (the edge of
+  // its stability region on the negative real axis: 6.1 for DOP853, 3.25 for DOPRI5) counts as
+  // stiff: its size is set by stability, not by accuracy. After kStiffSteps such steps, not
+  // interrupted by kNonstiffSteps others in a row, the problem is stiff; integrate() stops there
+  // (as with the stop condition) and stiffness_detected() says so, provided at least
+  // `min_steps_ahead` steps of the current size remain to t_end: a change of method costs a
+  // Jacobian and factorizations and pays only ahead of many stability-limited steps. (Hairer's
+  // codes make the first test only after 1000 steps, then every 1000th until a first stiff one;
+  // here every step is tested, two norms beside 12 right-hand sides, so that an expensive stiff
+  // problem is recognized after a few tens of steps, and the steps ahead decide whether to act.)
+  void set_stiffness_detection(bool on, double min_steps_ahead = 0.0);
+  bool stiffness_detected() const;   // the last integrate() stopped because of stiffness
+  double stiffness_estimate() const;  // h|λ| of the last accepted step (0 if not detecting)
+  static double stiffness_bound(Method m);  // that bound for h|λ| (DOP853 or DOPRI5)
+  static constexpr int kStiffSteps = 15, kNonstiffSteps = 6;
+
  private:
   enum class Attempt { Accepted, ErrorTooLarge, Failed };
 
@@ -84,6 +108,8 @@ class Integrator {
   double initial_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y);
   Attempt attempt_step(const Rhs& f, double t, double h, double t_new, const Eigen::VectorXd& y,
                        bool dense);
+  void estimate_stiffness(double h);
+  bool stiff_after_step();
   double error_norm(double h);
   double step_factor() const;
   bool build_dense(const Rhs& f, double t, double h, const Eigen::VectorXd& y);
@@ -103,6 +129,9 @@ class Integrator {
   StopCondition stop_;
   StepStart step_start_;
   IntegratorStats stats_;
+  bool detect_stiffness_ = false, stiff_ = false;
+  double hlamb_ = 0.0, min_steps_ahead_ = 0.0;
+  int stiff_steps_ = 0, nonstiff_steps_ = 0;   // Hairer's IASTI and NONSTI
   // Work space, allocated once so that the step loop never touches the heap.
   std::vector<Eigen::VectorXd> k_;       // stages; k_[0] = f(t, y)
   std::vector<Eigen::VectorXd> dense_;   // coefficients of the dense-output polynomial

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
 #include <complex>
 #include <functional>
 #include <string>
@@ -60,6 +61,17 @@ class Radau5 {
 
   const Radau5Stats& stats() const;  // cumulative over all integrate calls
 
+  // Non-stiffness detection, for a return to an explicit method (bound > 0; 0: off): the spectral
+  // radius ρ(J) of every Jacobian taken is computed (its eigenvalues, O(n³) like a
+  // factorization, once per Jacobian), and an accepted step of size h with ρ h ≤ bound counts as
+  // non-stiff: an explicit method whose stability region reaches out to |hλ| = bound would be
+  // stable at this step size. After kNonstiffSteps such steps in a row integrate() stops there
+  // (as with the stop condition) and nonstiffness_detected() says so.
+  void set_nonstiffness_detection(double bound);
+  bool nonstiffness_detected() const;  // the last integrate() stopped because of it
+  double spectral_radius() const;      // ρ(J) of the last Jacobian (0 if not detecting)
+  static constexpr int kNonstiffSteps = 15;
+
  private:
   enum class Attempt { Accepted, ErrorTooLarge, SlowNewton, Failed };
 
@@ -85,6 +97,10 @@ class Radau5 {
   StepStart step_start_;
   Jacobian jac_;
   Radau5Stats stats_;
+  double nonstiff_bound_ = 0.0, rho_ = 0.0;
+  bool nonstiff_ = false;
+  int nonstiff_steps_ = 0;
+  Eigen::EigenSolver<Eigen::MatrixXd> eigen_;
   std::string failure_;
 
   // Newton state carried between steps (Hairer's FACCON and THETA).

@@ -24,6 +24,7 @@ namespace spacar {
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 struct RunOptions {
+  // AUTO: DOP853 until it detects stiffness, RADAU5 until the stiffness goes (integrate_block).
   Method method = Method::DOP853;
   double initial_step = 0.0;  // > 0: continue with this step (RESTART 0 across blocks)
   // Called after every output time is recorded (index k, data of that state, its linearization
@@ -43,6 +44,12 @@ struct RunOptions {
 // crawl through millions of round-off-limited steps.
 constexpr double kMinTolerance = 100.0 * 2.220446049250313e-16;
 
+// A change of integrator within a block (method AUTO): at time t, from one to the other.
+struct MethodSwitch {
+  double t;
+  Method from, to;
+};
+
 struct BlockResults {
   Eigen::VectorXd t;
   RowMatrix x, xd, xdd;        // nt x nx
@@ -51,6 +58,8 @@ struct BlockResults {
   std::vector<Linearization> linearizations;  // at every output time if LINE or LINEAR ≥ 1
   long rhs_evaluations = 0, steps = 0, accepted = 0, rejected = 0, newton_iterations = 0;
   long jacobians = 0, decompositions = 0;  // implicit method (RADAU5) only
+  Method method = Method::DOP853;          // the integrator the block started with
+  std::vector<MethodSwitch> switches;      // method AUTO: the changes of integrator
   double last_step = 0.0;
   double wall_time = 0.0;      // seconds spent in the block
   bool recursive = false;      // the right-hand sides took the recursive path (tree.hpp)
@@ -151,15 +160,22 @@ class Simulation {
   void allocate_results(BlockResults& res, const BlockPlan& plan) const;
   // k_out: the output times recorded (also when it throws).
   void integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out);
-  // One integrator run from t towards t_end through `times`, until the end or a repartition of a
-  // free rotation; the time reached. Counters and the last step go to res.
-  double integrate_segment(BlockResults& res, const RunOptions& options, const Settings& st, double t, double t_end,
-                           double h, Eigen::VectorXd& Y, const std::vector<double>& times,
-                           const Integrator::Output& output);
+  // How a segment ended: the time reached (t_end, or earlier for a repartition or a switch) and
+  // whether the integrator asks to hand over to the other one (method AUTO).
+  struct SegmentEnd {
+    double t;
+    bool switch_method;
+  };
+  // One run of the integrator `method` (not AUTO) from t towards t_end through `times`, until the
+  // end, a repartition of a free rotation or, with `auto_switch`, a change of stiffness.
+  // Counters and the last step go to res.
+  SegmentEnd integrate_segment(BlockResults& res, const RunOptions& options, Method method, bool auto_switch,
+                               const Settings& st, double t, double t_end, double h, Eigen::VectorXd& Y,
+                               const std::vector<double>& times, const Integrator::Output& output);
   template <class Integ>
-  double run_segment(Integ& integ, BlockResults& res, const RunOptions& options, const Settings& st, double t,
-                     double t_end, double h, Eigen::VectorXd& Y, const std::vector<double>& times,
-                     const Integrator::Output& output);
+  SegmentEnd run_segment(Integ& integ, BlockResults& res, const RunOptions& options, const Settings& st, double t,
+                         double t_end, double h, Eigen::VectorXd& Y, const std::vector<double>& times,
+                         const Integrator::Output& output);
   void record(BlockResults& res, int k);
   // InputError unless q and q̇ have one value per degree of freedom (`what`: the entry point).
   void require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;
