@@ -20,7 +20,7 @@ Method parse_method(const std::string& name) {
   if (name == "dopri5") return Method::DOPRI5;
   if (name == "radau5") return Method::RADAU5;
   if (name == "auto") return Method::AUTO;
-  throw InputError("unknown integration method '" + name + "' (dop853, dopri5, radau5)");
+  throw InputError("unknown integration method '" + name + "' (auto, dop853, dopri5, radau5)");
 }
 
 const char* method_name(Method m) {
