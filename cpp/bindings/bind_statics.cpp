@@ -25,6 +25,7 @@ py::dict static_results_to_dict(StaticResults&& r) {
   d["step_cuts"] = r.step_cuts;
   d["kinematic_iterations"] = r.kinematic_iterations;
   d["indefinite_at"] = r.indefinite_at;
+  d["limit_points"] = r.limit_points;
   d["wall_time"] = r.wall_time;
   d["warnings"] = r.warnings;
   return d;
@@ -35,12 +36,15 @@ py::dict static_results_to_dict(StaticResults&& r) {
 void bind_statics(py::module_& m) {
   m.def(
       "solve_static",
-      [](Model& model, int steps, int max_iterations, int max_cuts, double tolerance) {
+      [](Model& model, int steps, int max_iterations, int max_cuts, double tolerance, bool arc_length,
+         int max_steps) {
         StaticOptions opt;
         opt.steps = steps;
         opt.max_iterations = max_iterations;
         opt.max_cuts = max_cuts;
         opt.tolerance = tolerance;
+        opt.arc_length = arc_length;
+        opt.max_steps = max_steps;
         StaticResults r;
         std::exception_ptr failure;
         {
@@ -55,9 +59,9 @@ void bind_statics(py::module_& m) {
         return static_results_to_dict(std::move(r));
       },
       py::arg("model"), py::arg("steps") = 10, py::arg("max_iterations") = 30, py::arg("max_cuts") = 12,
-      py::arg("tolerance") = 1e-10,
-      "Static equilibrium of the model's block in load steps; StaticError (with `results`, the converged "
-      "steps) if Newton fails beyond the smallest step.");
+      py::arg("tolerance") = 1e-10, py::arg("arc_length") = false, py::arg("max_steps") = 200,
+      "Static equilibrium of the model's block in load steps (or by the arc-length method past limit "
+      "points); StaticError (with `results`, the converged steps) if no equilibrium is found.");
 }
 
 }  // namespace spacar::bindings
