@@ -9,7 +9,8 @@
 ``spacar static FILE`` the static equilibrium of every block under its loads (docs/statics.md),
                        in load steps, with the state dump after every END.
 ``spacar check FILE``  summary of the model of the first block: nodes and elements by type,
-                       coordinates and deformations per class, degrees of freedom.
+                       coordinates and deformations per class, degrees of freedom; with
+                       ``--release`` the redundant constraints named are released first.
 
 Everything that is not the dump is printed as ``*`` comment lines, so the output is valid input.
 """
@@ -173,6 +174,13 @@ def _check(args) -> int:
     _comment(f"spacar check: {args.file}")
     for w in model.warnings:
         _comment(f"warning: {w}")
+    if args.release:
+        released = model.release_overconstraints()
+        elements = model.elements
+        _comment(f"released {len(released)} redundant constraint{'s' if len(released) != 1 else ''}"
+                 + (":" if released else " (none is over-constrained)"))
+        for e, i in released:
+            _comment(f"RLSE {e} {i}   (element {e} ({elements[e].type_name}) deformation {i})")
     _comment(model.check())
     return 0
 
@@ -230,6 +238,8 @@ def main(argv=None) -> int:
     static.set_defaults(func=_static)
     check = sub.add_parser("check", help="summarise the model: nodes, elements, classes, degrees of freedom")
     check.add_argument("file")
+    check.add_argument("--release", action="store_true",
+                       help="release (RLSE) the redundant constraints the diagnosis names, then check again")
     check.set_defaults(func=_check)
     args = parser.parse_args(argv)
     try:
