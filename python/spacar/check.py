@@ -114,7 +114,7 @@ def release_overconstraints(model) -> list:
     for e, i in diagnosis.redundant:
         el = elements.get(e)
         if el is None or el.cls[i - 1].name != "fixed":
-            what = "an automatic element" if el is None else f"a {el.cls[i - 1].name} deformation"
+            what = "an automatic element" if el is None else f"{el.cls[i - 1].name}, not fixed"
             refused.append(f"element {e} deformation {i} ({what})")
     if refused:
         raise InputError("cannot release the redundant constraints " + ", ".join(refused) +

@@ -7,7 +7,8 @@
                        ``<stem>.gif`` (``--animation`` for another file or format), where
                        ``<stem>`` is the input file name without extension.
 ``spacar static FILE`` the static equilibrium of every block under its loads (docs/statics.md),
-                       in load steps, with the state dump after every END.
+                       in load steps (or past limit points with ``--arc-length``), with the
+                       state dump after every END.
 ``spacar check FILE``  summary of the model of the first block: nodes and elements by type,
                        coordinates and deformations per class, degrees of freedom; with
                        ``--release`` the redundant constraints named are released first.

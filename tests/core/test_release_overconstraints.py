@@ -115,3 +115,23 @@ def test_nothing_to_release_says_so(tmp_path, capsys):
     path.write_text(WELDED_FOURBAR.replace("PLBEAM 3 8 9 6 7", "PLBEAM 3 8 9 6 10"))
     assert main(["check", str(path), "--release"]) == 0
     assert "* released 0 redundant constraints (none is over-constrained)" in capsys.readouterr().out
+
+
+def test_a_redundant_input_is_not_released():
+    """Two actuators (INPUTE) between the same nodes: the redundancy is among the prescribed
+    deformations, which RLSE cannot fix; InputError names it and the model is not changed."""
+    m = spacar.Model()
+    m.pltruss(1, 1, 3)
+    m.pltruss(2, 1, 3)
+    m.pltruss(3, 2, 3)
+    m.x(1, 0.0, 0.0)
+    m.x(2, 1.0, 0.0)
+    m.x(3, 0.5, 0.5)
+    m.fix(1)
+    m.fix(2)
+    m.inpute(1, 1)
+    m.inpute(2, 1)
+    assert m.check().diagnosis.redundant == [(2, 1)]
+    with pytest.raises(spacar.InputError, match=r"element 2 deformation 1 \(input, not fixed\)"):
+        m.release_overconstraints()
+    assert [c.name for c in m.elements[3].cls] == ["fixed"]
