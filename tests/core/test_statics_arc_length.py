@@ -21,26 +21,7 @@ import pytest
 from scipy.optimize import brentq, minimize_scalar
 
 import spacar
-
-
-def von_mises_truss(P, h=0.1, EA=1.0):
-    """Two PLTRUSSes from (∓1, 0) to the apex (0, h), the apex moving vertically (DYNX), a dead
-    downward load P (as in test_statics.py)."""
-    m = spacar.Model()
-    m.pltruss(1, 1, 3)
-    m.pltruss(2, 2, 3)
-    m.x(1, -1.0, 0.0)
-    m.x(2, 1.0, 0.0)
-    m.x(3, 0.0, h)
-    m.fix(1)
-    m.fix(2)
-    m.fix(3, 1)
-    m.dynx(3, 2)
-    for e in (1, 2):
-        m.rlse(e, 1)
-        m.estiff(e, EA)
-    m.force(3, 0.0, -P)
-    return m
+from test_statics import plbeam_cantilever, von_mises_truss  # tests/core/test_statics.py
 
 
 def truss_load(y, h):
@@ -205,3 +186,13 @@ def test_cli_static_arc_length(tmp_path, capsys):
     assert "limit point passed at load factor 0.66666" in out
     y = [float(line.split()[3]) for line in out.splitlines() if line.startswith("XY") and line.split()[1] == "3"]
     assert y[-1] < -h
+
+
+def test_arc_length_on_a_large_deflection_cantilever_ends_where_load_steps_end():
+    """Many DOFs and no limit point (a PLBEAM cantilever under P L²/EI = 3): λ rises monotonically
+    and the last row is the load-stepping equilibrium."""
+    arc = spacar.static(plbeam_cantilever(20, force=(0.0, 3.0)), steps=5, arc_length=True)
+    plain = spacar.static(plbeam_cantilever(20, force=(0.0, 3.0)), steps=5)
+    assert arc.stats["limit_points"] == [] and arc.stats["indefinite_at"] is None
+    assert arc.t[-1] == 1.0 and np.all(np.diff(arc.t) > 0)
+    np.testing.assert_allclose(arc.x[-1], plain.x[-1], atol=1e-9)
