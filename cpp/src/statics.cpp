@@ -663,7 +663,6 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
       ds *= 0.5;
       continue;
     }
-    cuts = 0;
     rows.converged(b.lambda);
     // λ turned between a and b: a limit point, located before the state moves on.
     const bool turned = (a.tau[nd] > 0.0) != (b.tau[nd] > 0.0);
@@ -684,8 +683,9 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
       try {
         path.evaluate(qhat, 1.0, Fs, gs);
         last = path.solve(1.0, true);
-      } catch (const KinematicsError&) {
+      } catch (const KinematicsError& err) {
         last.converged = false;
+        last.why = std::string("the kinematics has no solution there (") + err.what() + ")";
       }
       if (last.converged) {
         report_limit();
@@ -693,10 +693,17 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
         rows.store(1.0, iterations + last.iterations);
         return;
       }
-      ++res.step_cuts;  // no equilibrium at λ = 1 from there: a shorter step
+      if (++cuts > opt.max_cuts) {  // no equilibrium at λ = 1 from there: a shorter step, or give up
+        res.load_reached = a.lambda;
+        throw StaticError("the arc-length method passed load factor 1 after " + num(a.lambda) +
+                          " but Newton at load factor 1 failed from there: " + last.why + " (step halved " +
+                          std::to_string(opt.max_cuts) + " times in a row)");
+      }
+      ++res.step_cuts;
       ds *= 0.5;
       continue;
     }
+    cuts = 0;
     report_limit();
     if (turned) {  // back to b from the limit point's search
       path.restore(b.state);
