@@ -58,7 +58,8 @@ std::string dof_name(const System& sys, int j) {
   return "DYNE " + sys.def_name(sys.e_dyn[j - nxd]);
 }
 
-double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K) {
+double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K,
+                     Eigen::VectorXd* dR_dlambda) {
   const int nd = sys.n_dof();
   // At rest: no rates, no accelerations, hence no inertia or convective forces.
   data.qhat_d.setZero();
@@ -68,6 +69,8 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
   data.xdd.setZero();
   data.edd.setZero();
   compute_inertia_and_loads(sys, data);
+  Eigen::VectorXd full_load;
+  if (dR_dlambda) full_load = data.f;
   data.f *= lambda;
   constitutive_stresses(sys, data);
   // The unbalanced load w = −λf + Σ Bᵀσ on every coordinate; R = DF_qᵀ w.
@@ -81,6 +84,7 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
   w -= data.f;
   for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
   R.noalias() = data.DFq.transpose() * w;
+  if (dR_dlambda) dR_dlambda->noalias() = -data.DFq.transpose() * full_load;
   // Reaction stresses of the velocity rows from the equilibrium of the calculable coordinates,
   // A_Vᵀ y = −w_c (formulation.md §6); on DOF deformation rows y → 0 at equilibrium. With them
   // Σ σ_k H_k is exactly the derivative of DF_q (the second-order transfer) contracted with w.
@@ -256,6 +260,24 @@ class EquilibriumPath {
     return directions(direction) + " (eigenvalue " + num(lowest / big) + " of the largest entry)";
   }
 
+  // For the arc-length method: the state with the DOFs (and inputs) at q̂, at load factor λ:
+  // the scaled residual of the path Fs = S (R − (1 − λ) R0), its derivative in λ at fixed q,
+  // gs = S (−DF_qᵀ f + R0), and the tangent (scaled_tangent()). Returns the force scale.
+  double evaluate(const Eigen::VectorXd& qhat, double lambda, Eigen::VectorXd& Fs, Eigen::VectorXd& gs) {
+    place(qhat);
+    Eigen::VectorXd R, g;
+    const double force = static_forces(sys_, data_, lambda, R, &K_, &g);
+    R -= (1.0 - lambda) * R0_;
+    g += R0_;
+    Fs = scale_.cwiseProduct(R);
+    gs = scale_.cwiseProduct(g);
+    return force;
+  }
+  Eigen::MatrixXd scaled_tangent() const { return scale_.asDiagonal() * K_ * scale_.asDiagonal(); }
+  const Eigen::VectorXd& scale() const { return scale_; }
+  bool inputs_move() const { return p0_ != p1_; }
+  std::string dof_directions(const Eigen::VectorXd& v) const { return directions(v); }
+
   struct Snapshot {
     Eigen::VectorXd x, qhat, angle_ref;
     Eigen::MatrixXd DF;
@@ -323,6 +345,183 @@ class EquilibriumPath {
   bool have_DF_ = false;
 };
 
+// Riks' normal-plane arc-length method on y = (q_s, μ), q_s the DOFs divided by their scale
+// and μ = c λ, c the size of dq_s/dλ at the start (so that a first step weighs displacement and
+// load alike). Each step predicts along the unit tangent τ of the last point and corrects by
+// Newton on the residual bordered with τᵀ (y − y_predicted) = 0: the bordered matrix stays
+// regular at limit points, where K alone is singular. The tangent at a new point solves the
+// same bordered system with the previous tangent, τ_oldᵀ τ > 0: the path goes on in the
+// direction it came from, λ falling after a limit point. The step length follows the Newton
+// iterations; a failed step is halved.
+class ArcLength {
+ public:
+  ArcLength(const System& sys, EquilibriumPath& path, const StaticOptions& opt, StaticResults& res)
+      : sys_(sys), path_(path), opt_(opt), res_(res), nd_(sys.n_dof()) {}
+
+  struct Point {
+    EquilibriumPath::Snapshot state;
+    double lambda = 0.0;
+    Eigen::VectorXd tau;  // unit tangent in y
+  };
+
+  // The starting point (the current state at λ = 0), its tangent, c and the first step length
+  // (the one that raises λ by 1/steps along the tangent).
+  Point start(const Eigen::VectorXd& qhat) {
+    Point p;
+    Eigen::VectorXd Fs;
+    path_.evaluate(qhat, 0.0, Fs, gs_);
+    const Eigen::MatrixXd Ks = path_.scaled_tangent();
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(Ks);
+    lu.setThreshold(1e-13);
+    if (nd_ > 0 && !lu.isInvertible())
+      throw StaticError("arc-length continuation needs a regular tangent stiffness at the start; it is singular in " +
+                        path_.dof_directions(lu.kernel().col(0)));
+    c_ = nd_ > 0 ? lu.solve(-gs_).norm() : 0.0;
+    if (!(c_ > 0.0) || !std::isfinite(c_)) c_ = 1.0;  // nothing loaded: λ alone
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(nd_ + 1);
+    e[nd_] = 1.0;
+    p.state = path_.save();
+    p.tau = tangent(e);
+    first_length_ = c_ / opt_.steps / p.tau[nd_];
+    return p;
+  }
+  double first_length() const { return first_length_; }
+
+  struct Step {
+    bool converged = false;
+    int iterations = 0;
+    std::string why;
+    int worst = -1;
+    double worst_residual = 0.0;
+  };
+
+  // From point a (the state restored to it), a step of length ds: the new point in `b`.
+  Step step(const Point& a, double ds, Point& b) {
+    path_.restore(a.state);
+    Eigen::VectorXd qhat = a.state.qhat;
+    const Eigen::VectorXd& scale = path_.scale();
+    for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += scale[j] * ds * a.tau[j];
+    double lambda = a.lambda + ds * a.tau[nd_] / c_;
+    Step s = correct(qhat, lambda, a.tau);
+    if (!s.converged) return s;
+    b.state = path_.save();
+    b.lambda = lambda;
+    b.tau = tangent(a.tau);
+    if (!b.tau.allFinite()) {
+      s.converged = false;
+      s.why = "the tangent of the path is not defined there";
+    } else if (b.tau.dot(a.tau) < 0.5) {  // turned by more than 60°: the step may have left the path
+      s.converged = false;
+      s.why = "the path turns too sharply within the step";
+    }
+    return s;
+  }
+
+  // The limit point between a and b (the λ component of the tangent changes sign): Illinois'
+  // regula falsi on the step length for τ_λ = 0. Returns the extreme λ found (λ is stationary
+  // there, so its error is quadratic in that of the step length). Leaves the state anywhere.
+  double limit_point(const Point& a, const Point& b, double ds) {
+    double lo = 0.0, hi = ds, f_lo = a.tau[nd_], f_hi = b.tau[nd_];
+    const bool maximum = a.tau[nd_] > 0.0;
+    double extreme = maximum ? std::max(a.lambda, b.lambda) : std::min(a.lambda, b.lambda);
+    int side = 0;
+    for (int it = 0; it < 60 && hi - lo > 1e-9 * ds; ++it) {
+      double s = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+      if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
+      Point p;
+      if (!step(a, s, p).converged) break;
+      extreme = maximum ? std::max(extreme, p.lambda) : std::min(extreme, p.lambda);
+      const double f = p.tau[nd_];
+      if (f == 0.0) break;
+      if ((f > 0.0) == (f_lo > 0.0)) {
+        lo = s, f_lo = f;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      } else {
+        hi = s, f_hi = f;
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      }
+    }
+    return extreme;
+  }
+
+ private:
+  // Newton on [F(q, λ); nᵀ (y − y0)] = 0 from y0 = (q̂, λ).
+  Step correct(Eigen::VectorXd qhat, double& lambda, const Eigen::VectorXd& n) {
+    Step s;
+    const Eigen::VectorXd& scale = path_.scale();
+    Eigen::VectorXd Fs;
+    double last_correction = std::numeric_limits<double>::infinity();
+    for (int it = 0;; ++it) {
+      double force = 0.0;
+      try {
+        force = path_.evaluate(qhat, lambda, Fs, gs_);
+      } catch (const KinematicsError& err) {
+        s.why = std::string("the kinematics has no solution there (") + err.what() + ")";
+        return s;
+      }
+      if (!Fs.allFinite() || !gs_.allFinite()) {
+        s.why = "the forces or the stiffness are not finite";
+        return s;
+      }
+      double res_max = 0.0;
+      if (nd_ > 0) {
+        res_max = Fs.cwiseAbs().maxCoeff(&s.worst);
+        s.worst_residual = Fs[s.worst] / scale[s.worst];
+      }
+      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nd_ + 1);
+      rhs.head(nd_) = -Fs;
+      const Eigen::VectorXd dy = bordered(n).partialPivLu().solve(rhs);
+      if (!dy.allFinite()) {
+        s.why = "the bordered tangent is singular";
+        return s;
+      }
+      // The largest change of a scaled DOF or of λ.
+      const double correction = std::max(nd_ > 0 ? dy.head(nd_).cwiseAbs().maxCoeff() : 0.0, std::abs(dy[nd_]) / c_);
+      if (res_max <= opt_.tolerance * force || correction <= 1e-13 ||
+          (last_correction <= 1e-12 && res_max <= 1e-6 * force)) {
+        s.converged = true;
+        return s;
+      }
+      if (it == opt_.max_iterations) {
+        s.why = "Newton's method did not converge in " + std::to_string(opt_.max_iterations) + " iterations";
+        return s;
+      }
+      ++s.iterations;
+      ++res_.newton_iterations;
+      last_correction = correction;
+      for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += scale[j] * dy[j];
+      lambda += dy[nd_] / c_;
+    }
+  }
+
+  // [K_s, g_s / c; nᵀ] at the last evaluation.
+  Eigen::MatrixXd bordered(const Eigen::VectorXd& n) const {
+    Eigen::MatrixXd J(nd_ + 1, nd_ + 1);
+    J.topLeftCorner(nd_, nd_) = path_.scaled_tangent();
+    J.topRightCorner(nd_, 1) = gs_ / c_;
+    J.row(nd_) = n.transpose();
+    return J;
+  }
+
+  // The unit tangent at the last evaluation, oriented by nᵀ τ > 0.
+  Eigen::VectorXd tangent(const Eigen::VectorXd& n) const {
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(nd_ + 1);
+    e[nd_] = 1.0;
+    const Eigen::VectorXd t = bordered(n).partialPivLu().solve(e);
+    return t / t.norm();
+  }
+
+  const System& sys_;
+  EquilibriumPath& path_;
+  const StaticOptions& opt_;
+  StaticResults& res_;
+  const int nd_;
+  double c_ = 1.0, first_length_ = 0.0;
+  Eigen::VectorXd gs_;
+};
+
 void check_options(const StaticOptions& o) {
   if (o.steps < 1)
     throw InputError("static: the number of load steps must be at least 1, got " + std::to_string(o.steps));
@@ -332,6 +531,203 @@ void check_options(const StaticOptions& o) {
     throw InputError("static: max_cuts must be between 0 and 50, got " + std::to_string(o.max_cuts));
   if (!(o.tolerance > 0.0 && o.tolerance < 1.0))
     throw InputError("static: the tolerance must be between 0 and 1, got " + num(o.tolerance));
+  if (o.max_steps < 1)
+    throw InputError("static: max_steps must be at least 1, got " + std::to_string(o.max_steps));
+}
+
+}  // namespace
+
+namespace {
+
+// The results' rows and the checks made at every converged equilibrium.
+class Rows {
+ public:
+  Rows(const System& sys, const Data& data, EquilibriumPath& path, StaticResults& res, int capacity)
+      : data_(data), path_(path), res_(res) {
+    res.load.resize(capacity);
+    for (RowMatrix* m : {&res.x, &res.reaction}) m->resize(capacity, sys.nx);
+    for (RowMatrix* m : {&res.e, &res.sigma}) m->resize(capacity, sys.ne);
+  }
+
+  // An equilibrium reached at λ (the tangent of the last evaluation is there): is it stable?
+  void converged(double lambda) {
+    res_.load_reached = lambda;
+    if (!std::isnan(res_.indefinite_at)) return;
+    const std::string dir = path_.indefinite();
+    if (dir.empty()) return;
+    res_.indefinite_at = lambda;
+    res_.warnings.push_back("the tangent stiffness is indefinite at load factor " + num(lambda) + " in " + dir +
+                            ": the equilibrium is unstable (a buckling or limit load was passed)");
+  }
+
+  void store(double lambda, int iterations) {
+    res_.load[rows_] = lambda;
+    res_.x.row(rows_) = data_.x;
+    res_.e.row(rows_) = data_.e;
+    res_.sigma.row(rows_) = data_.sigma;
+    res_.reaction.row(rows_) = data_.reaction;
+    res_.iterations.push_back(iterations);
+    ++rows_;
+  }
+  int count() const { return rows_; }
+
+  void finish() {
+    res_.load.conservativeResize(rows_);
+    for (RowMatrix* m : {&res_.x, &res_.reaction, &res_.e, &res_.sigma}) m->conservativeResize(rows_, m->cols());
+  }
+
+ private:
+  const Data& data_;
+  EquilibriumPath& path_;
+  StaticResults& res_;
+  int rows_ = 0;
+};
+
+// λ from 0 to 1 in equal steps, a step halved when Newton fails.
+void follow_load_steps(const System& sys, EquilibriumPath& path, const StaticOptions& opt, StaticResults& res,
+                       Rows& rows) {
+  const int n = opt.steps;
+  const double nominal = 1.0 / n, smallest = nominal * std::ldexp(1.0, -opt.max_cuts);
+  double lambda = 0.0, step = nominal;
+  int iterations = 0;
+  while (rows.count() < n) {
+    const double target = static_cast<double>(rows.count() + 1) / n;
+    // Land exactly on the load factor of the next row.
+    const double next = lambda + step >= target - 1e-12 * nominal ? target : lambda + step;
+    const EquilibriumPath::Snapshot before = path.save();
+    // The last chance: the smallest step allowed, or one whose half would not change λ (with
+    // max_cuts near 50 the steps fall below the round-off of λ, and halving forever would hang).
+    const bool last_chance = step <= smallest * (1.0 + 1e-9) || lambda + 0.5 * step == lambda;
+    const EquilibriumPath::Attempt a = path.solve(next, last_chance);
+    iterations += a.iterations;
+    if (!a.converged) {
+      const bool hopeless = a.singular_at_start || last_chance;
+      if (hopeless) {
+        std::ostringstream os;
+        os << "no static equilibrium found beyond load factor " << num(lambda) << " (of 1; tried " << num(next)
+           << "): " << a.why;
+        if (a.worst >= 0) os << "; worst residual " << num(a.worst_residual) << " on " << dof_name(sys, a.worst);
+        if (!a.singular_at_start) {
+          os << " (load step cut " << res.step_cuts << " times, down to " << num(step)
+             << "). The load may exceed a limit point (snap-through or collapse): follow the path past it with "
+                "the arc-length method (arc_length=True, --arc-length); or the model has a degree of freedom "
+                "without stiffness";
+        } else {
+          os << ". Give that degree of freedom stiffness (ESTIFF) or a support (FIX)";
+        }
+        throw StaticError(os.str());
+      }
+      path.restore(before);
+      ++res.step_cuts;
+      step *= 0.5;
+      continue;
+    }
+    lambda = next;
+    rows.converged(lambda);
+    if (lambda == target) {
+      rows.store(lambda, iterations);
+      iterations = 0;
+    }
+    step = std::min(2.0 * step, nominal);  // back towards the nominal step after a cut
+  }
+}
+
+// The arc-length path from λ = 0 until it reaches λ = 1 (ArcLength): a row per step, limit
+// points located and reported, the last row at λ = 1 exactly by Newton at fixed λ from the
+// point interpolated between the steps before and after.
+void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOptions& opt, StaticResults& res,
+                       Rows& rows) {
+  if (path.inputs_move())
+    throw InputError("static: the arc-length method follows loads; this block also moves inputs (INPUTX/INPUTE "
+                     "with XD, XDD or ED, EDD): apply them in a block of their own without arc_length");
+  const int nd = sys.n_dof();
+  ArcLength arc(sys, path, opt, res);
+  ArcLength::Point a = arc.start(path.save().qhat);
+  const double nominal = arc.first_length();
+  double ds = nominal;
+  int cuts = 0, iterations = 0, done = 0;
+  while (done < opt.max_steps) {
+    ArcLength::Point b;
+    const ArcLength::Step s = arc.step(a, ds, b);
+    iterations += s.iterations;
+    if (!s.converged) {
+      if (++cuts > opt.max_cuts) {
+        res.load_reached = a.lambda;
+        std::ostringstream os;
+        os << "the arc-length method failed beyond load factor " << num(a.lambda) << ": " << s.why;
+        if (s.worst >= 0) os << "; worst residual " << num(s.worst_residual) << " on " << dof_name(sys, s.worst);
+        os << " (step halved " << opt.max_cuts << " times in a row)";
+        throw StaticError(os.str());
+      }
+      ++res.step_cuts;
+      ds *= 0.5;
+      continue;
+    }
+    rows.converged(b.lambda);
+    // λ turned between a and b: a limit point, located before the state moves on.
+    const bool turned = (a.tau[nd] > 0.0) != (b.tau[nd] > 0.0);
+    const double limit = turned ? arc.limit_point(a, b, ds) : 0.0;
+    auto report_limit = [&]() {
+      if (!turned) return;
+      res.limit_points.push_back(limit);
+      res.warnings.push_back("limit point at load factor " + num(limit) +
+                             (b.tau[nd] < 0.0 ? " (a maximum: snap-through)" : " (a minimum)"));
+    };
+    if (b.lambda >= 1.0 && a.lambda < 1.0) {
+      // Newton at λ = 1 from the point between a and b where λ is 1 on the chord.
+      const double w = (1.0 - a.lambda) / (b.lambda - a.lambda);
+      const Eigen::VectorXd qhat = (1.0 - w) * a.state.qhat + w * b.state.qhat;
+      Eigen::VectorXd Fs, gs;
+      path.restore(a.state);
+      EquilibriumPath::Attempt last;
+      try {
+        path.evaluate(qhat, 1.0, Fs, gs);
+        last = path.solve(1.0, true);
+      } catch (const KinematicsError& err) {
+        last.converged = false;
+        last.why = std::string("the kinematics has no solution there (") + err.what() + ")";
+      }
+      if (last.converged) {
+        report_limit();
+        rows.converged(1.0);
+        rows.store(1.0, iterations + last.iterations);
+        return;
+      }
+      if (++cuts > opt.max_cuts) {  // no equilibrium at λ = 1 from there: a shorter step, or give up
+        res.load_reached = a.lambda;
+        throw StaticError("the arc-length method passed load factor 1 after " + num(a.lambda) +
+                          " but Newton at load factor 1 failed from there: " + last.why + " (step halved " +
+                          std::to_string(opt.max_cuts) + " times in a row)");
+      }
+      ++res.step_cuts;
+      ds *= 0.5;
+      continue;
+    }
+    cuts = 0;
+    report_limit();
+    if (turned) {  // back to b from the limit point's search
+      path.restore(b.state);
+      Eigen::VectorXd Fs, gs;
+      path.evaluate(b.state.qhat, b.lambda, Fs, gs);
+    }
+    ++done;
+    rows.store(b.lambda, iterations);
+    iterations = 0;
+    // Next step: about four Newton iterations per step, at most twice the first length.
+    const double grow = std::sqrt(4.0 / std::max(s.iterations, 1));
+    ds = std::min(ds * std::clamp(grow, 0.5, 2.0), 2.0 * nominal);
+    a = std::move(b);
+  }
+  res.load_reached = a.lambda;
+  std::ostringstream os;
+  os << "the arc-length method did not reach load factor 1 in " << opt.max_steps << " steps: load factor "
+     << num(a.lambda) << " reached";
+  if (!res.limit_points.empty()) {
+    os << " after limit points at";
+    for (double l : res.limit_points) os << " " << num(l);
+  }
+  os << ". Allow more steps (max_steps) or longer ones (fewer steps)";
+  throw StaticError(os.str());
 }
 
 }  // namespace
@@ -346,86 +742,57 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
   res.warnings = sys.warnings;
   res.coord_label = sys.coord_label;
   res.def_label = sys.def_label;
-  const int n = opt.steps;
+  const int n = opt.arc_length ? opt.max_steps + 1 : opt.steps;  // arc length: the last row at λ = 1
   require_memory(Data::estimate_dense_bytes(sys) + 8.0 * n * (2.0 * sys.nx + 2.0 * sys.ne + 2.0),
                  "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
                      std::to_string(sys.ne) + " deformations in " + std::to_string(n) + " load steps",
-                 "use fewer load steps");
-  res.load.resize(n);
-  for (RowMatrix* m : {&res.x, &res.reaction}) m->resize(n, sys.nx);
-  for (RowMatrix* m : {&res.e, &res.sigma}) m->resize(n, sys.ne);
-  int rows = 0;
-  auto finish = [&]() {
-    res.load.conservativeResize(rows);
-    for (RowMatrix* m : {&res.x, &res.reaction, &res.e, &res.sigma}) m->conservativeResize(rows, m->cols());
-    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
-
+                 opt.arc_length ? "allow fewer steps (max_steps)" : "use fewer load steps");
   sim.assemble();
   data.t = sys.t0;
   EquilibriumPath path(sys, data, opt, res);
   path.start();
-  const double nominal = 1.0 / n, smallest = nominal * std::ldexp(1.0, -opt.max_cuts);
-  double lambda = 0.0, step = nominal;
-  int iterations = 0;
+  Rows rows(sys, data, path, res, n);
   try {
-    while (rows < n) {
-      const double target = static_cast<double>(rows + 1) / n;
-      // Land exactly on the load factor of the next row.
-      const double next = lambda + step >= target - 1e-12 * nominal ? target : lambda + step;
-      const EquilibriumPath::Snapshot before = path.save();
-      const bool last_chance = step <= smallest * (1.0 + 1e-9);
-      const EquilibriumPath::Attempt a = path.solve(next, last_chance);
-      iterations += a.iterations;
-      if (!a.converged) {
-        const bool hopeless = a.singular_at_start || last_chance;
-        if (hopeless) {
-          std::ostringstream os;
-          os << "no static equilibrium found beyond load factor " << num(lambda) << " (of 1; tried " << num(next)
-             << "): " << a.why;
-          if (a.worst >= 0)
-            os << "; worst residual " << num(a.worst_residual) << " on " << dof_name(sys, a.worst);
-          if (!a.singular_at_start) {
-            os << " (load step cut " << res.step_cuts << " times, down to " << num(step)
-               << "). The load may exceed a limit point (snap-through or collapse), which needs an arc-length "
-                  "method; or the model has a degree of freedom without stiffness";
-          } else {
-            os << ". Give that degree of freedom stiffness (ESTIFF) or a support (FIX)";
-          }
-          throw StaticError(os.str());
-        }
-        path.restore(before);
-        ++res.step_cuts;
-        step *= 0.5;
-        continue;
-      }
-      lambda = res.load_reached = next;
-      if (std::isnan(res.indefinite_at)) {
-        const std::string dir = path.indefinite();
-        if (!dir.empty()) {
-          res.indefinite_at = lambda;
-          res.warnings.push_back("the tangent stiffness is indefinite at load factor " + num(lambda) + " in " + dir +
-                                 ": the equilibrium is unstable (a buckling or limit load was passed)");
-        }
-      }
-      if (lambda == target) {
-        res.load[rows] = lambda;
-        res.x.row(rows) = data.x;
-        res.e.row(rows) = data.e;
-        res.sigma.row(rows) = data.sigma;
-        res.reaction.row(rows) = data.reaction;
-        res.iterations.push_back(iterations);
-        iterations = 0;
-        ++rows;
-      }
-      step = std::min(2.0 * step, nominal);  // back towards the nominal step after a cut
-    }
+    if (opt.arc_length)
+      follow_arc_length(sys, path, opt, res, rows);
+    else
+      follow_load_steps(sys, path, opt, res, rows);
   } catch (const Error&) {
-    finish();
+    rows.finish();
+    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     throw;
   }
-  finish();
+  rows.finish();
+  res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   sim.store_state();
+}
+
+StaticTangent static_tangent(Model& model, double load_factor, const Eigen::VectorXd* x, const Eigen::VectorXd* e) {
+  Simulation sim(model);
+  sim.assemble();
+  const System& sys = sim.system();
+  Data& data = sim.data();
+  if (x || e) {
+    if (!x || !e || x->size() != sys.nx || e->size() != sys.ne)
+      throw InputError("static_tangent: x and e must both be given, with " + std::to_string(sys.nx) + " and " +
+                       std::to_string(sys.ne) + " values");
+    // The row is a solved state: its positions, and the independent coordinates from them; the
+    // kinematics then only refreshes the deformations and their derivatives there.
+    data.x = *x;
+    for (int g = 0; g < sys.nx; ++g)
+      if (sys.qhat_col_x[g] >= 0) data.qhat[sys.qhat_col_x[g]] = (*x)[g];
+    for (int k = 0; k < sys.ne; ++k)
+      if (sys.qhat_col_e[k] >= 0) data.qhat[sys.qhat_col_e[k]] = (*e)[k];
+    data.jacobian_reusable = false;
+    solve_positions(sys, data, std::max(sys.settings.maxiterat, 50), std::min(sys.settings.epskin, 1e-10), false);
+  }
+  StaticTangent t;
+  static_forces(sys, data, load_factor, t.R, &t.K);
+  t.DF = Eigen::MatrixXd(data.DFq);
+  t.x = data.x;
+  t.coord_label = sys.coord_label;
+  for (int j = 0; j < sys.n_dof(); ++j) t.dof_names.push_back(dof_name(sys, j));
+  return t;
 }
 
 }  // namespace spacar

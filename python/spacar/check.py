@@ -1,13 +1,15 @@
 """Checks of a model before an analysis (``spacar check``): nodes and elements by type,
 coordinates and deformations per class, degrees of freedom, and the diagnosis of the constraint
 block — which rigid deformations are redundant and could be released, which coordinates are
-undetermined (formulation.md §2.3)."""
+undetermined (formulation.md §2.3) — and the release of the redundant ones
+(``spacar check --release``, :func:`release_overconstraints`)."""
 from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass
 
 from . import _core
+from .errors import InputError
 
 COORD_CLASSES = ("fixed", "input", "dynamic", "calculable")
 DEF_CLASSES = ("fixed", "released", "input", "dynamic", "linearization", "nonholonomic", "kinematic")
@@ -95,6 +97,33 @@ def check(model) -> Check:
     return Check(summary(model), diagnosis)
 
 
+def release_overconstraints(model) -> list:
+    """Release (RLSE) the redundant rigid deformations that the constraint diagnosis names
+    (``model.check().diagnosis.redundant``), as SPACAR Light's "autosolve" does: afterwards the
+    constraints have full rank. Returns the released ``(element, deformation)`` pairs, empty
+    if nothing is over-constrained. The released deformations carry no stress (or that of their
+    ESTIFF, if given). Undetermined coordinates are not touched (the diagnosis still names
+    them). Raises InputError, changing nothing, when a redundant deformation cannot be released
+    (an input or degree-of-freedom deformation, or one of the automatic L2MIN1 elements of a
+    LAMBDA node: fix the model by hand there) or the constraint block is too large to diagnose."""
+    diagnosis = check(model).diagnosis
+    if not diagnosis.detailed:
+        raise InputError("the constraint block is too large for the diagnosis: no over-constraints released")
+    elements = model.elements
+    refused = []
+    for e, i in diagnosis.redundant:
+        el = elements.get(e)
+        if el is None or el.cls[i - 1].name != "fixed":
+            what = "an automatic element" if el is None else f"{el.cls[i - 1].name}, not fixed"
+            refused.append(f"element {e} deformation {i} ({what})")
+    if refused:
+        raise InputError("cannot release the redundant constraints " + ", ".join(refused) +
+                         ": only fixed deformations of the input can be released (RLSE)")
+    for e, i in diagnosis.redundant:
+        model.rlse(e, i)
+    return list(diagnosis.redundant)
+
+
 def summary(model) -> Summary:
     """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
     nodes are included (they are created at the first END). An empty model (e.g. an input of
@@ -110,4 +139,4 @@ def summary(model) -> Summary:
     return Summary(nodes, elements, coords, defs)
 
 
-__all__ = ["Summary", "Diagnosis", "Check", "summary", "check"]
+__all__ = ["Summary", "Diagnosis", "Check", "summary", "check", "release_overconstraints"]

@@ -7,9 +7,11 @@
                        ``<stem>.gif`` (``--animation`` for another file or format), where
                        ``<stem>`` is the input file name without extension.
 ``spacar static FILE`` the static equilibrium of every block under its loads (docs/statics.md),
-                       in load steps, with the state dump after every END.
+                       in load steps (or past limit points with ``--arc-length``), with the
+                       state dump after every END.
 ``spacar check FILE``  summary of the model of the first block: nodes and elements by type,
-                       coordinates and deformations per class, degrees of freedom.
+                       coordinates and deformations per class, degrees of freedom; with
+                       ``--release`` the redundant constraints named are released first.
 
 Everything that is not the dump is printed as ``*`` comment lines, so the output is valid input.
 """
@@ -149,7 +151,8 @@ def _static(args) -> int:
         _comment("no input block ended with END: nothing to analyse")
         return 0
     n_warn = len(model.warnings)
-    blocks = static_blocks(model, steps=args.steps, max_cuts=args.max_cuts, tolerance=args.tolerance)
+    blocks = static_blocks(model, steps=args.steps, max_cuts=args.max_cuts, tolerance=args.tolerance,
+                           arc_length=args.arc_length, max_steps=args.max_steps)
     for k, res in enumerate(blocks):
         for w in model.warnings[n_warn:]:
             _comment(f"warning: {w}")
@@ -157,6 +160,8 @@ def _static(args) -> int:
         s = res.stats
         _comment(f"block {k + 1}: static equilibrium in {len(res.t)} load steps, {s['newton_iterations']} Newton "
                  f"iterations ({s['step_cuts']} step cuts), {s['wall_time'] * 1e3:.1f} ms")
+        for limit in s["limit_points"]:
+            _comment(f"limit point passed at load factor {limit:.10g}")
         if s["indefinite_at"] is not None:
             _comment(f"the tangent stiffness is indefinite from load factor {s['indefinite_at']:g}: unstable")
         _print_forces(res, model, args.dump_digits)
@@ -170,6 +175,13 @@ def _check(args) -> int:
     _comment(f"spacar check: {args.file}")
     for w in model.warnings:
         _comment(f"warning: {w}")
+    if args.release:
+        released = model.release_overconstraints()
+        elements = model.elements
+        _comment(f"released {len(released)} redundant constraint{'s' if len(released) != 1 else ''}"
+                 + (":" if released else " (none is over-constrained)"))
+        for e, i in released:
+            _comment(f"RLSE {e} {i}   (element {e} ({elements[e].type_name}) deformation {i})")
     _comment(model.check())
     return 0
 
@@ -217,6 +229,10 @@ def main(argv=None) -> int:
     static.add_argument("--steps", type=int, default=10, metavar="N", help="equal load steps per block (default 10)")
     static.add_argument("--max-cuts", type=int, default=12, metavar="N",
                         help="halvings of a load step in which Newton fails before giving up (default 12)")
+    static.add_argument("--arc-length", action="store_true",
+                        help="follow the equilibrium path past limit points (snap-through) by the arc-length method")
+    static.add_argument("--max-steps", type=int, default=200, metavar="N",
+                        help="arc-length steps per block before giving up (default 200)")
     static.add_argument("--tolerance", type=float, default=1e-10,
                         help="residual relative to the largest load balanced (default 1e-10)")
     static.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
@@ -224,6 +240,8 @@ def main(argv=None) -> int:
     static.set_defaults(func=_static)
     check = sub.add_parser("check", help="summarise the model: nodes, elements, classes, degrees of freedom")
     check.add_argument("file")
+    check.add_argument("--release", action="store_true",
+                       help="release (RLSE) the redundant constraints the diagnosis names, then check again")
     check.set_defaults(func=_check)
     args = parser.parse_args(argv)
     try:

@@ -379,6 +379,13 @@ class Model:
 
         return check(self)
 
+    def release_overconstraints(self) -> list:
+        """Release (RLSE) the redundant rigid deformations that :meth:`check` names; returns the
+        released ``(element, deformation)`` pairs. See :func:`spacar.check.release_overconstraints`."""
+        from .check import release_overconstraints
+
+        return release_overconstraints(self)
+
     def run_blocks(self, **kwargs):
         """Analyse the blocks of the input in order, as ``spacar run`` does: the current block
         first, then each later block applied to the state reached. Yields one

@@ -7,7 +7,11 @@
 
 The solve runs in C++ (cpp/src/statics.cpp): full Newton on the reduced equations at rest with
 the exact tangent stiffness K0 + G0, the load factor λ raised from 0 to 1 in equal steps, a step
-halved when Newton fails in it.
+halved when Newton fails in it; or, with ``arc_length=True``, the path followed in (q, λ) past
+limit points::
+
+    res = spacar.static(model, steps=20, arc_length=True)
+    res.stats["limit_points"]               # load factors of the limit points passed
 """
 from __future__ import annotations
 
@@ -36,6 +40,7 @@ def _results(arrays: dict, model) -> Results:
         "step_cuts": int(arrays["step_cuts"]),
         "kinematic_iterations": int(arrays["kinematic_iterations"]),
         "indefinite_at": None if np.isnan(indefinite) else indefinite,
+        "limit_points": [float(v) for v in arrays["limit_points"]],
         "wall_time": float(arrays["wall_time"]),
     }
     res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
@@ -49,8 +54,8 @@ def _count(value, name: str, low: int, high: int) -> int:
     return int(value)
 
 
-def static(model, steps: int = 10, *, max_iterations: int = 30, max_cuts: int = 12,
-           tolerance: float = 1e-10) -> Results:
+def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int = 200,
+           max_iterations: int = 30, max_cuts: int = 12, tolerance: float = 1e-10) -> Results:
     """Static equilibrium of the model's current block: the configuration in which the degrees of
     freedom (DYNX, DYNE) are in equilibrium at rest under the block's loads (FORCE, TORQUEL,
     GRAVITY, and the prestress of deformations given with E), with the inputs (INPUTX, INPUTE)
@@ -66,13 +71,23 @@ def static(model, steps: int = 10, *, max_iterations: int = 30, max_cuts: int = 
     halved, up to ``max_cuts`` times. ``tolerance``: the residual relative to the largest load
     balanced. No mass is needed.
 
+    With ``arc_length=True`` the equilibrium path is followed in (q, λ) instead (Riks'
+    normal-plane arc-length method): past limit points (snap-through), λ falling and rising
+    again, until λ reaches 1. The first step raises λ by about 1/``steps``; later steps adapt
+    to the Newton iterations (a failed step is halved, ``max_cuts`` times in a row at most);
+    one row per step (``res.t`` = λ may decrease), the last row at λ = 1 exactly. Limit points
+    passed are located (λ stationary along the path) and listed in
+    ``res.stats["limit_points"]`` with a warning each. At most ``max_steps`` steps, then
+    StaticError. Loads only: a block that also moves inputs is refused (InputError).
+
     Returns :class:`spacar.Results` with one row per load step (``res.t`` holds λ; the last row
     is the full load): x, e, the complete stresses σ (reaction stresses included) and the
     reactions, rates and accelerations zero; ``res.stats`` has ``newton_iterations``,
     ``iterations`` (per row), ``step_cuts``, ``load_reached`` (the last converged load factor),
-    ``kinematic_iterations``, ``wall_time`` and ``indefinite_at`` (the first load factor at
-    which the tangent stiffness is indefinite, i.e. the equilibrium is unstable because a
-    buckling load was passed; None if never, with a warning in ``model.warnings`` otherwise).
+    ``kinematic_iterations``, ``wall_time``, ``limit_points`` (the load factors of the limit
+    points passed; arc length only) and ``indefinite_at`` (the first load factor at which the
+    tangent stiffness is indefinite, i.e. the equilibrium is unstable because a buckling load
+    was passed; None if never, with a warning in ``model.warnings`` otherwise).
     The model's state is left at the equilibrium, at rest, at the block's start time.
 
     Raises :class:`spacar.StaticError` if no equilibrium is found (loads beyond a limit point,
@@ -82,10 +97,14 @@ def static(model, steps: int = 10, *, max_iterations: int = 30, max_cuts: int = 
     steps = _count(steps, "steps", 1, 10**7)
     max_iterations = _count(max_iterations, "max_iterations", 1, 1000)
     max_cuts = _count(max_cuts, "max_cuts", 0, 50)
+    max_steps = _count(max_steps, "max_steps", 1, 10**6)
+    if not isinstance(arc_length, bool):
+        raise InputError(f"arc_length must be True or False, got {show(arc_length)}")
     if isinstance(tolerance, bool) or not isinstance(tolerance, numbers.Real) or not 0 < tolerance < 1:
         raise InputError(f"tolerance must be a number between 0 and 1, got {show(tolerance)}")
     try:  # the core prepares the model (the first END) as a simulation does
-        arrays = _core.solve_static(model.core, steps, max_iterations, max_cuts, float(tolerance))
+        arrays = _core.solve_static(model.core, steps, max_iterations, max_cuts, float(tolerance), arc_length,
+                                    max_steps)
     except SpacarError as err:
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):

@@ -9,7 +9,9 @@
 // generalized form when a block continues from an equilibrium).
 // Full Newton with the exact tangent stiffness ∂R/∂q = K0 + G0 of the linearization (structural
 // plus geometric, formulation.md §7.2; C0 = N0 = 0 at rest), λ from 0 to 1 in equal load steps,
-// a step halved when Newton fails there. No mass is needed.
+// a step halved when Newton fails there. No mass is needed. With arc_length the path is followed
+// in (q, λ) instead (Riks' normal-plane arc-length method): past limit points, λ rising and
+// falling, until λ = 1.
 #pragma once
 
 #include <Eigen/Dense>
@@ -31,6 +33,8 @@ struct StaticOptions {
   int max_iterations = 30;   // Newton iterations per (sub)step
   int max_cuts = 12;         // halvings of a load step before giving up
   double tolerance = 1e-10;  // residual relative to the largest generalized force balanced
+  bool arc_length = false;   // follow the path in (q, λ) past limit points (see follow_arc_length)
+  int max_steps = 200;       // arc-length steps before giving up (one result row each)
 };
 
 struct StaticResults {
@@ -45,6 +49,7 @@ struct StaticResults {
   // First converged load factor at which the tangent stiffness is indefinite (an equilibrium
   // past a buckling or limit point: unstable), NaN if it never was.
   double indefinite_at = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> limit_points;  // arc length: load factors of the limit points passed
   double wall_time = 0.0;
   std::vector<std::string> warnings;
 };
@@ -53,9 +58,11 @@ struct StaticResults {
 // R (n_dof) and, if K is not null, the tangent stiffness ∂R/∂q (n_dof x n_dof). Leaves in data
 // the transfer functions, the rates at zero, data.f = λ f, the complete stresses σ (reaction
 // stresses of the velocity rows from the equilibrium of the calculable coordinates) and the
-// reactions on the fixed and input coordinates. Returns the scale of R: the largest applied or
-// elastic load on a coordinate (loads on lengths times the mean element length).
-double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K);
+// reactions on the fixed and input coordinates. If dR_dlambda is not null, ∂R/∂λ at fixed
+// positions: −DF_qᵀ f. Returns the scale of R: the largest applied or elastic load on a
+// coordinate (loads on lengths times the mean element length).
+double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K,
+                     Eigen::VectorXd* dR_dlambda = nullptr);
 
 // "DYNX node 3 component 2" / "DYNE element 2 (PLBEAM) deformation 3" of degree of freedom j.
 std::string dof_name(const System& sys, int j);
@@ -64,5 +71,20 @@ std::string dof_name(const System& sys, int j);
 // λ = 1 and store it in the model (at rest, at the block's start time). On failure StaticError
 // with `res` holding the rows converged before it; the model is then not changed.
 void solve_static(Model& model, StaticResults& res, const StaticOptions& options = {});
+
+// The tangent of the static solve (spacar.compliance): R and K = K0 + G0 under λ times the
+// block's loads, DF of the degrees of freedom (∂x/∂q), x and the names of the DOFs.
+struct StaticTangent {
+  Eigen::VectorXd R, x;
+  Eigen::MatrixXd K, DF;
+  std::vector<std::array<int, 2>> coord_label;
+  std::vector<std::string> dof_names;
+};
+
+// At the model's current state or, given both x and e (a row of static results), at that row:
+// the model is assembled as a simulation does and put there. InputError if only one of x, e is
+// given or their sizes are wrong.
+StaticTangent static_tangent(Model& model, double load_factor, const Eigen::VectorXd* x = nullptr,
+                             const Eigen::VectorXd* e = nullptr);
 
 }  // namespace spacar
