@@ -74,7 +74,7 @@ def test_motion_and_stress_follow_the_closed_form(method, zeta):
 # for 1000 steps of the current size ahead does not fit in the 1 s block (over 10 s: a switch at
 # t = 2.55 s). Found by this test; the xfail goes when the guard allows the switch.
 @pytest.mark.parametrize("eps", [1e-6, pytest.param(1e-8, marks=pytest.mark.xfail(
-    strict=True, reason="auto does not detect the stiffness at EPSINT 1e-8 (stays on DOP853)"))])
+    strict=True, reason="auto stays on DOP853 at EPSINT 1e-8 (the steps-ahead guard)"))])
 def test_stiff_oscillator_takes_few_implicit_steps(eps):
     # ω = 10⁴ rad/s, ζ = 0.5 over 1 s: the motion has decayed after a few ms, after which DOP853's
     # steps are held at its stability limit h|λ| ≈ 6 (about 2000 steps at 1e-6); Radau's grow.
