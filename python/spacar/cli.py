@@ -77,13 +77,22 @@ def _print_forces(res, model, digits: int) -> None:
             _comment(f"{'SIGMA':<8s} {e:3d} {i:3d}" + real.format(res.sigma[-1, k]))
 
 
-def _run(args) -> int:
+def _read_for_analysis(args, analysis: str = ""):
+    """The model of the input file, its header and reader warnings printed; None (said in a comment)
+    if no block ended with END."""
     model = read(args.file)
-    _comment(f"spacar {__version__}: {args.file}")
+    _comment(f"spacar {__version__}{analysis}: {args.file}")
     for w in model.warnings:
         _comment(f"warning: {w}")
     if not model.blocks:
         _comment("no input block ended with END: nothing to analyse")
+        return None
+    return model
+
+
+def _run(args) -> int:
+    model = _read_for_analysis(args)
+    if model is None:
         return 0
     if args.output_stem:
         model.output_stem = args.output_stem
@@ -143,12 +152,8 @@ def _write_animation(res, path) -> None:
 def _static(args) -> int:
     from .statics import static_blocks
 
-    model = read(args.file)
-    _comment(f"spacar {__version__} static: {args.file}")
-    for w in model.warnings:
-        _comment(f"warning: {w}")
-    if not model.blocks:
-        _comment("no input block ended with END: nothing to analyse")
+    model = _read_for_analysis(args, " static")
+    if model is None:
         return 0
     n_warn = len(model.warnings)
     blocks = static_blocks(model, steps=args.steps, max_cuts=args.max_cuts, tolerance=args.tolerance,
