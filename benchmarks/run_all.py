@@ -1,7 +1,8 @@
 """Run every benchmark and write its section of docs/performance.md (and the plots under
 docs/img/): the manual's slider-crank (spacar alone, benchmarks/slidercrank.py), then spacar
 side by side with the peers — rigid chains (chains.py), the four-bar (fourbar.py), the flexible
-cantilever (cantilever.py) and the manual's slider-crank against exudyn (slidercrank_exudyn.py).
+cantilever (cantilever.py), the manual's slider-crank against exudyn (slidercrank_exudyn.py) and
+the steel cantilever's time to tip accuracy with the stiff integrator (stiff.py).
 
     python benchmarks/run_all.py [--quick] [--no-write] [--only chains fourbar ...]
 
@@ -24,6 +25,7 @@ import chains  # noqa: E402
 import fourbar  # noqa: E402
 import slidercrank  # noqa: E402
 import slidercrank_exudyn  # noqa: E402
+import stiff  # noqa: E402
 
 CASES = {
     "slidercrank": slidercrank,
@@ -31,6 +33,7 @@ CASES = {
     "fourbar": fourbar,
     "cantilever": cantilever,
     "slidercrank_exudyn": slidercrank_exudyn,
+    "stiff": stiff,
 }
 
 
