@@ -20,17 +20,10 @@ import numpy as np
 from . import _core
 from ._util import show
 from .errors import InputError, StaticError
+from .geometry import euler_e
 
 # The coordinates of a node kind that describe its displacement.
 _SIZE = {"XY": 2, "BETA": 1, "XYZ": 3}
-
-
-def _E(lam) -> np.ndarray:
-    """E(λ) of formulation §0: ω = 2 E(λ) λ̇ in global axes."""
-    l0, l1, l2, l3 = lam
-    return np.array([[-l1, l0, -l3, l2],
-                     [-l2, l3, l0, -l1],
-                     [-l3, -l2, l1, l0]])
 
 
 def _rows(tangent: dict, nodes: dict, n, what: str) -> np.ndarray:
@@ -42,7 +35,7 @@ def _rows(tangent: dict, nodes: dict, n, what: str) -> np.ndarray:
     DF = np.asarray(tangent["DF"])[rows]
     if kind == "LAMBDA":
         lam = np.asarray(tangent["x"])[rows]
-        return 2.0 * _E(lam / np.linalg.norm(lam)) @ DF
+        return 2.0 * euler_e(lam / np.linalg.norm(lam)) @ DF
     if kind not in _SIZE:
         raise InputError(f"{what} {int(n)} has no coordinates used by an element")
     return DF

@@ -190,6 +190,15 @@ def rotation(lam) -> np.ndarray:
     return (l0 * l0 - lb @ lb) * np.eye(3) + 2.0 * np.outer(lb, lb) + 2.0 * l0 * skew
 
 
+def euler_e(lam) -> np.ndarray:
+    """E(λ) of formulation.md §0, the 3 × 4 matrix of ω = 2 E(λ) λ̇ in global axes; λ of shape
+    (..., 4) gives (..., 3, 4)."""
+    l0, l1, l2, l3 = np.moveaxis(np.asarray(lam, dtype=float), -1, 0)
+    return np.stack([np.stack([-l1, l0, -l3, l2], -1),
+                     np.stack([-l2, l3, l0, -l1], -1),
+                     np.stack([-l3, -l2, l1, l0], -1)], -2)
+
+
 def hermite(xp, tp, xq, tq, l0: float, n: int = 21) -> np.ndarray:
     """Points r(ξ), ξ = 0..1 (n values), of the cubic Hermite curve with end points xp, xq and
     end tangents dr/dξ = l0 tp, l0 tq."""

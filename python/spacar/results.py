@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError
-from .geometry import Geometry
+from .geometry import Geometry, euler_e
 from .linearize import MATRICES, Linearization
 
 # name: (attribute, over coordinates or deformations, MATASC label prefix, description)
@@ -386,11 +386,7 @@ class Results:
         if len(cols) != 4:
             raise InputError(f"node {n} is not a LAMBDA node")
         lam, r = self.x[:, cols], self.reaction[:, cols]
-        l0, l1, l2, l3 = lam.T
-        E = np.stack([np.stack([-l1, l0, -l3, l2], -1),
-                      np.stack([-l2, l3, l0, -l1], -1),
-                      np.stack([-l3, -l2, l1, l0], -1)], 1)  # (nt, 3, 4)
-        return 0.5 * np.einsum("tij,tj->ti", E, r)
+        return 0.5 * np.einsum("tij,tj->ti", euler_e(lam), r)
 
     def __len__(self):
         return len(self.t)

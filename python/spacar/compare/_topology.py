@@ -34,7 +34,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import InputError
-from ..geometry import rotation  # R(λ), body → global
+from ..geometry import euler_e, rotation  # E(λ) of ω = 2 E(λ) λ̇; R(λ), body → global
 
 PLANAR_BEAMS = ("PLBEAM", "PLBEAMNL")
 SPATIAL_BEAMS = ("BEAM", "BEAMNL")
@@ -58,11 +58,6 @@ class UnsupportedModelError(InputError):
 def rot_z(beta: float) -> np.ndarray:
     c, s = math.cos(beta), math.sin(beta)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def E_matrix(lam) -> np.ndarray:
-    l0, l1, l2, l3 = lam
-    return np.array([[-l1, l0, -l3, l2], [-l2, l3, l0, -l1], [-l3, -l2, l1, l0]])
 
 
 def lambda_of_rotation(R: np.ndarray, near=None) -> np.ndarray:
@@ -263,7 +258,7 @@ class Topology:
             return np.array([0.0, 0.0, xd[self.coord_index[(n, 1)]]])
         lam = [x[self.coord_index[(n, i)]] for i in range(1, 5)]
         lamd = [xd[self.coord_index[(n, i)]] for i in range(1, 5)]
-        return 2.0 * E_matrix(lam) @ np.asarray(lamd)
+        return 2.0 * euler_e(lam) @ np.asarray(lamd)
 
     def body_omega_rows(self, b: int, x, DF) -> np.ndarray:
         """∂ω_b/∂(columns of DF): 3 × ncols."""
@@ -276,7 +271,7 @@ class Topology:
             return out
         idx = [self.coord_index[(n, i)] for i in range(1, 5)]
         lam = x[idx]
-        return 2.0 * E_matrix(lam) @ DF[idx]
+        return 2.0 * euler_e(lam) @ DF[idx]
 
     def point_position(self, node: int, x) -> np.ndarray:
         k = 2 if self.node_kind[node] == NK.XY else 3
