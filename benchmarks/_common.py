@@ -115,11 +115,13 @@ def best_time(fn, repeat: int = 3, budget: float = 5.0, min_time: float = 0.0, s
             return best, value
 
 
-def simulate_best(model, repeat: int = 3, budget: float = 2.0, recursive: bool = True, min_time: float = 0.0):
+def simulate_best(model, repeat: int = 3, budget: float = 2.0, recursive: bool = True, min_time: float = 0.0,
+                  **options):
     """Best wall time of ``spacar.simulate`` as :func:`best_time`, each run on a fresh copy of the
     model (copied outside the timing); returns (results of the last run, seconds).
-    ``recursive=False``: the general path only."""
-    best, res = best_time(lambda m: spacar.simulate(m, recursive=recursive), repeat, budget, min_time,
+    ``recursive=False``: the general path only; ``options``: further arguments of simulate
+    (``method=``, ``progress=``)."""
+    best, res = best_time(lambda m: spacar.simulate(m, recursive=recursive, **options), repeat, budget, min_time,
                           setup=model.copy)
     return res, best
 
