@@ -2,8 +2,15 @@
 section.stresses and the buckling modes (issue 19; the worked example of docs/statics.md),
 against the small-deflection formulas of flexure design computed here: drive stiffness
 24 EI/L³, its drop by 6P/5L under a compressive load P on the stage, the largest bending stress
-3 E t u / L² at a drive displacement u, and the buckling load 2π²EI/L² of the two clamped-guided
-leaves (sway mode)."""
+3 E t u / L² at a drive displacement u, the buckling load 2π²EI/L² of the two clamped-guided
+leaves (sway mode), and the drop of the support stiffness with the drive displacement u,
+
+    K_support(u) = 2 / (L/EA + L u² / (700 EI))
+
+(Awtar, Slocum and Sevincer 2007, "Characteristics of beam-based flexure modules", J. Mech.
+Des. 129: the elastokinematic axial compliance u²/700 of a guided beam, normalised; for a leaf of
+thickness t, K(u)/K(0) = 1/(1 + (3/175)(u/t)²), the leaf's support stiffness falls to a third at
+u = 10 t)."""
 from __future__ import annotations
 
 import numpy as np
@@ -80,3 +87,32 @@ def test_buckling_load_of_the_guide():
     # The sway mode: the stage moves sideways, not down.
     dx, dy = shapes_x[res.coordinate_index(STAGE, 1), 0], shapes_x[res.coordinate_index(STAGE, 2), 0]
     assert abs(dy) < 1e-3 * abs(dx)
+
+
+def support_stiffness_at_stage_centre(m):
+    """The stiffness along the leaves (y) at the middle of the stage, with the drive (x) held
+    and the stage free to tilt: from the stage node's 3 × 3 compliance (x, y, β), x held by a
+    Schur complement, the centre point's y moving by δy + (D/2) δβ under a force there (a
+    force Fy and a moment (D/2) Fy on the stage node)."""
+    C = spacar.compliance(m, STAGE, rotation=STAGE + 1)
+    rest = [1, 2]
+    held = C[np.ix_(rest, rest)] - np.outer(C[rest, 0], C[0, rest]) / C[0, 0]
+    t = np.array([1.0, D / 2])
+    return 1.0 / (t @ held @ t)
+
+
+@pytest.mark.parametrize("drive", [0.0, 10.0, 20.0, 40.0])
+def test_support_stiffness_drops_with_the_drive_displacement(drive):
+    m, leaf = leaf_guide("plbeamnl")
+    EA, EI = leaf.plbeam_estiff()
+    if drive:
+        m.force(STAGE, drive, 0.0)
+        spacar.static(m, steps=4)
+    u = m.nodes[STAGE].x[0]
+    published = 2.0 / (L / EA + L * u**2 / (700 * EI))
+    K = support_stiffness_at_stage_centre(m)
+    # The formula is the first term of a series in u²: spacar is off by about 1e-2 (u/(L/10))²,
+    # the next term (1.1 % at u = 4.7 mm, where the support stiffness has dropped to 39 %).
+    assert K == pytest.approx(published, rel=1e-12 + 1.5e-2 * (u / (0.1 * L)) ** 2)
+    if drive == 40.0:
+        assert 0.09 * L < u < 0.1 * L and K < 0.4 * 2 * EA / L
