@@ -2,7 +2,8 @@
 docs/img/): the manual's slider-crank (spacar alone, benchmarks/slidercrank.py), then spacar
 side by side with the peers — rigid chains (chains.py), the four-bar (fourbar.py), the flexible
 cantilever (cantilever.py), the manual's slider-crank against exudyn (slidercrank_exudyn.py) and
-the steel cantilever's time to tip accuracy with the stiff integrator (stiff.py).
+the steel cantilever's time to tip accuracy with the stiff integrator (stiff.py) and the
+static solve of a large-deflection cantilever against exudyn's SolveStatic (statics.py).
 
     python benchmarks/run_all.py [--quick] [--no-write] [--only chains fourbar ...]
 
@@ -25,6 +26,7 @@ import chains  # noqa: E402
 import fourbar  # noqa: E402
 import slidercrank  # noqa: E402
 import slidercrank_exudyn  # noqa: E402
+import statics  # noqa: E402
 import stiff  # noqa: E402
 
 CASES = {
@@ -34,6 +36,7 @@ CASES = {
     "cantilever": cantilever,
     "slidercrank_exudyn": slidercrank_exudyn,
     "stiff": stiff,
+    "statics": statics,
 }
 
 
