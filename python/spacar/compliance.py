@@ -46,7 +46,9 @@ def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.n
     :func:`spacar.static`, which leaves the model there, or an unloaded model), or at row ``k``
     of ``results`` of :func:`spacar.static` of this model (its load factor λ = ``results.t[k]``
     and its degrees of freedom; e.g. the drive stiffness along a load path; loads reached from
-    an unloaded start, inputs not moving).
+    an unloaded start, inputs not moving). ``model`` may also be those results themselves,
+    ``compliance(res, node, k=...)``: they keep the model they were solved for (not through a
+    pickle: loaded results need the model passed).
 
     ``node``: a position node (XY: rows x, y; XYZ: x, y, z) or a rotation node alone (BETA: β;
     LAMBDA: the rotation vector in global axes); ``rotation``: the BETA or LAMBDA node of the
@@ -59,9 +61,18 @@ def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.n
     Raises :class:`spacar.StaticError` when the tangent stiffness is singular (a mechanism: a
     degree of freedom without stiffness), naming the direction."""
     from .model import Model
+    from .results import Results
 
+    if isinstance(model, Results):
+        if results is not None:
+            raise InputError("give the static results once: compliance(results, node) or compliance(model, node, results=...)")
+        results = model
+        model = getattr(results, "_static_model", None)
+        if model is None:
+            raise InputError("these results do not carry their model (only spacar.static's do, and not through a "
+                             "pickle): call compliance(model, node, results=res)")
     if not isinstance(model, Model):
-        raise InputError(f"compliance needs a spacar.Model (at its equilibrium), got {show(model)}")
+        raise InputError(f"compliance needs a spacar.Model (at its equilibrium) or spacar.static's results, got {show(model)}")
     if results is None:
         tangent = _core.static_tangent(model.core)
     else:

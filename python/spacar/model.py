@@ -355,6 +355,14 @@ class Model:
     def current_time(self) -> float:
         return self._core.time
 
+    @classmethod
+    def _of_core(cls, core: _core.Model) -> "Model":
+        """A Model around an existing core model (not copied), e.g. the snapshot that static
+        results keep."""
+        model = cls()
+        model._core = core
+        return model
+
     def copy(self) -> "Model":
         """An independent copy of the model and its state (blocks included)."""
         other = Model()

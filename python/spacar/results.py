@@ -142,8 +142,9 @@ class Results:
         self._geometry, self._geometry_source = value, None
 
     def __getstate__(self):
-        # Pickles hold the Geometry (plain data, as before it was lazy), not the model's core.
-        state = {k: v for k, v in self.__dict__.items() if k not in ("_geometry", "_geometry_source")}
+        # Pickles hold the Geometry (plain data, as before it was lazy), not the model's core
+        # (nor the model that static results keep for spacar.compliance).
+        state = {k: v for k, v in self.__dict__.items() if k not in ("_geometry", "_geometry_source", "_static_model")}
         state["geometry"] = self.geometry
         return state
 

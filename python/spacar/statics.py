@@ -22,6 +22,7 @@ import numpy as np
 from . import _core
 from ._util import show
 from .errors import InputError, SpacarError, StaticError  # noqa: F401  (StaticError: spacar.statics.StaticError)
+from .model import Model
 from .results import Results
 
 
@@ -44,7 +45,10 @@ def _results(arrays: dict, model) -> Results:
         "wall_time": float(arrays["wall_time"]),
     }
     res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
-    res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
+    # A copy of the model at the end of the solve: res.geometry is built from it when first used,
+    # and spacar.compliance(res, node) takes the loads and elements from it (not pickled).
+    res._geometry_source = core = model.core.copy()
+    res._static_model = Model._of_core(core)
     return res
 
 

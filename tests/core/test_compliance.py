@@ -6,6 +6,8 @@ central differences of static solutions (the geometric stiffness of the load inc
 """
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -158,3 +160,19 @@ def test_compliance_along_a_static_load_path():
     assert along[0][1, 1] > along[1][1, 1] > along[3][1, 1]  # the elastica stiffens with the load
     with pytest.raises(InputError, match="spacar.static"):
         spacar.compliance(model, 2 * n + 1, results=object())
+
+
+def test_static_results_carry_their_model():
+    n, P = 8, 3.0
+    model = planar_cantilever(n, 1.0, 1e3, 1.0, force=(0.0, P))
+    res = spacar.static(model, steps=4)
+    model.force(2 * n + 1, 0.0, 10 * P)   # changing the model afterwards does not change the results' copy
+    for k in (1, -1):
+        expected = spacar.compliance(planar_cantilever(n, 1.0, 1e3, 1.0, force=(0.0, P)), 2 * n + 1,
+                                     results=res, k=k)
+        np.testing.assert_allclose(spacar.compliance(res, 2 * n + 1, k=k), expected, rtol=1e-12, atol=1e-15)
+    with pytest.raises(InputError, match="once"):
+        spacar.compliance(res, 2 * n + 1, results=res)
+    loaded = pickle.loads(pickle.dumps(res))
+    with pytest.raises(InputError, match="do not carry their model"):
+        spacar.compliance(loaded, 2 * n + 1)
