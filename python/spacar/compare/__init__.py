@@ -6,6 +6,8 @@ a spacar model, run it, and return side-by-side arrays.
 * :mod:`spacar.compare.exudyn` — rigid bodies with revolute/spherical joints, joint springs,
   closed loops, sliders, prescribed crank rotation, and flexible planar beams as ANCF cable
   elements; trajectories mapped back onto spacar's nodal coordinates.
+* :mod:`spacar.compare.exudyn_static` — static equilibria of planar flexure models (beams as
+  exudyn's geometrically exact 2D beams, SolveStatic).
 
 Both need the optional extra ``compare`` (``pip install "spacar[compare]"``: exudyn and pin);
 the submodules import their peer on first use, so ``import spacar.compare`` always works.
