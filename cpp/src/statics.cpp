@@ -59,7 +59,7 @@ std::string dof_name(const System& sys, int j) {
 }
 
 double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K,
-                     Eigen::VectorXd* dR_dlambda) {
+                     Eigen::VectorXd* dR_dlambda, const Eigen::VectorXd* input_rate) {
   const int nd = sys.n_dof();
   // At rest: no rates, no accelerations, hence no inertia or convective forces.
   data.qhat_d.setZero();
@@ -111,6 +111,24 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
   Eigen::MatrixXd DFeq(sys.ne, nd);
   for (int j = 0; j < nd; ++j) DFeq.col(j) = data.DFe.col(sys.dof_cols[j]);
   add_structural_stiffness(sys, DFeq, *K);
+  if (dR_dlambda && input_rate && input_rate->size() > 0) {
+    // The same tangent in the direction of the inputs' motion: the inputs are further columns
+    // of q̂, and Σ σ_k H_k with the complete stresses differentiates DF_q along them too.
+    Eigen::VectorXd dx = Eigen::VectorXd::Zero(sys.nx), de = Eigen::VectorXd::Zero(sys.ne);
+    for (int i = 0; i < sys.n_input(); ++i) {
+      dx.noalias() += (*input_rate)[i] * data.DF.col(sys.input_cols[i]);
+      de.noalias() += (*input_rate)[i] * data.DFe.col(sys.input_cols[i]);
+    }
+    Eigen::VectorXd response = data.DFq.transpose() * (Kx * dx);
+    for (const SystemElement& se : sys.elements) {
+      if (!se.has_constitutive) continue;
+      Eigen::VectorXd s_de = se.S * de.segment(se.def_offset, se.nd);
+      for (int a = 0; a < se.nd; ++a)
+        if (!constitutive_class(sys.def_class[se.def_offset + a])) s_de[a] = 0.0;
+      response.noalias() += DFeq.middleRows(se.def_offset, se.nd).transpose() * s_de;
+    }
+    *dR_dlambda += response;
+  }
   return scale;
 }
 
@@ -157,8 +175,7 @@ class EquilibriumPath {
   // return to the start's sign (the jump past a limit point) fails.
   Attempt solve(double lambda, bool last_chance) {
     Attempt a;
-    Eigen::VectorXd qhat = data_.qhat;
-    for (int i = 0; i < sys_.n_input(); ++i) qhat[sys_.input_cols[i]] = p0_[i] + lambda * (p1_[i] - p0_[i]);
+    Eigen::VectorXd qhat = with_inputs(data_.qhat, lambda);
     Eigen::VectorXd R;
     double last_correction = std::numeric_limits<double>::infinity();
     int start_sign = 0;
@@ -264,9 +281,10 @@ class EquilibriumPath {
   // the scaled residual of the path Fs = S (R − (1 − λ) R0), its derivative in λ at fixed q,
   // gs = S (−DF_qᵀ f + R0), and the tangent (scaled_tangent()). Returns the force scale.
   double evaluate(const Eigen::VectorXd& qhat, double lambda, Eigen::VectorXd& Fs, Eigen::VectorXd& gs) {
-    place(qhat);
+    place(with_inputs(qhat, lambda));
     Eigen::VectorXd R, g;
-    const double force = static_forces(sys_, data_, lambda, R, &K_, &g);
+    const Eigen::VectorXd rate = p1_ - p0_;
+    const double force = static_forces(sys_, data_, lambda, R, &K_, &g, &rate);
     R -= (1.0 - lambda) * R0_;
     g += R0_;
     Fs = scale_.cwiseProduct(R);
@@ -275,7 +293,6 @@ class EquilibriumPath {
   }
   Eigen::MatrixXd scaled_tangent() const { return scale_.asDiagonal() * K_ * scale_.asDiagonal(); }
   const Eigen::VectorXd& scale() const { return scale_; }
-  bool inputs_move() const { return p0_ != p1_; }
   std::string dof_directions(const Eigen::VectorXd& v) const { return directions(v); }
 
   struct Snapshot {
@@ -293,6 +310,12 @@ class EquilibriumPath {
   }
 
  private:
+  // q̂ with the inputs at their values for load factor λ (moved linearly from p0 to p1).
+  Eigen::VectorXd with_inputs(Eigen::VectorXd qhat, double lambda) const {
+    for (int i = 0; i < sys_.n_input(); ++i) qhat[sys_.input_cols[i]] = p0_[i] + lambda * (p1_[i] - p0_[i]);
+    return qhat;
+  }
+
   // Positions for q̂: the calculable coordinates predicted along DF from the last state, then
   // solved by Newton on the constraints.
   void place(const Eigen::VectorXd& qhat) {
@@ -637,9 +660,6 @@ void follow_load_steps(const System& sys, EquilibriumPath& path, const StaticOpt
 // point interpolated between the steps before and after.
 void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOptions& opt, StaticResults& res,
                        Rows& rows) {
-  if (path.inputs_move())
-    throw InputError("static: the arc-length method follows loads; this block also moves inputs (INPUTX/INPUTE "
-                     "with XD, XDD or ED, EDD): apply them in a block of their own without arc_length");
   const int nd = sys.n_dof();
   ArcLength arc(sys, path, opt, res);
   ArcLength::Point a = arc.start(path.save().qhat);

@@ -82,7 +82,8 @@ def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int =
     one row per step (``res.t`` = λ may decrease), the last row at λ = 1 exactly. Limit points
     passed are located (λ stationary along the path) and listed in
     ``res.stats["limit_points"]`` with a warning each. At most ``max_steps`` steps, then
-    StaticError. Loads only: a block that also moves inputs is refused (InputError).
+    StaticError. Inputs that the block moves travel with λ, as the loads do (a drive that
+    folds back, displacement control through a compliant spring, is followed past its folds).
 
     Returns :class:`spacar.Results` with one row per load step (``res.t`` holds λ; the last row
     is the full load): x, e, the complete stresses σ (reaction stresses included) and the

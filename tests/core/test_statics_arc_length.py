@@ -163,10 +163,59 @@ def test_without_arc_length_a_load_beyond_the_limit_fails_quickly():
     assert info.value.results.stats["load_reached"] == pytest.approx(1 / 1.5, abs=1e-3)
 
 
-def test_arc_length_refuses_moving_inputs_and_bad_options():
-    m, _ = pinned_arch(4, 0.0, apex_input=0.01)
-    with pytest.raises(spacar.InputError, match="arc-length method follows loads"):
-        spacar.static(m, arc_length=True)
+def truss_pushed_through_a_spring(k, drop, h=0.1, s=1.0):
+    """The von Mises truss (EA = 1) without load, its apex pushed down through a soft spring
+    (a PLTRUSS of stiffness k and length s) whose upper end, node 4, is an input moved down by
+    `drop` over the block: displacement control through a compliant drive. When k is less than
+    the truss's largest negative stiffness the drive's travel folds back (snap-through under
+    displacement control)."""
+    m = von_mises_truss(0.0, h)
+    m.pltruss(3, 3, 4)
+    m.x(4, 0.0, h + s)
+    m.fix(4, 1)
+    m.apply("INPUTX", 4, 2)
+    m.xd(4, 2, -drop)
+    m.timestep(1, 1.0)
+    m.rlse(3, 1)
+    m.estiff(3, k * s)     # PLTRUSS: σ = (EA/l0) e
+    return m
+
+
+def test_arc_length_with_a_moving_input_passes_the_folds_of_the_drive():
+    h, s, k = 0.1, 1.0, 0.005
+    l0 = np.hypot(1.0, h)
+    # Equilibrium of the apex at height y: the drive's end at y4(y) = y + s − P(y)/k.
+    drive = lambda y: y + s - truss_load(y, h) / k  # noqa: E731
+    # Folds where P'(y) = k: 2/l³ − 2/l0 = k.
+    l_fold = (2.0 / (k + 2.0 / l0)) ** (1.0 / 3.0)
+    y_fold = np.sqrt(l_fold**2 - 1.0)
+    drop = h + s - drive(-1.5 * h)          # the apex ends at −1.5 h, below the inverted state
+    m = truss_pushed_through_a_spring(k, drop, h, s)
+    with pytest.raises(spacar.StaticError):  # load steps stop at the first fold
+        spacar.static(m.copy(), steps=20)
+    res = spacar.static(m, steps=20, arc_length=True)
+    lam = lambda y: (h + s - drive(y)) / drop  # noqa: E731
+    limits = res.stats["limit_points"]
+    assert len(limits) == 2
+    assert limits[0] == pytest.approx(lam(y_fold), rel=1e-6)     # the drive's travel is largest there
+    assert limits[1] == pytest.approx(lam(-y_fold), rel=1e-6)    # and smallest here
+    assert res.t[-1] == 1.0
+    assert res.node(3).x[-1, 1] == pytest.approx(-1.5 * h, rel=1e-9)
+    # Every row is an equilibrium: the drive end where λ puts it, the apex where the spring holds it.
+    y, y4 = res.node(3).x[:, 1], res.node(4).x[:, 1]
+    np.testing.assert_allclose(y4, h + s - res.t * drop, atol=1e-12)
+    np.testing.assert_allclose(drive(y), y4, atol=1e-9)
+
+
+def test_arc_length_with_moving_inputs_and_no_fold_agrees_with_load_steps():
+    m, apex = pinned_arch(8, 0.0, apex_input=0.06)
+    arc = spacar.static(m.copy(), steps=6, arc_length=True)
+    plain = spacar.static(m, steps=6)
+    assert arc.t[-1] == 1.0 and arc.stats["limit_points"] == []
+    np.testing.assert_allclose(arc.x[-1], plain.x[-1], atol=1e-11)
+
+
+def test_arc_length_bad_options():
     for kwargs in ({"arc_length": 1}, {"arc_length": True, "max_steps": 0}):
         with pytest.raises(spacar.InputError):
             spacar.static(von_mises_truss(1e-4), **kwargs)

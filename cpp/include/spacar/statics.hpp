@@ -58,11 +58,13 @@ struct StaticResults {
 // R (n_dof) and, if K is not null, the tangent stiffness ∂R/∂q (n_dof x n_dof). Leaves in data
 // the transfer functions, the rates at zero, data.f = λ f, the complete stresses σ (reaction
 // stresses of the velocity rows from the equilibrium of the calculable coordinates) and the
-// reactions on the fixed and input coordinates. If dR_dlambda is not null, ∂R/∂λ at fixed
-// positions: −DF_qᵀ f. Returns the scale of R: the largest applied or elastic load on a
-// coordinate (loads on lengths times the mean element length).
+// reactions on the fixed and input coordinates. If dR_dlambda is not null (needs K), ∂R/∂λ at
+// fixed DOFs: −DF_qᵀ f, plus, when the inputs move with λ at the rates `input_rate` (n_input,
+// ordered as input_cols), the tangent's response to that motion, ∂R/∂p · input_rate. Returns
+// the scale of R: the largest applied or elastic load on a coordinate (loads on lengths times
+// the mean element length).
 double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K,
-                     Eigen::VectorXd* dR_dlambda = nullptr);
+                     Eigen::VectorXd* dR_dlambda = nullptr, const Eigen::VectorXd* input_rate = nullptr);
 
 // "DYNX node 3 component 2" / "DYNE element 2 (PLBEAM) deformation 3" of degree of freedom j.
 std::string dof_name(const System& sys, int j);
