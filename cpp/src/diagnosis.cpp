@@ -200,8 +200,11 @@ std::string weakest_constraint(const System& sys, Data& data) {
   std::ostringstream os;
   os << "the reduced mass matrix is singular at t = " << data.t << " (smallest eigenvalue " << lam[0]
      << "): the degrees of freedom";
-  for (int j = 0; j < nd; ++j) {
+  // At most eight named (a massless mesh would list every DOF), then how many more.
+  const int total = static_cast<int>(std::count(named.begin(), named.end(), true));
+  for (int j = 0, shown = 0; j < nd && shown < 8; ++j) {
     if (!named[j]) continue;
+    ++shown;
     const int col = sys.dof_cols[j];
     os << " [";
     for (int g = 0; g < sys.nx; ++g)
@@ -210,6 +213,7 @@ std::string weakest_constraint(const System& sys, Data& data) {
       if (sys.qhat_col_e[k] == col) os << "DYNE " << sys.def_name(k);
     os << "]";
   }
+  if (total > 8) os << " and " << total - 8 << " more";
   os << " move no mass; add MASS or EMASS to the nodes or elements they move";
   throw SingularMassError(os.str());
 }

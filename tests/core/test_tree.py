@@ -243,3 +243,18 @@ def test_blocks_continue_on_the_recursive_path():
     general = spacar.simulate(one, recursive=False)
     np.testing.assert_allclose(second.x[-1], general.x[-1], rtol=0, atol=1e-7)
     np.testing.assert_allclose(second.e[-1], general.e[-1], rtol=0, atol=1e-7)
+
+
+def test_a_massless_mesh_names_a_few_degrees_of_freedom_and_counts_the_rest():
+    m = spacar.Model()
+    n = 12
+    for k in range(1, n + 1):
+        m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
+        m.x(2 * k + 1, k / n, 0.0)
+        m.estiff(k, 0.0, 1.0)
+        m.dyne(k, 2, 3)
+    m.fix(1)
+    m.fix(2)
+    with pytest.raises(spacar.SingularMassError, match=r"deformation 3\] and 16 more move no mass") as info:
+        spacar.simulate(m)
+    assert len(info.value.args[0]) < 700
