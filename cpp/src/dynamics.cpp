@@ -15,10 +15,6 @@ namespace spacar {
 
 namespace {
 
-bool constitutive_class(DefClass c) {
-  return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
-}
-
 // out = M acc, element by element (point masses, element masses, rigid bodies).
 void inertia_times(const System& sys, const Data& data, const Eigen::VectorXd& acc, Eigen::VectorXd& out) {
   out = sys.point_mass.cwiseProduct(acc);
@@ -270,6 +266,24 @@ void nodal_reactions(const System& sys, Data& data) {
     const CoordClass c = sys.coord_class[g];
     if (c != CoordClass::Fixed && c != CoordClass::Input) data.reaction[g] = 0.0;
   }
+}
+
+Eigen::MatrixXd global_constitutive(const System& sys, bool damping) {
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(sys.ne, sys.ne);
+  for (const SystemElement& se : sys.elements) {
+    const Eigen::MatrixXd& Se = damping ? se.D : se.S;
+    for (int a = 0; a < se.nd; ++a) {
+      if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
+      S.block(se.def_offset + a, se.def_offset, 1, se.nd) = Se.row(a);
+    }
+  }
+  return S;
+}
+
+Eigen::MatrixXd congruence(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A) {
+  const Eigen::SparseMatrix<double> As = A.sparseView();
+  const Eigen::MatrixXd AT = As * T;
+  return T.transpose() * AT;
 }
 
 Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::VectorXd& sigma) {

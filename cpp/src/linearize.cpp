@@ -14,27 +14,6 @@
 
 namespace spacar {
 
-namespace {
-
-bool constitutive_class(DefClass c) {
-  return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
-}
-
-// Block-diagonal constitutive matrix (stiffness or damping) over the deformations whose
-// stresses are constitutive, as in constitutive_stresses().
-Eigen::MatrixXd global_constitutive(const System& sys, bool damping) {
-  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(sys.ne, sys.ne);
-  for (const SystemElement& se : sys.elements) {
-    const Eigen::MatrixXd& Se = damping ? se.D : se.S;
-    for (int a = 0; a < se.nd; ++a) {
-      if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
-      S.block(se.def_offset + a, se.def_offset, 1, se.nd) = Se.row(a);
-    }
-  }
-  return S;
-}
-
-}  // namespace
 
 Linearizer::Linearizer(const Model& model, const std::map<int, int>& dependent)
     : lin_(compile(model, dependent, true)), ld_(std::make_unique<Data>(*lin_)) {}
@@ -127,17 +106,10 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
     lin.DFez.col(i) = ld_->DFe.col(L.dof_cols[order_[i]]);
   }
   assemble_mass_matrix(L, *ld_);
-  // The mass, constitutive and geometric matrices are block sparse (element by element): as
-  // sparse factors the products cost half the dense ones (one dense product each).
-  auto reduce = [](const Eigen::MatrixXd& T, const Eigen::MatrixXd& A) -> Eigen::MatrixXd {
-    const Eigen::SparseMatrix<double> As = A.sparseView();
-    const Eigen::MatrixXd AT = As * T;
-    return T.transpose() * AT;
-  };
-  lin.M0 = reduce(lin.DFz, ld_->M);
-  lin.K0 = reduce(lin.DFez, global_constitutive(L, false));
-  lin.D0 = reduce(lin.DFez, global_constitutive(L, true));
-  lin.G0 = reduce(lin.DFz, geometric_stiffness(L, *ld_, data.sigma));
+  lin.M0 = congruence(lin.DFz, ld_->M);
+  lin.K0 = congruence(lin.DFez, global_constitutive(L, false));
+  lin.D0 = congruence(lin.DFez, global_constitutive(L, true));
+  lin.G0 = congruence(lin.DFz, geometric_stiffness(L, *ld_, data.sigma));
   lin.AK0.resize(nk, nz);
   for (int j = 0; j < nk; ++j) lin.AK0.row(j) = lin.DFez.row(sys.e_kinematic[j]);
 

@@ -14,10 +14,6 @@ namespace spacar {
 
 namespace {
 
-bool constitutive_class(DefClass c) {
-  return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
-}
-
 // Σ_k B_kᵀ σ_k over all deformations, added to out.
 void add_stress_loads(const System& sys, const Data& data, Eigen::VectorXd& out) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
@@ -28,18 +24,6 @@ void add_stress_loads(const System& sys, const Data& data, Eigen::VectorXd& out)
       if (s == 0.0) continue;
       for (size_t j = 0; j < se.coords.size(); ++j) out[se.coords[j]] += w.B(a, j) * s;
     }
-  }
-}
-
-// DF_q^eᵀ S DF_q^e over the constitutive deformations: the structural stiffness K0.
-void add_structural_stiffness(const System& sys, const Eigen::MatrixXd& DFeq, Eigen::MatrixXd& K) {
-  for (const SystemElement& se : sys.elements) {
-    if (!se.has_constitutive) continue;
-    Eigen::MatrixXd S = se.S;
-    for (int a = 0; a < se.nd; ++a)
-      if (!constitutive_class(sys.def_class[se.def_offset + a])) S.row(a).setZero();
-    const auto De = DFeq.middleRows(se.def_offset, se.nd);
-    K.noalias() += De.transpose() * S * De;
   }
 }
 
@@ -107,10 +91,10 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
   Eigen::MatrixXd Kx = geometric_stiffness(sys, data, data.sigma);
   if (lambda != 1.0 && (sys.gravity.squaredNorm() > 0.0 || !sys.torquel.empty()))
     Kx -= (1.0 - lambda) * geometric_stiffness(sys, data, Eigen::VectorXd::Zero(sys.ne));
-  K->noalias() = data.DFq.transpose() * Kx * data.DFq;
   Eigen::MatrixXd DFeq(sys.ne, nd);
   for (int j = 0; j < nd; ++j) DFeq.col(j) = data.DFe.col(sys.dof_cols[j]);
-  add_structural_stiffness(sys, DFeq, *K);
+  const Eigen::MatrixXd S = global_constitutive(sys, false);
+  *K = congruence(data.DFq, Kx) + congruence(DFeq, S);   // G0 + K0
   if (dR_dlambda && input_rate && input_rate->size() > 0) {
     // The same tangent in the direction of the inputs' motion: the inputs are further columns
     // of q̂, and Σ σ_k H_k with the complete stresses differentiates DF_q along them too.
@@ -119,15 +103,7 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
       dx.noalias() += (*input_rate)[i] * data.DF.col(sys.input_cols[i]);
       de.noalias() += (*input_rate)[i] * data.DFe.col(sys.input_cols[i]);
     }
-    Eigen::VectorXd response = data.DFq.transpose() * (Kx * dx);
-    for (const SystemElement& se : sys.elements) {
-      if (!se.has_constitutive) continue;
-      Eigen::VectorXd s_de = se.S * de.segment(se.def_offset, se.nd);
-      for (int a = 0; a < se.nd; ++a)
-        if (!constitutive_class(sys.def_class[se.def_offset + a])) s_de[a] = 0.0;
-      response.noalias() += DFeq.middleRows(se.def_offset, se.nd).transpose() * s_de;
-    }
-    *dR_dlambda += response;
+    dR_dlambda->noalias() += data.DFq.transpose() * (Kx * dx) + DFeq.transpose() * (S * de);
   }
   return scale;
 }

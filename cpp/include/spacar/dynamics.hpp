@@ -26,6 +26,19 @@ void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R);
 // and DF_qᵀ from solves with the velocity block. Requires positions and solve_velocities_direct.
 void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R);
 
+// The deformations whose stresses follow from their constitutive law (σ = S e + D ė).
+inline bool constitutive_class(DefClass c) {
+  return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
+}
+
+// Block-diagonal constitutive matrix (ne x ne; stiffness S, or damping D) over the
+// deformations whose stresses are constitutive, as in constitutive_stresses().
+Eigen::MatrixXd global_constitutive(const System& sys, bool damping);
+
+// Tᵀ A T for a block-sparse A (element by element: mass, constitutive, geometric matrices):
+// A taken as a sparse factor, which halves the cost of the dense products.
+Eigen::MatrixXd congruence(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A);
+
 // Σ σ_k H_k − ∂f/∂x (nx x nx) at the current positions for the stress vector sigma: the
 // geometric stiffness of the stresses and the stiffness of position-dependent loads.
 Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::VectorXd& sigma);
