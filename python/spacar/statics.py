@@ -22,7 +22,7 @@ import numpy as np
 from . import _core
 from ._util import show
 from .errors import InputError, SpacarError, StaticError  # noqa: F401  (StaticError: spacar.statics.StaticError)
-from .results import Results
+from .results import Results, dof_labels
 
 
 def _results(arrays: dict, model) -> Results:
@@ -43,7 +43,9 @@ def _results(arrays: dict, model) -> Results:
         "limit_points": [float(v) for v in arrays["limit_points"]],
         "wall_time": float(arrays["wall_time"]),
     }
-    res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
+    # The DOFs of the system the solve compiled: the same model compiled again.
+    dofs = dof_labels(_core.Simulation(model.core).system, model.core)
+    res = Results(table, arrays["coord_label"], arrays["def_label"], stats, dof_labels=dofs)
     res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
     return res
 
