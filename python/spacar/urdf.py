@@ -201,6 +201,10 @@ class _Reader:
         self.ignored(root)
         return links, joints
 
+    def dissipative(self, joint) -> bool:
+        dyn, where = joint.find("dynamics"), f"joint {joint.get('name')!r}"
+        return any(self.numbers(dyn, a, 1, (0.0,), where)[0] for a in ("damping", "friction"))
+
     def ignored(self, root):
         """Warnings for what a dynamic model of rigid bodies leaves out."""
         geometry = sum(len(link.findall(t)) for link in root.findall("link") for t in ("visual", "collision"))
@@ -217,7 +221,7 @@ class _Reader:
                           ("safety_controller", "<safety_controller> is ignored"),
                           ("calibration", "<calibration> is ignored")):
             which = [j.get("name") for j in root.findall("joint") if j.find(tag) is not None
-                     and (tag != "dynamics" or any(float(j.find(tag).get(a, 0) or 0) for a in ("damping", "friction")))]
+                     and (tag != "dynamics" or self.dissipative(j))]
             if which:
                 self.warnings.append(f"{text} (joints {', '.join(which)})")
 
