@@ -74,13 +74,27 @@ class _Joint:
 class _Body:
     """A rigid body: the links merged by fixed joints; positions and tensors in the global axes
     of the zero configuration."""
-    origin: np.ndarray
+    origin: np.ndarray               # its first point; the moments below are about it
     lam: int = 0                     # its LAMBDA node
     points: list = field(default_factory=list)   # [(position, node)]; points[0] is the origin
     mass: float = 0.0
     first_moment: np.ndarray = field(default_factory=lambda: np.zeros(3))  # Σ m c
-    # Σ (R I Rᵀ + m (|c|² 1 − c cᵀ)): the inertia about the global origin
+    # Σ (R I Rᵀ + m (|c|² 1 − c cᵀ)), c the centres of mass from the origin
     inertia_o: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+
+    def add(self, link: _Link, R, origin):
+        """Add the inertia of a link whose frame is (R, origin) in the zero configuration."""
+        c = origin + R @ link.com - self.origin
+        self.mass += link.mass
+        self.first_moment += link.mass * c
+        self.inertia_o += R @ link.inertia @ R.T + link.mass * (c @ c * np.eye(3) - np.outer(c, c))
+
+    def centre_and_inertia(self):
+        """(centre of mass, rotational inertia about it); the centre None without mass."""
+        if self.mass == 0:
+            return None, self.inertia_o
+        c = self.first_moment / self.mass
+        return self.origin + c, self.inertia_o - self.mass * (c @ c * np.eye(3) - np.outer(c, c))
 
 
 def rpy_matrix(rpy) -> np.ndarray:
@@ -295,15 +309,6 @@ def _perpendicular(d) -> np.ndarray:
     return np.cross(d, np.eye(3)[k])
 
 
-def _add_inertia(body: _Body, link: _Link, R, origin):
-    if link.mass == 0 and not np.any(link.inertia):
-        return
-    c = origin + R @ link.com
-    body.mass += link.mass
-    body.first_moment += link.mass * c
-    body.inertia_o += R @ link.inertia @ R.T + link.mass * (c @ c * np.eye(3) - np.outer(c, c))
-
-
 def from_urdf(path, gravity=(0.0, 0.0, -9.81)) -> Model:
     """A spacar :class:`Model` of the fixed-base robot described by the URDF file ``path``: its
     revolute, continuous, prismatic and fixed joints, branches, link inertias (mass, centre of
@@ -311,8 +316,8 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81)) -> Model:
     zero configuration, with ``GRAVITY`` ``gravity`` (default 0 0 −9.81).
 
     One DOF per moving joint, in Pinocchio's joint order and sign (see :mod:`spacar.urdf`): the
-    joint of DOF k is HINGE (revolute, continuous) or BEARING (prismatic) element k + 1, its
-    e1 DYNE; ``model.urdf_joints`` lists the joint names in that order and
+    joint of the k-th DOF (from 1) is HINGE (revolute, continuous) or BEARING (prismatic)
+    element k, its e1 DYNE; ``model.urdf_joints`` lists the joint names in that order and
     ``model.urdf_links`` gives each link's ``(position node, orientation node)`` (the origin of
     its frame and the LAMBDA node of its body). Initial joint values and rates are given as for
     any model: ``model.e(k, 1, q0)``, ``model.ed(k, 1, qd0)``; a TIMESTEP is needed to simulate.
@@ -345,14 +350,14 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81)) -> Model:
     m = Model()
     b = _Builder(m, scale)
     moving = [j for j in order if j.type in MOVING]
+    element_of = {j.name: k for k, j in enumerate(moving, start=1)}
     next_element = len(moving) + 1  # elements 1..n are the joints: the DOFs in their order
     ground = _Body(np.zeros(3))
     ground.lam = b.lambda_node(fixed=True)
     body_of = {root: ground}
     bodies = [ground]
     n_origin, next_element = b.point(ground, np.zeros(3), True, next_element)
-    link_nodes = {root: (n_origin, ground.lam)}
-    _add_inertia(ground, links[root], *frame[root])
+    link_nodes = {root: (n_origin, ground.lam)}  # (the ground's inertia does not matter)
     for j in order:
         parent = body_of[j.parent]
         R, o = frame[j.child]
@@ -361,7 +366,7 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81)) -> Model:
             body_of[j.child] = parent
             n, next_element = b.point(parent, o, on_ground, next_element)
         else:
-            k = moving.index(j) + 1
+            k = element_of[j.name]
             child = _Body(o)
             child.lam = b.lambda_node()
             axis = R @ j.axis
@@ -378,16 +383,14 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81)) -> Model:
             body_of[j.child] = child
             bodies.append(child)
         link_nodes[j.child] = (n, body_of[j.child].lam)
-        _add_inertia(body_of[j.child], links[j.child], R, o)
+        if body_of[j.child] is not ground:
+            body_of[j.child].add(links[j.child], R, o)
 
     for body in bodies[1:]:
-        if body.mass > 0:
-            c = body.first_moment / body.mass
+        c, J = body.centre_and_inertia()
+        if c is not None:
             n, next_element = b.point(body, c, False, next_element)
             b.node_mass[n] = b.node_mass.get(n, 0.0) + body.mass
-            J = body.inertia_o - body.mass * (c @ c * np.eye(3) - np.outer(c, c))
-        else:
-            J = body.inertia_o
         if np.any(J):
             m.mass(body.lam, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
     for n, mass in sorted(b.node_mass.items()):
