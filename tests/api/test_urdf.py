@@ -251,3 +251,18 @@ def test_ur5_gravity_swing_matches_aba_integrated_by_scipy():
     assert np.abs(res.q).max() > 1.0  # it swings
     np.testing.assert_allclose(res.q, ref.y[:n].T, rtol=0, atol=1e-9)
     np.testing.assert_allclose(res.qd, ref.y[n:].T, rtol=0, atol=1e-8)
+
+
+def test_initial_joint_values_place_the_links_as_pinocchio_does():
+    peer = Peer("panda")
+    model = load(peer.path)
+    q0 = np.array([0.3, -0.8, 0.5, -2.0, 0.4, 1.5, 0.7, 0.01, 0.02])
+    for k, (value, rate) in enumerate(zip(q0, np.linspace(0.1, 0.9, 9)), start=1):
+        model.e(k, 1, value)
+        model.ed(k, 1, rate)
+    model.timestep(2, 0.01)
+    res = spacar.simulate(model)
+    np.testing.assert_allclose(res.q[0], q0, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(res.qd[0], np.linspace(0.1, 0.9, 9), rtol=0, atol=1e-14)
+    peer.column = {lbl: i for i, lbl in enumerate(res.coordinate_labels)}
+    assert peer.link_position_error(res.x[0], q0) < 1e-12
