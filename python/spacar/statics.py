@@ -25,7 +25,7 @@ from .errors import InputError, SpacarError, StaticError  # noqa: F401  (StaticE
 from .results import Results, dof_labels
 
 
-def _results(arrays: dict, model) -> Results:
+def _results(arrays: dict, model, dofs) -> Results:
     load = np.asarray(arrays["load"], dtype=float)
     x, e = arrays["x"], arrays["e"]
     rest_x, rest_e = np.zeros_like(x), np.zeros_like(e)
@@ -43,8 +43,6 @@ def _results(arrays: dict, model) -> Results:
         "limit_points": [float(v) for v in arrays["limit_points"]],
         "wall_time": float(arrays["wall_time"]),
     }
-    # The DOFs of the system the solve compiled: the same model compiled again.
-    dofs = dof_labels(_core.Simulation(model.core).system, model.core)
     res = Results(table, arrays["coord_label"], arrays["def_label"], stats, dof_labels=dofs)
     res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
     return res
@@ -104,6 +102,9 @@ def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int =
         raise InputError(f"arc_length must be True or False, got {show(arc_length)}")
     if isinstance(tolerance, bool) or not isinstance(tolerance, numbers.Real) or not 0 < tolerance < 1:
         raise InputError(f"tolerance must be a number between 0 and 1, got {show(tolerance)}")
+    # The DOFs of the system the solve compiles: the model compiled as the core's solve compiles it
+    # (before it, so that a freely rotating LAMBDA node keeps the same dependent parameter).
+    dofs = dof_labels(_core.Simulation(model.core).system, model.core)
     try:  # the core prepares the model (the first END) as a simulation does
         arrays = _core.solve_static(model.core, steps, max_iterations, max_cuts, float(tolerance), arc_length,
                                     max_steps)
@@ -111,10 +112,10 @@ def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int =
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):
             model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
-            err.results = _results(partial, model)
+            err.results = _results(partial, model, dofs)
         raise
     model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    return _results(arrays, model)
+    return _results(arrays, model, dofs)
 
 
 def static_blocks(model, **kwargs):
