@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _core
 from .errors import InputError
 from .geometry import Geometry, euler_e
 from .linearize import MATRICES, Linearization
@@ -48,9 +49,10 @@ ALIASES = {
     "reaction": "reaction", "reactions": "reaction", "r": "reaction", "rx": "reaction",
 }
 # A label may end in the element type, as the DOF labels do ("e(3,1) HINGE").
-_LABEL_RE = re.compile(r"^\s*([A-Za-z]+)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)\s*(?:[A-Za-z][A-Za-z0-9]*\s*)?$")
+_LABEL_RE = re.compile(r"^\s*([A-Za-z]+)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)\s*(?:([A-Za-z][A-Za-z0-9]*)\s*)?$")
 _LINE_RE = re.compile(r"^\s*([A-Za-z]+)\s+(\d+)\s+(\d+)\s*$")
 _ARRAYS = ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")
+_ELEMENT_TYPES = frozenset(t.name for t in _core.element_catalogue())
 
 
 def dof_labels(system, core) -> list:
@@ -83,6 +85,8 @@ def parse_spec(spec) -> tuple:
         m = _LABEL_RE.match(spec) or _LINE_RE.match(spec)
         if not m:
             raise InputError(f"cannot read {spec!r} as a quantity: write e.g. 'x(8,1)', 'e(2,2)' or 'XD 2 1'")
+        if m.re is _LABEL_RE and m.group(4) and m.group(4).upper() not in _ELEMENT_TYPES:
+            raise InputError(f"cannot read {spec!r} as a quantity: {m.group(4)!r} is not an element type")
         return quantity(m.group(1)), int(m.group(2)), int(m.group(3))
     try:
         name, number, index = spec

@@ -112,3 +112,5 @@ def test_dof_labels_parse_as_keys():
     np.testing.assert_array_equal(res[f"e({HINGE + 1},1) PLHINGE"], res.q[:, 0])
     with pytest.raises(spacar.InputError):
         res["e(1,1) PLHINGE extra"]
+    with pytest.raises(spacar.InputError, match="not an element type"):
+        res[f"e({HINGE + 1},1) FIX"]
