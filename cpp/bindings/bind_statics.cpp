@@ -17,6 +17,8 @@ py::dict static_results_to_dict(StaticResults&& r) {
   py::dict d;
   d["coord_label"] = r.coord_label;
   d["def_label"] = r.def_label;
+  d["x_dyn"] = r.x_dyn;
+  d["e_dyn"] = r.e_dyn;
   d["load"] = std::move(r.load);
   d["x"] = std::move(r.x);
   d["e"] = std::move(r.e);

@@ -738,6 +738,8 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
   res.warnings = sys.warnings;
   res.coord_label = sys.coord_label;
   res.def_label = sys.def_label;
+  res.x_dyn = sys.x_dyn;
+  res.e_dyn = sys.e_dyn;
   const int n = opt.arc_length ? opt.max_steps + 1 : opt.steps;  // arc length: the last row at λ = 1
   require_memory(Data::estimate_dense_bytes(sys) + 8.0 * n * (2.0 * sys.nx + 2.0 * sys.ne + 2.0),
                  "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +

@@ -38,6 +38,7 @@ from .results import Results
 from .simulate import simulate
 from .statics import StaticError, static
 from .sweep import SweepError, SweepResult, sweep
+from .urdf import from_urdf
 
 __version__ = "0.1.0"
 
@@ -97,6 +98,7 @@ __all__ = [
     "KEYWORDS",
     "read",
     "read_string",
+    "from_urdf",
     "parse",
     "dump",
     "simulate",

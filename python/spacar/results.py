@@ -11,6 +11,8 @@ element numbers and by the input keyword names::
     res.deformation(2, 2)      # (nt,) element 2 deformation 2
     res["XD", 2, 1]            # by keyword name: velocity of node 2 component 1
     res["e(2,2)"]              # by MATASC column label
+    res.q, res.qd, res.qdd     # (nt, ndof) the degrees of freedom, in the model's DOF order
+    res.dof_labels             # ["x(5,1)", "e(3,1) HINGE", ...]: DYNX coordinates, then DYNE
 
 ``to_pandas()`` (pandas optional), ``save``/``load`` (NumPy ``.npz``) and the plot helpers
 ``plot``, ``draw``, ``animate`` (matplotlib, imported only when used).
@@ -23,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _core
 from .errors import InputError
 from .geometry import Geometry, euler_e
 from .linearize import MATRICES, Linearization
@@ -45,9 +48,24 @@ ALIASES = {
     "sigma": "sigma", "s": "sigma", "sig": "sigma", "stress": "sigma",
     "reaction": "reaction", "reactions": "reaction", "r": "reaction", "rx": "reaction",
 }
-_LABEL_RE = re.compile(r"^\s*([A-Za-z]+)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)\s*$")
+# A label may end in the element type, as the DOF labels do ("e(3,1) HINGE").
+_LABEL_RE = re.compile(r"^\s*([A-Za-z]+)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)\s*(?:([A-Za-z][A-Za-z0-9]*)\s*)?$")
 _LINE_RE = re.compile(r"^\s*([A-Za-z]+)\s+(\d+)\s+(\d+)\s*$")
 _ARRAYS = ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")
+_ELEMENT_TYPES = frozenset(t.name for t in _core.element_catalogue())
+
+
+def dof_labels(system, core) -> list:
+    """Labels of the degrees of freedom of a compiled system (``_core.Simulation(...).system``) in
+    its DOF order, the order of q in the core: the DYNX coordinates ascending (``"x(5,1)"``),
+    then the DYNE deformations ascending, with their element type (``"e(3,1) HINGE"``)."""
+    out = [f"x({n},{c})" for n, c in (system.coord_label[g] for g in system.x_dyn)]
+    if len(system.e_dyn):
+        elements = core.elements  # a snapshot of all elements: taken once
+        for k in system.e_dyn:
+            e, i = system.def_label[k]
+            out.append(f"e({e},{i}) {elements[e].type_name}")
+    return out
 
 
 def quantity(name: str) -> str:
@@ -67,6 +85,8 @@ def parse_spec(spec) -> tuple:
         m = _LABEL_RE.match(spec) or _LINE_RE.match(spec)
         if not m:
             raise InputError(f"cannot read {spec!r} as a quantity: write e.g. 'x(8,1)', 'e(2,2)' or 'XD 2 1'")
+        if m.re is _LABEL_RE and m.group(4) and m.group(4).upper() not in _ELEMENT_TYPES:
+            raise InputError(f"cannot read {spec!r} as a quantity: {m.group(4)!r} is not an element type")
         return quantity(m.group(1)), int(m.group(2)), int(m.group(3))
     try:
         name, number, index = spec
@@ -104,13 +124,17 @@ class Results:
     ascending (node, component) order, ``e``, ``ed``, ``edd``, ``sigma`` (nt, ne) for all
     deformations in ascending (element, deformation) order; ``coordinate_labels`` and
     ``deformation_labels`` give the (node, component) and (element, deformation) of each column.
+    ``q``, ``qd``, ``qdd`` (nt, ndof) are the degrees of freedom, their rates and accelerations
+    in the model's DOF order (the order of ``spacar.linearize``'s z and of the core's q: DYNX
+    coordinates ascending, then DYNE deformations ascending), named by ``dof_labels``
+    (``"x(5,1)"``, ``"e(3,1) HINGE"``; each also a key: ``res["e(3,1) HINGE"]``).
     ``geometry`` (a :class:`spacar.geometry.Geometry`) describes the model for drawing,
     ``linearizations`` holds one :class:`spacar.Linearization` per output time when the model
     asks for them (LINE, LINEAR), ``stats`` the integrator's work.
     """
 
     def __init__(self, arrays: dict, coordinate_labels, deformation_labels, stats: dict,
-                 geometry: Geometry | None = None, linearizations=(), settings_linear=None):
+                 geometry: Geometry | None = None, linearizations=(), settings_linear=None, dof_labels=()):
         self.t = np.asarray(arrays["t"], dtype=float)
         self.x, self.xd, self.xdd = arrays["x"], arrays["xd"], arrays["xdd"]
         self.e, self.ed, self.edd, self.sigma = arrays["e"], arrays["ed"], arrays["edd"], arrays["sigma"]
@@ -126,6 +150,38 @@ class Results:
         self.geometry = geometry
         self._coord = {lbl: i for i, lbl in enumerate(self.coordinate_labels)}
         self._def = {lbl: i for i, lbl in enumerate(self.deformation_labels)}
+        self._set_dofs(dof_labels)
+
+    def _set_dofs(self, labels):
+        # Each DOF is a column of x (DYNX) or of e (DYNE): res.q gathers them in the DOF order.
+        self.dof_labels = [str(lbl) for lbl in labels]
+        self._dof_x, self._dof_e = ([], []), ([], [])  # (positions in q, columns of x / e)
+        for j, lbl in enumerate(self.dof_labels):
+            attr, col = self.column(lbl)
+            target = self._dof_x if attr == "x" else self._dof_e
+            target[0].append(j)
+            target[1].append(col)
+
+    def _dof_values(self, x, e) -> np.ndarray:
+        out = np.empty((len(self.t), len(self.dof_labels)))
+        out[:, self._dof_x[0]] = x[:, self._dof_x[1]]
+        out[:, self._dof_e[0]] = e[:, self._dof_e[1]]
+        return out
+
+    @property
+    def q(self) -> np.ndarray:
+        """(nt, ndof): the degrees of freedom over time, in the order of :attr:`dof_labels`."""
+        return self._dof_values(self.x, self.e)
+
+    @property
+    def qd(self) -> np.ndarray:
+        """(nt, ndof): the rates of the degrees of freedom."""
+        return self._dof_values(self.xd, self.ed)
+
+    @property
+    def qdd(self) -> np.ndarray:
+        """(nt, ndof): the accelerations of the degrees of freedom."""
+        return self._dof_values(self.xdd, self.edd)
 
     # The geometry is only needed for drawing, plotting and saving, and building it costs more than
     # a small run: spacar.simulate stores a copy of the model's core as it was at the run
@@ -152,6 +208,8 @@ class Results:
         state = dict(state)
         geometry = state.pop("geometry", None)
         self.__dict__.update(state)
+        if "dof_labels" not in state:  # pickled before the results had their DOFs
+            self._set_dofs(())
         self.geometry = geometry
 
     @property
@@ -312,6 +370,7 @@ class Results:
             "stats": {k: (v if v is None or isinstance(v, (int, float, str, list)) else float(v))
                       for k, v in self.stats.items()},
             "settings_linear": self.settings_linear,
+            "dof_labels": self.dof_labels,
             "geometry": None if self.geometry is None else self.geometry.to_dict(),
             "linearizations": lin_meta,
         }
@@ -334,12 +393,14 @@ class Results:
                 lins.append(Linearization.from_arrays(lm["t"], lm["z_labels"], lm["n_line"], mats, coord, defs,
                                                       lm.get("y_labels")))
         geometry = None if meta["geometry"] is None else Geometry.from_dict(meta["geometry"])
-        return cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"])
+        return cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"],
+                   meta.get("dof_labels", ()))  # (files written before the DOFs were saved lack them)
 
     @classmethod
     def concatenate(cls, results) -> "Results":
         """One Results of several consecutive blocks of the same model (a block boundary time
-        appears twice, as in the MATASC files)."""
+        appears twice, as in the MATASC files). If the blocks' degrees of freedom differ (a block
+        changed the classes), the whole has none (``dof_labels`` empty)."""
         results = list(results)
         if not results:
             raise InputError("concatenate() needs at least one Results")
@@ -356,8 +417,11 @@ class Results:
                 elif isinstance(v, (int, float)):
                     stats[k] = stats.get(k, 0) + v
         lins = [lin for r in results for lin in r.linearizations]
+        # Blocks that change the classes have different DOFs: then no q over the whole.
+        same_dofs = all(r.dof_labels == first.dof_labels for r in results)
         return cls(arrays, first.coordinate_labels, first.deformation_labels, stats,
-                   results[-1].geometry or first.geometry, lins, results[-1].settings_linear)
+                   results[-1].geometry or first.geometry, lins, results[-1].settings_linear,
+                   first.dof_labels if same_dofs else ())
 
     # --- plots (matplotlib, imported when used) ------------------------------------------------
 

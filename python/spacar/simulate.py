@@ -8,7 +8,7 @@ from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
 from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
-from .results import Results
+from .results import Results, dof_labels
 
 
 def _method_used(arrays: dict) -> str:
@@ -28,7 +28,8 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     if method == "radau5" or arrays["switches"]:
         stats.update(jacobians=arrays["jacobians"], decompositions=arrays["decompositions"])
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
-    res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear)
+    res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear,
+                  dof_labels(system, model.core))
     res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
     return res
 

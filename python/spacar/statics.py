@@ -16,6 +16,7 @@ limit points::
 from __future__ import annotations
 
 import numbers
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -23,7 +24,7 @@ from . import _core
 from ._util import show
 from .errors import InputError, SpacarError, StaticError  # noqa: F401  (StaticError: spacar.statics.StaticError)
 from .model import Model
-from .results import Results
+from .results import Results, dof_labels
 
 
 def _results(arrays: dict, model) -> Results:
@@ -44,7 +45,9 @@ def _results(arrays: dict, model) -> Results:
         "limit_points": [float(v) for v in arrays["limit_points"]],
         "wall_time": float(arrays["wall_time"]),
     }
-    res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
+    # The degrees of freedom of the system the solve compiled.
+    system = SimpleNamespace(**{k: arrays[k] for k in ("coord_label", "def_label", "x_dyn", "e_dyn")})
+    res = Results(table, arrays["coord_label"], arrays["def_label"], stats, dof_labels=dof_labels(system, model.core))
     # A copy of the model at the end of the solve: res.geometry is built from it when first used,
     # and spacar.compliance(res, node) takes the loads and elements from it (not pickled).
     res._geometry_source = core = model.core.copy()

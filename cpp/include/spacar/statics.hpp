@@ -39,6 +39,7 @@ struct StaticOptions {
 
 struct StaticResults {
   std::vector<std::array<int, 2>> coord_label, def_label;  // (node, component), (element, deformation)
+  std::vector<int> x_dyn, e_dyn;   // the degrees of freedom: coordinate and deformation indices
   Eigen::VectorXd load;            // load factor λ of each row (k / steps)
   RowMatrix x, e, sigma, reaction; // rows x nx / ne: sigma complete (reaction stresses included)
   std::vector<int> iterations;     // Newton iterations from the previous row (cut sub-steps included)

@@ -1,0 +1,406 @@
+"""Robots from URDF files (docs/robots.md)::
+
+    model = spacar.from_urdf("ur5_robot.urdf")          # fixed base, GRAVITY 0 0 -9.81
+    model.timestep(100, 0.5)
+    res = spacar.simulate(model)
+    res.q                                                 # (nt, n joints): Pinocchio's q
+    model.urdf_joints                                     # the joint of each DOF
+
+A URDF robot becomes a spacar model of rigid spatial bodies, built as the element set builds
+them (docs/elements.md):
+
+* a **body** per moving joint (and the ground): the links joined to it by fixed joints merged
+  into it, as Pinocchio merges them; one LAMBDA node carries its orientation, its points (the
+  link frames' origins, the joints to its children, its centre of mass) are XYZ nodes held by
+  rigid BEAMs from the body's origin (each BEAM with its own end LAMBDA node; points of the ground
+  are fixed nodes);
+* a **revolute or continuous joint** is a HINGE from the parent's LAMBDA node to the child's about
+  the joint axis, its rotation e1 the DOF (DYNE), the misalignments fixed; the child's origin is
+  the parent's XYZ node at the joint;
+* a **prismatic joint** is a BEARING from the parent's point at the joint to the child's origin
+  along the joint axis, its axial displacement e1 the DOF, the other five deformations fixed;
+* **inertia**: the body's mass (MASS) at its centre of mass and its rotational inertia about it
+  (MASS with the inertia tensor) on its LAMBDA node.
+
+The model is built in the URDF's zero configuration: every LAMBDA node at its reference, so a
+body's orientation is its rotation from that configuration and the inertia tensors are given in
+the global axes of it. The DOFs are the joints in Pinocchio's order (depth first from the root
+link, the children of a link in the order of their joint names, as urdfdom stores them; for a
+chain, root to tip), element k being joint k, so that ``res.q`` (in rad and m) is the ``q`` of
+``pinocchio.buildModelFromUrdf`` with the same signs.
+
+Parsed with the standard library's ``xml.etree``; Pinocchio is not needed.
+"""
+from __future__ import annotations
+
+import math
+import os
+import warnings
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._util import show
+from .errors import InputError
+from .model import Model
+
+MOVING = ("revolute", "continuous", "prismatic")
+# Points of a body closer than this (relative to the robot's size) are one node: a BEAM needs a
+# length.
+_SAME_POINT = 1e-12
+
+
+@dataclass
+class _Link:
+    name: str
+    mass: float = 0.0
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))       # in the link frame
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))  # about the COM, in the link frame
+
+
+@dataclass
+class _Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    xyz: np.ndarray
+    rpy: np.ndarray
+    axis: np.ndarray
+
+
+@dataclass
+class _Body:
+    """A rigid body: the links merged by fixed joints; positions and tensors in the global axes
+    of the zero configuration."""
+    origin: np.ndarray               # its first point; the moments below are about it
+    lam: int = 0                     # its LAMBDA node
+    points: list = field(default_factory=list)   # [(position, node)]; points[0] is the origin
+    mass: float = 0.0
+    first_moment: np.ndarray = field(default_factory=lambda: np.zeros(3))  # Σ m c
+    # Σ (R I Rᵀ + m (|c|² 1 − c cᵀ)), c the centres of mass from the origin
+    inertia_o: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+
+    def add(self, link: _Link, R, origin):
+        """Add the inertia of a link whose frame is (R, origin) in the zero configuration."""
+        c = origin + R @ link.com - self.origin
+        self.mass += link.mass
+        self.first_moment += link.mass * c
+        self.inertia_o += R @ link.inertia @ R.T + link.mass * (c @ c * np.eye(3) - np.outer(c, c))
+
+    def centre_and_inertia(self):
+        """(centre of mass, rotational inertia about it); the centre None without mass."""
+        if self.mass == 0:
+            return None, self.inertia_o
+        c = self.first_moment / self.mass
+        return self.origin + c, self.inertia_o - self.mass * (c @ c * np.eye(3) - np.outer(c, c))
+
+
+def rpy_matrix(rpy) -> np.ndarray:
+    """URDF's rotation of roll, pitch, yaw: Rz(yaw) Ry(pitch) Rx(roll)."""
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+# --- reading ------------------------------------------------------------------------------------
+
+class _Reader:
+    def __init__(self, path):
+        self.path = str(path)
+        self.warnings = []
+
+    def fail(self, text):
+        raise InputError(f"{self.path}: {text}")
+
+    def numbers(self, elem, attr, n, default, where):
+        text = elem.get(attr) if elem is not None else None
+        if text is None:
+            return np.array(default, dtype=float)
+        try:
+            values = [float(v) for v in text.split()]
+        except ValueError:
+            values = []
+        if len(values) != n or not all(math.isfinite(v) for v in values):
+            self.fail(f"{where}: {attr}={text!r} must be {n} finite number{'s' if n > 1 else ''}")
+        return np.array(values)
+
+    def origin(self, elem, where):
+        o = elem.find("origin")
+        return self.numbers(o, "xyz", 3, (0, 0, 0), where), self.numbers(o, "rpy", 3, (0, 0, 0), where)
+
+    def name(self, elem, what):
+        name = elem.get("name")
+        if not name:
+            self.fail(f"a <{what}> without a name")
+        return name
+
+    def link(self, elem) -> _Link:
+        link = _Link(self.name(elem, "link"))
+        inertial = elem.find("inertial")
+        if inertial is None:
+            return link
+        where = f"link {link.name!r}"
+        xyz, rpy = self.origin(inertial, where)
+        mass = inertial.find("mass")
+        link.mass = float(self.numbers(mass, "value", 1, (0.0,), where)[0]) if mass is not None else 0.0
+        if link.mass < 0:
+            self.fail(f"{where}: negative mass {link.mass:g}")
+        i = inertial.find("inertia")
+        get = {k: float(self.numbers(i, k, 1, (0.0,), where)[0]) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+        J = np.array([[get["ixx"], get["ixy"], get["ixz"]],
+                      [get["ixy"], get["iyy"], get["iyz"]],
+                      [get["ixz"], get["iyz"], get["izz"]]])
+        R = rpy_matrix(rpy)
+        link.com, link.inertia = xyz, R @ J @ R.T
+        return link
+
+    def joint(self, elem, links) -> _Joint:
+        name = self.name(elem, "joint")
+        kind = elem.get("type")
+        where = f"joint {name!r}"
+        if kind in ("floating", "planar"):
+            self.fail(f"{where} is {kind}: spacar.from_urdf builds fixed-base robots of revolute, continuous, "
+                      "prismatic and fixed joints (a floating base is not supported)")
+        if kind not in MOVING + ("fixed",):
+            self.fail(f"{where} has type {kind!r}: use revolute, continuous, prismatic or fixed")
+        ends = []
+        for tag in ("parent", "child"):
+            e = elem.find(tag)
+            link = e.get("link") if e is not None else None
+            if link is None:
+                self.fail(f"{where} has no <{tag} link=...>")
+            if link not in links:
+                self.fail(f"{where}: its {tag} link {link!r} is not defined")
+            ends.append(link)
+        xyz, rpy = self.origin(elem, where)
+        axis = self.numbers(elem.find("axis"), "xyz", 3, (1, 0, 0), where)
+        if kind in MOVING:
+            norm = np.linalg.norm(axis)
+            if not norm > 0:
+                self.fail(f"{where}: the axis has zero length")
+            axis = axis / norm
+        if elem.find("mimic") is not None:
+            self.warnings.append(f"{where}: <mimic> is ignored; the joint is an independent DOF "
+                                 "(as in Pinocchio's model without mimic joints)")
+        return _Joint(name, kind, ends[0], ends[1], xyz, rpy, axis)
+
+    def read(self):
+        try:
+            root = ET.parse(self.path).getroot()
+        except ET.ParseError as err:
+            self.fail(f"not a well-formed URDF (XML) file: {err}")
+        except OSError as err:
+            raise InputError(f"{self.path}: cannot read the URDF file: {err.strerror or err}") from None
+        if root.tag != "robot":
+            self.fail(f"the root element is <{root.tag}>, not <robot>")
+        links = {}
+        for elem in root.findall("link"):
+            link = self.link(elem)
+            if link.name in links:
+                self.fail(f"link {link.name!r} is defined twice")
+            links[link.name] = link
+        if not links:
+            self.fail("the robot has no links")
+        joints, names = [], set()
+        for elem in root.findall("joint"):
+            j = self.joint(elem, links)
+            if j.name in names:
+                self.fail(f"joint {j.name!r} is defined twice")
+            names.add(j.name)
+            joints.append(j)
+        self.ignored(root)
+        return links, joints
+
+    def dissipative(self, joint) -> bool:
+        dyn, where = joint.find("dynamics"), f"joint {joint.get('name')!r}"
+        return any(self.numbers(dyn, a, 1, (0.0,), where)[0] for a in ("damping", "friction"))
+
+    def ignored(self, root):
+        """Warnings for what a dynamic model of rigid bodies leaves out."""
+        geometry = sum(len(link.findall(t)) for link in root.findall("link") for t in ("visual", "collision"))
+        if geometry:
+            self.warnings.append(f"{geometry} <visual>/<collision> geometries (meshes, shapes) are not imported: "
+                                 "the model holds the links' inertias only")
+        for tag, text in (("transmission", "transmissions (actuators) are not imported"),
+                          ("gazebo", "<gazebo> extensions are ignored")):
+            n = len(root.findall(tag))
+            if n:
+                self.warnings.append(f"{n} {text}")
+        for tag, text in (("limit", "joint limits are not enforced"),
+                          ("dynamics", "joint damping and friction (<dynamics>) are not modelled"),
+                          ("safety_controller", "<safety_controller> is ignored"),
+                          ("calibration", "<calibration> is ignored")):
+            which = [j.get("name") for j in root.findall("joint") if j.find(tag) is not None
+                     and (tag != "dynamics" or self.dissipative(j))]
+            if which:
+                self.warnings.append(f"{text} (joints {', '.join(which)})")
+
+
+def _tree(reader, links, joints) -> tuple:
+    """The root link and the joints in Pinocchio's order: depth first from the root link, the children of a link in
+    the order of their joint names (urdfdom keeps the joints in a map by name)."""
+    children: dict = {}
+    parent_of = {}
+    for j in joints:
+        if j.child in parent_of:
+            reader.fail(f"link {j.child!r} is the child of two joints ({parent_of[j.child].name!r}, {j.name!r}): "
+                        "closed loops are not URDF trees")
+        parent_of[j.child] = j
+        children.setdefault(j.parent, []).append(j)
+    roots = [name for name in links if name not in parent_of]
+    if len(roots) != 1:
+        reader.fail(f"the links must form one tree with one root; roots found: {roots or 'none (a loop)'}")
+    order = []
+    stack = sorted(children.get(roots[0], []), key=lambda j: j.name, reverse=True)
+    while stack:
+        j = stack.pop()
+        order.append(j)
+        stack.extend(sorted(children.get(j.child, []), key=lambda j: j.name, reverse=True))
+    if len(order) != len(joints):  # a loop apart from the root's tree
+        reader.fail("the joints do not form a tree reachable from the root link")
+    return roots[0], order
+
+
+# --- building -----------------------------------------------------------------------------------
+
+class _Builder:
+    def __init__(self, model: Model, scale: float):
+        self.m = model
+        self.tol = _SAME_POINT * scale
+        self.next_node = 1
+        self.node_mass: dict = {}
+
+    def node(self):
+        n = self.next_node
+        self.next_node += 1
+        return n
+
+    def lambda_node(self, fixed=False):
+        n = self.node()
+        self.m.lambda_(n, 1.0, 0.0, 0.0, 0.0)
+        if fixed:
+            self.m.fix(n)
+        return n
+
+    def point(self, body: _Body, p, ground: bool, next_element):
+        """The XYZ node of body at p (an existing one if it is there already)."""
+        for q, n in body.points:
+            if np.abs(q - p).max() <= self.tol:
+                return n, next_element
+        n = self.node()
+        self.m.xyz(n, *p)
+        if ground:
+            self.m.fix(n)
+        else:  # a rigid BEAM from the body's origin, with its own end orientation node
+            o, origin = body.points[0][1], body.points[0][0]
+            self.m.beam(next_element, o, body.lam, n, self.lambda_node(), *_perpendicular(p - origin))
+            next_element += 1
+        body.points.append((p, n))
+        return n, next_element
+
+
+def _perpendicular(d) -> np.ndarray:
+    """A vector perpendicular to d (the cross-section axis of a BEAM along d)."""
+    k = int(np.argmin(np.abs(d)))
+    return np.cross(d, np.eye(3)[k])
+
+
+def from_urdf(path, gravity=(0.0, 0.0, -9.81)) -> Model:
+    """A spacar :class:`Model` of the fixed-base robot described by the URDF file ``path``: its
+    revolute, continuous, prismatic and fixed joints, branches, link inertias (mass, centre of
+    mass, inertia tensor with the origin's rpy), joint origins (xyz, rpy) and axes, in the URDF's
+    zero configuration, with ``GRAVITY`` ``gravity`` (default 0 0 −9.81).
+
+    One DOF per moving joint, in Pinocchio's joint order and sign (see :mod:`spacar.urdf`): the
+    joint of the k-th DOF (from 1) is HINGE (revolute, continuous) or BEARING (prismatic)
+    element k, its e1 DYNE; ``model.urdf_joints`` lists the joint names in that order and
+    ``model.urdf_links`` gives each link's ``(position node, orientation node)`` (the origin of
+    its frame and the LAMBDA node of its body). Initial joint values and rates are given as for
+    any model: ``model.e(k, 1, q0)``, ``model.ed(k, 1, qd0)``; a TIMESTEP is needed to simulate.
+
+    What the model leaves out is listed as warnings (Python warnings and ``model.warnings``):
+    geometry (meshes), transmissions, joint limits, damping and friction, mimic relations (the
+    mimic joint becomes an independent DOF). Floating and planar joints (a floating base) and
+    anything that is not a tree of links raise :class:`spacar.InputError` naming the file; so
+    does a file that is not well-formed XML.
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"from_urdf needs the path of a URDF file, got {show(path)}")
+    try:
+        g = np.array([float(v) for v in gravity])
+    except (TypeError, ValueError):
+        g = np.array([])
+    if g.shape != (3,) or not np.isfinite(g).all():
+        raise InputError(f"gravity must be three finite numbers (gx, gy, gz), got {show(gravity)}")
+    reader = _Reader(os.fspath(path))
+    links, joints = reader.read()
+    root, order = _tree(reader, links, joints)
+
+    # Link frames in the zero configuration: (rotation, origin) in the global axes.
+    frame = {root: (np.eye(3), np.zeros(3))}
+    for j in order:
+        R, o = frame[j.parent]
+        frame[j.child] = (R @ rpy_matrix(j.rpy), o + R @ j.xyz)
+    scale = max([1.0] + [float(np.abs(o).max()) for _, o in frame.values()])
+
+    m = Model()
+    b = _Builder(m, scale)
+    moving = [j for j in order if j.type in MOVING]
+    element_of = {j.name: k for k, j in enumerate(moving, start=1)}
+    next_element = len(moving) + 1  # elements 1..n are the joints: the DOFs in their order
+    ground = _Body(np.zeros(3))
+    ground.lam = b.lambda_node(fixed=True)
+    body_of = {root: ground}
+    bodies = [ground]
+    n_origin, next_element = b.point(ground, np.zeros(3), True, next_element)
+    link_nodes = {root: (n_origin, ground.lam)}  # (the ground's inertia does not matter)
+    for j in order:
+        parent = body_of[j.parent]
+        R, o = frame[j.child]
+        on_ground = parent is ground
+        if j.type == "fixed":
+            body_of[j.child] = parent
+            n, next_element = b.point(parent, o, on_ground, next_element)
+        else:
+            k = element_of[j.name]
+            child = _Body(o)
+            child.lam = b.lambda_node()
+            axis = R @ j.axis
+            if j.type == "prismatic":
+                p, next_element = b.point(parent, o, on_ground, next_element)
+                n = b.node()
+                m.xyz(n, *o)
+                m.bearing(k, p, parent.lam, n, child.lam, *axis)  # e2..e6 stay fixed
+            else:
+                n, next_element = b.point(parent, o, on_ground, next_element)
+                m.hinge(k, parent.lam, child.lam, *axis)
+            m.dyne(k, 1)
+            child.points.append((o, n))
+            body_of[j.child] = child
+            bodies.append(child)
+        link_nodes[j.child] = (n, body_of[j.child].lam)
+        if body_of[j.child] is not ground:
+            body_of[j.child].add(links[j.child], R, o)
+
+    for body in bodies[1:]:
+        c, J = body.centre_and_inertia()
+        if c is not None:
+            n, next_element = b.point(body, c, False, next_element)
+            b.node_mass[n] = b.node_mass.get(n, 0.0) + body.mass
+        if np.any(J):
+            m.mass(body.lam, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
+    for n, mass in sorted(b.node_mass.items()):
+        m.mass(n, mass)
+    if np.any(g):
+        m.gravity(*g)
+
+    m.urdf_joints = [j.name for j in moving]
+    m.urdf_links = link_nodes
+    for w in reader.warnings:
+        m.warnings.append(f"{reader.path}: {w}")
+        warnings.warn(f"{reader.path}: {w}", stacklevel=2)
+    return m
