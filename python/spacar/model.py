@@ -372,6 +372,9 @@ class Model:
         other.warnings = list(self.warnings)
         other._continue_step = self._continue_step
         other.output_stem = self.output_stem
+        for name in ("urdf_joints", "urdf_links"):   # set by spacar.from_urdf
+            if hasattr(self, name):
+                setattr(other, name, list(getattr(self, name)) if name == "urdf_joints" else dict(getattr(self, name)))
         return other
 
     def summary(self):

@@ -71,6 +71,10 @@ def test_fixed_joints_merge_into_one_body():
     assert lam["link2"] == lam["flange"] == lam["tool"] == lam["tcp"]
     assert lam["world"] == lam["base"] != lam["link1"]
     assert model.urdf_joints == ["j1", "j2"]
+    copy = model.copy()
+    assert copy.urdf_joints == model.urdf_joints and copy.urdf_links == model.urdf_links
+    copy.urdf_joints.append("x")
+    assert model.urdf_joints == ["j1", "j2"]
 
 
 def test_what_is_left_out_is_reported(tmp_path):
