@@ -1,6 +1,9 @@
 // The model (model.hpp): its builder methods, its fields read-only, and its pickling.
 #include <pybind11/stl.h>
 
+#include <sstream>
+#include <string>
+
 #include "bindings.hpp"
 #include "spacar/model.hpp"
 #include "spacar/serialize.hpp"
@@ -28,6 +31,55 @@ Model model_from_pickle(const py::tuple& state) {
   return model_from_state(s);
 }
 
+const char* class_name(CoordClass c) {
+  switch (c) {
+    case CoordClass::Fixed: return "fixed";
+    case CoordClass::Input: return "input";
+    case CoordClass::Dynamic: return "dynamic";
+    default: return "calculable";
+  }
+}
+
+const char* class_name(DefClass c) {
+  switch (c) {
+    case DefClass::Released: return "released";
+    case DefClass::Input: return "input";
+    case DefClass::Dynamic: return "dynamic";
+    case DefClass::Linearization: return "linearization";
+    case DefClass::Nonholonomic: return "nonholonomic";
+    case DefClass::Kinematic: return "kinematic";
+    default: return "fixed";
+  }
+}
+
+// "(0.5, 0)" and "[fixed, dynamic]": the values and classes of a repr.
+template <class V>
+std::string values(const V& v) {
+  std::ostringstream os;
+  os << "(";
+  for (size_t i = 0; i < v.size(); ++i) os << (i ? ", " : "") << v[i];
+  os << ")";
+  return os.str();
+}
+
+template <class C>
+std::string classes(const std::vector<C>& v) {
+  std::string s = "[";
+  for (size_t i = 0; i < v.size(); ++i) s += std::string(i ? ", " : "") + class_name(v[i]);
+  return s + "]";
+}
+
+// <Node 3 XY x = (0.5, 0) [calculable, calculable]>
+std::string node_repr(const Node& n) {
+  return "<Node " + std::to_string(n.id) + " " + node_keyword(n.kind) + " x = " + values(n.x) + " " + classes(n.cls) + ">";
+}
+
+// <Element 2 PLBEAM nodes (3, 4, 5, 6) e = (0, 0, 0) [fixed, dynamic, dynamic]>
+std::string element_repr(const Element& e) {
+  return "<Element " + std::to_string(e.id) + " " + element_catalogue()[e.type].name + " nodes " + values(e.nodes) +
+         " e = " + values(e.e) + " " + classes(e.cls) + ">";
+}
+
 }  // namespace
 
 void bind_model(py::module_& m) {
@@ -45,9 +97,10 @@ void bind_model(py::module_& m) {
       .value("nonholonomic", DefClass::Nonholonomic)
       .value("kinematic", DefClass::Kinematic);
 
-  bind_fields<Node>(m, "Node", kNodeFields);
+  bind_fields<Node>(m, "Node", kNodeFields).def("__repr__", &node_repr);
   bind_fields<Element>(m, "Element", kElementFields)
-      .def_property_readonly("type_name", [](const Element& e) { return element_catalogue()[e.type].name; });
+      .def_property_readonly("type_name", [](const Element& e) { return element_catalogue()[e.type].name; })
+      .def("__repr__", &element_repr);
   bind_fields<Settings>(m, "Settings", kSettingsFields);
 
   py::class_<Model>(m, "Model")

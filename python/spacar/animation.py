@@ -13,7 +13,7 @@ from matplotlib import animation as _mpl_animation
 
 from .errors import InputError
 from .plotting import Scene
-from .results import Results
+from .results import Results, require_results
 
 
 class Animation(_mpl_animation.FuncAnimation):
@@ -41,6 +41,7 @@ def animate(res: Results, *, step: int = 1, max_frames: int | None = 200, interv
     ``trace``, ``beam_points`` as in :func:`spacar.draw`. ``close`` closes the figure so that a
     notebook shows only the animation, not an extra still image (default: with the inline and
     non-interactive backends). Save with :func:`save_animation` or ``anim.save(...)``."""
+    require_results(res, "animate")
     nt = len(res.t)
     if nt == 0:
         raise InputError("these results have no output times")

@@ -77,8 +77,14 @@ class Check:
     summary: Summary
     diagnosis: Diagnosis
 
+    @property
+    def ok(self) -> bool:
+        """Nothing to report: a model with elements whose constraints determine its calculable
+        coordinates (``spacar check`` exits 1 otherwise)."""
+        return self.diagnosis.ok and sum(self.summary.elements.values()) > 0
+
     def __str__(self):
-        if self.diagnosis.ok:
+        if self.ok:
             verdict = "the constraints determine the calculable coordinates"
         else:
             verdict = "problems:" if self.diagnosis.detailed else "not diagnosed:"
@@ -88,7 +94,8 @@ class Check:
 def check(model) -> Check:
     """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly)."""
     if not model.nodes and not model.elements:
-        return Check(summary(model), Diagnosis(0, 0, 0, [], [], "  the model is empty"))
+        why = " (no input block ended with END)" if getattr(model, "source", None) and not model.blocks else ""
+        return Check(summary(model), Diagnosis(0, 0, 0, [], [], f"  the model is empty{why}"))
     copy = model.copy()
     copy.prepare()
     d = _core.Simulation(copy.core).diagnose()

@@ -12,6 +12,11 @@
 ``spacar check FILE``  summary of the model of the first block: nodes and elements by type,
                        coordinates and deformations per class, degrees of freedom; with
                        ``--release`` the redundant constraints named are released first.
+                       Exits 1 when it reports problems (an empty model, redundant or missing
+                       constraints), so that it can gate a script or a grading run.
+
+Exit status: 0 success; 1 an error (printed as ``spacar: <Error>: ...`` on stderr), or problems
+reported by ``check``, or no input block ended with END (``run``, ``static``); 2 bad arguments.
 
 Everything that is not the dump is printed as ``*`` comment lines, so the output is valid input.
 """
@@ -85,7 +90,7 @@ def _read_for_analysis(args, analysis: str = ""):
     for w in model.warnings:
         _comment(f"warning: {w}")
     if not model.blocks:
-        _comment("no input block ended with END: nothing to analyse")
+        _comment("no input block ended with END: nothing to analyse (end the input with a line END)")
         return None
     return model
 
@@ -93,7 +98,7 @@ def _read_for_analysis(args, analysis: str = ""):
 def _run(args) -> int:
     model = _read_for_analysis(args)
     if model is None:
-        return 0
+        return 1
     if args.output_stem:
         model.output_stem = args.output_stem
     animated = []
@@ -154,7 +159,7 @@ def _static(args) -> int:
 
     model = _read_for_analysis(args, " static")
     if model is None:
-        return 0
+        return 1
     n_warn = len(model.warnings)
     blocks = static_blocks(model, steps=args.steps, max_cuts=args.max_cuts, tolerance=args.tolerance,
                            arc_length=args.arc_length, max_steps=args.max_steps)
@@ -187,8 +192,9 @@ def _check(args) -> int:
                  + (":" if released else " (none is over-constrained)"))
         for e, i in released:
             _comment(f"RLSE {e} {i}   (element {e} ({elements[e].type_name}) deformation {i})")
-    _comment(model.check())
-    return 0
+    result = model.check()
+    _comment(result)
+    return 0 if result.ok else 1   # a gate: 1 when the check reports problems
 
 
 def _digits(text: str) -> int:

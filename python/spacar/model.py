@@ -163,7 +163,16 @@ class Model:
 
     def _coord_class(self, name, args):
         n, comps = self._call(name, *args)
+        node = self._core.nodes.get(n) if name in ("DYNX", "INPUTX") else None
+        before = [c.name for c in node.cls] if node is not None else []
         self._core.set_coordinate_class(n, comps, _COORD[name])
+        if before:  # a FIX that a later line frees is more often a slip than meant
+            freed = [i + 1 for i, c in enumerate(before) if c == "fixed" and (not comps or i + 1 in comps)]
+            if freed:
+                where = f"{self._origin}: " if self._origin else ""
+                self.warnings.append(f"{where}{name} {n} {' '.join(map(str, freed))} frees component"
+                                     f"{'s' if len(freed) > 1 else ''} {', '.join(map(str, freed))} of node {n}, "
+                                     "fixed by an earlier FIX")
 
     def _def_class(self, name, args):
         e, idx = self._call(name, *args)

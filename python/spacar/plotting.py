@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt
 
 from .errors import InputError
 from .geometry import frame_coordinates, shapes
-from .results import Results
+from .results import Results, require_results
 
 STYLE = {
     "beam": dict(color="C0", lw=2.5, solid_capstyle="round", zorder=3),
@@ -54,6 +54,7 @@ def plot(res: Results, y, x="t", ax=None, **kwargs):
     A quantity is a MATASC label (``"x(8,1)"``, ``"e(2,2)"``, ``"s(2,1)"`` for σ, ``"r(1,1)"``
     for a reaction), a keyword line (``"XD 2 1"``) or a tuple (``("EDD", 2, 3)``). Extra keyword
     arguments go to ``Axes.plot`` (``label`` names a single curve in a legend). Returns the axes."""
+    require_results(res, "plot")
     if ax is None:
         _, ax = plt.subplots()
     ys = y if isinstance(y, list) else [y]
@@ -261,6 +262,7 @@ def draw(res: Results, k: int = -1, *, time: float | None = None, ax=None, label
     coordinates (e.g. a buckling mode, ``Linearization.buckling_modes()[2][:, 0]``, or a
     vibration mode) added to that state, times ``scale`` (default: its largest displacement a
     tenth of the model's size). Returns the :class:`Scene` (its ``ax`` is the axes)."""
+    require_results(res, "draw")
     if time is not None:
         k = res.time_index(time)
     k = range(len(res.t))[k]

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from .errors import InputError
+from ._util import show
+from .errors import InputError, SpacarError
 from .geometry import Geometry, euler_e
 from .linearize import MATRICES, Linearization
 
@@ -53,6 +54,17 @@ _LABEL_RE = re.compile(r"^\s*([A-Za-z]+)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)\s*(?:([A-
 _LINE_RE = re.compile(r"^\s*([A-Za-z]+)\s+(\d+)\s+(\d+)\s*$")
 _ARRAYS = ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")
 _ELEMENT_TYPES = frozenset(t.name for t in _core.element_catalogue())
+
+
+def require_results(res, what: str) -> None:
+    """Refuse anything but Results in the drawing and plotting functions, with what to do."""
+    from .model import Model
+
+    if isinstance(res, Model):
+        raise SpacarError(f"spacar.{what} draws results, not a model: simulate first, e.g. "
+                          f"res = spacar.simulate(model); spacar.{what}(res, ...)")
+    if not isinstance(res, Results):
+        raise InputError(f"spacar.{what} needs spacar.Results (of spacar.simulate or spacar.static), got {show(res)}")
 
 
 def dof_labels(system, core) -> list:

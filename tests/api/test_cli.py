@@ -173,7 +173,7 @@ def test_empty_input_is_nothing(tmp_path, capsys, text):
     path.write_text(text)
     for command in ("run", "check"):
         code, stdout, stderr = run_main(capsys, command, str(path))
-        assert code == 0, stderr
+        assert code == 1, stderr   # nothing analysed, an empty model: a gate must not pass it
         assert stderr == ""
         assert stdout and all(line.startswith("*") for line in stdout.splitlines()), stdout
     assert "degrees of freedom: 0" in stdout
