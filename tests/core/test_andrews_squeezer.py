@@ -13,6 +13,7 @@ import pytest
 
 import spacar
 from support import andrews_squeezer as sq
+from support.paths import ROOT
 
 N_OUT = 6
 
@@ -64,3 +65,10 @@ def test_tight_dop853_to_the_reference(reference):
     res = spacar.simulate(sq.squeezer_model(eps=1e-12, n_out=N_OUT), method="dop853")
     # Measured 4.6e-12 rad: the two formulations agree to the reference's own accuracy.
     np.testing.assert_allclose(sq.angles(res), reference[:, :7], rtol=0, atol=1e-10)
+
+
+def test_example_file_is_the_model(reference):
+    # examples/andrews_squeezer.dat: the dump of squeezer_model(eps=1e-10, n_out=30).
+    res = spacar.simulate(spacar.read(ROOT / "examples" / "andrews_squeezer.dat"), method="dop853")
+    assert res.t[-1] == pytest.approx(sq.T_END) and len(res.t) == 31
+    np.testing.assert_allclose(sq.angles(res)[::5], reference[:, :7], rtol=0, atol=1e-8)
