@@ -222,10 +222,16 @@ def _cell(r, fmt_setting):
     return f"{C.fmt_time(r['wall'])} / {r['steps']} / {fmt_setting(r['setting'])}"
 
 
+def _steps_at(series, eps):
+    r = next((x for x in series if x["setting"] == eps), None)
+    return "—" if r is None or r.get("over_limit") else str(r["steps"])
+
+
 def _table(res, case, cfg):
     head = "k (rod EI × k)" if case == "slidercrank" else "n (elements)"
+    eps0 = cfg["eps"][0]
     lines = [f"| {head} | target [m] | dop853 | radau5 | auto | exudyn GA, best ρ∞ | exudyn trapezoidal | exudyn best / spacar best | "
-             "dop853 / spacar best | model difference [m] |", "|---" * 10 + "|"]
+             f"dop853 / spacar best | model difference [m] | steps at EPS {eps0:g}: dop853 / radau5 / auto |", "|---" * 11 + "|"]
     for variant, row in res[case].items():
         target = row["target"]
         sp = {m: steady(row["spacar"][m], target) for m in METHODS}
@@ -241,7 +247,7 @@ def _table(res, case, cfg):
         lines.append(f"| {variant} | {target:.1e} | {_cell(sp['dop853'], eps)} | {_cell(sp['radau5'], eps)} | {_cell(sp['auto'], eps)} | "
                      f"{ga_cell} | {_cell(tr, step)} | {C.fmt_ratio(best_ex, best_sp)} | "
                      f"{C.fmt_ratio(sp['dop853'] and sp['dop853']['wall'], best_sp)} | "
-                     f"{C.fmt_err(row['model_difference'])} |")
+                     f"{C.fmt_err(row['model_difference'])} | {' / '.join(_steps_at(row['spacar'][m], eps0) for m in METHODS)} |")
     return lines
 
 
@@ -268,7 +274,9 @@ def section_lines(res) -> list:
              f"reach the target, after a run of {RUN_BUDGET:g} s, or before a run beyond {RUN_LIMIT:g} s. Cell: the "
              "*steady* time to the target (the fastest run from which on every tighter run of the series reaches it) "
              "/ its steps / its setting; \"—\": the series did not reach the target within the limits. Ratios against "
-             "the faster of radau5 and auto.", ""]
+             "the faster of radau5 and auto. The last column, the steps at the loosest setting (reached "
+             "by every series), shows the growth with the stiffness itself: DOP853's steps are set by "
+             "stability there.", ""]
     loose = [f"{case} {v}" for case in ("slidercrank", "cantilever") for v, row in res[case].items()
              if row.get("exudyn_reference_newton_rtol")]
     if loose:
