@@ -1,6 +1,8 @@
 """Benchmark: the steel cantilever of docs/stiff-integration.md — spacar's DOP853, Radau IIA and
 automatic choice over a range of EPSINT, against exudyn's generalized-α on ANCF cable elements
-over a range of step sizes: tip accuracy at t = 0.2 s against wall time.
+over a range of step sizes: tip accuracy at t = 0.2 s against wall time; then (stiff_scaling.py)
+step counts and time to a tip accuracy for the slider-crank with its rod's EI × 1 … 10⁴ and the
+cantilever with 4 … 32 elements, against exudyn's generalized-α and trapezoidal rule.
 
 Model (spacar.compare.models.cantilever): 8 PLBEAMs, 1 m, clamped, axially rigid, bending DYNE
 (16 DOFs), EI = 175 N m², ρA = 0.785 kg/m (steel, 10 × 10 mm), released from the straight state
@@ -27,6 +29,7 @@ import time
 
 import spacar
 import _common as C
+import stiff_scaling
 from spacar.compare import models
 
 TITLE = "Stiff integration: steel cantilever, time to tip accuracy"
@@ -105,6 +108,7 @@ def run(a) -> dict:
     out["exudyn_vs_spacar"] = abs(out["exudyn_reference"] - spacar_ref)
     for x in out["exudyn"]:
         x["error_vs_spacar"] = abs(x["tip_y"] - spacar_ref)
+    out["scaling"] = stiff_scaling.run(quick)
     return out
 
 
@@ -185,6 +189,8 @@ def section(r: dict, plots: dict | None = None) -> str:
               "about 10⁵, is set by stability, not by EPS)."]
     if plots:
         lines += [""] + [f"![{k}]({v})" for k, v in plots.items()]
+    if "scaling" in r:
+        lines += ["", *stiff_scaling.section_lines(r["scaling"])]
     return "\n".join(lines) + "\n"
 
 
