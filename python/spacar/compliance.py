@@ -11,7 +11,7 @@ current state under the block's full loads) seen through the transfer function o
 
 so C_ij is the displacement i of the node per unit load j on it (a small load added to the
 block's loads). For a LAMBDA node the rows of T are the small rotation vector in global axes,
-δθ = 2 E(λ) δλ (formulation §0): the rotations are compliant to moments in global axes.
+δθ = 2 E(λ) δλ (docs/formulation.md §2): the rotations are compliant to moments in global axes.
 """
 from __future__ import annotations
 

@@ -183,7 +183,7 @@ class Geometry:
 
 
 def rotation(lam) -> np.ndarray:
-    """R(λ) of Euler parameters λ = (λ0, λ1, λ2, λ3) (formulation.md §0), body → global."""
+    """R(λ) of Euler parameters λ = (λ0, λ1, λ2, λ3) (docs/formulation.md §2), body → global."""
     l0, l1, l2, l3 = (float(v) for v in lam)
     lb = np.array([l1, l2, l3])
     skew = np.array([[0.0, -l3, l2], [l3, 0.0, -l1], [-l2, l1, 0.0]])
@@ -191,7 +191,7 @@ def rotation(lam) -> np.ndarray:
 
 
 def euler_e(lam) -> np.ndarray:
-    """E(λ) of formulation.md §0, the 3 × 4 matrix of ω = 2 E(λ) λ̇ in global axes; λ of shape
+    """E(λ) of docs/formulation.md §2, the 3 × 4 matrix of ω = 2 E(λ) λ̇ in global axes; λ of shape
     (..., 4) gives (..., 3, 4)."""
     l0, l1, l2, l3 = np.moveaxis(np.asarray(lam, dtype=float), -1, 0)
     return np.stack([np.stack([-l1, l0, -l3, l2], -1),
