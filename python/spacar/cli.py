@@ -52,7 +52,13 @@ def _print_linearization(res) -> None:
     _comment(f"linearized equations at t = {lin.t:g}: {len(lin.z_labels)} coordinates")
     if not lin.z_labels:  # no degrees of freedom and no LINE parameters
         return
-    _comment("eigenfrequencies [Hz] (undamped; negative: unstable): " + " ".join(f"{f:.6g}" for f in lin.eigenfrequencies()))
+    # Zero frequencies (rigid-body motions, a neutral direction) come out as round-off: counted, not
+    # printed, as the zero eigenvalues are.
+    freqs = np.asarray(lin.eigenfrequencies(), dtype=float)
+    big = max(1.0, float(np.abs(freqs).max(initial=0.0)))
+    shown = [f for f in freqs if abs(f) > 1e-6 * big]
+    zero = f" ({len(freqs) - len(shown)} zero)" if len(shown) < len(freqs) else ""
+    _comment(f"eigenfrequencies [Hz] (undamped; negative: unstable){zero}: " + " ".join(f"{f:.6g}" for f in shown))
     lam = lin.eigenvalues()
     scale = max(1.0, float(np.abs(lam).max(initial=0.0)))
     nonzero = [z for z in lam if abs(z) > 1e-6 * scale]

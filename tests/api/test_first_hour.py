@@ -57,3 +57,11 @@ def test_check_exit_status_is_a_gate(tmp_path, capsys):
     assert "the model is empty (no input block ended with END)" in out
     assert main(["run", str(open_block)]) == 1
     assert "end the input with a line END" in capsys.readouterr().out
+
+
+def test_bicycle_run_prints_no_round_off_frequencies(capsys):
+    assert main(["run", str(EXAMPLES / "bicycle.dat")]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("* eigenfrequencies"))
+    head, values = line.split(":")
+    assert "(1 zero)" in head
+    assert all(abs(float(v)) > 1e-3 for v in values.split())
