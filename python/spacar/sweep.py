@@ -404,6 +404,7 @@ class SweepResult:
     grid: dict | None = None
     seconds: np.ndarray | None = None      # wall time of each case in its worker
     wall_time: float = 0.0                 # of the whole sweep
+    workers: int = 1                       # threads, processes or cluster workers that ran the cases
     warnings: list = field(default_factory=list)   # (index, message) of new warnings per case
     coordinate_labels: list | None = None  # columns of x, xd, xdd, reaction: (node, component)
     deformation_labels: list | None = None  # columns of e, ed, edd, sigma: (element, deformation)
@@ -568,9 +569,12 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
 
     Where the cases run: ``client`` (a ``dask.distributed.Client``) runs them on that cluster;
     ``executor`` (any ``concurrent.futures.Executor``) on it; otherwise ``workers`` local
-    processes (default: the number of CPUs; started with "spawn", so scripts need the ``if
-    __name__ == "__main__":`` guard), or in this process with ``workers=1``. Cases go in chunks
-    of ``chunksize`` (default: about four chunks per worker).
+    processes (started with "spawn", so scripts need the ``if __name__ == "__main__":`` guard),
+    or in this process with ``workers=1``. By default (``workers=None``) threads of this process,
+    one per CPU: the analysis runs in C++ without the GIL, so threads run cases in parallel
+    without the start-up, import and pickling costs of processes (which made a sweep of short runs
+    slower than a plain loop). Cases go in chunks of ``chunksize`` (default: about four chunks
+    per worker). ``result.workers`` says how many ran them.
 
     ``progress``: True for a progress bar (tqdm when installed), False for none, None (default)
     for a bar in an interactive session (a terminal or a Jupyter kernel, unless
@@ -629,6 +633,12 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
         if client is None and executor is None and n_workers == 1:
             for chunk in chunks:
                 collect(chunk, _run_cases(task, chunk))
+        elif client is None and executor is None and workers is None:
+            # Threads share the task: nothing to pickle, nothing to start.
+            with concurrent.futures.ThreadPoolExecutor(max_workers=n_workers) as pool:
+                futures = {pool.submit(_run_cases, task, chunk): chunk for chunk in chunks}
+                for future in concurrent.futures.as_completed(futures):
+                    collect(futures[future], future.result())
         else:
             payload = _dumps(task)
             if client is not None:
@@ -651,7 +661,9 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     finally:
         bar.close()
 
-    return _gather(task, names, cases, grid, outcomes, time.perf_counter() - start)
+    result = _gather(task, names, cases, grid, outcomes, time.perf_counter() - start)
+    result.workers = n_workers
+    return result
 
 
 def _client_workers(client) -> int:

@@ -222,3 +222,22 @@ def test_progress_bar(capsys):
     spacar.sweep(spacar.read(EXAMPLE), {"XD 2 1": [1.0, 2.0], "TIMESTEP": [(1, 0.05)]}, workers=1, progress=True)
     err = capsys.readouterr().err
     assert "spacar.sweep" in err and "2/2" in err
+
+
+def test_default_sweep_runs_threads_without_pickling(monkeypatch):
+    """Short runs must not pay for processes (issue 23: the process default made a sweep of
+    short runs 1.45× slower than a plain loop): the default shares the task with threads."""
+    import spacar.sweep as sweep_module
+
+    def no_pickling(obj):
+        raise AssertionError("the default sweep pickled its task")
+
+    monkeypatch.setattr(sweep_module, "_dumps", no_pickling)
+    model = spacar.read(EXAMPLES / "slidercrank.dat")
+    values = list(np.linspace(0.1, 0.4, 6))
+    result = spacar.sweep(model, {"EMASS 3": values}, progress=False)
+    assert result.ok.all() and result.workers == min(os.cpu_count() or 1, 6)
+    for v, x in zip(values, result.values["x"]):
+        m = model.copy()
+        m.emass(3, v)
+        np.testing.assert_array_equal(x, spacar.simulate(m, progress=False).x[-1])
