@@ -227,7 +227,9 @@ def test_progress_bar(capsys):
 def test_default_sweep_runs_threads_without_pickling(monkeypatch):
     """Short runs must not pay for processes (issue 23: the process default made a sweep of
     short runs 1.45× slower than a plain loop): the default shares the task with threads."""
-    import spacar.sweep as sweep_module
+    import sys
+
+    sweep_module = sys.modules["spacar.sweep"]
 
     def no_pickling(obj):
         raise AssertionError("the default sweep pickled its task")
