@@ -7,30 +7,17 @@
 #include <string>
 
 #include "spacar/catalogue.hpp"
+#include "spacar/spatial_tree.hpp"
 #include "spacar/topology.hpp"
+#include "tree_common.hpp"
 
 namespace spacar {
 
 namespace {
 
-constexpr int kGround = -1;
-
-struct NodeInfo {
-  NodeKind kind = NodeKind::Any;
-  int coord = 0;       // first coordinate
-  bool fixed = true;   // every coordinate fixed
-  bool free = true;    // every coordinate calculable or dynamic (DYNX)
-};
-
-// Node numbers of an element's coordinates, in slot order.
-std::vector<int> element_nodes(const System& sys, const SystemElement& se) {
-  std::vector<int> nodes;
-  for (int g : se.coords) {
-    const int id = sys.coord_label[g][0];
-    if (nodes.empty() || nodes.back() != id) nodes.push_back(id);
-  }
-  return nodes;
-}
+using tree_detail::element_nodes;
+using tree_detail::kGround;
+using tree_detail::NodeInfo;
 
 // Rigid-motion row of a coordinate: its rate for the body twist (ω, vx, vy) at the pin, with
 // b the coordinate's point relative to the pin (world axes at the reference state).
@@ -70,17 +57,10 @@ class PlanarTree::Builder {
     for (size_t j = 0; j < sys_.x_dyn.size(); ++j) dof_of_coord_[sys_.x_dyn[j]] = static_cast<int>(j);
     for (int g = 0; g < sys_.nx; ++g) {
       const NodeKind kind = sys_.coord_node_kind[g];
-      const CoordClass c = sys_.coord_class[g];
       if (kind != NodeKind::XY && kind != NodeKind::Beta) return false;
-      if (c == CoordClass::Dynamic && kind != NodeKind::Beta) return false;  // DYNX only on rotations
-      auto [it, fresh] = nodes_.try_emplace(sys_.coord_label[g][0]);
-      if (fresh) {
-        it->second.kind = kind;
-        it->second.coord = g;
-      }
-      it->second.fixed = it->second.fixed && c == CoordClass::Fixed;
-      it->second.free = it->second.free && (c == CoordClass::Calculable || c == CoordClass::Dynamic);
+      if (sys_.coord_class[g] == CoordClass::Dynamic && kind != NodeKind::Beta) return false;  // DYNX only on rotations
     }
+    nodes_ = tree_detail::system_nodes(sys_);
     for (const auto& [id, n] : nodes_)
       if (!n.fixed && !n.free) return false;  // partly fixed: neither a pin nor a body node
     return true;
@@ -299,15 +279,8 @@ class PlanarTree::Builder {
   }
 
   // The element's mass matrix on the rigid motions about the pin p0: Tᵀ M T.
-  Eigen::Matrix3d element_inertia(const SystemElement& se, const Eigen::Vector2d& p0) {
-    if (!se.has_mass) return Eigen::Matrix3d::Zero();
-    const int n = static_cast<int>(se.coords.size());
-    Eigen::VectorXd xl(n), vl = Eigen::VectorXd::Zero(n), h(n);
-    Eigen::MatrixXd M(n, n), T(n, 3);
-    for (int a = 0; a < n; ++a) xl[a] = x_[se.coords[a]];
-    se.kernel->mass(xl.data(), vl.data(), M.data(), h.data());
-    for (int a = 0; a < n; ++a) T.row(a) = rigid_row_of(se.coords[a], p0);
-    return T.transpose() * M * T;
+  Eigen::Matrix3d element_inertia(const SystemElement& se, const Eigen::Vector2d& p0) const {
+    return tree_detail::element_inertia<3>(se, x_, [&](int g) { return rigid_row_of(g, p0); });
   }
 
   // A node moving with body `index`: its point mass into I, its loads, its coordinates.
@@ -359,6 +332,13 @@ class PlanarTree::Builder {
   std::map<int, int> owner_;           // XY node → body (index in bodies_) it moves with, kGround
   std::vector<Eigen::Vector2d> pin0_;  // reference pin of each placed body
 };
+
+std::unique_ptr<RecursiveTree> RecursiveTree::detect(const System& sys, const Data& data, std::string* why) {
+  if (sys.dim == 3) return SpatialTree::detect(sys, data, why);
+  std::unique_ptr<RecursiveTree> tree = PlanarTree::detect(sys, data);
+  if (!tree && why) *why = "not a planar open tree of rigid bodies (tree.hpp)";
+  return tree;
+}
 
 std::unique_ptr<PlanarTree> PlanarTree::detect(const System& sys, const Data& data) {
   auto tree = std::unique_ptr<PlanarTree>(new PlanarTree());
@@ -510,5 +490,33 @@ void PlanarTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen
     xdd[f.coord + 1] = bd.sw * ax + bd.cw * ay + gy;
   }
 }
+
+namespace tree_detail {
+
+std::map<int, NodeInfo> system_nodes(const System& sys) {
+  std::map<int, NodeInfo> nodes;
+  for (int g = 0; g < sys.nx; ++g) {
+    const CoordClass c = sys.coord_class[g];
+    auto [it, fresh] = nodes.try_emplace(sys.coord_label[g][0]);
+    if (fresh) {
+      it->second.kind = sys.coord_node_kind[g];
+      it->second.coord = g;
+    }
+    it->second.fixed = it->second.fixed && c == CoordClass::Fixed;
+    it->second.free = it->second.free && (c == CoordClass::Calculable || c == CoordClass::Dynamic);
+  }
+  return nodes;
+}
+
+std::vector<int> element_nodes(const System& sys, const SystemElement& se) {
+  std::vector<int> nodes;
+  for (int g : se.coords) {
+    const int id = sys.coord_label[g][0];
+    if (nodes.empty() || nodes.back() != id) nodes.push_back(id);
+  }
+  return nodes;
+}
+
+}  // namespace tree_detail
 
 }  // namespace spacar

@@ -14,6 +14,7 @@
 
 #include <Eigen/Dense>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "spacar/data.hpp"
@@ -21,18 +22,31 @@
 
 namespace spacar {
 
-class PlanarTree {
+// The recursive right-hand side of an open tree of rigid bodies: planar (PlanarTree) or spatial
+// (SpatialTree, spatial_tree.hpp).
+class RecursiveTree {
  public:
-  // The tree of the system if it is one, else nullptr. The body geometry and inertia are taken
-  // at the positions in data, which must satisfy the constraints (a solved state).
-  static std::unique_ptr<PlanarTree> detect(const System& sys, const Data& data);
+  virtual ~RecursiveTree() = default;
+  // The planar or spatial tree of the system if it is one, else nullptr and (if why is given)
+  // the reason. Taken at the positions in data, which must satisfy the constraints.
+  static std::unique_ptr<RecursiveTree> detect(const System& sys, const Data& data, std::string* why = nullptr);
 
   // At (q, q̇) (no inputs, no integrated deformations): the positions, velocities and
   // accelerations of every coordinate into x, xd, xdd (length nx; fixed coordinates are left as
   // they are) and the DOF accelerations into qdd. False if an articulated inertia is not
   // positive (a body that moves no mass): the general path names the DOFs.
+  virtual bool solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
+                     Eigen::VectorXd& xdd, double* qdd) = 0;
+};
+
+class PlanarTree : public RecursiveTree {
+ public:
+  // The tree of the system if it is one, else nullptr. The body geometry and inertia are taken
+  // at the positions in data, which must satisfy the constraints (a solved state).
+  static std::unique_ptr<PlanarTree> detect(const System& sys, const Data& data);
+
   bool solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd,
-             double* qdd);
+             double* qdd) override;
 
   int n_bodies() const { return static_cast<int>(bodies_.size()); }
 
