@@ -4,7 +4,6 @@
 #include <cmath>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include "spacar/catalogue.hpp"
 #include "spacar/elements/spatial.hpp"
@@ -155,53 +154,19 @@ class SpatialTree::Builder {
     return true;
   }
 
-  // The bodies: moving rigid beams sharing a LAMBDA node are one (rigid_bodies), numbered in the
-  // order of their first beam.
+  // The bodies: moving rigid beams sharing a LAMBDA node are one.
   bool group_bodies() {
-    std::vector<std::vector<int>> links;
-    for (const auto& [i, ids] : beams_) {
-      links.emplace_back();
-      for (int id : ids)
-        if (nodes_[id].kind == NodeKind::Lambda) links.back().push_back(id);
-    }
-    const std::vector<std::vector<int>> rigid = rigid_bodies({}, links);
-    std::map<int, int> rigid_of;  // LAMBDA node → rigid_bodies() index
-    for (size_t r = 0; r < rigid.size(); ++r)
-      for (int id : rigid[r]) rigid_of[id] = static_cast<int>(r);
-    std::map<int, int> body_of_rigid;
-    for (const auto& [i, ids] : beams_) {
-      int r = -1;
-      for (int id : ids)
-        if (nodes_[id].kind == NodeKind::Lambda) r = rigid_of.at(id);
-      auto [it, fresh] = body_of_rigid.try_emplace(r, static_cast<int>(points_.size()));
-      if (fresh) {
-        points_.emplace_back();
-        lambdas_.emplace_back();
-        beams_of_.emplace_back();
-      }
-      const int b = it->second;
-      beams_of_[b].push_back(i);
-      for (int id : ids) (nodes_[id].kind == NodeKind::Lambda ? lambdas_[b] : points_[b]).insert(id);
-    }
-    for (size_t b = 0; b < lambdas_.size(); ++b)
-      for (int id : lambdas_[b]) body_of_lambda_[id] = static_cast<int>(b);
-    placed_.assign(points_.size(), -1);
-    pin_.assign(points_.size(), -1);
-    // Every free node moves with a body.
-    std::set<int> moving;
-    for (size_t b = 0; b < points_.size(); ++b) {
-      moving.insert(points_[b].begin(), points_[b].end());
-      moving.insert(lambdas_[b].begin(), lambdas_[b].end());
-    }
-    for (const auto& [id, n] : nodes_)
-      if (!n.fixed && !moving.count(id)) return refuse("node " + std::to_string(id) + " moves with no rigid BEAM");
+    g_ = tree_detail::group_beams(beams_, nodes_, NodeKind::Lambda);
+    if (g_.stray >= 0) return refuse("node " + std::to_string(g_.stray) + " moves with no rigid BEAM");
+    placed_.assign(g_.points.size(), -1);
+    pin_.assign(g_.points.size(), -1);
     for (const auto& [id, n] : nodes_)
       if (n.kind == NodeKind::XYZ && n.fixed) owner_[id] = kGround;
     return true;
   }
 
   int body_of(int lambda_node) const {
-    return nodes_.at(lambda_node).fixed ? kGround : body_of_lambda_.at(lambda_node);
+    return nodes_.at(lambda_node).fixed ? kGround : g_.body_of.at(lambda_node);
   }
   bool is_placed(int body) const { return body == kGround || placed_[body] >= 0; }
   Eigen::Vector3d xyz(int id) const { return x_.segment<3>(nodes_.at(id).coord); }
@@ -210,7 +175,7 @@ class SpatialTree::Builder {
   // The one XYZ node of the body on its parent (or fixed): its pin, −1 if none, −2 if more.
   int pin_of(int body) const {
     int pin = -1;
-    for (int id : points_[body])
+    for (int id : g_.points[body])
       if (owner_.count(id)) pin = pin == -1 ? id : -2;
     return pin;
   }
@@ -242,7 +207,7 @@ class SpatialTree::Builder {
     }
     for (size_t b = 0; b < placed_.size(); ++b)
       if (placed_[b] < 0)
-        return refuse("the body of node " + std::to_string(*points_[b].begin()) +
+        return refuse("the body of node " + std::to_string(*g_.points[b].begin()) +
                       " does not hang from the ground by DOF hinges (a spherical joint, or a loop)");
     return true;
   }
@@ -289,12 +254,12 @@ class SpatialTree::Builder {
     const Eigen::Vector3d p0 = xyz(pin);
     bd.parent = parent;
     bd.r = parent == kGround ? p0 : Eigen::Vector3d(p0 - pin0_[parent]);
-    for (int id : points_[body])
+    for (int id : g_.points[body])
       if (id != pin) owner_[id] = index;
     Mat6 I = Mat6::Zero();
     auto row = [&](int g) { return rigid_row_of(g, p0); };
-    for (int i : beams_of_[body]) I += tree_detail::element_inertia<6>(sys_.elements[i], x_, row);
-    for (int id : points_[body]) {
+    for (int i : g_.beams[body]) I += tree_detail::element_inertia<6>(sys_.elements[i], x_, row);
+    for (int id : g_.points[body]) {
       if (id == pin) continue;  // its point mass and loads move with the parent
       for (int c = 0; c < 3; ++c) {
         const int g = nodes_[id].coord + c;
@@ -302,7 +267,7 @@ class SpatialTree::Builder {
       }
       tree_.followers_.push_back({nodes_[id].coord, index, true, xyz(id) - p0, Quat::Zero()});
     }
-    for (int id : lambdas_[body]) {
+    for (int id : g_.orientations[body]) {
       tree_.followers_.push_back({nodes_[id].coord, index, false, Vec3::Zero(), lambda(id)});
       lambda_body_[nodes_[id].coord] = index;
     }
@@ -353,9 +318,7 @@ class SpatialTree::Builder {
   std::map<int, NodeInfo> nodes_;
   std::vector<std::pair<int, std::vector<int>>> beams_;  // moving rigid beams: element, nodes
   std::vector<Hinge> hinges_;
-  std::vector<std::set<int>> points_, lambdas_;  // nodes of each body
-  std::vector<std::vector<int>> beams_of_;
-  std::map<int, int> body_of_lambda_;   // LAMBDA node of a moving beam → body
+  tree_detail::BeamBodies g_;           // the bodies' nodes and beams
   std::map<int, int> lambda_body_;      // first λ coordinate → index in bodies_
   std::vector<int> placed_;             // body → index in bodies_, −1: not yet
   std::vector<int> pin_;                // body → its pin node, −1: not placed

@@ -106,55 +106,25 @@ class PlanarTree::Builder {
     return true;
   }
 
-  // The bodies: moving rigid beams sharing a BETA node are one (rigid_bodies), numbered in the
-  // order of their first beam.
+  // The bodies: moving rigid beams sharing a BETA node are one.
   bool group_bodies() {
-    std::vector<std::vector<int>> links;
-    for (const auto& [i, ids] : beams_) {
-      links.emplace_back();
-      for (int id : ids)
-        if (nodes_[id].kind == NodeKind::Beta) links.back().push_back(id);
-    }
-    const std::vector<std::vector<int>> rigid = rigid_bodies({}, links);
-    for (size_t r = 0; r < rigid.size(); ++r)
-      for (int id : rigid[r]) rigid_body_of_[id] = static_cast<int>(r);
-    for (const auto& [i, ids] : beams_) {
-      int r = -1;
-      for (int id : ids)
-        if (nodes_[id].kind == NodeKind::Beta) r = rigid_body_of_.at(id);
-      auto [it, fresh] = body_of_rigid_.try_emplace(r, static_cast<int>(xy_.size()));
-      if (fresh) {
-        xy_.emplace_back();
-        beta_.emplace_back();
-        beams_of_.emplace_back();
-      }
-      const int b = it->second;
-      beams_of_[b].push_back(i);
-      for (int id : ids) (nodes_[id].kind == NodeKind::Beta ? beta_[b] : xy_[b]).insert(id);
-    }
-    placed_.assign(xy_.size(), -1);
-    pin_.assign(xy_.size(), -1);
-    // Every free node moves with a body.
-    std::set<int> moving;
-    for (size_t b = 0; b < xy_.size(); ++b) {
-      moving.insert(xy_[b].begin(), xy_[b].end());
-      moving.insert(beta_[b].begin(), beta_[b].end());
-    }
-    for (const auto& [id, n] : nodes_)
-      if (!n.fixed && !moving.count(id)) return false;
+    g_ = tree_detail::group_beams(beams_, nodes_, NodeKind::Beta);
+    if (g_.stray >= 0) return false;  // every free node moves with a body
+    placed_.assign(g_.points.size(), -1);
+    pin_.assign(g_.points.size(), -1);
     for (const auto& [id, n] : nodes_)
       if (n.kind == NodeKind::XY && n.fixed) owner_[id] = kGround;
     return true;
   }
 
-  int body_of_beta(int id) { return nodes_[id].fixed ? kGround : body_of_rigid_.at(rigid_body_of_.at(id)); }
+  int body_of_beta(int id) { return nodes_[id].fixed ? kGround : g_.body_of.at(id); }
   bool is_placed(int body) const { return body == kGround || placed_[body] >= 0; }
   Eigen::Vector2d xy(int id) const { return {x_[nodes_.at(id).coord], x_[nodes_.at(id).coord + 1]}; }
 
   // The DYNX rotation coordinate of a body, −1 if none (−2: more than one).
   int dynamic_rotation(int body) const {
     int found = -1;
-    for (int id : beta_[body])
+    for (int id : g_.orientations[body])
       if (sys_.coord_class[nodes_.at(id).coord] == CoordClass::Dynamic) found = found == -1 ? nodes_.at(id).coord : -2;
     return found;
   }
@@ -162,7 +132,7 @@ class PlanarTree::Builder {
   // The one XY node of the body on a placed body (or fixed): its pin, −1 if none, −2 if more.
   int pin_of(int body) const {
     int pin = -1;
-    for (int id : xy_[body])
+    for (int id : g_.points[body])
       if (owner_.count(id)) pin = pin == -1 ? id : -2;
     return pin;
   }
@@ -177,8 +147,8 @@ class PlanarTree::Builder {
       hinges_at[body_of_beta(hinges_[i].a)].push_back(static_cast<int>(i));
       hinges_at[body_of_beta(hinges_[i].b)].push_back(static_cast<int>(i));
     }
-    for (size_t b = 0; b < xy_.size(); ++b)
-      for (int id : xy_[b]) bodies_at[id].push_back(static_cast<int>(b));
+    for (size_t b = 0; b < g_.points.size(); ++b)
+      for (int id : g_.points[b]) bodies_at[id].push_back(static_cast<int>(b));
     std::vector<int> queue = {kGround};
     for (size_t k = 0; k < queue.size(); ++k) {
       const int parent = queue[k];
@@ -236,7 +206,7 @@ class PlanarTree::Builder {
     for (const auto& [id, owner] : owner_)
       if (body == kGround && owner == kGround) out.push_back(id);
     if (body != kGround)
-      for (int id : xy_[body])
+      for (int id : g_.points[body])
         if (id != pin_[body]) out.push_back(id);
     return out;
   }
@@ -253,13 +223,13 @@ class PlanarTree::Builder {
     const Eigen::Vector2d p0 = xy(pin);
     bd.parent = parent;
     bd.r = parent == kGround ? p0 : Eigen::Vector2d(p0 - pin0_[parent]);
-    for (int id : xy_[body])
+    for (int id : g_.points[body])
       if (id != pin) owner_[id] = index;
     Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
-    for (int i : beams_of_[body]) I += element_inertia(sys_.elements[i], p0);
-    for (int id : xy_[body])
+    for (int i : g_.beams[body]) I += element_inertia(sys_.elements[i], p0);
+    for (int id : g_.points[body])
       if (id != pin) follow(id, index, p0, I);
-    for (int id : beta_[body]) follow(id, index, p0, I);
+    for (int id : g_.orientations[body]) follow(id, index, p0, I);
     // The projection is a rigid body's inertia only if the mass model moves rigidly with the
     // nodes (equal masses in x and y, no coupling between them).
     const double scale = I.cwiseAbs().maxCoeff();
@@ -323,10 +293,7 @@ class PlanarTree::Builder {
   std::map<int, int> dof_of_coord_;    // DYNX coordinate → its position in q
   std::vector<std::pair<int, std::vector<int>>> beams_;  // moving rigid beams: element, nodes
   std::vector<Hinge> hinges_;
-  std::map<int, int> rigid_body_of_;   // BETA node of a moving beam → its rigid_bodies() index
-  std::map<int, int> body_of_rigid_;    // rigid_bodies() index → body
-  std::vector<std::set<int>> xy_, beta_;  // nodes of each body
-  std::vector<std::vector<int>> beams_of_;
+  tree_detail::BeamBodies g_;          // the bodies' nodes and beams
   std::vector<int> placed_;            // body → index in bodies_, −1: not yet
   std::vector<int> pin_;               // body → its pin node, −1: not placed
   std::map<int, int> owner_;           // XY node → body (index in bodies_) it moves with, kGround
@@ -506,6 +473,46 @@ std::map<int, NodeInfo> system_nodes(const System& sys) {
     it->second.free = it->second.free && (c == CoordClass::Calculable || c == CoordClass::Dynamic);
   }
   return nodes;
+}
+
+BeamBodies group_beams(const std::vector<std::pair<int, std::vector<int>>>& beams,
+                       const std::map<int, NodeInfo>& nodes, NodeKind orientation) {
+  std::vector<std::vector<int>> links;
+  for (const auto& [i, ids] : beams) {
+    links.emplace_back();
+    for (int id : ids)
+      if (nodes.at(id).kind == orientation) links.back().push_back(id);
+  }
+  const std::vector<std::vector<int>> rigid = rigid_bodies({}, links);
+  std::map<int, int> rigid_of;      // orientation node → rigid_bodies() index
+  for (size_t r = 0; r < rigid.size(); ++r)
+    for (int id : rigid[r]) rigid_of[id] = static_cast<int>(r);
+  BeamBodies out;
+  std::map<int, int> body_of_rigid;  // rigid_bodies() index → body
+  for (size_t k = 0; k < beams.size(); ++k) {
+    const auto& [i, ids] = beams[k];
+    auto [it, fresh] = body_of_rigid.try_emplace(rigid_of.at(links[k].front()), static_cast<int>(out.points.size()));
+    if (fresh) {
+      out.points.emplace_back();
+      out.orientations.emplace_back();
+      out.beams.emplace_back();
+    }
+    const int b = it->second;
+    out.beams[b].push_back(i);
+    for (int id : ids) (nodes.at(id).kind == orientation ? out.orientations[b] : out.points[b]).insert(id);
+  }
+  std::set<int> moving;
+  for (size_t b = 0; b < out.points.size(); ++b) {
+    moving.insert(out.points[b].begin(), out.points[b].end());
+    moving.insert(out.orientations[b].begin(), out.orientations[b].end());
+    for (int id : out.orientations[b]) out.body_of[id] = static_cast<int>(b);
+  }
+  for (const auto& [id, n] : nodes)
+    if (!n.fixed && !moving.count(id)) {
+      out.stray = id;
+      break;
+    }
+  return out;
 }
 
 std::vector<int> element_nodes(const System& sys, const SystemElement& se) {

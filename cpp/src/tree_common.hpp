@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 #include <map>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "spacar/system.hpp"
@@ -26,6 +28,18 @@ std::map<int, NodeInfo> system_nodes(const System& sys);
 
 // Node numbers of an element's coordinates, in slot order.
 std::vector<int> element_nodes(const System& sys, const SystemElement& se);
+
+// Moving rigid beams joined into bodies by their shared orientation nodes (BETA or LAMBDA;
+// rigid_bodies), the bodies numbered in the order of their first beam.
+struct BeamBodies {
+  std::vector<std::set<int>> points, orientations;  // nodes of each body
+  std::vector<std::vector<int>> beams;              // elements of each body
+  std::map<int, int> body_of;                       // orientation node → body
+  int stray = -1;                                   // a free node on no body (no tree), or −1
+};
+// beams: (element index, its nodes) of every moving rigid beam.
+BeamBodies group_beams(const std::vector<std::pair<int, std::vector<int>>>& beams,
+                       const std::map<int, NodeInfo>& nodes, NodeKind orientation);
 
 // The element's mass matrix at the positions x, projected on the rigid motions of a body:
 // Tᵀ M T, with T's row a the rate of the element's coordinate a for the body's velocity (rows
