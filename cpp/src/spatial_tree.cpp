@@ -34,6 +34,14 @@ Eigen::Vector4d compose(const Eigen::Vector4d& p, const Eigen::Vector4d& r) {
   return out;
 }
 
+// E(λ)ᵀ ω = (0, ω) ⊗ λ.
+Eigen::Vector4d euler_E_transpose_times(const Eigen::Vector4d& l, const Eigen::Vector3d& w) {
+  Eigen::Vector4d out;
+  out[0] = -w.dot(l.tail<3>());
+  out.tail<3>() = l[0] * w + w.cross(l.tail<3>());
+  return out;
+}
+
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d S;
   S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
@@ -351,6 +359,22 @@ SpatialTree::Vec6 SpatialTree::to_parent(const Body& bd, const Vec6& f) {
   return out;
 }
 
+// Xᵀ I X with X = [E 0; −E r̃ E] (parent → body, motion vectors), by blocks: rotated,
+// I' = [A B; Bᵀ C] in the parent's axes, then moved to its origin,
+// [A + r̃Bᵀ + (r̃Bᵀ)ᵀ − r̃Cr̃, B + r̃C; (B + r̃C)ᵀ, C] — a third of the full 6×6 products.
+void SpatialTree::add_inertia_to_parent(const Body& bd, const Mat6& I, Mat6& parent) {
+  const Mat3& E = bd.E;
+  const Mat3 Ib = I.topLeftCorner<3, 3>(), Bb = I.topRightCorner<3, 3>(), Cb = I.bottomRightCorner<3, 3>();
+  const Mat3 A = E.transpose() * Ib * E, B = E.transpose() * Bb * E, C = E.transpose() * Cb * E;
+  const Mat3 rx = skew(bd.r);
+  const Mat3 rC = rx * C, rBt = rx * B.transpose();
+  parent.topLeftCorner<3, 3>() += A + rBt + rBt.transpose() - rC * rx;
+  const Mat3 coupling = B + rC;
+  parent.topRightCorner<3, 3>() += coupling;
+  parent.bottomLeftCorner<3, 3>() += coupling.transpose();
+  parent.bottomRightCorner<3, 3>() += C;
+}
+
 bool SpatialTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
                         Eigen::VectorXd& xdd, double* qdd) {
   outward(q, qd);
@@ -369,12 +393,13 @@ void SpatialTree::outward(const double* q, const double* qd) {
     const double theta = bd.sign * (q[bd.dof] - bd.offset);  // rotation relative to the parent
     bd.ud = bd.sign * qd[bd.dof];
     bd.tau = -bd.sign * (bd.stiffness * q[bd.dof] + bd.damping * qd[bd.dof]);  // τ_q = −σ
-    const double c = std::cos(theta), s = std::sin(theta);
+    const double ch = std::cos(0.5 * theta), sh = std::sin(0.5 * theta);  // of the half angle, for λ too
+    const double c = 1.0 - 2.0 * sh * sh, s = 2.0 * sh * ch;
     const Vec3& k = bd.axis;
     const Mat3 rel = c * Mat3::Identity() + s * skew(k) + (1.0 - c) * k * k.transpose();  // body → parent
     bd.E = rel.transpose();
     Quat q_rel;
-    q_rel << std::cos(0.5 * theta), std::sin(0.5 * theta) * k;
+    q_rel << ch, sh * k;
     Vec6 v = Vec6::Zero();
     v.head<3>() = bd.ud * k;
     if (!p) {
@@ -421,12 +446,8 @@ bool SpatialTree::articulate() {
     if (bd.parent == kGround) continue;
     const Mat6 Ia = bd.IA - bd.U * bd.U.transpose() / bd.d;
     const Vec6 pa = bd.pA + Ia * bd.bias + bd.U * (bd.u / bd.d);
-    Mat6 X = Mat6::Zero();  // parent → body, motion vectors
-    X.topLeftCorner<3, 3>() = bd.E;
-    X.bottomRightCorner<3, 3>() = bd.E;
-    X.bottomLeftCorner<3, 3>() = -bd.E * skew(bd.r);
     Body& p = bodies_[bd.parent];
-    p.IA.noalias() += X.transpose() * Ia * X;
+    add_inertia_to_parent(bd, Ia, p.IA);
     p.pA += to_parent(bd, pa);
   }
   return true;
@@ -453,10 +474,10 @@ void SpatialTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eige
     if (!f.point) {  // λ = λ_body ⊗ λ0, λ̇ = ½ E(λ)ᵀ ω, λ̈ = ½ E(λ̇)ᵀ ω + ½ E(λ)ᵀ ω̇ (world ω)
       const Quat l = compose(bd.lambda, f.lambda0);
       const Vec3 ww = bd.R * w, wdw = bd.R * wd;
-      const Quat ld = 0.5 * euler_E(l).transpose() * ww;
+      const Quat ld = 0.5 * euler_E_transpose_times(l, ww);
       x.segment<4>(f.coord) = l;
       xd.segment<4>(f.coord) = ld;
-      xdd.segment<4>(f.coord) = 0.5 * (euler_E(ld).transpose() * ww + euler_E(l).transpose() * wdw);
+      xdd.segment<4>(f.coord) = 0.5 * (euler_E_transpose_times(ld, ww) + euler_E_transpose_times(l, wdw));
       continue;
     }
     const Vec3 vp = bd.v.tail<3>() + w.cross(f.b);  // of the point, in body axes

@@ -92,6 +92,8 @@ class SpatialTree : public RecursiveTree {
   // Motion vectors from the parent's coordinates to the body's; force vectors back (the transpose).
   static Vec6 to_child(const Body& bd, const Vec6& m);
   static Vec6 to_parent(const Body& bd, const Vec6& f);
+  // The body's (articulated) inertia I, body coordinates, added to its parent's in the parent's.
+  static void add_inertia_to_parent(const Body& bd, const Mat6& I, Mat6& parent);
 
   std::vector<Body> bodies_;
   std::vector<Follower> followers_;
