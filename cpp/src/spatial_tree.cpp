@@ -123,13 +123,14 @@ class SpatialTree::Builder {
   bool read_elements() {
     for (size_t i = 0; i < sys_.elements.size(); ++i) {
       const SystemElement& se = sys_.elements[i];
-      const std::string& type = element_catalogue()[se.type].name;
+      // Every node is spatial (read_nodes): the beams are BEAM(NL), the hinges HINGE.
+      const ElementType& type = element_catalogue()[se.type];
       const std::vector<int> ids = element_nodes(sys_, se);
-      if (type == "BEAM" || type == "BEAMNL") {
+      if (type.family == ElementFamily::Beam) {
         if (!read_beam(static_cast<int>(i), se, ids)) return false;
-      } else if (type == "HINGE") {
+      } else if (type.family == ElementFamily::Hinge) {
         if (!read_hinge(static_cast<int>(i), se, ids)) return false;
-      } else if (type != "L2MIN1") {  // L2MIN1: the normalisation the tree keeps exactly
+      } else if (!type.automatic) {  // L2MIN1: the normalisation the tree keeps exactly
         return refuse(element_name(se) + " is not a BEAM, BEAMNL, HINGE or L2MIN1");
       }
     }
@@ -373,16 +374,6 @@ void SpatialTree::add_inertia_to_parent(const Body& bd, const Mat6& I, Mat6& par
   parent.topRightCorner<3, 3>() += coupling;
   parent.bottomLeftCorner<3, 3>() += coupling.transpose();
   parent.bottomRightCorner<3, 3>() += C;
-}
-
-bool SpatialTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
-                        Eigen::VectorXd& xdd, double* qdd) {
-  outward(q, qd);
-  applied_loads();
-  if (!articulate()) return false;
-  accelerations(qdd);
-  move_coordinates(x, xd, xdd);
-  return true;
 }
 
 // Outwards: rotations, pins, velocities, velocity-product accelerations and the bias forces of

@@ -331,8 +331,8 @@ PlanarTree::Mat3 PlanarTree::inertia_to_parent(const Body& bd, const Mat3& I) {
   return X.transpose() * I * X;
 }
 
-bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
-                       Eigen::VectorXd& xdd, double* qdd) {
+bool RecursiveTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
+                          Eigen::VectorXd& xdd, double* qdd) {
   outward(q, qd);
   applied_loads();
   if (!articulate()) return false;

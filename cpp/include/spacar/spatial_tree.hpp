@@ -37,9 +37,6 @@ class SpatialTree : public RecursiveTree {
   // constraints (a solved state).
   static std::unique_ptr<SpatialTree> detect(const System& sys, const Data& data, std::string* why = nullptr);
 
-  bool solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd,
-             double* qdd) override;
-
  private:
   using Vec3 = Eigen::Vector3d;
   using Mat3 = Eigen::Matrix3d;
@@ -82,12 +79,11 @@ class SpatialTree : public RecursiveTree {
   };
   class Builder;
 
-  // The phases of solve().
-  void outward(const double* q, const double* qd);
-  void applied_loads();
-  bool articulate();
-  void accelerations(double* qdd);
-  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const;
+  void outward(const double* q, const double* qd) override;
+  void applied_loads() override;
+  bool articulate() override;
+  void accelerations(double* qdd) override;
+  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
 
   // Motion vectors from the parent's coordinates to the body's; force vectors back (the transpose).
   static Vec6 to_child(const Body& bd, const Vec6& m);

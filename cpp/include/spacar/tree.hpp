@@ -35,8 +35,21 @@ class RecursiveTree {
   // accelerations of every coordinate into x, xd, xdd (length nx; fixed coordinates are left as
   // they are) and the DOF accelerations into qdd. False if an articulated inertia is not
   // positive (a body that moves no mass): the general path names the DOFs.
-  virtual bool solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
-                     Eigen::VectorXd& xdd, double* qdd) = 0;
+  bool solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd,
+             double* qdd);
+
+ protected:
+  // The phases of solve(), the articulated-body algorithm in the tree's algebra. Outwards: body
+  // rotations, positions, velocities, bias accelerations and forces, joint torques;
+  virtual void outward(const double* q, const double* qd) = 0;
+  // the applied loads on the bodies;
+  virtual void applied_loads() = 0;
+  // inwards: articulated inertias and bias forces, false if a joint's inertia is not positive;
+  virtual bool articulate() = 0;
+  // outwards: joint and body accelerations, q̈;
+  virtual void accelerations(double* qdd) = 0;
+  // the coordinates moving with the bodies.
+  virtual void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const = 0;
 };
 
 class PlanarTree : public RecursiveTree {
@@ -44,9 +57,6 @@ class PlanarTree : public RecursiveTree {
   // The tree of the system if it is one, else nullptr. The body geometry and inertia are taken
   // at the positions in data, which must satisfy the constraints (a solved state).
   static std::unique_ptr<PlanarTree> detect(const System& sys, const Data& data);
-
-  bool solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd,
-             double* qdd) override;
 
   int n_bodies() const { return static_cast<int>(bodies_.size()); }
 
@@ -98,12 +108,11 @@ class PlanarTree : public RecursiveTree {
   };
   class Builder;
 
-  // The phases of solve().
-  void outward(const double* q, const double* qd);
-  void applied_loads();
-  bool articulate();
-  void accelerations(double* qdd);
-  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const;
+  void outward(const double* q, const double* qd) override;
+  void applied_loads() override;
+  bool articulate() override;
+  void accelerations(double* qdd) override;
+  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
 
   // Transform of motion vectors from the parent's coordinates to the body's.
   static Vec3 to_child(const Body& bd, const Vec3& m);
