@@ -253,9 +253,9 @@ bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd&
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   check_time(t);
-  if (tree_ && tree_state(t, Y, tree_qdd_)) {
+  // The recursive path: q̈ only; the coordinates follow where a general evaluation needs them.
+  if (tree_ && tree_->solve(Y.data(), Y.data() + nd, dY.data() + dY.size() - nd)) {
     dY.head(nd) = Y.tail(nd);
-    dY.tail(nd) = tree_qdd_;
     return;
   }
   struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side

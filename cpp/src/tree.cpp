@@ -333,11 +333,16 @@ PlanarTree::Mat3 PlanarTree::inertia_to_parent(const Body& bd, const Mat3& I) {
 
 bool RecursiveTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
                           Eigen::VectorXd& xdd, double* qdd) {
+  if (!solve(q, qd, qdd)) return false;
+  move_coordinates(x, xd, xdd);
+  return true;
+}
+
+bool RecursiveTree::solve(const double* q, const double* qd, double* qdd) {
   outward(q, qd);
   applied_loads();
   if (!articulate()) return false;
   accelerations(qdd);
-  move_coordinates(x, xd, xdd);
   return true;
 }
 

@@ -37,6 +37,8 @@ class RecursiveTree {
   // positive (a body that moves no mass): the general path names the DOFs.
   bool solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd,
              double* qdd);
+  // The DOF accelerations only (nothing written if false).
+  bool solve(const double* q, const double* qd, double* qdd);
 
  protected:
   // The phases of solve(), the articulated-body algorithm in the tree's algebra. Outwards: body
