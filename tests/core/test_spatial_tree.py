@@ -75,7 +75,52 @@ def branched_tree(loads=True, seed=5):
     return m
 
 
+def random_tree(n, seed, loads=True):
+    """n bodies hung at random from the ground or an earlier body, at its end point or at an
+    offset point of a second beam rigidly joined to it; hinges about random axes pointing either
+    way, some with springs and dampers; random masses, inertia tensors and gravity; ``loads``:
+    random TORQUEL and FORCE."""
+    rng = np.random.default_rng(seed)
+    m = spacar.Model()
+    m.xyz(1, *rng.normal(size=3) * 0.1)
+    points = {0: [1]}  # body → its points where children may hang (the ground: node 1)
+    position = {1: np.array(m.nodes[1].x)}
+    for i in range(1, n + 1):
+        parent = int(rng.integers(0, i))
+        pin = int(rng.choice(points[parent]))
+        end, offset = 100 + i, 300 + i
+        position[end] = position[pin] + rng.normal(size=3) * 0.4
+        position[offset] = position[end] + rng.normal(size=3) * 0.2
+        m.xyz(end, *position[end])
+        m.xyz(offset, *position[offset])
+        m.beam(i, pin, 1000 + i, end, 2000 + i, *rng.normal(size=3))
+        m.beam(500 + i, end, 2000 + i, offset, 3000 + i, *rng.normal(size=3))  # rigidly joined
+        parent_lambda = 10 if parent == 0 else 2000 + parent
+        ends = (parent_lambda, 1000 + i) if rng.random() < 0.5 else (1000 + i, parent_lambda)
+        m.hinge(700 + i, *ends, *rng.normal(size=3))
+        m.dyne(700 + i, 1)
+        m.emass(i, 0.5 + rng.random(), *(1e-3 * rng.random(3)))
+        m.mass(offset, 0.1 + 0.2 * rng.random())
+        J = _box(0.2 + 0.3 * rng.random(), *(0.1 + 0.2 * rng.random(3)), rng)
+        m.mass(2000 + i, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
+        torque, force = 0.2 * rng.normal(size=3), 0.3 * rng.normal(size=3)
+        if loads:
+            m.torquel(3000 + i, *torque)
+            m.force(offset, *force)
+        if rng.random() < 0.5:
+            m.estiff(700 + i, rng.random())
+            m.edampp(700 + i, 0.1 * rng.random())
+        points[i] = [end, offset]
+    m.fix(1)
+    m.fix(10)
+    m.gravity(*rng.normal(size=3) * 5.0)
+    m.epskin(1e-13)
+    return m
+
+
 TREES = {
+    "random tree 7": lambda: random_tree(7, seed=1),
+    "random tree 9": lambda: random_tree(9, seed=2),
     "chain 6": lambda: models.spatial_chain(6, seed=6, epskin=1e-13),
     "chain springs": lambda: models.spatial_chain(4, seed=7, stiffness=2.5, epskin=1e-13),
     "chain straight ground": lambda: models.spatial_chain(3, seed=3, ground_rotation=False, epskin=1e-13),
@@ -108,6 +153,7 @@ PINOCCHIO_TREES = {
     "chain 8": lambda: models.spatial_chain(8, seed=8, epskin=1e-13),
     "chain springs": lambda: models.spatial_chain(5, seed=2, stiffness=1.5, epskin=1e-13),
     "branched": lambda: branched_tree(loads=False),
+    "random tree 8": lambda: random_tree(8, seed=3, loads=False),
 }
 
 
