@@ -128,9 +128,11 @@ void bind_simulation(py::module_& m) {
             out["xdd"] = xdd;
             return out;
           },
-          "The recursive path of planar rigid trees at (q, q̇), its tree taken at the solved state of the first "
-          "call: a dict of qdd, x, xd, xdd (None for other systems); a check of it against solve_state() and "
-          "move_to().")
+          "The recursive path of planar and spatial rigid trees at (q, q̇), its tree taken at the solved state "
+          "of the first call: a dict of qdd, x, xd, xdd (None for other systems); a check of it against "
+          "solve_state() and move_to().")
+      .def("recursive_refusal", &Simulation::recursive_refusal,
+           "Why the system takes the general path rather than the recursive one ('' if it is a rigid tree).")
       .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))
       .def(
           "run",

@@ -253,9 +253,9 @@ bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd&
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   check_time(t);
-  if (tree_ && tree_state(t, Y, tree_qdd_)) {
+  // The recursive path: q̈ only; the coordinates follow where a general evaluation needs them.
+  if (tree_ && tree_->solve(Y.data(), Y.data() + nd, dY.data() + dY.size() - nd)) {
     dY.head(nd) = Y.tail(nd);
-    dY.tail(nd) = tree_qdd_;
     return;
   }
   struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side
@@ -279,7 +279,7 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
 bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
                                  Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
   require_dof_sizes("recursive_state", q, qd);
-  if (!tree_) tree_ = PlanarTree::detect(*sys_, *data_);
+  if (!tree_) tree_ = RecursiveTree::detect(*sys_, *data_);
   if (!tree_) return false;
   Eigen::VectorXd x1 = data_->x, xd1 = Eigen::VectorXd::Zero(sys_->nx), xdd1 = xd1, qdd1(sys_->n_dof());
   if (!tree_->solve(q.data(), qd.data(), x1, xd1, xdd1, qdd1.data())) return false;
@@ -288,6 +288,11 @@ bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd
   xd = xd1;
   xdd = xdd1;
   return true;
+}
+
+std::string Simulation::recursive_refusal() const {
+  std::string why;
+  return RecursiveTree::detect(*sys_, *data_, &why) ? std::string() : why;
 }
 
 Eigen::VectorXd Simulation::reduced_accelerations() {
@@ -478,7 +483,7 @@ void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) cons
 
 void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out) {
   assemble();
-  tree_ = plan.integrate && options.recursive ? PlanarTree::detect(*sys_, *data_) : nullptr;
+  tree_ = plan.integrate && options.recursive ? RecursiveTree::detect(*sys_, *data_) : nullptr;
   res.recursive = tree_ != nullptr;
   if (tree_) {
     base_.xd = base_.xdd = Eigen::VectorXd::Zero(sys_->nx);

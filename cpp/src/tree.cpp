@@ -7,30 +7,17 @@
 #include <string>
 
 #include "spacar/catalogue.hpp"
+#include "spacar/spatial_tree.hpp"
 #include "spacar/topology.hpp"
+#include "tree_common.hpp"
 
 namespace spacar {
 
 namespace {
 
-constexpr int kGround = -1;
-
-struct NodeInfo {
-  NodeKind kind = NodeKind::Any;
-  int coord = 0;       // first coordinate
-  bool fixed = true;   // every coordinate fixed
-  bool free = true;    // every coordinate calculable or dynamic (DYNX)
-};
-
-// Node numbers of an element's coordinates, in slot order.
-std::vector<int> element_nodes(const System& sys, const SystemElement& se) {
-  std::vector<int> nodes;
-  for (int g : se.coords) {
-    const int id = sys.coord_label[g][0];
-    if (nodes.empty() || nodes.back() != id) nodes.push_back(id);
-  }
-  return nodes;
-}
+using tree_detail::element_nodes;
+using tree_detail::kGround;
+using tree_detail::NodeInfo;
 
 // Rigid-motion row of a coordinate: its rate for the body twist (ω, vx, vy) at the pin, with
 // b the coordinate's point relative to the pin (world axes at the reference state).
@@ -70,17 +57,10 @@ class PlanarTree::Builder {
     for (size_t j = 0; j < sys_.x_dyn.size(); ++j) dof_of_coord_[sys_.x_dyn[j]] = static_cast<int>(j);
     for (int g = 0; g < sys_.nx; ++g) {
       const NodeKind kind = sys_.coord_node_kind[g];
-      const CoordClass c = sys_.coord_class[g];
       if (kind != NodeKind::XY && kind != NodeKind::Beta) return false;
-      if (c == CoordClass::Dynamic && kind != NodeKind::Beta) return false;  // DYNX only on rotations
-      auto [it, fresh] = nodes_.try_emplace(sys_.coord_label[g][0]);
-      if (fresh) {
-        it->second.kind = kind;
-        it->second.coord = g;
-      }
-      it->second.fixed = it->second.fixed && c == CoordClass::Fixed;
-      it->second.free = it->second.free && (c == CoordClass::Calculable || c == CoordClass::Dynamic);
+      if (sys_.coord_class[g] == CoordClass::Dynamic && kind != NodeKind::Beta) return false;  // DYNX only on rotations
     }
+    nodes_ = tree_detail::system_nodes(sys_);
     for (const auto& [id, n] : nodes_)
       if (!n.fixed && !n.free) return false;  // partly fixed: neither a pin nor a body node
     return true;
@@ -126,55 +106,25 @@ class PlanarTree::Builder {
     return true;
   }
 
-  // The bodies: moving rigid beams sharing a BETA node are one (rigid_bodies), numbered in the
-  // order of their first beam.
+  // The bodies: moving rigid beams sharing a BETA node are one.
   bool group_bodies() {
-    std::vector<std::vector<int>> links;
-    for (const auto& [i, ids] : beams_) {
-      links.emplace_back();
-      for (int id : ids)
-        if (nodes_[id].kind == NodeKind::Beta) links.back().push_back(id);
-    }
-    const std::vector<std::vector<int>> rigid = rigid_bodies({}, links);
-    for (size_t r = 0; r < rigid.size(); ++r)
-      for (int id : rigid[r]) rigid_body_of_[id] = static_cast<int>(r);
-    for (const auto& [i, ids] : beams_) {
-      int r = -1;
-      for (int id : ids)
-        if (nodes_[id].kind == NodeKind::Beta) r = rigid_body_of_.at(id);
-      auto [it, fresh] = body_of_rigid_.try_emplace(r, static_cast<int>(xy_.size()));
-      if (fresh) {
-        xy_.emplace_back();
-        beta_.emplace_back();
-        beams_of_.emplace_back();
-      }
-      const int b = it->second;
-      beams_of_[b].push_back(i);
-      for (int id : ids) (nodes_[id].kind == NodeKind::Beta ? beta_[b] : xy_[b]).insert(id);
-    }
-    placed_.assign(xy_.size(), -1);
-    pin_.assign(xy_.size(), -1);
-    // Every free node moves with a body.
-    std::set<int> moving;
-    for (size_t b = 0; b < xy_.size(); ++b) {
-      moving.insert(xy_[b].begin(), xy_[b].end());
-      moving.insert(beta_[b].begin(), beta_[b].end());
-    }
-    for (const auto& [id, n] : nodes_)
-      if (!n.fixed && !moving.count(id)) return false;
+    g_ = tree_detail::group_beams(beams_, nodes_, NodeKind::Beta);
+    if (g_.stray >= 0) return false;  // every free node moves with a body
+    placed_.assign(g_.points.size(), -1);
+    pin_.assign(g_.points.size(), -1);
     for (const auto& [id, n] : nodes_)
       if (n.kind == NodeKind::XY && n.fixed) owner_[id] = kGround;
     return true;
   }
 
-  int body_of_beta(int id) { return nodes_[id].fixed ? kGround : body_of_rigid_.at(rigid_body_of_.at(id)); }
+  int body_of_beta(int id) { return nodes_[id].fixed ? kGround : g_.body_of.at(id); }
   bool is_placed(int body) const { return body == kGround || placed_[body] >= 0; }
   Eigen::Vector2d xy(int id) const { return {x_[nodes_.at(id).coord], x_[nodes_.at(id).coord + 1]}; }
 
   // The DYNX rotation coordinate of a body, −1 if none (−2: more than one).
   int dynamic_rotation(int body) const {
     int found = -1;
-    for (int id : beta_[body])
+    for (int id : g_.orientations[body])
       if (sys_.coord_class[nodes_.at(id).coord] == CoordClass::Dynamic) found = found == -1 ? nodes_.at(id).coord : -2;
     return found;
   }
@@ -182,7 +132,7 @@ class PlanarTree::Builder {
   // The one XY node of the body on a placed body (or fixed): its pin, −1 if none, −2 if more.
   int pin_of(int body) const {
     int pin = -1;
-    for (int id : xy_[body])
+    for (int id : g_.points[body])
       if (owner_.count(id)) pin = pin == -1 ? id : -2;
     return pin;
   }
@@ -197,8 +147,8 @@ class PlanarTree::Builder {
       hinges_at[body_of_beta(hinges_[i].a)].push_back(static_cast<int>(i));
       hinges_at[body_of_beta(hinges_[i].b)].push_back(static_cast<int>(i));
     }
-    for (size_t b = 0; b < xy_.size(); ++b)
-      for (int id : xy_[b]) bodies_at[id].push_back(static_cast<int>(b));
+    for (size_t b = 0; b < g_.points.size(); ++b)
+      for (int id : g_.points[b]) bodies_at[id].push_back(static_cast<int>(b));
     std::vector<int> queue = {kGround};
     for (size_t k = 0; k < queue.size(); ++k) {
       const int parent = queue[k];
@@ -256,7 +206,7 @@ class PlanarTree::Builder {
     for (const auto& [id, owner] : owner_)
       if (body == kGround && owner == kGround) out.push_back(id);
     if (body != kGround)
-      for (int id : xy_[body])
+      for (int id : g_.points[body])
         if (id != pin_[body]) out.push_back(id);
     return out;
   }
@@ -273,13 +223,13 @@ class PlanarTree::Builder {
     const Eigen::Vector2d p0 = xy(pin);
     bd.parent = parent;
     bd.r = parent == kGround ? p0 : Eigen::Vector2d(p0 - pin0_[parent]);
-    for (int id : xy_[body])
+    for (int id : g_.points[body])
       if (id != pin) owner_[id] = index;
     Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
-    for (int i : beams_of_[body]) I += element_inertia(sys_.elements[i], p0);
-    for (int id : xy_[body])
+    for (int i : g_.beams[body]) I += element_inertia(sys_.elements[i], p0);
+    for (int id : g_.points[body])
       if (id != pin) follow(id, index, p0, I);
-    for (int id : beta_[body]) follow(id, index, p0, I);
+    for (int id : g_.orientations[body]) follow(id, index, p0, I);
     // The projection is a rigid body's inertia only if the mass model moves rigidly with the
     // nodes (equal masses in x and y, no coupling between them).
     const double scale = I.cwiseAbs().maxCoeff();
@@ -299,15 +249,8 @@ class PlanarTree::Builder {
   }
 
   // The element's mass matrix on the rigid motions about the pin p0: Tᵀ M T.
-  Eigen::Matrix3d element_inertia(const SystemElement& se, const Eigen::Vector2d& p0) {
-    if (!se.has_mass) return Eigen::Matrix3d::Zero();
-    const int n = static_cast<int>(se.coords.size());
-    Eigen::VectorXd xl(n), vl = Eigen::VectorXd::Zero(n), h(n);
-    Eigen::MatrixXd M(n, n), T(n, 3);
-    for (int a = 0; a < n; ++a) xl[a] = x_[se.coords[a]];
-    se.kernel->mass(xl.data(), vl.data(), M.data(), h.data());
-    for (int a = 0; a < n; ++a) T.row(a) = rigid_row_of(se.coords[a], p0);
-    return T.transpose() * M * T;
+  Eigen::Matrix3d element_inertia(const SystemElement& se, const Eigen::Vector2d& p0) const {
+    return tree_detail::element_inertia<3>(se, x_, [&](int g) { return rigid_row_of(g, p0); });
   }
 
   // A node moving with body `index`: its point mass into I, its loads, its coordinates.
@@ -350,15 +293,19 @@ class PlanarTree::Builder {
   std::map<int, int> dof_of_coord_;    // DYNX coordinate → its position in q
   std::vector<std::pair<int, std::vector<int>>> beams_;  // moving rigid beams: element, nodes
   std::vector<Hinge> hinges_;
-  std::map<int, int> rigid_body_of_;   // BETA node of a moving beam → its rigid_bodies() index
-  std::map<int, int> body_of_rigid_;    // rigid_bodies() index → body
-  std::vector<std::set<int>> xy_, beta_;  // nodes of each body
-  std::vector<std::vector<int>> beams_of_;
+  tree_detail::BeamBodies g_;          // the bodies' nodes and beams
   std::vector<int> placed_;            // body → index in bodies_, −1: not yet
   std::vector<int> pin_;               // body → its pin node, −1: not placed
   std::map<int, int> owner_;           // XY node → body (index in bodies_) it moves with, kGround
   std::vector<Eigen::Vector2d> pin0_;  // reference pin of each placed body
 };
+
+std::unique_ptr<RecursiveTree> RecursiveTree::detect(const System& sys, const Data& data, std::string* why) {
+  if (sys.dim == 3) return SpatialTree::detect(sys, data, why);
+  std::unique_ptr<RecursiveTree> tree = PlanarTree::detect(sys, data);
+  if (!tree && why) *why = "not a planar open tree of rigid bodies (tree.hpp)";
+  return tree;
+}
 
 std::unique_ptr<PlanarTree> PlanarTree::detect(const System& sys, const Data& data) {
   auto tree = std::unique_ptr<PlanarTree>(new PlanarTree());
@@ -384,13 +331,18 @@ PlanarTree::Mat3 PlanarTree::inertia_to_parent(const Body& bd, const Mat3& I) {
   return X.transpose() * I * X;
 }
 
-bool PlanarTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
-                       Eigen::VectorXd& xdd, double* qdd) {
+bool RecursiveTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,
+                          Eigen::VectorXd& xdd, double* qdd) {
+  if (!solve(q, qd, qdd)) return false;
+  move_coordinates(x, xd, xdd);
+  return true;
+}
+
+bool RecursiveTree::solve(const double* q, const double* qd, double* qdd) {
   outward(q, qd);
   applied_loads();
   if (!articulate()) return false;
   accelerations(qdd);
-  move_coordinates(x, xd, xdd);
   return true;
 }
 
@@ -510,5 +462,73 @@ void PlanarTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen
     xdd[f.coord + 1] = bd.sw * ax + bd.cw * ay + gy;
   }
 }
+
+namespace tree_detail {
+
+std::map<int, NodeInfo> system_nodes(const System& sys) {
+  std::map<int, NodeInfo> nodes;
+  for (int g = 0; g < sys.nx; ++g) {
+    const CoordClass c = sys.coord_class[g];
+    auto [it, fresh] = nodes.try_emplace(sys.coord_label[g][0]);
+    if (fresh) {
+      it->second.kind = sys.coord_node_kind[g];
+      it->second.coord = g;
+    }
+    it->second.fixed = it->second.fixed && c == CoordClass::Fixed;
+    it->second.free = it->second.free && (c == CoordClass::Calculable || c == CoordClass::Dynamic);
+  }
+  return nodes;
+}
+
+BeamBodies group_beams(const std::vector<std::pair<int, std::vector<int>>>& beams,
+                       const std::map<int, NodeInfo>& nodes, NodeKind orientation) {
+  std::vector<std::vector<int>> links;
+  for (const auto& [i, ids] : beams) {
+    links.emplace_back();
+    for (int id : ids)
+      if (nodes.at(id).kind == orientation) links.back().push_back(id);
+  }
+  const std::vector<std::vector<int>> rigid = rigid_bodies({}, links);
+  std::map<int, int> rigid_of;      // orientation node → rigid_bodies() index
+  for (size_t r = 0; r < rigid.size(); ++r)
+    for (int id : rigid[r]) rigid_of[id] = static_cast<int>(r);
+  BeamBodies out;
+  std::map<int, int> body_of_rigid;  // rigid_bodies() index → body
+  for (size_t k = 0; k < beams.size(); ++k) {
+    const auto& [i, ids] = beams[k];
+    auto [it, fresh] = body_of_rigid.try_emplace(rigid_of.at(links[k].front()), static_cast<int>(out.points.size()));
+    if (fresh) {
+      out.points.emplace_back();
+      out.orientations.emplace_back();
+      out.beams.emplace_back();
+    }
+    const int b = it->second;
+    out.beams[b].push_back(i);
+    for (int id : ids) (nodes.at(id).kind == orientation ? out.orientations[b] : out.points[b]).insert(id);
+  }
+  std::set<int> moving;
+  for (size_t b = 0; b < out.points.size(); ++b) {
+    moving.insert(out.points[b].begin(), out.points[b].end());
+    moving.insert(out.orientations[b].begin(), out.orientations[b].end());
+    for (int id : out.orientations[b]) out.body_of[id] = static_cast<int>(b);
+  }
+  for (const auto& [id, n] : nodes)
+    if (!n.fixed && !moving.count(id)) {
+      out.stray = id;
+      break;
+    }
+  return out;
+}
+
+std::vector<int> element_nodes(const System& sys, const SystemElement& se) {
+  std::vector<int> nodes;
+  for (int g : se.coords) {
+    const int id = sys.coord_label[g][0];
+    if (nodes.empty() || nodes.back() != id) nodes.push_back(id);
+  }
+  return nodes;
+}
+
+}  // namespace tree_detail
 
 }  // namespace spacar

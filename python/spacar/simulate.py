@@ -65,9 +65,10 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
     :class:`spacar.TimeLimitError`.
 
-    ``recursive``: planar open trees of rigid bodies (rigid PLBEAMs joined by PLHINGEs whose
-    rotations are the degrees of freedom) integrate with the articulated-body algorithm in the
-    hinge angles instead of the constraint formulation (the same equations, several times
+    ``recursive``: planar and spatial open trees of rigid bodies (rigid PLBEAMs joined by
+    PLHINGEs, or rigid BEAMs joined by HINGEs, whose rotations are the degrees of freedom)
+    integrate with the articulated-body algorithm in the hinge angles instead of the constraint
+    formulation (the same equations, several times
     cheaper per right-hand side; the output times are solved by the general path). ``False``
     always takes the general path. ``res.stats["recursive"]`` says which path ran.
 

@@ -34,8 +34,8 @@ struct RunOptions {
   double time_limit = 0.0;
   // Integration steps (accepted and rejected) over the whole block.
   long max_steps = Integrator::kMaxSteps;
-  // Planar trees of rigid bodies take the recursive (articulated-body) right-hand side
-  // (tree.hpp); false: always the general constraint formulation.
+  // Planar and spatial trees of rigid bodies take the recursive (articulated-body) right-hand
+  // side (tree.hpp, spatial_tree.hpp); false: always the general constraint formulation.
   bool recursive = true;
 };
 
@@ -121,11 +121,14 @@ class Simulation {
   // Its Jacobian ∂(q̇, ẏ, q̈)/∂(q, y, q̇) at (t, Y) from the linearized equations (simulate_jacobian.cpp).
   void jacobian(double t, const Eigen::VectorXd& Y, Eigen::MatrixXd& J);
   // The state at (q, q̇) by the recursive path: q̈ and the coordinates' positions, velocities and
-  // accelerations; false (nothing written) if the system is not a planar tree of rigid bodies or
-  // a body moves no mass. The tree is taken at the solved state of the first call (after
-  // assemble(): the assembled state) and kept until the next run.
+  // accelerations; false (nothing written) if the system is not a planar or spatial tree of
+  // rigid bodies or a body moves no mass. The tree is taken at the solved state of the first
+  // call (after assemble(): the assembled state) and kept until the next run.
   bool recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
                        Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd);
+  // Why the system is not a tree for the recursive path, at the current (solved) state; empty
+  // if it is one.
+  std::string recursive_refusal() const;
   // q̈ of the reduced equations (3.1) with transfer functions at the last evaluated state, the
   // state left as it was: an independent check of the integration path's sparse solve.
   Eigen::VectorXd reduced_accelerations();
@@ -212,8 +215,8 @@ class Simulation {
   Eigen::VectorXd predicted_;    // change of the positions predicted by the transfer function
   bool have_transfer_ = false;
   std::unique_ptr<Linearizer> linearizer_;
-  // The recursive right-hand side of planar rigid trees, set for a run (RunOptions::recursive).
-  std::unique_ptr<PlanarTree> tree_;
+  // The recursive right-hand side of planar and spatial rigid trees, set for a run (RunOptions::recursive).
+  std::unique_ptr<RecursiveTree> tree_;
   Eigen::VectorXd tree_qdd_;
   // The tree's state at (t, Y) into base_ (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.

@@ -14,6 +14,7 @@
 
 #include <Eigen/Dense>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "spacar/data.hpp"
@@ -21,11 +22,14 @@
 
 namespace spacar {
 
-class PlanarTree {
+// The recursive right-hand side of an open tree of rigid bodies: planar (PlanarTree) or spatial
+// (SpatialTree, spatial_tree.hpp).
+class RecursiveTree {
  public:
-  // The tree of the system if it is one, else nullptr. The body geometry and inertia are taken
-  // at the positions in data, which must satisfy the constraints (a solved state).
-  static std::unique_ptr<PlanarTree> detect(const System& sys, const Data& data);
+  virtual ~RecursiveTree() = default;
+  // The planar or spatial tree of the system if it is one, else nullptr and (if why is given)
+  // the reason. Taken at the positions in data, which must satisfy the constraints.
+  static std::unique_ptr<RecursiveTree> detect(const System& sys, const Data& data, std::string* why = nullptr);
 
   // At (q, q̇) (no inputs, no integrated deformations): the positions, velocities and
   // accelerations of every coordinate into x, xd, xdd (length nx; fixed coordinates are left as
@@ -33,6 +37,28 @@ class PlanarTree {
   // positive (a body that moves no mass): the general path names the DOFs.
   bool solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd,
              double* qdd);
+  // The DOF accelerations only (nothing written if false).
+  bool solve(const double* q, const double* qd, double* qdd);
+
+ protected:
+  // The phases of solve(), the articulated-body algorithm in the tree's algebra. Outwards: body
+  // rotations, positions, velocities, bias accelerations and forces, joint torques;
+  virtual void outward(const double* q, const double* qd) = 0;
+  // the applied loads on the bodies;
+  virtual void applied_loads() = 0;
+  // inwards: articulated inertias and bias forces, false if a joint's inertia is not positive;
+  virtual bool articulate() = 0;
+  // outwards: joint and body accelerations, q̈;
+  virtual void accelerations(double* qdd) = 0;
+  // the coordinates moving with the bodies.
+  virtual void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const = 0;
+};
+
+class PlanarTree : public RecursiveTree {
+ public:
+  // The tree of the system if it is one, else nullptr. The body geometry and inertia are taken
+  // at the positions in data, which must satisfy the constraints (a solved state).
+  static std::unique_ptr<PlanarTree> detect(const System& sys, const Data& data);
 
   int n_bodies() const { return static_cast<int>(bodies_.size()); }
 
@@ -84,12 +110,11 @@ class PlanarTree {
   };
   class Builder;
 
-  // The phases of solve().
-  void outward(const double* q, const double* qd);
-  void applied_loads();
-  bool articulate();
-  void accelerations(double* qdd);
-  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const;
+  void outward(const double* q, const double* qd) override;
+  void applied_loads() override;
+  bool articulate() override;
+  void accelerations(double* qdd) override;
+  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
 
   // Transform of motion vectors from the parent's coordinates to the body's.
   static Vec3 to_child(const Body& bd, const Vec3& m);
