@@ -540,6 +540,7 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
   if (method == Method::RADAU5) {
     Radau5 integ(static_cast<int>(Y.size()));
     integ.set_jacobian([this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) { jacobian(tt, y, J); });
+    integ.set_second_order(sys_->n_dof());  // Y = (q, y, q̇): q̇ = dq/dt (jacobian's first rows)
     // The Jacobian (a linearization) costs several right-hand sides per DOF: keep it longer.
     integ.set_jacobian_reuse(0.1);
     // Back to DOP853 when its stability bound (|hλ| ≤ 6.1) would allow kExplicitGain times
