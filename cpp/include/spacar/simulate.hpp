@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "spacar/chain.hpp"
 #include "spacar/data.hpp"
 #include "spacar/integrator.hpp"
 #include "spacar/linearize.hpp"
@@ -214,6 +215,9 @@ class Simulation {
   std::unique_ptr<Linearizer> linearizer_;
   // The recursive right-hand side of planar rigid trees, set for a run (RunOptions::recursive).
   std::unique_ptr<PlanarTree> tree_;
+  // The explicit positions of open chains in the right-hand sides (chain.hpp), set for a run
+  // (RunOptions::recursive) when the system is one and no tree_.
+  std::unique_ptr<ExplicitChain> chain_;
   Eigen::VectorXd tree_qdd_;
   // The tree's state at (t, Y) into base_ (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.
