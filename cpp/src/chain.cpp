@@ -111,15 +111,17 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
       b.coords = U;
       for (size_t s = 0; s < group.size(); ++s) {
         const SystemElement& se = sys.elements[group[s]];
-        std::vector<int> col(se.coords.size(), -1);
-        for (size_t l = 0; l < se.coords.size(); ++l) {
-          const auto at = std::find(U.begin(), U.end(), se.coords[l]);
-          if (at != U.end()) col[l] = static_cast<int>(at - U.begin());
-        }
-        b.column.push_back(col);
         for (int a = 0; a < se.nd; ++a) {
           const int k = se.def_offset + a;
-          if (sys.row_P[k] >= 0) b.rows.push_back({static_cast<int>(s), a, k, sys.row_P[k]});
+          if (sys.row_P[k] < 0) continue;
+          const int j = static_cast<int>(b.rows.size());
+          b.rows.push_back({k, sys.row_P[k]});
+          for (size_t l = 0; l < se.coords.size(); ++l) {
+            const auto at = std::find(U.begin(), U.end(), se.coords[l]);
+            const Block::Term term{j, static_cast<int>(s), a, static_cast<int>(l),
+                                   at != U.end() ? static_cast<int>(at - U.begin()) : se.coords[l]};
+            (at != U.end() ? b.unknown_terms : b.known_terms).push_back(term);
+          }
         }
       }
       const int n = static_cast<int>(U.size());
@@ -143,13 +145,13 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
 
 void ExplicitChain::assemble(const Data& data, Block& b) const {
   b.A.setZero();
-  for (size_t j = 0; j < b.rows.size(); ++j) {
-    const Row& row = b.rows[j];
-    const Eigen::MatrixXd& B = data.work[b.elements[row.slot]].B;
-    const std::vector<int>& col = b.column[row.slot];
-    for (size_t l = 0; l < col.size(); ++l)
-      if (col[l] >= 0) b.A(static_cast<int>(j), col[l]) += B(row.local, static_cast<int>(l));
-  }
+  for (const Block::Term& t : b.unknown_terms)
+    b.A(t.j, t.target) += data.work[b.elements[t.slot]].B(t.local, t.coord);
+}
+
+void ExplicitChain::add_known(const Data& data, Block& b, const Eigen::VectorXd& v, double sign) const {
+  for (const Block::Term& t : b.known_terms)
+    b.r[t.j] += sign * data.work[b.elements[t.slot]].B(t.local, t.coord) * v[t.target];
 }
 
 void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter, double tol) {
@@ -164,15 +166,8 @@ void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter,
     for (int i : b.elements) evaluate_element(sys, data, i);
   step_.setZero(sys.nx);
   for (Block& b : blocks_) {
-    for (size_t j = 0; j < b.rows.size(); ++j) {
-      const Row& row = b.rows[j];
-      const SystemElement& se = sys.elements[b.elements[row.slot]];
-      const Eigen::MatrixXd& B = data.work[b.elements[row.slot]].B;
-      double v = data.e[row.def] - data.target[row.row];
-      for (size_t l = 0; l < se.coords.size(); ++l)
-        if (b.column[row.slot][l] < 0) v += B(row.local, static_cast<int>(l)) * step_[se.coords[l]];
-      b.r[static_cast<int>(j)] = v;
-    }
+    for (size_t j = 0; j < b.rows.size(); ++j) b.r[static_cast<int>(j)] = data.e[b.rows[j].def] - data.target[b.rows[j].row];
+    add_known(data, b, step_, 1.0);
     assemble(data, b);
     if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "position");
     for (size_t j = 0; j < b.coords.size(); ++j) step_[b.coords[j]] = -b.dx[static_cast<int>(j)];
@@ -223,15 +218,10 @@ void ExplicitChain::solve_velocities(const System& sys, Data& data) {
   for (Block& b : blocks_) {
     // B_u ẋ_u = ė − B_k ẋ_k over the block's rows, ė the q̂ rate of the row (0 if fixed).
     for (size_t j = 0; j < b.rows.size(); ++j) {
-      const Row& row = b.rows[j];
-      const int col = sys.qhat_col_e[row.def];
-      double v = col >= 0 ? data.qhat_d[col] : 0.0;
-      const SystemElement& se = sys.elements[b.elements[row.slot]];
-      const Eigen::MatrixXd& B = data.work[b.elements[row.slot]].B;
-      for (size_t l = 0; l < se.coords.size(); ++l)
-        if (b.column[row.slot][l] < 0) v -= B(row.local, static_cast<int>(l)) * data.xd[se.coords[l]];
-      b.r[static_cast<int>(j)] = v;
+      const int col = sys.qhat_col_e[b.rows[j].def];
+      b.r[static_cast<int>(j)] = col >= 0 ? data.qhat_d[col] : 0.0;
     }
+    add_known(data, b, data.xd, -1.0);
     assemble(data, b);
     if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "velocity");
     for (size_t j = 0; j < b.coords.size(); ++j) data.xd[b.coords[j]] = b.dx[static_cast<int>(j)];

@@ -149,8 +149,8 @@ void Radau5::set_second_order(int m) {
   G2_.setZero(r, m);
   rr_.setZero(r);
   cr_.setZero(r);
-  lu_real_ = Eigen::PartialPivLU<Eigen::MatrixXd>(r);
-  lu_complex_ = Eigen::PartialPivLU<Eigen::MatrixXcd>(r);
+  piv_real_.assign(r, 0);
+  piv_complex_.assign(r, 0);
 }
 
 void Radau5::set_jacobian_reuse(double theta) {
@@ -210,6 +210,46 @@ void reduced_matrix(const Eigen::MatrixXd& J, int m, Scalar sigma, Matrix& E, Ma
   E.rightCols(r - m) = -J.block(m, m, r, r - m).template cast<Scalar>();
   E.topRightCorner(r - m, r - m).diagonal().array() += sigma;
 }
+
+
+// LU factorization with partial pivoting in place (A = P L U, piv the row interchanges), and the
+// solve with it. The Newton matrices are small (the DOFs of a structure, tens): a plain
+// column-oriented elimination costs less than a general blocked LU's dispatch, and the pivot
+// search on |re| + |im| (LAPACK's CABS1) avoids a hypot per complex entry.
+double magnitude(double v) { return std::abs(v); }
+double magnitude(const std::complex<double>& v) { return std::abs(v.real()) + std::abs(v.imag()); }
+
+template <class Matrix>
+void lu_factor(Matrix& A, std::vector<int>& piv) {
+  const int n = static_cast<int>(A.rows());
+  for (int k = 0; k < n; ++k) {
+    int p = k;
+    for (int i = k + 1; i < n; ++i)
+      if (magnitude(A(i, k)) > magnitude(A(p, k))) p = i;
+    piv[k] = p;
+    if (p != k) A.row(p).swap(A.row(k));
+    const auto inv = 1.0 / A(k, k);  // a zero pivot gives non-finite solutions, checked there
+    for (int i = k + 1; i < n; ++i) A(i, k) *= inv;
+    for (int j = k + 1; j < n; ++j) {
+      const auto a = A(k, j);
+      for (int i = k + 1; i < n; ++i) A(i, j) -= A(i, k) * a;
+    }
+  }
+}
+
+template <class Matrix, class Vector>
+void lu_solve(const Matrix& LU, const std::vector<int>& piv, Vector& x) {
+  const int n = static_cast<int>(LU.rows());
+  for (int k = 0; k < n; ++k)
+    if (piv[k] != k) std::swap(x[k], x[piv[k]]);
+  for (int k = 0; k < n; ++k)
+    for (int i = k + 1; i < n; ++i) x[i] -= LU(i, k) * x[k];
+  for (int k = n - 1; k >= 0; --k) {
+    x[k] /= LU(k, k);
+    for (int i = 0; i < k; ++i) x[i] -= LU(i, k) * x[k];
+  }
+}
+
 }  // namespace
 
 void Radau5::factorize(double h) {
@@ -217,9 +257,9 @@ void Radau5::factorize(double h) {
   sigma1_ = tb.L(0, 0) / h;
   sigma2_ = std::complex<double>(tb.L(1, 1), tb.L(2, 1)) / h;
   reduced_matrix(J_, m_, sigma1_, E1_, G1_);
-  lu_real_.compute(E1_);
+  lu_factor(E1_, piv_real_);
   reduced_matrix(J_, m_, sigma2_, E2_, G2_);
-  lu_complex_.compute(E2_);
+  lu_factor(E2_, piv_complex_);
   ++stats_.ndec;
 }
 
@@ -227,7 +267,7 @@ void Radau5::solve_real(const Eigen::VectorXd& r, Eigen::VectorXd& x) {
   const int m = m_, k = n_ - m_;
   rr_ = r.tail(k);
   rr_.noalias() += G1_ * r.head(m);
-  rr_ = lu_real_.solve(rr_);
+  lu_solve(E1_, piv_real_, rr_);
   x.head(k) = rr_;
   x.tail(m) = sigma1_ * rr_.head(m) - r.head(m);
 }
@@ -236,7 +276,7 @@ void Radau5::solve_complex(Eigen::VectorXcd& r) {
   const int m = m_, k = n_ - m_;
   cr_ = r.tail(k);
   cr_.noalias() += G2_ * r.head(m);
-  cr_ = lu_complex_.solve(cr_);
+  lu_solve(E2_, piv_complex_, cr_);
   r.tail(m) = sigma2_ * cr_.head(m) - r.head(m);
   r.head(k) = cr_;
 }

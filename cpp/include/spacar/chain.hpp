@@ -44,8 +44,6 @@ class ExplicitChain {
 
  private:
   struct Row {
-    int slot;     // the element's place in Block::elements
-    int local;    // deformation within the element
     int def;      // global deformation index
     int row;      // row of the position block (sys.row_P)
   };
@@ -54,11 +52,19 @@ class ExplicitChain {
     std::vector<int> elements;            // evaluated at every iteration
     std::vector<int> coords;              // global indices of the unknowns
     std::vector<Row> rows;
-    std::vector<std::vector<int>> column;  // per element of the block: local coordinate → unknown, −1 if known
+    // The entries of B that the block uses, listed once: row j of the block, the element's slot,
+    // its local deformation and coordinate, and the unknown (in A) or the global coordinate
+    // (known: a term of the right-hand side).
+    struct Term {
+      int j, slot, local, coord, target;
+    };
+    std::vector<Term> unknown_terms, known_terms;
     Eigen::MatrixXd A;                    // ∂(rows)/∂(unknowns)
     Eigen::VectorXd r, dx;
   };
   void assemble(const Data& data, Block& b) const;
+  // Σ over the known coordinates of B(row, l) v[coord], per row of the block, added to b.r.
+  void add_known(const Data& data, Block& b, const Eigen::VectorXd& v, double sign) const;
   static KinematicsError singular(const System& sys, const Data& data, const Block& b, const char* what);
 
   std::vector<Block> blocks_;

@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <complex>
 #include <functional>
 #include <string>
@@ -121,7 +122,8 @@ class Radau5 {
   double h_old_ = 0.0, t_new_ = 0.0;
 
   // Work space, allocated once.
-  // E1_, E2_: the reduced Newton matrices (size n − m); G1_, G2_: the columns of the rates in
+  // E1_, E2_: the reduced Newton matrices (size n − m), overwritten by their LU factors;
+  // G1_, G2_: the columns of the rates in
   // the remaining rows, σ S − J[m:n, n−m:n], which carry the eliminated rows into them.
   Eigen::MatrixXd J_, E1_, G1_;
   Eigen::MatrixXcd E2_, G2_;
@@ -129,8 +131,7 @@ class Radau5 {
   std::complex<double> sigma2_;
   Eigen::VectorXd rr_;
   Eigen::VectorXcd cr_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_real_;
-  Eigen::PartialPivLU<Eigen::MatrixXcd> lu_complex_;
+  std::vector<int> piv_real_, piv_complex_;  // row interchanges of the LU factors in E1_, E2_
   Eigen::VectorXd f0_, scale_, y_stage_, y_new_, y_out_, err_v_, dz_, tmp_;
   Eigen::VectorXcd ctmp_;
   Eigen::VectorXd z_[3], w_[3], fz_[3], poly_[3];
