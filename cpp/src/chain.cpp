@@ -177,7 +177,8 @@ void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter,
   int most = 0;
   for (Block& b : blocks_) {
     // Newton on the block's coordinates until the residual is below tol, then one polish
-    // iteration, as solve_positions() on all of them.
+    // iteration, as solve_positions() on all of them; none if the residual is already a
+    // thousandth of tol (the general path's criterion when it reuses a factorization).
     bool converged = false;
     for (int it = 0;; ++it) {
       for (int i : b.elements) evaluate_element(sys, data, i);
@@ -187,7 +188,7 @@ void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter,
         rmax = std::max(rmax, std::abs(b.r[static_cast<int>(j)]));
       }
       const bool finite = b.r.allFinite();
-      if (finite && converged) break;  // polished
+      if (finite && (converged || rmax <= 1e-3 * tol)) break;  // polished
       converged = finite && rmax <= tol;
       if (!finite || (it >= max_iter && !converged)) {
         std::ostringstream os;
