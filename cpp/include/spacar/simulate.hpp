@@ -36,7 +36,8 @@ struct RunOptions {
   // Integration steps (accepted and rejected) over the whole block.
   long max_steps = Integrator::kMaxSteps;
   // Planar trees of rigid bodies take the recursive (articulated-body) right-hand side
-  // (tree.hpp); false: always the general constraint formulation.
+  // (tree.hpp), other open chains the explicit positions (chain.hpp); false: always the general
+  // constraint formulation.
   bool recursive = true;
 };
 
