@@ -22,18 +22,20 @@ from support.simulation import assembled
 START, END, HINGE = models.START, models.END, models.HINGE
 
 
-def flexible_chain(n, seed, eps=1e-9):
+def flexible_chain(n, seed, eps=1e-9, drive=None):
     """n flexible PLBEAMs in random directions from the fixed node 1, clamped at the ground BETA
     node END (itself at a random angle); each joint at random a DOF hinge with a spring or a
     rigid connection (the beams share the BETA node); bending DYNE, on some beams also the
-    elongation; masses, a tip load and gravity with an x component."""
+    elongation; masses, a tip load and gravity with an x component. ``drive``: "INPUTX" turns
+    the ground node END with a prescribed motion, "INPUTE" makes the first joint a hinge whose
+    angle is prescribed."""
     rng = np.random.default_rng(seed)
     m = spacar.Model()
     p = np.zeros(2)
     m.x(1, *p)
     m.beta(END, rng.uniform(-1.0, 1.0))
     for i in range(1, n + 1):
-        hinged = i > 1 and rng.random() < 0.5
+        hinged = (i > 1 and rng.random() < 0.5) or (i == 1 and drive == "INPUTE")
         start = START + i if hinged else END + i - 1
         m.plbeam(i, i, start, i + 1, END + i)
         a = rng.uniform(-math.pi, math.pi)
@@ -46,11 +48,21 @@ def flexible_chain(n, seed, eps=1e-9):
         m.emass(i, rng.uniform(0.5, 1.5))
         if hinged:
             m.plhinge(HINGE + i, END + i - 1, START + i)
-            m.dyne(HINGE + i, 1)
-            m.estiff(HINGE + i, rng.uniform(0.5, 2.0))
+            if i == 1:
+                m.inpute(HINGE + 1, 1)
+                m.ed(HINGE + 1, 1, 2.0)
+                m.edd(HINGE + 1, 1, -3.0)
+            else:
+                m.dyne(HINGE + i, 1)
+                m.estiff(HINGE + i, rng.uniform(0.5, 2.0))
             m.mass(START + i, 0.01)
     m.fix(1)
-    m.fix(END)
+    if drive == "INPUTX":
+        m.inputx(END, 1)
+        m.xd(END, 1, 1.5)
+        m.xdd(END, 1, 2.0)
+    else:
+        m.fix(END)
     m.mass(n + 1, 0.2)
     m.force(n + 1, 0.3, -0.5)
     m.gravity(1.0, -9.81)
@@ -73,6 +85,8 @@ def flexible_spatial_chain(n=3, seed=2):
 CHAINS = {f"planar {n} seed {seed}": (lambda n=n, seed=seed: flexible_chain(n, seed))
           for n, seed in ((1, 0), (3, 1), (6, 2), (8, 3), (12, 4))}
 CHAINS["cantilever"] = lambda: models.cantilever(8, ei=175.0, rho_a=0.785)
+CHAINS["driven ground (INPUTX)"] = lambda: flexible_chain(4, 6, drive="INPUTX")
+CHAINS["driven hinge (INPUTE)"] = lambda: flexible_chain(4, 7, drive="INPUTE")
 CHAINS["spatial"] = flexible_spatial_chain
 
 
@@ -91,14 +105,15 @@ def test_chain_state_equals_the_general_path(name):
     sim = assembled(CHAINS[name]())
     q0 = np.array(sim.system.q0)
     rng = np.random.default_rng(5)
-    for _ in range(4):
+    for k in range(4):
+        t = 0.05 * k  # the inputs move with time
         q = q0 + rng.uniform(-0.1, 0.1, q0.size)
         qd = rng.uniform(-2.0, 2.0, q0.size)
-        sim.move_to(0.0, q, qd)
+        sim.move_to(t, q, qd)
         expected = {k: np.array(getattr(sim.data, k)) for k in ("x", "xd", "xdd", "qdd", "e", "ed")}
         near = q - rng.uniform(-0.02, 0.02, q0.size)
-        sim.move_to(0.0, near, qd)
-        got = _testing.chain_state(sim, 0.0, q, qd)
+        sim.move_to(t, near, qd)
+        got = _testing.chain_state(sim, t, q, qd)
         assert got is not None and got["blocks"] >= 1
         assert got["newton_iterations"] >= 1  # it did iterate from the state nearby
         for key in expected:
@@ -106,8 +121,11 @@ def test_chain_state_equals_the_general_path(name):
                                        atol=1e-11 * max(1.0, np.abs(expected[key]).max()), err_msg=key)
 
 
-@pytest.mark.parametrize("method", ["radau5", "dop853"])
-@pytest.mark.parametrize("name", ["planar 6 seed 2", "spatial"])
+# (DOP853 on the INPUTE-driven chain stops with a step size underflow at t = 0 on both paths, as
+# before the explicit chain existed: a matter of DOP853 and the input, not of this path.)
+@pytest.mark.parametrize("name, method", [("planar 6 seed 2", "radau5"), ("planar 6 seed 2", "dop853"),
+                                          ("spatial", "radau5"), ("spatial", "dop853"),
+                                          ("driven hinge (INPUTE)", "radau5"), ("driven ground (INPUTX)", "dop853")])
 def test_runs_with_and_without_the_chain_agree(name, method):
     """The same motion within the tolerances (EPS 1e-9): the right-hand sides agree to round-off,
     but a trial step too large for the kinematics may fail on one path and not on the other, so
