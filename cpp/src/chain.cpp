@@ -78,9 +78,16 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
   for (int g : sys.x_calc) known[g] = 0;
   auto chain = std::unique_ptr<ExplicitChain>(new ExplicitChain());
   std::vector<int> pending;
+  std::vector<char> is_pending(sys.elements.size(), 0);
+  std::vector<std::vector<int>> touching(sys.nx);  // the pending elements on each coordinate
   for (int i = 0; i < static_cast<int>(sys.elements.size()); ++i) {
-    if (position_rows(sys, i) > 0) pending.push_back(i);
-    else chain->rest_.push_back(i);
+    if (position_rows(sys, i) == 0) {
+      chain->rest_.push_back(i);
+      continue;
+    }
+    pending.push_back(i);
+    is_pending[i] = 1;
+    for (int g : sys.elements[i].coords) touching[g].push_back(i);
   }
   // Greedy: an element whose rows, with those of the pending elements whose unknowns lie within
   // its own (the L2MIN1 of a rotation it reaches), are as many as its unknowns determines them.
@@ -94,17 +101,18 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
       if (U.empty()) return nullptr;  // rows on known coordinates only: a loop closes here
       std::vector<int> group{i};
       int rows = position_rows(sys, i);
-      for (int j : pending) {
-        if (j == i) continue;
-        const std::vector<int> Uj = unknown_coords(sys, known, j);
-        const bool inside = !Uj.empty() && std::all_of(Uj.begin(), Uj.end(), [&](int g) {
-          return std::find(U.begin(), U.end(), g) != U.end();
-        });
-        if (inside) {
-          group.push_back(j);
-          rows += position_rows(sys, j);
+      for (int g : U)
+        for (int j : touching[g]) {
+          if (j == i || !is_pending[j] || std::find(group.begin(), group.end(), j) != group.end()) continue;
+          const std::vector<int> Uj = unknown_coords(sys, known, j);
+          const bool inside = !Uj.empty() && std::all_of(Uj.begin(), Uj.end(), [&](int c) {
+            return std::find(U.begin(), U.end(), c) != U.end();
+          });
+          if (inside) {
+            group.push_back(j);
+            rows += position_rows(sys, j);
+          }
         }
-      }
       if (rows != static_cast<int>(U.size())) continue;
       Block b;
       b.elements = group;
@@ -130,6 +138,7 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
       b.dx.setZero(n);
       chain->blocks_.push_back(std::move(b));
       for (int g : U) known[g] = 1;
+      for (int j : group) is_pending[j] = 0;
       pending.erase(std::remove_if(pending.begin(), pending.end(),
                                    [&](int j) { return std::find(group.begin(), group.end(), j) != group.end(); }),
                     pending.end());
