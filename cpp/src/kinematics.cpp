@@ -35,9 +35,6 @@ void set_dofs(const System& sys, Data& data, const double* q, const double* qd) 
   for (size_t j = 0; j < sys.x_dyn.size(); ++j) data.x[sys.x_dyn[j]] = q[j];
 }
 
-namespace {
-
-// Targets of the position rows: fixed/LINE/kinematic from the system, inputs and DOFs from q̂.
 void set_targets(const System& sys, Data& data) {
   for (size_t r = 0; r < sys.defs_P.size(); ++r) {
     const int k = sys.defs_P[r];
@@ -47,6 +44,8 @@ void set_targets(const System& sys, Data& data) {
     else data.target[r] = sys.e_target[k];
   }
 }
+
+namespace {
 
 void compute_residual(const System& sys, Data& data) {
   for (size_t r = 0; r < sys.defs_P.size(); ++r) data.residual[r] = data.e[sys.defs_P[r]] - data.target[r];
@@ -108,6 +107,17 @@ void assemble_block(const System& sys, Data& data, BlockMatrix& A, const std::ve
   for (size_t i = 0; i < sys.elements.size(); ++i) A.add(block[i], data.work[i].B);
 }
 
+namespace {
+// Angles come from atan2 in (−π, π]: move each to the branch nearest to its target (position
+// rows) or to its previous value, so that hinges can turn any number of times.
+void unwrap_angle(const System& sys, Data& data, int k, double period) {
+  const int r = sys.row_P[k];
+  const double ref = r >= 0 ? data.target[r] : data.angle_ref[k];
+  if (std::isfinite(ref)) data.e[k] += period * std::round((ref - data.e[k]) / period);
+  data.angle_ref[k] = data.e[k];
+}
+}  // namespace
+
 void evaluate_elements(const System& sys, Data& data) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
@@ -115,16 +125,23 @@ void evaluate_elements(const System& sys, Data& data) {
     for (size_t j = 0; j < se.coords.size(); ++j) w.x[j] = data.x[se.coords[j]];
     se.kernel->first_derivatives(w.x.data(), data.e.data() + se.def_offset, w.B.data());
   }
-  // Angles come from atan2 in (−π, π]: move each to the branch nearest to its target (position
-  // rows) or to its previous value, so that hinges can turn any number of times. Velocity-level
-  // deformations have no value as a function of x: theirs is integrated (data.e_integrated).
+  // Velocity-level deformations have no value as a function of x: theirs is integrated
+  // (data.e_integrated).
   for (int k = 0; k < sys.ne; ++k)
     if (sys.def_velocity_level[k]) data.e[k] = data.e_integrated[k];
-  for (const auto& [k, period] : sys.periodic_defs) {
-    const int r = sys.row_P[k];
-    const double ref = r >= 0 ? data.target[r] : data.angle_ref[k];
-    if (std::isfinite(ref)) data.e[k] += period * std::round((ref - data.e[k]) / period);
-    data.angle_ref[k] = data.e[k];
+  for (const auto& [k, period] : sys.periodic_defs) unwrap_angle(sys, data, k, period);
+}
+
+void evaluate_element(const System& sys, Data& data, int i) {
+  const SystemElement& se = sys.elements[i];
+  ElementWork& w = data.work[i];
+  for (size_t j = 0; j < se.coords.size(); ++j) w.x[j] = data.x[se.coords[j]];
+  se.kernel->first_derivatives(w.x.data(), data.e.data() + se.def_offset, w.B.data());
+  for (int a = 0; a < se.nd; ++a) {
+    const int k = se.def_offset + a;
+    if (sys.def_velocity_level[k]) data.e[k] = data.e_integrated[k];
+    const double period = se.kernel->period(a);
+    if (period > 0.0) unwrap_angle(sys, data, k, period);
   }
 }
 
@@ -207,6 +224,10 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
        << worst_rows(sys, data, 3);
     throw KinematicsError(os.str());
   }
+  check_auto_released(sys, data, tol);
+}
+
+void check_auto_released(const System& sys, const Data& data, double tol) {
   // Deformations without calculable coordinates are not in the block: check them directly.
   for (int k : sys.auto_released) {
     const double r = data.e[k] - sys.e_target[k];
@@ -330,6 +351,10 @@ void calculable_rates(const System& sys, Data& data, const Eigen::VectorXd& qhat
 void solve_velocities_direct(const System& sys, Data& data) {
   if (!sys.x_calc.empty()) factorize_velocity_block(sys, data);
   calculable_rates(sys, data, data.qhat_d, false, data.xd);
+  deformation_rates(sys, data);
+}
+
+void deformation_rates(const System& sys, Data& data) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
     ElementWork& w = data.work[i];

@@ -82,10 +82,7 @@ Radau5::Radau5(int n)
   if (n < 1) throw std::invalid_argument("Radau5: the system needs at least one state");
   set_tolerances(Eigen::VectorXd::Constant(n, 1e-6), Eigen::VectorXd::Constant(n, 1e-6));
   J_.setZero(n, n);
-  E1_.setZero(n, n);
-  E2_.setZero(n, n);
-  lu_real_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n);
-  lu_complex_ = Eigen::PartialPivLU<Eigen::MatrixXcd>(n);
+  set_second_order(0);
   for (Eigen::VectorXd* v : {&f0_, &scale_, &y_stage_, &y_new_, &y_out_, &err_v_, &dz_, &tmp_}) v->setZero(n);
   ctmp_.setZero(n);
   for (int i = 0; i < 3; ++i)
@@ -142,6 +139,20 @@ void Radau5::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
 void Radau5::set_step_start(StepStart start) { step_start_ = std::move(start); }
 void Radau5::set_jacobian(Jacobian jac) { jac_ = std::move(jac); }
 
+void Radau5::set_second_order(int m) {
+  if (m < 0 || 2 * m > n_) throw std::invalid_argument("Radau5: the second-order positions must be at most half the states");
+  m_ = m;
+  const int r = n_ - m;
+  E1_.setZero(r, r);
+  E2_.setZero(r, r);
+  G1_.setZero(r, m);
+  G2_.setZero(r, m);
+  rr_.setZero(r);
+  cr_.setZero(r);
+  piv_real_.assign(r, 0);
+  piv_complex_.assign(r, 0);
+}
+
 void Radau5::set_jacobian_reuse(double theta) {
   if (!(theta > 0 && theta < 1)) throw std::invalid_argument("Radau5: the reuse threshold must be in (0, 1)");
   theta_reuse_ = theta;
@@ -185,16 +196,89 @@ double Radau5::initial_step(const Rhs& f, double t0, double t_end, const Eigen::
   return std::min({100.0 * h0, h1, span});
 }
 
-// The real matrix γ/h - J and the complex one (α + iβ)/h - J, factorized.
+// The real matrix γ/h - J and the complex one (α + iβ)/h - J, factorized; with second-order
+// structure (m_ > 0) reduced to the unknowns (a, b) = (y[0:m], y[m:n−m]). The rows i < m read
+// σ a_i − c_i = r_i, so c = σ a − r[0:m]; put into the rows m.. (σ − J)[m:n, :] x = r[m:n]:
+//   [−J[m:n, 0:m] + σ G | (σ − J)[m:n, m:n−m]] (a, b) = r[m:n] + G r[0:m],  G = (σ − J)[m:n, n−m:n].
+namespace {
+template <class Scalar, class Matrix>
+void reduced_matrix(const Eigen::MatrixXd& J, int m, Scalar sigma, Matrix& E, Matrix& G) {
+  const int n = static_cast<int>(J.rows()), r = n - m;
+  G = -J.block(m, n - m, r, m).template cast<Scalar>();
+  G.bottomRows(m).diagonal().array() += sigma;
+  E.leftCols(m) = -J.block(m, 0, r, m).template cast<Scalar>() + sigma * G;
+  E.rightCols(r - m) = -J.block(m, m, r, r - m).template cast<Scalar>();
+  E.topRightCorner(r - m, r - m).diagonal().array() += sigma;
+}
+
+
+// LU factorization with partial pivoting in place (A = P L U, piv the row interchanges), and the
+// solve with it. The Newton matrices are small (the DOFs of a structure, tens): a plain
+// column-oriented elimination costs less than a general blocked LU's dispatch, and the pivot
+// search on |re| + |im| (LAPACK's CABS1) avoids a hypot per complex entry.
+double magnitude(double v) { return std::abs(v); }
+double magnitude(const std::complex<double>& v) { return std::abs(v.real()) + std::abs(v.imag()); }
+
+template <class Matrix>
+void lu_factor(Matrix& A, std::vector<int>& piv) {
+  const int n = static_cast<int>(A.rows());
+  for (int k = 0; k < n; ++k) {
+    int p = k;
+    for (int i = k + 1; i < n; ++i)
+      if (magnitude(A(i, k)) > magnitude(A(p, k))) p = i;
+    piv[k] = p;
+    if (p != k) A.row(p).swap(A.row(k));
+    const auto inv = 1.0 / A(k, k);  // a zero pivot gives non-finite solutions, checked there
+    for (int i = k + 1; i < n; ++i) A(i, k) *= inv;
+    for (int j = k + 1; j < n; ++j) {
+      const auto a = A(k, j);
+      for (int i = k + 1; i < n; ++i) A(i, j) -= A(i, k) * a;
+    }
+  }
+}
+
+template <class Matrix, class Vector>
+void lu_solve(const Matrix& LU, const std::vector<int>& piv, Vector& x) {
+  const int n = static_cast<int>(LU.rows());
+  for (int k = 0; k < n; ++k)
+    if (piv[k] != k) std::swap(x[k], x[piv[k]]);
+  for (int k = 0; k < n; ++k)
+    for (int i = k + 1; i < n; ++i) x[i] -= LU(i, k) * x[k];
+  for (int k = n - 1; k >= 0; --k) {
+    x[k] /= LU(k, k);
+    for (int i = 0; i < k; ++i) x[i] -= LU(i, k) * x[k];
+  }
+}
+
+}  // namespace
+
 void Radau5::factorize(double h) {
   const Tableau& tb = tableau();
-  E1_ = -J_;
-  E1_.diagonal().array() += tb.L(0, 0) / h;
-  lu_real_.compute(E1_);
-  E2_ = -J_.cast<std::complex<double>>();
-  E2_.diagonal().array() += std::complex<double>(tb.L(1, 1), tb.L(2, 1)) / h;
-  lu_complex_.compute(E2_);
+  sigma1_ = tb.L(0, 0) / h;
+  sigma2_ = std::complex<double>(tb.L(1, 1), tb.L(2, 1)) / h;
+  reduced_matrix(J_, m_, sigma1_, E1_, G1_);
+  lu_factor(E1_, piv_real_);
+  reduced_matrix(J_, m_, sigma2_, E2_, G2_);
+  lu_factor(E2_, piv_complex_);
   ++stats_.ndec;
+}
+
+void Radau5::solve_real(const Eigen::VectorXd& r, Eigen::VectorXd& x) {
+  const int m = m_, k = n_ - m_;
+  rr_ = r.tail(k);
+  rr_.noalias() += G1_ * r.head(m);
+  lu_solve(E1_, piv_real_, rr_);
+  x.head(k) = rr_;
+  x.tail(m) = sigma1_ * rr_.head(m) - r.head(m);
+}
+
+void Radau5::solve_complex(Eigen::VectorXcd& r) {
+  const int m = m_, k = n_ - m_;
+  cr_ = r.tail(k);
+  cr_.noalias() += G2_ * r.head(m);
+  lu_solve(E2_, piv_complex_, cr_);
+  r.tail(m) = sigma2_ * cr_.head(m) - r.head(m);
+  r.head(k) = cr_;
 }
 
 // Starting values of the Newton iterations: zero, or the previous step's collocation polynomial
@@ -236,8 +320,8 @@ Radau5::Attempt Radau5::newton(const Rhs& f, double t, double h, const Eigen::Ve
                    (tb.L(1, 1) * w_[1] + tb.L(1, 2) * w_[2]) / h;
     ctmp_.imag() = tb.TI(2, 0) * fz_[0] + tb.TI(2, 1) * fz_[1] + tb.TI(2, 2) * fz_[2] -
                    (tb.L(2, 1) * w_[1] + tb.L(2, 2) * w_[2]) / h;
-    fz_[0] = lu_real_.solve(tmp_);
-    ctmp_ = lu_complex_.solve(ctmp_);
+    solve_real(tmp_, fz_[0]);
+    solve_complex(ctmp_);
     fz_[1] = ctmp_.real();
     fz_[2] = ctmp_.imag();
     if (!(fz_[0].allFinite() && fz_[1].allFinite() && fz_[2].allFinite())) {
@@ -282,13 +366,13 @@ bool Radau5::estimate_error(const Rhs& f, double t, double h, const Eigen::Vecto
   scale_ = atol_.array() + rtol_.array() * y.array().abs().max(y_new_.array().abs());
   dz_ = (tb.d[0] * z_[0] + tb.d[1] * z_[1] + tb.d[2] * z_[2]) / h;
   tmp_ = f0_ + dz_;
-  err_v_ = lu_real_.solve(tmp_);
+  solve_real(tmp_, err_v_);
   err_ = std::max(scaled_rms(err_v_, scale_), kMinError);
   if (err_ >= 1.0 && refine) {
     y_stage_ = y + err_v_;
     if (!eval(f, t, y_stage_, tmp_)) return false;
     tmp_ += dz_;
-    err_v_ = lu_real_.solve(tmp_);
+    solve_real(tmp_, err_v_);
     err_ = std::max(scaled_rms(err_v_, scale_), kMinError);
   }
   if (std::isfinite(err_)) return true;

@@ -131,10 +131,17 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
     predict_from(positions, t, q);
   }
   const bool check = in_rhs_ && anchor_.valid;
+  // Right-hand sides of an open chain: positions and velocities element by element (chain.hpp);
+  // other evaluations also factorize the velocity block, which the forces and transfer use.
+  ExplicitChain* chain = in_rhs_ ? chain_.get() : nullptr;
+  auto positions = [&]() {
+    if (chain) chain->solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin);
+    else solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
+  };
   std::string why;
   bool ok = false;
   try {
-    solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
+    positions();
     ok = !check || continuous_with_step_start(why);
   } catch (const KinematicsError& err) {
     if (!check && !base_.valid) throw;
@@ -146,10 +153,11 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
     // last solution itself); if the result is still not continuous, reject the step.
     if (check) predict_from(anchor_, t, q);
     else predict_from(base_, base_.t, q);
-    solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
+    positions();
     if (check && !continuous_with_step_start(why)) throw KinematicsError(why);
   }
-  solve_velocities_direct(sys, *data_);
+  if (chain) chain->solve_velocities(sys, *data_);
+  else solve_velocities_direct(sys, *data_);
   solve_dynamics_direct(sys, *data_);
   remember(base_);
   have_transfer_ = false;
@@ -400,6 +408,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     has_deadline_ = false;
     tree_.reset();
+    chain_.reset();
   };
   try {
     integrate_block(res, options, plan, k_out);
@@ -485,6 +494,7 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   assemble();
   tree_ = plan.integrate && options.recursive ? RecursiveTree::detect(*sys_, *data_) : nullptr;
   res.recursive = tree_ != nullptr;
+  chain_ = plan.integrate && options.recursive && !tree_ ? ExplicitChain::detect(*sys_) : nullptr;
   if (tree_) {
     base_.xd = base_.xdd = Eigen::VectorXd::Zero(sys_->nx);
     base_.t = plan.t0;
@@ -545,6 +555,7 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
   if (method == Method::RADAU5) {
     Radau5 integ(static_cast<int>(Y.size()));
     integ.set_jacobian([this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) { jacobian(tt, y, J); });
+    integ.set_second_order(sys_->n_dof());  // Y = (q, y, q̇): q̇ = dq/dt (jacobian's first rows)
     // The Jacobian (a linearization) costs several right-hand sides per DOF: keep it longer.
     integ.set_jacobian_reuse(0.1);
     // Back to DOP853 when its stability bound (|hλ| ≤ 6.1) would allow kExplicitGain times
@@ -658,6 +669,7 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   const long newton = data_->total_newton_iterations;
   sys_ = compile(model_, dependent_);
   data_ = std::make_unique<Data>(*sys_);
+  if (chain_) chain_ = ExplicitChain::detect(*sys_);
   data_->x = x;
   data_->angle_ref = angles;
   data_->e_integrated = integrated;

@@ -1,6 +1,6 @@
 // spacar._testing: direct access to pieces of the core that the shipped API does not expose, for
 // the tests and the peer comparisons (spacar.compare): one element kernel, the Runge-Kutta
-// integrators (Runge-Kutta and Radau IIA) on a Python right-hand side, the sparse LU, the static forces. Kept out of spacar._core.
+// integrators (Runge-Kutta and Radau IIA) on a Python right-hand side, the sparse LU, the static forces, the explicit chain kinematics. Kept out of spacar._core.
 #include <pybind11/pybind11.h>
 
 namespace py = pybind11;
@@ -10,6 +10,7 @@ void bind_integrator(py::module_& m);
 void bind_sparse(py::module_& m);
 void bind_statics(py::module_& m);
 void bind_radau(py::module_& m);
+void bind_chain(py::module_& m);
 
 PYBIND11_MODULE(_testing, m) {
   m.doc() = "spacar core internals for tests and peer comparisons";
@@ -20,4 +21,5 @@ PYBIND11_MODULE(_testing, m) {
   bind_sparse(m);
   bind_statics(m);
   bind_radau(m);
+  bind_chain(m);
 }

@@ -15,8 +15,17 @@ void set_inputs(const System& sys, Data& data, double t);
 // Degrees of freedom q and their rates: x^d into x, e^d into the targets, q̂ parts.
 void set_dofs(const System& sys, Data& data, const double* q, const double* qd);
 
+// Targets of the position rows (data.target): fixed/LINE/kinematic values from the system,
+// inputs and DOFs from q̂.
+void set_targets(const System& sys, Data& data);
+
 // e and the element first derivatives at data.x.
 void evaluate_elements(const System& sys, Data& data);
+// The same for element i alone (its angles unwrapped as evaluate_elements does; the targets set).
+void evaluate_element(const System& sys, Data& data, int i);
+// KinematicsError unless the fixed deformations without calculable coordinates (auto_released)
+// are at their targets within tol.
+void check_auto_released(const System& sys, const Data& data, double tol);
 
 // Newton iteration on x^c until max|D^P(x) − target| ≤ tol, then one polish iteration; leaves e
 // and B evaluated at the solution. assembly: allow max(max_iter, 50) iterations with
@@ -32,6 +41,9 @@ void solve_velocities(const System& sys, Data& data);
 // Velocities without transfer functions (the integration path): ẋ^c from one solve with the
 // velocity block, ė = B ẋ, and the convective terms c.
 void solve_velocities_direct(const System& sys, Data& data);
+
+// ė = B ẋ and the convective terms c, element by element, for the current ẋ.
+void deformation_rates(const System& sys, Data& data);
 
 // ẍ = DF q̂̈ + acc0 and ë = B ẍ + c, for the current q̂̈.
 void solve_accelerations(const System& sys, Data& data);

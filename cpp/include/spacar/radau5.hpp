@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <complex>
 #include <functional>
 #include <string>
@@ -53,6 +54,12 @@ class Radau5 {
   // The Jacobian is kept for the next step when the Newton contraction rate of the step was at
   // most this (Hairer's default 0.001; about 0.1 when the Jacobian is expensive).
   void set_jacobian_reuse(double theta);
+  // Second-order structure (Hairer's M1): the first m components are positions whose derivatives
+  // are the last m components, f_i(t, y) = y_{n−m+i}, so that the first m rows of J are
+  // [0 … 0 I]. The linear systems of the Newton iterations are then reduced to size n − m by
+  // eliminating those rows (eight times fewer operations per factorization for m = n/2).
+  // Call before integrate(); 0 (the default): no structure assumed.
+  void set_second_order(int m);
 
   // As Integrator::integrate: y(t0) -> y(t_end) with out(t_k, y(t_k)) at the output times from
   // the collocation polynomial of the step containing t_k.
@@ -78,6 +85,10 @@ class Radau5 {
   bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
   double initial_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y);
   void factorize(double h);
+  // x = (σ − J)⁻¹ r with the factorization of the real shift σ = γ/h (x may alias nothing).
+  void solve_real(const Eigen::VectorXd& r, Eigen::VectorXd& x);
+  // r ← ((α + iβ)/h − J)⁻¹ r with the complex factorization.
+  void solve_complex(Eigen::VectorXcd& r);
   void starting_values(double h);
   Attempt newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y);
   bool estimate_error(const Rhs& f, double t, double h, const Eigen::VectorXd& y, bool refine);
@@ -87,6 +98,7 @@ class Radau5 {
   size_t emit_outputs(const std::vector<double>& touts, size_t next, double t_new, const Output& out);
 
   int n_;
+  int m_ = 0;                     // second-order positions (set_second_order)
   Eigen::VectorXd rtol_, atol_;   // mapped tolerances
   double fnewt_ = 0.03;           // Newton stopping criterion (scaled norm of the increment)
   double theta_reuse_ = 0.001;
@@ -110,10 +122,16 @@ class Radau5 {
   double h_old_ = 0.0, t_new_ = 0.0;
 
   // Work space, allocated once.
-  Eigen::MatrixXd J_, E1_;
-  Eigen::MatrixXcd E2_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_real_;
-  Eigen::PartialPivLU<Eigen::MatrixXcd> lu_complex_;
+  // E1_, E2_: the reduced Newton matrices (size n − m), overwritten by their LU factors;
+  // G1_, G2_: the columns of the rates in
+  // the remaining rows, σ S − J[m:n, n−m:n], which carry the eliminated rows into them.
+  Eigen::MatrixXd J_, E1_, G1_;
+  Eigen::MatrixXcd E2_, G2_;
+  double sigma1_ = 0.0;
+  std::complex<double> sigma2_;
+  Eigen::VectorXd rr_;
+  Eigen::VectorXcd cr_;
+  std::vector<int> piv_real_, piv_complex_;  // row interchanges of the LU factors in E1_, E2_
   Eigen::VectorXd f0_, scale_, y_stage_, y_new_, y_out_, err_v_, dz_, tmp_;
   Eigen::VectorXcd ctmp_;
   Eigen::VectorXd z_[3], w_[3], fz_[3], poly_[3];

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "spacar/chain.hpp"
 #include "spacar/data.hpp"
 #include "spacar/integrator.hpp"
 #include "spacar/linearize.hpp"
@@ -35,7 +36,8 @@ struct RunOptions {
   // Integration steps (accepted and rejected) over the whole block.
   long max_steps = Integrator::kMaxSteps;
   // Planar and spatial trees of rigid bodies take the recursive (articulated-body) right-hand
-  // side (tree.hpp, spatial_tree.hpp); false: always the general constraint formulation.
+  // side (tree.hpp, spatial_tree.hpp), other open chains the explicit positions (chain.hpp);
+  // false: always the general constraint formulation.
   bool recursive = true;
 };
 
@@ -217,6 +219,9 @@ class Simulation {
   std::unique_ptr<Linearizer> linearizer_;
   // The recursive right-hand side of planar and spatial rigid trees, set for a run (RunOptions::recursive).
   std::unique_ptr<RecursiveTree> tree_;
+  // The explicit positions of open chains in the right-hand sides (chain.hpp), set for a run
+  // (RunOptions::recursive) when the system is one and no tree_.
+  std::unique_ptr<ExplicitChain> chain_;
   Eigen::VectorXd tree_qdd_;
   // The tree's state at (t, Y) into base_ (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.

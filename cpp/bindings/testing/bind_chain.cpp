@@ -1,0 +1,44 @@
+// spacar._testing: the explicit kinematics of open chains (chain.hpp) at a state, for the tests
+// against the general path (Simulation.solve_state).
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+
+#include "spacar/chain.hpp"
+#include "spacar/dynamics.hpp"
+#include "spacar/errors.hpp"
+#include "spacar/kinematics.hpp"
+#include "spacar/simulate.hpp"
+
+namespace py = pybind11;
+
+void bind_chain(py::module_& m) {
+  m.def(
+      "chain_state",
+      [](spacar::Simulation& sim, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) -> py::object {
+        const spacar::System& sys = sim.system();
+        if (q.size() != sys.n_dof() || qd.size() != sys.n_dof())
+          throw spacar::InputError("chain_state(): q and qd must have one value per degree of freedom");
+        std::unique_ptr<spacar::ExplicitChain> chain = spacar::ExplicitChain::detect(sys);
+        if (!chain) return py::none();
+        spacar::Data& d = sim.data();
+        spacar::set_inputs(sys, d, t);
+        spacar::set_dofs(sys, d, q.data(), qd.data());
+        chain->solve_positions(sys, d, sys.settings.maxiterat, sys.settings.epskin);
+        chain->solve_velocities(sys, d);
+        spacar::solve_dynamics_direct(sys, d);
+        py::dict out;
+        out["x"] = d.x;
+        out["xd"] = d.xd;
+        out["xdd"] = d.xdd;
+        out["qdd"] = d.qdd;
+        out["e"] = d.e;
+        out["ed"] = d.ed;
+        out["blocks"] = chain->blocks();
+        out["newton_iterations"] = d.newton_iterations;
+        return out;
+      },
+      py::arg("simulation"), py::arg("t"), py::arg("q"), py::arg("qd"),
+      "The right-hand side's state by the explicit chain at (t, q, q̇), starting from the simulation's "
+      "current positions (a dict of x, xd, xdd, qdd, e, ed, blocks, newton_iterations; None if the system "
+      "is not an open chain). The simulation's data is left at that state.");
+}

@@ -1,0 +1,75 @@
+// Explicit kinematics of open chains (formulation.md §2 solved in tree order): where the position
+// constraints can be ordered so that each element (or an element with the normalisation of the
+// Euler parameters it determines) has as many known deformation values (fixed, input, DOF, LINE)
+// as unknown coordinates once the coordinates before it are known, the positions follow element
+// by element outward from the known coordinates: a cantilever, a robot arm with flexible links,
+// a rigid or flexible tree. Each step is a Newton iteration of the element's few coordinates (one
+// or two iterations from the predicted positions), instead of a Newton iteration on all
+// calculable coordinates with a sparse factorization per iteration; the velocities follow in the
+// same order from the element's small linear system. The first Newton step is that of all
+// coordinates together (the block-triangular Jacobian, solved block by block), so that the motion
+// of the coordinates a block starts from reaches its own before its iterations.
+//
+// Refused (detect() returns nullptr), for the general path: closed loops (an element whose known
+// values over-determine the coordinates it reaches), nonholonomic constraints (the velocity rows
+// are not the position rows), velocity-level deformations among the position rows, and
+// coordinates that only a group of several elements determines together (other than an element
+// and the L2MIN1 normalisations of the rotations it reaches).
+#pragma once
+
+#include <Eigen/Dense>
+#include <memory>
+#include <vector>
+
+#include "spacar/data.hpp"
+#include "spacar/errors.hpp"
+#include "spacar/system.hpp"
+
+namespace spacar {
+
+class ExplicitChain {
+ public:
+  // The order of the system, or nullptr if it is not an open chain in the sense above.
+  static std::unique_ptr<ExplicitChain> detect(const System& sys);
+
+  // Positions of the calculable coordinates from the known ones (inputs and DOFs set in data,
+  // the calculable coordinates holding the starting guess), as solve_positions() leaves them:
+  // e and B evaluated at the solution, data.residual and the iteration counters set. Throws
+  // KinematicsError when an element's iteration does not converge in max_iter iterations.
+  void solve_positions(const System& sys, Data& data, int max_iter, double tol);
+  // ẋ of the calculable coordinates, ė and the convective terms, as solve_velocities_direct().
+  void solve_velocities(const System& sys, Data& data);
+
+  int blocks() const { return static_cast<int>(blocks_.size()); }
+
+ private:
+  struct Row {
+    int def;      // global deformation index
+    int row;      // row of the position block (sys.row_P)
+  };
+  // One step of the order: the unknown coordinates and the rows that determine them.
+  struct Block {
+    std::vector<int> elements;            // evaluated at every iteration
+    std::vector<int> coords;              // global indices of the unknowns
+    std::vector<Row> rows;
+    // The entries of B that the block uses, listed once: row j of the block, the element's slot,
+    // its local deformation and coordinate, and the unknown (in A) or the global coordinate
+    // (known: a term of the right-hand side).
+    struct Term {
+      int j, slot, local, coord, target;
+    };
+    std::vector<Term> unknown_terms, known_terms;
+    Eigen::MatrixXd A;                    // ∂(rows)/∂(unknowns)
+    Eigen::VectorXd r, dx;
+  };
+  void assemble(const Data& data, Block& b) const;
+  // Σ over the known coordinates of B(row, l) v[coord], per row of the block, added to b.r.
+  void add_known(const Data& data, Block& b, const Eigen::VectorXd& v, double sign) const;
+  static KinematicsError singular(const System& sys, const Data& data, const Block& b, const char* what);
+
+  std::vector<Block> blocks_;
+  std::vector<int> rest_;  // elements without position rows: evaluated once at the end
+  Eigen::VectorXd step_;   // the first Newton step of all coordinates (work space)
+};
+
+}  // namespace spacar

@@ -1,0 +1,242 @@
+// Explicit kinematics of open chains (chain.hpp).
+#include "spacar/chain.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "spacar/errors.hpp"
+#include "spacar/kinematics.hpp"
+
+namespace spacar {
+
+namespace {
+
+// The distinct coordinates of element i not yet known.
+std::vector<int> unknown_coords(const System& sys, const std::vector<char>& known, int i) {
+  std::vector<int> u;
+  for (int g : sys.elements[i].coords)
+    if (!known[g] && std::find(u.begin(), u.end(), g) == u.end()) u.push_back(g);
+  return u;
+}
+
+// x = A⁻¹ r by Gaussian elimination with partial pivoting, in place (A and r are overwritten):
+// the blocks have a few unknowns (3 for a planar beam, 7 for a spatial one), where a general
+// LU's blocking and dispatch cost more than the arithmetic. False if A is singular.
+bool small_solve(Eigen::MatrixXd& A, Eigen::VectorXd& r, Eigen::VectorXd& x) {
+  const int n = static_cast<int>(A.rows());
+  for (int c = 0; c < n; ++c) {
+    int p = c;
+    for (int i = c + 1; i < n; ++i)
+      if (std::abs(A(i, c)) > std::abs(A(p, c))) p = i;
+    if (!(A(p, c) != 0.0)) return false;
+    if (p != c) {
+      A.row(p).swap(A.row(c));
+      std::swap(r[p], r[c]);
+    }
+    for (int i = c + 1; i < n; ++i) {
+      const double f = A(i, c) / A(c, c);
+      for (int j = c + 1; j < n; ++j) A(i, j) -= f * A(c, j);
+      r[i] -= f * r[c];
+    }
+  }
+  for (int c = n - 1; c >= 0; --c) {
+    double v = r[c];
+    for (int j = c + 1; j < n; ++j) v -= A(c, j) * x[j];
+    x[c] = v / A(c, c);
+  }
+  return x.allFinite();
+}
+
+}  // namespace
+
+KinematicsError ExplicitChain::singular(const System& sys, const Data& data, const Block& b, const char* what) {
+  std::ostringstream os;
+  os << "the " << what << " constraints of " << sys.def_name(b.rows.front().def) << " and the elements it reaches "
+     << "are singular at t = " << data.t << " (explicit chain)";
+  return KinematicsError(os.str());
+}
+
+namespace {
+
+int position_rows(const System& sys, int i) {
+  const SystemElement& se = sys.elements[i];
+  int n = 0;
+  for (int a = 0; a < se.nd; ++a) n += sys.row_P[se.def_offset + a] >= 0;
+  return n;
+}
+
+}  // namespace
+
+std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
+  // Nonholonomic rows (velocity rows that are not position rows) and velocity-level values among
+  // the position rows have no explicit position path.
+  if (sys.defs_P != sys.defs_V || sys.defs_P.size() != sys.x_calc.size() || sys.x_calc.empty()) return nullptr;
+  for (int k : sys.defs_P)
+    if (sys.def_velocity_level[k]) return nullptr;
+  std::vector<char> known(sys.nx, 1);
+  for (int g : sys.x_calc) known[g] = 0;
+  auto chain = std::unique_ptr<ExplicitChain>(new ExplicitChain());
+  std::vector<int> pending;
+  std::vector<char> is_pending(sys.elements.size(), 0);
+  std::vector<std::vector<int>> touching(sys.nx);  // the pending elements on each coordinate
+  for (int i = 0; i < static_cast<int>(sys.elements.size()); ++i) {
+    if (position_rows(sys, i) == 0) {
+      chain->rest_.push_back(i);
+      continue;
+    }
+    pending.push_back(i);
+    is_pending[i] = 1;
+    for (int g : sys.elements[i].coords) touching[g].push_back(i);
+  }
+  // Greedy: an element whose rows, with those of the pending elements whose unknowns lie within
+  // its own (the L2MIN1 of a rotation it reaches), are as many as its unknowns determines them.
+  // Any order of such steps gives the same blocks; none left while elements are pending means a
+  // closed loop or a group of elements that only determine their coordinates together.
+  for (bool progress = true; progress && !pending.empty();) {
+    progress = false;
+    for (size_t p = 0; p < pending.size(); ++p) {
+      const int i = pending[p];
+      const std::vector<int> U = unknown_coords(sys, known, i);
+      if (U.empty()) return nullptr;  // rows on known coordinates only: a loop closes here
+      std::vector<int> group{i};
+      int rows = position_rows(sys, i);
+      for (int g : U)
+        for (int j : touching[g]) {
+          if (j == i || !is_pending[j] || std::find(group.begin(), group.end(), j) != group.end()) continue;
+          const std::vector<int> Uj = unknown_coords(sys, known, j);
+          const bool inside = !Uj.empty() && std::all_of(Uj.begin(), Uj.end(), [&](int c) {
+            return std::find(U.begin(), U.end(), c) != U.end();
+          });
+          if (inside) {
+            group.push_back(j);
+            rows += position_rows(sys, j);
+          }
+        }
+      if (rows != static_cast<int>(U.size())) continue;
+      Block b;
+      b.elements = group;
+      b.coords = U;
+      for (size_t s = 0; s < group.size(); ++s) {
+        const SystemElement& se = sys.elements[group[s]];
+        for (int a = 0; a < se.nd; ++a) {
+          const int k = se.def_offset + a;
+          if (sys.row_P[k] < 0) continue;
+          const int j = static_cast<int>(b.rows.size());
+          b.rows.push_back({k, sys.row_P[k]});
+          for (size_t l = 0; l < se.coords.size(); ++l) {
+            const auto at = std::find(U.begin(), U.end(), se.coords[l]);
+            const Block::Term term{j, static_cast<int>(s), a, static_cast<int>(l),
+                                   at != U.end() ? static_cast<int>(at - U.begin()) : se.coords[l]};
+            (at != U.end() ? b.unknown_terms : b.known_terms).push_back(term);
+          }
+        }
+      }
+      const int n = static_cast<int>(U.size());
+      b.A.setZero(n, n);
+      b.r.setZero(n);
+      b.dx.setZero(n);
+      chain->blocks_.push_back(std::move(b));
+      for (int g : U) known[g] = 1;
+      for (int j : group) is_pending[j] = 0;
+      pending.erase(std::remove_if(pending.begin(), pending.end(),
+                                   [&](int j) { return std::find(group.begin(), group.end(), j) != group.end(); }),
+                    pending.end());
+      progress = true;
+      break;
+    }
+  }
+  if (!pending.empty()) return nullptr;
+  for (int g : sys.x_calc)
+    if (!known[g]) return nullptr;
+  return chain;
+}
+
+void ExplicitChain::assemble(const Data& data, Block& b) const {
+  b.A.setZero();
+  for (const Block::Term& t : b.unknown_terms)
+    b.A(t.j, t.target) += data.work[b.elements[t.slot]].B(t.local, t.coord);
+}
+
+void ExplicitChain::add_known(const Data& data, Block& b, const Eigen::VectorXd& v, double sign) const {
+  for (const Block::Term& t : b.known_terms)
+    b.r[t.j] += sign * data.work[b.elements[t.slot]].B(t.local, t.coord) * v[t.target];
+}
+
+void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter, double tol) {
+  set_targets(sys, data);
+  // First one Newton step of all calculable coordinates from the starting positions, as the
+  // general path makes it: the Jacobian of an open chain is block triangular, so the step
+  // follows block by block, each block's rows taking the steps of the coordinates before it.
+  // It carries the motion of the coordinates a block starts from (a translation of the whole
+  // rest of the chain, far larger than its elements) to the block's own coordinates; then each
+  // block's Newton iterations start close to the solution.
+  for (const Block& b : blocks_)
+    for (int i : b.elements) evaluate_element(sys, data, i);
+  step_.setZero(sys.nx);
+  for (Block& b : blocks_) {
+    for (size_t j = 0; j < b.rows.size(); ++j) b.r[static_cast<int>(j)] = data.e[b.rows[j].def] - data.target[b.rows[j].row];
+    add_known(data, b, step_, 1.0);
+    assemble(data, b);
+    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "position");
+    for (size_t j = 0; j < b.coords.size(); ++j) step_[b.coords[j]] = -b.dx[static_cast<int>(j)];
+  }
+  if (!step_.allFinite()) throw singular(sys, data, blocks_.front(), "position");
+  for (int g : sys.x_calc) data.x[g] += step_[g];
+  int most = 0;
+  for (Block& b : blocks_) {
+    // Newton on the block's coordinates until the residual is below tol, then one polish
+    // iteration, as solve_positions() on all of them; none if the residual is already a
+    // thousandth of tol (the general path's criterion when it reuses a factorization).
+    bool converged = false;
+    for (int it = 0;; ++it) {
+      for (int i : b.elements) evaluate_element(sys, data, i);
+      double rmax = 0.0;
+      for (size_t j = 0; j < b.rows.size(); ++j) {
+        b.r[static_cast<int>(j)] = data.e[b.rows[j].def] - data.target[b.rows[j].row];
+        rmax = std::max(rmax, std::abs(b.r[static_cast<int>(j)]));
+      }
+      const bool finite = b.r.allFinite();
+      if (finite && (converged || rmax <= 1e-3 * tol)) break;  // polished
+      converged = finite && rmax <= tol;
+      if (!finite || (it >= max_iter && !converged)) {
+        std::ostringstream os;
+        os << "Newton iteration on the positions of " << sys.def_name(b.rows.front().def) << " and the "
+           << b.coords.size() - 1 << " other coordinates it determines (explicit chain) did not converge in "
+           << max_iter << " iterations at t = " << data.t << " (EPSKIN " << tol << "; residual "
+           << (finite ? rmax : INFINITY) << ")";
+        throw KinematicsError(os.str());
+      }
+      assemble(data, b);
+      if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "position");
+      for (size_t j = 0; j < b.coords.size(); ++j) data.x[b.coords[j]] -= b.dx[static_cast<int>(j)];
+      most = std::max(most, it + 1);
+    }
+  }
+  for (int i : rest_) evaluate_element(sys, data, i);
+  for (size_t r = 0; r < sys.defs_P.size(); ++r) data.residual[r] = data.e[sys.defs_P[r]] - data.target[r];
+  data.newton_iterations = 1 + most;
+  data.total_newton_iterations += 1 + most;
+  data.jacobian_reusable = false;  // no factorization of the velocity block made
+  check_auto_released(sys, data, tol);
+}
+
+void ExplicitChain::solve_velocities(const System& sys, Data& data) {
+  data.xd.setZero();
+  for (int g : sys.x_input) data.xd[g] = data.qhat_d[sys.qhat_col_x[g]];
+  for (int g : sys.x_dyn) data.xd[g] = data.qhat_d[sys.qhat_col_x[g]];
+  for (Block& b : blocks_) {
+    // B_u ẋ_u = ė − B_k ẋ_k over the block's rows, ė the q̂ rate of the row (0 if fixed).
+    for (size_t j = 0; j < b.rows.size(); ++j) {
+      const int col = sys.qhat_col_e[b.rows[j].def];
+      b.r[static_cast<int>(j)] = col >= 0 ? data.qhat_d[col] : 0.0;
+    }
+    add_known(data, b, data.xd, -1.0);
+    assemble(data, b);
+    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "velocity");
+    for (size_t j = 0; j < b.coords.size(); ++j) data.xd[b.coords[j]] = b.dx[static_cast<int>(j)];
+  }
+  deformation_rates(sys, data);
+}
+
+}  // namespace spacar
