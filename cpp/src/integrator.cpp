@@ -331,7 +331,11 @@ double Integrator::initial_step(const Rhs& f, double t0, double t_end, const Eig
   const double span = std::min(hmax_, t_end - t0);
   const double rms = 1.0 / std::sqrt(static_cast<double>(n_));
   scale_ = atol_.array() + rtol_.array() * y.array().abs();
-  const double d0 = (y.array() / scale_.array()).matrix().norm() * rms;
+  // Components at round-off (an assembly's 1e-17 for an exact zero) count as zero: against a
+  // tight absolute tolerance they would make d0 pass Hairer's 1e-5 test and 0.01 d0/d1, which
+  // also caps the step below at 100 times itself, spuriously tiny (1e-18 s).
+  const double noise = 1e-14 * std::max(1.0, y.cwiseAbs().maxCoeff());
+  const double d0 = ((y.array().abs() > noise).select(y.array(), 0.0) / scale_.array()).matrix().norm() * rms;
   const double d1 = (k_[0].array() / scale_.array()).matrix().norm() * rms;
   const double h0 = std::min((d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1, span);
 
