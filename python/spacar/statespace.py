@@ -1,0 +1,275 @@
+"""State-space models of the linearized equations with physical inputs and outputs (issue 22):
+
+    d/dt s = A s + B u,    y = C s + D u,    s = [δz; δy^k; δż]
+
+in the minimal coordinates of :mod:`spacar.linearize` — z the degrees of freedom (and LINE
+parameters), y^k the kinematic coordinates of nonholonomic constraints, no constraint states.
+The inputs u are forces on nodal coordinates (INPUTF) and actuator stresses on deformations
+(INPUTS); the outputs y are nodal coordinates (OUTX), deformations (OUTE) and their rates (OUTXP,
+OUTEP). They enter through the first-order transfer functions DF = ∂x/∂z and DFe = ∂e/∂z: a
+force f on a coordinate does the virtual work f δx = f DF δz, so its generalized force is DFᵀ f;
+a stress σ does σ δe on the deformation and loads the coordinates by −DFeᵀ σ (the sign of the
+elements' own stresses: σ > 0 is tension).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ._util import show
+from .errors import InputError
+from .linearize import Linearization, linearized_simulation
+from .model import Model, Signal
+
+INPUT_KEYWORDS = ("INPUTF", "INPUTS")
+OUTPUT_KEYWORDS = ("OUTX", "OUTXP", "OUTE", "OUTEP")
+_NAMES = {"INPUTF": "f", "INPUTS": "sigma", "OUTX": "x", "OUTXP": "xd", "OUTE": "e", "OUTEP": "ed"}
+
+
+class StateSpace:
+    """A linear time-invariant model ds/dt = A s + B u, y = C s + D u (NumPy arrays) with the
+    labels of its states, inputs and outputs (``"x(2,1)"``: coordinate 1 of node 2, ``"xd(2,1)"``
+    its rate, ``"e(3,2)"``/``"ed(3,2)"`` a deformation and its rate, ``"f(2,1)"`` a force input,
+    ``"sigma(3,2)"`` a stress input). ``t`` is the time of the state linearized about and
+    ``linearization`` the :class:`spacar.Linearization` it was built from. Time in seconds:
+    poles in rad/s."""
+
+    def __init__(self, A, B, C, D, state_labels, input_labels, output_labels, t=0.0, linearization=None):
+        self.A, self.B, self.C, self.D = (np.asarray(m, dtype=float) for m in (A, B, C, D))
+        self.state_labels = list(state_labels)
+        self.input_labels = list(input_labels)
+        self.output_labels = list(output_labels)
+        self.t = float(t)
+        self.linearization = linearization
+
+    def poles(self) -> np.ndarray:
+        """Eigenvalues of A in rad/s (complex), sorted by |Im| and then Re: the eigenvalues of
+        :meth:`spacar.Linearization.eigenvalues`."""
+        lam = np.linalg.eigvals(self.A)
+        return lam[np.lexsort((lam.real, np.abs(lam.imag)))]
+
+    def frequency_response(self, freqs, unit: str = "Hz") -> np.ndarray:
+        """The transfer matrix C (iω I − A)⁻¹ B + D at each frequency, complex, of shape
+        (len(freqs), outputs, inputs). ``freqs`` in Hz (``unit="Hz"``, ω = 2π f) or in rad/s
+        (``unit="rad/s"``)."""
+        w = _frequencies(freqs, unit)
+        n = self.A.shape[0]
+        out = np.empty((w.size, self.C.shape[0], self.B.shape[1]), dtype=complex)
+        for j, wj in enumerate(w):
+            out[j] = self.C @ np.linalg.solve(1j * wj * np.eye(n) - self.A, self.B) + self.D
+        return out
+
+    def static_gain(self) -> np.ndarray:
+        """−C A⁻¹ B + D (outputs × inputs): the static response per unit input; needs a
+        non-singular A (no rigid-body motion, no free kinematic coordinates)."""
+        try:
+            return -self.C @ np.linalg.solve(self.A, self.B) + self.D
+        except np.linalg.LinAlgError:
+            raise InputError("static_gain: A is singular (a free rigid-body motion or kinematic coordinate "
+                             "has no static response)") from None
+
+    def bode(self, freqs=None, unit: str = "Hz"):
+        """A matplotlib figure with the magnitude (log scale) and phase (degrees) of every
+        output/input pair over ``freqs`` (default: a decade below the slowest to a decade above
+        the fastest pole). Returns the figure."""
+        import matplotlib.pyplot as plt  # lazily: `import spacar` stays light
+
+        if freqs is None:
+            mag = np.abs(self.poles())
+            mag = mag[mag > 1e-9 * max(mag.max(initial=0.0), 1.0)]
+            lo, hi = (mag.min() / 10, mag.max() * 10) if mag.size else (0.1, 100.0)
+            freqs, unit = np.logspace(np.log10(lo), np.log10(hi), 500), "rad/s"
+        w = _frequencies(freqs, unit)
+        x = w / (2 * np.pi) if unit == "Hz" else w
+        H = self.frequency_response(w, unit="rad/s")
+        fig, (ax_mag, ax_phase) = plt.subplots(2, 1, sharex=True)
+        for i, out in enumerate(self.output_labels):
+            for j, inp in enumerate(self.input_labels):
+                ax_mag.loglog(x, np.abs(H[:, i, j]), label=f"{out} / {inp}")
+                ax_phase.semilogx(x, np.degrees(np.unwrap(np.angle(H[:, i, j]))))
+        ax_mag.set_ylabel("magnitude")
+        ax_phase.set_ylabel("phase [deg]")
+        ax_phase.set_xlabel(f"frequency [{unit}]")
+        if self.input_labels and self.output_labels:
+            ax_mag.legend()
+        return fig
+
+    def to_scipy(self):
+        """The model as a ``scipy.signal.StateSpace``."""
+        import scipy.signal
+
+        return scipy.signal.StateSpace(self.A, self.B, self.C, self.D)
+
+    def to_control(self):
+        """The model as a ``control.StateSpace`` of python-control (the optional extra
+        ``spacar[control]``), with the labels as its signal names."""
+        try:
+            import control
+        except ImportError:
+            raise ImportError("to_control needs python-control: pip install 'spacar[control]'") from None
+        return control.ss(self.A, self.B, self.C, self.D, states=self.state_labels,
+                          inputs=self.input_labels, outputs=self.output_labels)
+
+    def __repr__(self):
+        return (f"<spacar.StateSpace at t = {self.t:g}: {len(self.state_labels)} states, "
+                f"{len(self.input_labels)} inputs, {len(self.output_labels)} outputs>")
+
+
+def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
+    """The state-space model of ``source`` linearized about a state.
+
+    ``source``: a :class:`spacar.Model`, or a :class:`spacar.Linearization` (e.g. one of
+    ``res.linearizations`` of a run with ``LINEAR 1``; ``at`` does not apply). ``at`` (a Model
+    only): None for the model's current state, ``(t, q, qd)`` as for :func:`spacar.linearize`,
+    or ``(res, t)`` for the state of the results ``res`` at its output time nearest to t.
+    ``inputs``/``outputs``: lists of ``(keyword, number, index)``, e.g. ``[("INPUTF", 2, 1)]``,
+    ``[("OUTX", 2, 1), ("OUTXP", 2, 1)]``; default the model's INPUTF/INPUTS and
+    OUTX/OUTXP/OUTE/OUTEP lines in the order of their k.
+
+    Rate outputs at a moving state include the convective term ∂(DF ż)/∂z, which needs the model
+    (central differences of the velocities) and is computed for holonomic models without LINE
+    parameters; otherwise they are refused there."""
+    if isinstance(source, Linearization):
+        if at is not None:
+            raise InputError("state_space: `at` applies to a Model; a Linearization is already at its state")
+        if inputs is None or outputs is None:
+            raise InputError("state_space of a Linearization needs inputs= and outputs= (it has no input lines)")
+        lin, velocities = source, None
+    elif isinstance(source, Model):
+        inputs = _signals(source.state_space_inputs, "inputs", INPUT_KEYWORDS) if inputs is None else inputs
+        outputs = _signals(source.state_space_outputs, "outputs", OUTPUT_KEYWORDS) if outputs is None else outputs
+        lin, sim, state = linearized_simulation(source, _state(at))
+        velocities = (sim, state)
+    else:
+        raise InputError(f"state_space: a spacar.Model or spacar.Linearization, got {show(source)}")
+    inputs = _checked(inputs, INPUT_KEYWORDS, "inputs")
+    outputs = _checked(outputs, OUTPUT_KEYWORDS, "outputs")
+    return _build(lin, inputs, outputs, velocities)
+
+
+def _state(at):
+    if at is None:
+        return None
+    if isinstance(at, tuple) and len(at) == 2 and hasattr(at[0], "time_index"):
+        res, t = at
+        k = res.time_index(t)
+        return res.t[k], res.q[k], res.qd[k]
+    return at
+
+
+def _signals(table: dict, what: str, keywords) -> list:
+    """The model's inputs or outputs in the order of k, which must run 1, 2, ... without gaps."""
+    ks = sorted(table)
+    if ks != list(range(1, len(ks) + 1)):
+        missing = sorted(set(range(1, ks[-1] + 1)) - set(ks))
+        raise InputError(f"state_space: the {what} must be numbered 1, 2, ... without gaps: "
+                         f"{', '.join(map(str, ks))} are defined, {missing[0]} is missing")
+    return [table[k] for k in ks]
+
+
+def _checked(signals, keywords, what) -> list:
+    out = []
+    for s in signals:
+        try:
+            keyword, number, index = s[:3]
+            keyword = str(keyword).upper()
+            ok = keyword in keywords and all(isinstance(v, (int, np.integer)) and not isinstance(v, bool)
+                                             for v in (number, index))
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise InputError(f"state_space: each of the {what} must be (keyword, number, index) with the keyword "
+                             f"one of {', '.join(keywords)}, got {show(s)}")
+        out.append(Signal(keyword, int(number), int(index), getattr(s, "origin", "")))
+    return out
+
+
+def _where(sig: Signal) -> str:
+    return sig.origin or f"{sig.keyword} {sig.number} {sig.index}"
+
+
+def _row(lin: Linearization, sig: Signal) -> tuple:
+    """(DF or DFe, the row of the signal's coordinate or deformation in it)."""
+    on_node = sig.keyword in ("INPUTF", "OUTX", "OUTXP")
+    labels = lin.coordinate_labels if on_node else lin.deformation_labels
+    key = (sig.number, sig.index)
+    if key not in labels:
+        what = "node {} has no coordinate {}" if on_node else "element {} has no deformation {}"
+        raise InputError(f"{_where(sig)}: {what.format(*key)}")
+    return (lin.DF if on_node else lin.DFe), labels.index(key)
+
+
+def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
+    n, k = lin.M0.shape[0], len(getattr(lin, "y_labels", []))
+    z_names = [f"{kind}({a},{b})" for kind, a, b in lin.z_labels]
+    # Generalized forces of the inputs (nz x m).
+    Q = np.zeros((n, len(inputs)))
+    for j, sig in enumerate(inputs):
+        T, r = _row(lin, sig)
+        if not np.any(T[r]):
+            raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
+                             "input coordinate, or a deformation that is not DYNE, released or LINE)")
+        Q[:, j] = T[r] if sig.keyword == "INPUTF" else -T[r]
+    A = lin.state_matrix()
+    B = np.vstack([np.zeros((n + k, len(inputs))), np.linalg.solve(lin.M0, Q)])
+    C = np.zeros((len(outputs), 2 * n + k))
+    rates = [s for s in outputs if s.keyword in ("OUTXP", "OUTEP")]
+    convective = _convective(lin, rates, velocities) if rates else None
+    for i, sig in enumerate(outputs):
+        T, r = _row(lin, sig)
+        if sig.keyword in ("OUTX", "OUTE"):
+            if k:
+                raise InputError(f"{_where(sig)}: position outputs of a nonholonomic model are not available "
+                                 "(their dependence on the kinematic coordinates is not computed); "
+                                 "use the rate (OUTXP, OUTEP)")
+            C[i, :n] = T[r]
+        else:
+            C[i, n + k:] = T[r]
+            C[i, :n] = convective[sig.keyword == "OUTEP"][r]
+    states = z_names + [f"e({a},{b})" for _, a, b in getattr(lin, "y_labels", [])] + \
+        [name.replace("(", "d(", 1) for name in z_names]
+    return StateSpace(A, B, C, np.zeros((len(outputs), len(inputs))), states,
+                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
+                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin)
+
+
+def _convective(lin, rates, velocities):
+    """(∂ẋ/∂z, ∂ė/∂z) at fixed ż: zero at rest; at a moving state central differences of the
+    velocities over the degrees of freedom, with the kinematics re-solved (sim.move_to)."""
+    nx, ne, n = lin.DF.shape[0], lin.DFe.shape[0], lin.M0.shape[0]
+    if velocities is None:
+        moving = None  # a Linearization alone: its velocities are unknown
+    else:
+        sim, (t, q, qd) = velocities
+        moving = bool(np.any(qd))
+    if moving is False:
+        return np.zeros((nx, n)), np.zeros((ne, n))
+    if moving is None or lin.n_line or len(getattr(lin, "y_labels", [])):
+        why = ("a Linearization alone does not give the velocities" if moving is None else
+               "the convective term is computed for holonomic models without LINE parameters only")
+        raise InputError(f"{_where(rates[0])}: a rate output at a moving state needs ∂(DF ż)/∂z: {why}; "
+                         "pass the Model, or linearize at rest")
+    dx, de = np.zeros((nx, n)), np.zeros((ne, n))
+    for j in range(n):
+        h = np.finfo(float).eps ** (1 / 3) * max(abs(q[j]), 1.0)
+        sides = []
+        for sign in (1.0, -1.0):
+            qj = q.copy()
+            qj[j] += sign * h
+            sim.move_to(t, qj, qd)
+            sides.append((np.array(sim.data.xd), np.array(sim.data.ed)))
+        dx[:, j] = (sides[0][0] - sides[1][0]) / (2 * h)
+        de[:, j] = (sides[0][1] - sides[1][1]) / (2 * h)
+    sim.move_to(t, q, qd)
+    return dx, de
+
+
+def _frequencies(freqs, unit) -> np.ndarray:
+    if unit not in ("Hz", "rad/s"):
+        raise InputError(f"unit must be 'Hz' or 'rad/s', got {show(unit)}")
+    try:
+        f = np.asarray(freqs, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError(f"freqs must be numbers, got {show(freqs)}") from None
+    if not np.isfinite(f).all():
+        raise InputError("freqs must be finite numbers")
+    return 2 * np.pi * f if unit == "Hz" else f
