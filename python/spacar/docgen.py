@@ -53,6 +53,8 @@ NOTES = {
     "OUTX": "Outputs and inputs must be numbered 1, 2, ... without gaps; a later line with the same k replaces it.",
     "OUTE": "For nonholonomic models the position outputs OUTX and OUTE are refused (their dependence on the "
             "kinematic coordinates is not computed); the rates OUTXP and OUTEP are available.",
+    "OUTS": "Strain-gauge style: σ = S e + D ė, dual to e as the stresses of FORCEMODE (the stress of a "
+            "beam's bending deformation is a moment divided by l0).",
     "END": "At the first END the automatic L2MIN1 elements and the reference geometry are made and the "
            "topology is frozen; then the model is assembled and analysed, and the dump is printed.",
     "EOF": "Text after EOF is an error.",

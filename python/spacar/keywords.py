@@ -168,6 +168,8 @@ _OTHER = [
             extension=True),
     Keyword("OUTEP", STATE_SPACE, (_p("k"), _p("e"), _p("i")), "output k is the rate of deformation i of element e",
             extension=True),
+    Keyword("OUTS", STATE_SPACE, (_p("k"), _p("e"), _p("i")),
+            "output k is the stress of deformation i of element e (a DYNE or released deformation)", extension=True),
     Keyword("EOF", CONTROL, (), "logical end of the input"),
     Keyword("END", CONTROL, (), "end of a block: the analysis runs, the state dump is printed"),
 ]

@@ -333,6 +333,10 @@ class Model:
         """OUTEP k e i: state-space output k is the rate of deformation i of element e."""
         self._signal("OUTEP", (k, e, i), self.state_space_outputs)
 
+    def outs(self, k, e, i):
+        """OUTS k e i: state-space output k is the stress of deformation i of element e."""
+        self._signal("OUTS", (k, e, i), self.state_space_outputs)
+
     # --- settings ---------------------------------------------------------------------------
 
     def timestep(self, n, tp):

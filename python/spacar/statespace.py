@@ -5,8 +5,8 @@
 in the minimal coordinates of :mod:`spacar.linearize` — z the degrees of freedom (and LINE
 parameters), y^k the kinematic coordinates of nonholonomic constraints, no constraint states.
 The inputs u are forces on nodal coordinates (INPUTF) and actuator stresses on deformations
-(INPUTS); the outputs y are nodal coordinates (OUTX), deformations (OUTE) and their rates (OUTXP,
-OUTEP). They enter through the first-order transfer functions DF = ∂x/∂z and DFe = ∂e/∂z: a
+(INPUTS); the outputs y are nodal coordinates (OUTX), deformations (OUTE), their rates (OUTXP,
+OUTEP) and the stresses of elastic deformations (OUTS). They enter through the first-order transfer functions DF = ∂x/∂z and DFe = ∂e/∂z: a
 force f on a coordinate does the virtual work f δx = f DF δz, so its generalized force is DFᵀ f;
 a stress σ does σ δe on the deformation and loads the coordinates by −DFeᵀ σ (the sign of the
 elements' own stresses: σ > 0 is tension).
@@ -15,21 +15,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _core
 from ._util import show
 from .errors import InputError
 from .linearize import Linearization, linearized_simulation
 from .model import Model, Signal
 
 INPUT_KEYWORDS = ("INPUTF", "INPUTS")
-OUTPUT_KEYWORDS = ("OUTX", "OUTXP", "OUTE", "OUTEP")
-_NAMES = {"INPUTF": "f", "INPUTS": "sigma", "OUTX": "x", "OUTXP": "xd", "OUTE": "e", "OUTEP": "ed"}
+OUTPUT_KEYWORDS = ("OUTX", "OUTXP", "OUTE", "OUTEP", "OUTS")
+_NAMES = {"INPUTF": "f", "INPUTS": "sigma", "OUTX": "x", "OUTXP": "xd", "OUTE": "e", "OUTEP": "ed", "OUTS": "sigma"}
 
 
 class StateSpace:
     """A linear time-invariant model ds/dt = A s + B u, y = C s + D u (NumPy arrays) with the
     labels of its states, inputs and outputs (``"x(2,1)"``: coordinate 1 of node 2, ``"xd(2,1)"``
     its rate, ``"e(3,2)"``/``"ed(3,2)"`` a deformation and its rate, ``"f(2,1)"`` a force input,
-    ``"sigma(3,2)"`` a stress input). ``t`` is the time of the state linearized about and
+    ``"sigma(3,2)"`` a stress input or output). ``t`` is the time of the state linearized about and
     ``linearization`` the :class:`spacar.Linearization` it was built from. Time in seconds:
     poles in rad/s."""
 
@@ -123,11 +124,11 @@ def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
     or ``(res, t)`` for the state of the results ``res`` at its output time nearest to t.
     ``inputs``/``outputs``: lists of ``(keyword, number, index)``, e.g. ``[("INPUTF", 2, 1)]``,
     ``[("OUTX", 2, 1), ("OUTXP", 2, 1)]``; default the model's INPUTF/INPUTS and
-    OUTX/OUTXP/OUTE/OUTEP lines in the order of their k.
+    OUTX/OUTXP/OUTE/OUTEP/OUTS lines in the order of their k.
 
-    Rate outputs at a moving state include the convective term ∂(DF ż)/∂z, which needs the model
-    (central differences of the velocities) and is computed for holonomic models without LINE
-    parameters; otherwise they are refused there."""
+    Rate outputs at a moving state include the convective term ∂(DF ż)/∂z, and stress outputs
+    need ∂σ/∂z and ∂σ/∂ż: both come from central differences on the Model, for holonomic models
+    without LINE parameters; otherwise they are refused."""
     if isinstance(source, Linearization):
         if at is not None:
             raise InputError("state_space: `at` applies to a Model; a Linearization is already at its state")
@@ -212,19 +213,20 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
     A = lin.state_matrix()
     B = np.vstack([np.zeros((n + k, len(inputs))), np.linalg.solve(lin.M0, Q)])
     C = np.zeros((len(outputs), 2 * n + k))
-    rates = [s for s in outputs if s.keyword in ("OUTXP", "OUTEP")]
-    convective = _convective(lin, rates, velocities) if rates else None
+    sens = _sensitivities(lin, outputs, velocities)
     for i, sig in enumerate(outputs):
         T, r = _row(lin, sig)
+        if k and sig.keyword in ("OUTX", "OUTE", "OUTS"):
+            raise InputError(f"{_where(sig)}: position and stress outputs of a nonholonomic model are not "
+                             "available (their dependence on the kinematic coordinates is not computed); "
+                             "use a rate (OUTXP, OUTEP)")
         if sig.keyword in ("OUTX", "OUTE"):
-            if k:
-                raise InputError(f"{_where(sig)}: position outputs of a nonholonomic model are not available "
-                                 "(their dependence on the kinematic coordinates is not computed); "
-                                 "use the rate (OUTXP, OUTEP)")
             C[i, :n] = T[r]
-        else:
+        elif sig.keyword in ("OUTXP", "OUTEP"):
             C[i, n + k:] = T[r]
-            C[i, :n] = convective[sig.keyword == "OUTEP"][r]
+            C[i, :n] = sens["xd" if sig.keyword == "OUTXP" else "ed"][r]
+        else:
+            C[i, :n], C[i, n + k:] = sens["sigma"][r], sens["sigma_d"][r]
     states = z_names + [f"e({a},{b})" for _, a, b in getattr(lin, "y_labels", [])] + \
         [name.replace("(", "d(", 1) for name in z_names]
     return StateSpace(A, B, C, np.zeros((len(outputs), len(inputs))), states,
@@ -232,35 +234,55 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin)
 
 
-def _convective(lin, rates, velocities):
-    """(∂ẋ/∂z, ∂ė/∂z) at fixed ż: zero at rest; at a moving state central differences of the
-    velocities over the degrees of freedom, with the kinematics re-solved (sim.move_to)."""
+def _sensitivities(lin, outputs, velocities) -> dict:
+    """What the outputs need beyond DF and DFe, at fixed ż: "xd", "ed" (∂ẋ/∂z, ∂ė/∂z, the
+    convective terms of the rates: zero at rest) and "sigma", "sigma_d" (∂σ/∂z, ∂σ/∂ż of the
+    stresses). Those not zero come from central differences over the degrees of freedom and
+    their rates, with the kinematics re-solved (sim.move_to) and the stresses evaluated."""
     nx, ne, n = lin.DF.shape[0], lin.DFe.shape[0], lin.M0.shape[0]
-    if velocities is None:
-        moving = None  # a Linearization alone: its velocities are unknown
-    else:
-        sim, (t, q, qd) = velocities
-        moving = bool(np.any(qd))
-    if moving is False:
-        return np.zeros((nx, n)), np.zeros((ne, n))
-    if moving is None or lin.n_line or len(getattr(lin, "y_labels", [])):
-        why = ("a Linearization alone does not give the velocities" if moving is None else
-               "the convective term is computed for holonomic models without LINE parameters only")
-        raise InputError(f"{_where(rates[0])}: a rate output at a moving state needs ∂(DF ż)/∂z: {why}; "
-                         "pass the Model, or linearize at rest")
-    dx, de = np.zeros((nx, n)), np.zeros((ne, n))
+    out = {"xd": np.zeros((nx, n)), "ed": np.zeros((ne, n))}
+    stresses = [s for s in outputs if s.keyword == "OUTS"]
+    rates = [s for s in outputs if s.keyword in ("OUTXP", "OUTEP")]
+    # at rest (ż = 0) the convective terms vanish; a Linearization alone does not say
+    at_rest = velocities is not None and not np.any(velocities[1][2])
+    needed = stresses + ([] if at_rest else rates)
+    if not needed:
+        return out
+    first = needed[0]
+    if velocities is None or lin.n_line or len(getattr(lin, "y_labels", [])):
+        what = "a stress output" if first.keyword == "OUTS" else "a rate output at a moving state"
+        why = ("a Linearization alone cannot be re-evaluated: pass the Model" if velocities is None else
+               "they are computed for holonomic models without LINE parameters only")
+        raise InputError(f"{_where(first)}: {what} needs differences of the velocities or stresses; {why}")
+    sim, (t, q, qd) = velocities
+    for sig in stresses:
+        c = sim.system.def_class[lin.deformation_labels.index((sig.number, sig.index))]
+        if c not in (_core.DefClass.released, _core.DefClass.dynamic):
+            raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
+                             "constitutive, σ = S e + D ė); this one is a reaction stress")
+
+    def at(qj, qdj):
+        sim.move_to(t, qj, qdj)
+        if stresses:
+            sim.forces()
+        return np.array(sim.data.xd), np.array(sim.data.ed), np.array(sim.data.sigma)
+
+    eps = np.finfo(float).eps ** (1 / 3)
+    out["sigma"], out["sigma_d"] = np.zeros((ne, n)), np.zeros((ne, n))
     for j in range(n):
-        h = np.finfo(float).eps ** (1 / 3) * max(abs(q[j]), 1.0)
-        sides = []
-        for sign in (1.0, -1.0):
-            qj = q.copy()
-            qj[j] += sign * h
-            sim.move_to(t, qj, qd)
-            sides.append((np.array(sim.data.xd), np.array(sim.data.ed)))
-        dx[:, j] = (sides[0][0] - sides[1][0]) / (2 * h)
-        de[:, j] = (sides[0][1] - sides[1][1]) / (2 * h)
+        h = eps * max(abs(q[j]), 1.0)
+        dq = np.zeros(n)
+        dq[j] = h
+        plus, minus = at(q + dq, qd), at(q - dq, qd)
+        out["xd"][:, j], out["ed"][:, j], out["sigma"][:, j] = ((a - b) / (2 * h) for a, b in zip(plus, minus))
+        if stresses:
+            h = eps * max(abs(qd[j]), 1.0)
+            dq[j] = h
+            out["sigma_d"][:, j] = (at(q, qd + dq)[2] - at(q, qd - dq)[2]) / (2 * h)
     sim.move_to(t, q, qd)
-    return dx, de
+    if at_rest:
+        out["xd"][:], out["ed"][:] = 0.0, 0.0
+    return out
 
 
 def _frequencies(freqs, unit) -> np.ndarray:

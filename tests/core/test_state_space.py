@@ -115,6 +115,27 @@ def test_damped_oscillator_frequency_response_is_the_closed_form():
                                    -zeta * wn + 1j * wn * np.sqrt(1 - zeta**2)], rel=1e-12)
 
 
+@pytest.mark.parametrize("state", [None, (0.0, [1.1], [0.3])])
+def test_stress_output_is_the_spring_damper_force(state):
+    mass, k, c = 2.0, 50.0, 0.7
+    m = oscillator(mass, k, c)
+    m.outs(5, 1, 1)
+    ss = spacar.state_space(m, at=state)
+    assert ss.output_labels[4] == "sigma(1,1)"
+    np.testing.assert_allclose(ss.C[4], [k, c], rtol=1e-9)   # σ = k e + c ė of a unit-length truss
+    w = 2 * np.pi * np.array([0.1, 1.0, 3.0])
+    H = ss.frequency_response(w, unit="rad/s")
+    np.testing.assert_allclose(H[:, 4, 0], (k + 1j * c * w) / (k - mass * w**2 + 1j * c * w), rtol=1e-9)
+
+
+def test_stress_output_needs_a_constitutive_deformation_and_the_model():
+    m = pendulum()
+    with pytest.raises(spacar.InputError, match="OUTS needs a DYNE or released deformation"):
+        spacar.state_space(m, inputs=[], outputs=[("OUTS", 1, 1)])
+    with pytest.raises(spacar.InputError, match="a stress output needs differences .* pass the Model"):
+        spacar.state_space(spacar.linearize(oscillator()), inputs=[], outputs=[("OUTS", 1, 1)])
+
+
 def test_rate_outputs_at_a_moving_state_include_the_convective_term():
     L, th, om = 0.8, 0.6, 2.5
     ss = spacar.state_space(pendulum(L), at=(0.0, [th], [om]))
@@ -190,7 +211,7 @@ def test_nonholonomic_model_inputs_and_rate_outputs():
     assert ss.A.shape == (2 * nz + nk,) * 2
     np.testing.assert_allclose(ss.poles(), lin.eigenvalues(), rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(ss.B[nz + nk:, 0], np.linalg.solve(lin.M0, lin.DF[lin.coordinate_labels.index((node, comp))]))
-    with pytest.raises(spacar.InputError, match="position outputs of a nonholonomic model"):
+    with pytest.raises(spacar.InputError, match="position and stress outputs of a nonholonomic model"):
         spacar.state_space(lin, inputs=[], outputs=[("OUTX", node, comp)])
 
 

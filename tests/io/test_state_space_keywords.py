@@ -29,6 +29,7 @@ OUTX 1 3 1
 OUTXP 2 3 1
 OUTE 4 2 1
 OUTEP 3 2 1
+OUTS 5 1 1
 END
 """
 
@@ -37,7 +38,7 @@ def test_keywords_are_read_into_the_model():
     m = spacar.read_string(TEXT, "chain.dat")
     assert {k: s[:3] for k, s in m.state_space_inputs.items()} == {1: ("INPUTS", 1, 1), 2: ("INPUTF", 3, 1)}
     assert {k: s[:3] for k, s in m.state_space_outputs.items()} == {
-        1: ("OUTX", 3, 1), 2: ("OUTXP", 3, 1), 3: ("OUTEP", 2, 1), 4: ("OUTE", 2, 1)}
+        1: ("OUTX", 3, 1), 2: ("OUTXP", 3, 1), 3: ("OUTEP", 2, 1), 4: ("OUTE", 2, 1), 5: ("OUTS", 1, 1)}
     assert m.state_space_inputs[2].origin == "chain.dat, line 17, keyword INPUTF"
 
 
@@ -45,7 +46,7 @@ def test_dump_round_trip():
     m = spacar.read_string(TEXT)
     text = m.dump(digits=17)
     for line in ("INPUTF     2   3   1", "INPUTS     1   1   1", "OUTX       1   3   1", "OUTXP      2   3   1",
-                 "OUTEP      3   2   1", "OUTE       4   2   1"):
+                 "OUTEP      3   2   1", "OUTE       4   2   1", "OUTS       5   1   1"):
         assert line in text.splitlines()
     again = spacar.read_string(text)
     assert {k: s[:3] for k, s in again.state_space_inputs.items()} == {k: s[:3] for k, s in m.state_space_inputs.items()}
@@ -54,7 +55,8 @@ def test_dump_round_trip():
     a, b = spacar.state_space(m), spacar.state_space(again)
     for name in "ABCD":
         np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-12, atol=1e-14)
-    assert a.input_labels == ["sigma(1,1)", "f(3,1)"] and a.output_labels == ["x(3,1)", "xd(3,1)", "ed(2,1)", "e(2,1)"]
+    assert a.input_labels == ["sigma(1,1)", "f(3,1)"] and a.output_labels == ["x(3,1)", "xd(3,1)", "ed(2,1)", "e(2,1)",
+                                                                           "sigma(1,1)"]
     # and the copy keeps them
     assert m.copy().state_space_outputs == m.state_space_outputs
 
