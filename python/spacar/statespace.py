@@ -56,7 +56,11 @@ class StateSpace:
         n = self.A.shape[0]
         out = np.empty((w.size, self.C.shape[0], self.B.shape[1]), dtype=complex)
         for j, wj in enumerate(w):
-            out[j] = self.C @ np.linalg.solve(1j * wj * np.eye(n) - self.A, self.B) + self.D
+            try:
+                out[j] = self.C @ np.linalg.solve(1j * wj * np.eye(n) - self.A, self.B) + self.D
+            except np.linalg.LinAlgError:
+                raise InputError(f"frequency_response: ω = {wj:g} rad/s is a pole of the model (e.g. ω = 0 "
+                                 "with a free rigid-body motion)") from None
         return out
 
     def static_gain(self) -> np.ndarray:
@@ -78,7 +82,7 @@ class StateSpace:
             mag = np.abs(self.poles())
             mag = mag[mag > 1e-9 * max(mag.max(initial=0.0), 1.0)]
             lo, hi = (mag.min() / 10, mag.max() * 10) if mag.size else (0.1, 100.0)
-            freqs, unit = np.logspace(np.log10(lo), np.log10(hi), 500), "rad/s"
+            freqs = np.logspace(np.log10(lo), np.log10(hi), 500) / (1.0 if unit == "rad/s" else 2 * np.pi)
         w = _frequencies(freqs, unit)
         x = w / (2 * np.pi) if unit == "Hz" else w
         H = self.frequency_response(w, unit="rad/s")

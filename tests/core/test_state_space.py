@@ -240,6 +240,10 @@ def test_bad_arguments():
         spacar.state_space(m, inputs=[("FORCE", 2, 1)])
     with pytest.raises(spacar.InputError, match="element 1 has no deformation 2"):
         spacar.state_space(m, outputs=[("OUTE", 1, 2)])
+    with pytest.raises(spacar.InputError, match="ω = 0 rad/s is a pole of the model"):
+        spacar.state_space(pendulum()).frequency_response([0.0])
+    with pytest.raises(spacar.InputError, match="A is singular"):
+        spacar.state_space(pendulum()).static_gain()
     with pytest.raises(spacar.InputError, match="unit must be"):
         spacar.state_space(m).frequency_response([1.0], unit="kHz")
     with pytest.raises(spacar.InputError, match="a rate output at a moving state"):
