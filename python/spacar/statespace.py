@@ -247,8 +247,9 @@ def _sensitivities(lin, outputs, velocities) -> dict:
     out = {"xd": np.zeros((nx, n)), "ed": np.zeros((ne, n))}
     stresses = [s for s in outputs if s.keyword == "OUTS"]
     rates = [s for s in outputs if s.keyword in ("OUTXP", "OUTEP")]
-    # at rest (ż = 0) the convective terms vanish; a Linearization alone does not say
-    at_rest = velocities is not None and not np.any(velocities[1][2])
+    # At rest (no coordinate moving: ż = 0 and the input motions still) the convective terms
+    # vanish; a Linearization alone does not say.
+    at_rest = velocities is not None and not np.any(np.asarray(velocities[0].data.xd))
     needed = stresses + ([] if at_rest else rates)
     if not needed:
         return out

@@ -147,6 +147,25 @@ def test_rate_outputs_at_a_moving_state_include_the_convective_term():
     assert ss.B[1, 0] == pytest.approx(np.cos(th) / (1.5 * L), rel=1e-12)
 
 
+def test_convective_term_of_an_input_motion():
+    """A mass sliding along a rod turned by an input motion at rate Ω (the rod's elongation e1
+    the DOF, r = l0 + e1): ẋ = ṙ cos α − r sin α Ω, ẏ = ṙ sin α + r cos α Ω, so even at ṙ = 0
+    the rates depend on r."""
+    a, r, Om = 0.5, 0.9, 1.7
+    m = spacar.Model()
+    m.plbeam(1, 1, 2, 3, 4)
+    m.x(3, r * np.cos(a), r * np.sin(a))
+    m.fix(1)
+    m.inputx(2, 1)
+    m.xd(2, 1, Om)
+    m.dyne(1, 1)
+    m.mass(3, 1.0)
+    m.outxp(1, 3, 1)
+    m.outxp(2, 3, 2)
+    ss = spacar.state_space(m)
+    np.testing.assert_allclose(ss.C, [[-np.sin(a) * Om, np.cos(a)], [np.cos(a) * Om, np.sin(a)]], rtol=1e-8)
+
+
 def test_state_of_results_and_the_default_state():
     m = pendulum()
     m.xd(2, 1, 1.0)
