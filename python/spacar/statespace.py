@@ -140,8 +140,8 @@ def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
             raise InputError("state_space of a Linearization needs inputs= and outputs= (it has no input lines)")
         lin, velocities = source, None
     elif isinstance(source, Model):
-        inputs = _signals(source.state_space_inputs, "inputs", INPUT_KEYWORDS) if inputs is None else inputs
-        outputs = _signals(source.state_space_outputs, "outputs", OUTPUT_KEYWORDS) if outputs is None else outputs
+        inputs = _signals(source.state_space_inputs, "inputs") if inputs is None else inputs
+        outputs = _signals(source.state_space_outputs, "outputs") if outputs is None else outputs
         lin, sim, state = linearized_simulation(source, _state(at))
         velocities = (sim, state)
     else:
@@ -161,7 +161,7 @@ def _state(at):
     return at
 
 
-def _signals(table: dict, what: str, keywords) -> list:
+def _signals(table: dict, what: str) -> list:
     """The model's inputs or outputs in the order of k, which must run 1, 2, ... without gaps."""
     ks = sorted(table)
     if ks != list(range(1, len(ks) + 1)):
@@ -172,6 +172,8 @@ def _signals(table: dict, what: str, keywords) -> list:
 
 
 def _checked(signals, keywords, what) -> list:
+    if isinstance(signals, (str, bytes)) or not hasattr(signals, "__iter__"):
+        raise InputError(f"state_space: {what} must be a list of (keyword, number, index), got {show(signals)}")
     out = []
     for s in signals:
         try:

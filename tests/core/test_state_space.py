@@ -255,6 +255,8 @@ def test_bad_arguments():
         spacar.state_space("model.dat")
     with pytest.raises(spacar.InputError, match="needs inputs= and outputs="):
         spacar.state_space(spacar.linearize(m))
+    with pytest.raises(spacar.InputError, match="outputs must be a list of"):
+        spacar.state_space(m, outputs=5)
     with pytest.raises(spacar.InputError, match="keyword one of INPUTF, INPUTS"):
         spacar.state_space(m, inputs=[("FORCE", 2, 1)])
     with pytest.raises(spacar.InputError, match="element 1 has no deformation 2"):
