@@ -34,8 +34,12 @@ class StateSpace:
     ``linearization`` the :class:`spacar.Linearization` it was built from. Time in seconds:
     poles in rad/s."""
 
-    def __init__(self, A, B, C, D, state_labels, input_labels, output_labels, t=0.0, linearization=None):
+    def __init__(self, A, B, C, D, state_labels, input_labels, output_labels, t=0.0, linearization=None,
+                 second_order=None):
+        """``second_order``: (M, Dm, K, Q) of the equations A and B come from, without kinematic
+        coordinates; the frequency response then solves them directly."""
         self.A, self.B, self.C, self.D = (np.asarray(m, dtype=float) for m in (A, B, C, D))
+        self._mdk = None if second_order is None else (*second_order, self.A.copy(), self.B.copy())
         self.state_labels = list(state_labels)
         self.input_labels = list(input_labels)
         self.output_labels = list(output_labels)
@@ -53,20 +57,41 @@ class StateSpace:
         (len(freqs), outputs, inputs). ``freqs`` in Hz (``unit="Hz"``, ω = 2π f) or in rad/s
         (``unit="rad/s"``)."""
         w = _frequencies(freqs, unit)
-        n = self.A.shape[0]
         out = np.empty((w.size, self.C.shape[0], self.B.shape[1]), dtype=complex)
+        second_order = self._second_order()
         for j, wj in enumerate(w):
             try:
-                out[j] = self.C @ np.linalg.solve(1j * wj * np.eye(n) - self.A, self.B) + self.D
+                if second_order:
+                    # s = [δz; iω δz] with (K − ω² M + iω Dm) δz = Q u: a system half the size,
+                    # without M⁻¹ (better conditioned for stiff models)
+                    M, Dm, K, Q = second_order
+                    X = np.linalg.solve(K - wj**2 * M + 1j * wj * Dm, Q)
+                    out[j] = self.C @ np.vstack([X, 1j * wj * X]) + self.D
+                else:
+                    out[j] = self.C @ np.linalg.solve(1j * wj * np.eye(self.A.shape[0]) - self.A, self.B) + self.D
             except np.linalg.LinAlgError:
                 raise InputError(f"frequency_response: ω = {wj:g} rad/s is a pole of the model (e.g. ω = 0 "
                                  "with a free rigid-body motion)") from None
         return out
 
+    def _second_order(self):
+        """(M, Dm, K, Q) of M δz̈ + Dm δż + K δz = Q u when the model has no kinematic coordinates
+        and A, B are still those built from them; None otherwise."""
+        if self._mdk is None:
+            return None
+        *mdk, A, B = self._mdk
+        return mdk if np.array_equal(A, self.A) and np.array_equal(B, self.B) else None
+
     def static_gain(self) -> np.ndarray:
         """−C A⁻¹ B + D (outputs × inputs): the static response per unit input; needs a
-        non-singular A (no rigid-body motion, no free kinematic coordinates)."""
+        non-singular A (no rigid-body motion, no free kinematic coordinates). Without kinematic
+        coordinates it is C [K⁻¹ Q; 0] + D, from the stiffness directly."""
+        second_order = self._second_order()
         try:
+            if second_order:
+                _, _, K, Q = second_order
+                X = np.linalg.solve(K, Q)
+                return self.C @ np.vstack([X, np.zeros_like(X)]) + self.D
             return -self.C @ np.linalg.solve(self.A, self.B) + self.D
         except np.linalg.LinAlgError:
             raise InputError("static_gain: A is singular (a free rigid-body motion or kinematic coordinate "
@@ -237,7 +262,8 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
         [name.replace("(", "d(", 1) for name in z_names]
     return StateSpace(A, B, C, np.zeros((len(outputs), len(inputs))), states,
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
-                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin)
+                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin,
+                      None if k else (lin.M0, lin.damping, lin.stiffness, Q))
 
 
 def _sensitivities(lin, outputs, velocities) -> dict:

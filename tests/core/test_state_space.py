@@ -82,6 +82,21 @@ def test_cantilever_static_gain_is_the_tip_compliance():
     assert ss.frequency_response([1e-6])[0, 0, 0] == pytest.approx(gain[0, 0], rel=1e-9)
 
 
+def test_fine_cantilever_keeps_its_static_gain_and_edited_matrices_are_used():
+    """100 elements: K0 spans 8 decades; the response is solved from K − ω²M + iωD (not from
+    M⁻¹K), so the static compliance stays at 1e-12. A changed A is used as it is."""
+    L, EI = 1.2, 2.0
+    ss = spacar.state_space(cantilever(100, L=L, EI=EI))
+    assert ss.static_gain()[0, 0] == pytest.approx(L**3 / (3 * EI), rel=1e-12)
+    assert ss.frequency_response([1e-8])[0, 0, 0].real == pytest.approx(L**3 / (3 * EI), rel=1e-12)
+    small = spacar.state_space(cantilever(3, L=L, EI=EI))
+    small.A = small.A.copy()
+    small.A[6:, 6:] -= 0.1 * np.eye(6)   # extra damping: no longer the linearization's equations
+    w = 2.0
+    expected = small.C @ np.linalg.solve(1j * w * np.eye(12) - small.A, small.B)
+    np.testing.assert_allclose(small.frequency_response([w], unit="rad/s")[0], expected, rtol=1e-12)
+
+
 def test_cantilever_poles_are_the_euler_bernoulli_frequencies():
     L, EI, rhoA = 1.2, 2.0, 3.0
     exact = np.array(BETA) ** 2 * np.sqrt(EI / (rhoA * L**4))
