@@ -147,10 +147,11 @@ class StateSpace:
 def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
     """The state-space model of ``source`` linearized about a state.
 
-    ``source``: a :class:`spacar.Model`, or a :class:`spacar.Linearization` (e.g. one of
-    ``res.linearizations`` of a run with ``LINEAR 1``; ``at`` does not apply). ``at`` (a Model
-    only): None for the model's current state, ``(t, q, qd)`` as for :func:`spacar.linearize`,
-    or ``(res, t)`` for the state of the results ``res`` at its output time nearest to t.
+    ``source``: a :class:`spacar.Model`; a :class:`spacar.Linearization`; or a
+    :class:`spacar.Results` of a run with LINE or ``LINEAR 1``, whose linearization at the output
+    time nearest to ``at`` (default the last) is taken. For a Model, ``at`` is None for the
+    model's current state, ``(t, q, qd)`` as for :func:`spacar.linearize`, or ``(res, t)`` for
+    the state of the results ``res`` at its output time nearest to t.
     ``inputs``/``outputs``: lists of ``(keyword, number, index)``, e.g. ``[("INPUTF", 2, 1)]``,
     ``[("OUTX", 2, 1), ("OUTXP", 2, 1)]``; default the model's INPUTF/INPUTS and
     OUTX/OUTXP/OUTE/OUTEP/OUTS lines in the order of their k.
@@ -158,6 +159,11 @@ def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
     Rate outputs at a moving state include the convective term ∂(DF ż)/∂z, and stress outputs
     need ∂σ/∂z and ∂σ/∂ż: both come from central differences on the Model, for holonomic models
     without LINE parameters; otherwise they are refused."""
+    if hasattr(source, "linearizations") and hasattr(source, "time_index"):  # a spacar.Results
+        if not source.linearizations:
+            raise InputError("state_space: these results have no linearizations (run with LINE or LINEAR 1), "
+                             "or pass the Model with at=(res, t)")
+        source, at = source.linearizations[source.time_index(source.t[-1] if at is None else at)], None
     if isinstance(source, Linearization):
         if at is not None:
             raise InputError("state_space: `at` applies to a Model; a Linearization is already at its state")
@@ -170,7 +176,7 @@ def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
         lin, sim, state = linearized_simulation(source, _state(at))
         velocities = (sim, state)
     else:
-        raise InputError(f"state_space: a spacar.Model or spacar.Linearization, got {show(source)}")
+        raise InputError(f"state_space: a spacar.Model, Linearization or Results, got {show(source)}")
     inputs = _checked(inputs, INPUT_KEYWORDS, "inputs")
     outputs = _checked(outputs, OUTPUT_KEYWORDS, "outputs")
     return _build(lin, inputs, outputs, velocities)

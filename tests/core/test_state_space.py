@@ -192,6 +192,15 @@ def test_state_of_results_and_the_default_state():
     assert a.t == pytest.approx(res.t[k])
     np.testing.assert_allclose(a.C, b.C, rtol=1e-12, atol=1e-14)
     np.testing.assert_allclose(a.A, b.A, rtol=1e-12, atol=1e-14)
+    # results with linearizations (LINEAR 1): the one at the output time
+    m.linear(1)
+    res = spacar.simulate(m.copy())
+    d = spacar.state_space(res, at=res.t[k], inputs=[("INPUTF", 3, 2)], outputs=[("OUTX", 3, 1)])
+    assert d.t == pytest.approx(res.t[k])
+    np.testing.assert_allclose(d.B, b.B, rtol=1e-9)
+    np.testing.assert_allclose(d.C[0], b.C[0], rtol=1e-9, atol=1e-12)
+    with pytest.raises(spacar.InputError, match="have no linearizations"):
+        spacar.state_space(spacar.simulate(pendulum()), inputs=[], outputs=[])
     # default: the model's current state (t = 0, β̇ = 1)
     c = spacar.state_space(m)
     assert c.C[1, 0] == pytest.approx(-0.8 * 1.0, rel=1e-8)
@@ -266,7 +275,7 @@ def test_input_on_a_fixed_coordinate_names_its_line():
 
 def test_bad_arguments():
     m = oscillator()
-    with pytest.raises(spacar.InputError, match="a spacar.Model or spacar.Linearization"):
+    with pytest.raises(spacar.InputError, match="a spacar.Model, Linearization or Results"):
         spacar.state_space("model.dat")
     with pytest.raises(spacar.InputError, match="needs inputs= and outputs="):
         spacar.state_space(spacar.linearize(m))
