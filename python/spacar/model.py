@@ -106,7 +106,7 @@ class Model:
         self._origin = ""      # input line being applied (file, line, keyword), for later messages
         self.output_stem = None  # stem of the MATASC files (None: input file name or "spacar")
         self._matasc_files = {}  # MATASC files created by this model's runs (later blocks append)
-        # State-space inputs and outputs (INPUTF, INPUTS; OUTX, OUTXP, OUTE, OUTEP): {k: Signal}
+        # State-space inputs and outputs (INPUTF, INPUTS; OUTX, OUTXP, OUTE, OUTEP, OUTS): {k: Signal}
         self.state_space_inputs = {}
         self.state_space_outputs = {}
 
