@@ -123,7 +123,7 @@ def dump(model, digits: int = 4) -> str:
     if core.gravity_given:
         out.add("GRAVITY", reals=core.gravity)
     # 9. state-space inputs and outputs
-    for table in (getattr(model, "state_space_inputs", {}), getattr(model, "state_space_outputs", {})):
+    for table in (model.state_space_inputs, model.state_space_outputs):
         for k, sig in sorted(table.items()):
             out.add(sig.keyword, [k, sig.number, sig.index])
     # 10. settings
