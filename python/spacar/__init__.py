@@ -37,6 +37,7 @@ from .geometry import Geometry
 from .results import Results
 from .simulate import simulate
 from .statics import StaticError, static
+from .statespace import StateSpace, state_space
 from .sweep import SweepError, SweepResult, sweep
 from .urdf import from_urdf
 
@@ -112,6 +113,8 @@ __all__ = [
     "SweepError",
     "linearize",
     "Linearization",
+    "state_space",
+    "StateSpace",
     "summary",
     "check",
     "Check",

@@ -78,6 +78,7 @@ ELEMENTS, NODES, BOUNDARY, INITIAL, PROPERTIES, SETTINGS, CONTROL = (
     "Settings and controls (§5.6)",
     "Input control",
 )
+STATE_SPACE = "State-space inputs and outputs"
 
 
 def _element_keywords():
@@ -152,6 +153,23 @@ _OTHER = [
     Keyword("RESTART", SETTINGS, (_p("flag"),), "0: continue the integrator; 1: restart it"),
     Keyword("LINEAR", SETTINGS, (_p("mode"),),
             "1: linearized equations at every output time; 2: also buckling factors", extension=True),
+    # The inputs u and outputs y of spacar.state_space (modern SPACAR's names; see
+    # docs/linearization.md): k numbers them 1, 2, ... in the order of u and y.
+    Keyword("INPUTF", STATE_SPACE, (_p("k"), _p("n"), _p("i")),
+            "input k is a force on coordinate i of node n (in the directions of FORCE)", extension=True),
+    Keyword("INPUTS", STATE_SPACE, (_p("k"), _p("e"), _p("i")),
+            "input k is an actuator stress on deformation i of element e (a DYNE, released or LINE deformation)",
+            extension=True),
+    Keyword("OUTX", STATE_SPACE, (_p("k"), _p("n"), _p("i")), "output k is coordinate i of node n",
+            extension=True),
+    Keyword("OUTXP", STATE_SPACE, (_p("k"), _p("n"), _p("i")), "output k is the rate of coordinate i of node n",
+            extension=True),
+    Keyword("OUTE", STATE_SPACE, (_p("k"), _p("e"), _p("i")), "output k is deformation i of element e",
+            extension=True),
+    Keyword("OUTEP", STATE_SPACE, (_p("k"), _p("e"), _p("i")), "output k is the rate of deformation i of element e",
+            extension=True),
+    Keyword("OUTS", STATE_SPACE, (_p("k"), _p("e"), _p("i")),
+            "output k is the stress of deformation i of element e (a DYNE or released deformation)", extension=True),
     Keyword("EOF", CONTROL, (), "logical end of the input"),
     Keyword("END", CONTROL, (), "end of a block: the analysis runs, the state dump is printed"),
 ]

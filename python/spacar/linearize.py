@@ -172,6 +172,13 @@ def linearize(model, state=None) -> Linearization:
     DYNE deformations ascending). The mechanism is assembled at the model's current state first
     and then moved continuously to ``state`` (the inputs at time t), so that the calculable
     coordinates stay on the branch of the assembled mechanism."""
+    return linearized_simulation(model, state)[0]
+
+
+def linearized_simulation(model, state=None):
+    """(Linearization, the simulation moved to the state, (t, q, qd) of the state): what
+    :func:`linearize` computes, with the simulation kept for further evaluations about the same
+    state (spacar.state_space differentiates the velocities there)."""
     sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
     sim.assemble()
     system = sim.system
@@ -187,5 +194,6 @@ def linearize(model, state=None) -> Linearization:
             raise InputError("state must be (t, q, qd): a time and two arrays of numbers") from None
         if not (np.isfinite(t) and np.isfinite(q).all() and np.isfinite(qd).all()):
             raise InputError("state (t, q, qd) must hold finite numbers only (no NaN or infinity)")
-    sim.move_to(float(t), np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
-    return Linearization(sim.linearize(), system.coord_label, system.def_label)
+    t, q, qd = float(t), np.array(q, dtype=float), np.array(qd, dtype=float)
+    sim.move_to(t, q, qd)
+    return Linearization(sim.linearize(), system.coord_label, system.def_label), sim, (t, q, qd)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from typing import NamedTuple
 
 import numpy as np
 
@@ -16,6 +17,16 @@ from .errors import InputError
 from .keywords import INT, KEYWORDS, Keyword
 
 _INT_LIMIT = 2**31 - 1
+
+
+class Signal(NamedTuple):
+    """A state-space input or output: its keyword (INPUTF, OUTX, ...), node or element number,
+    component or deformation index, and the input line that defined it (for later messages)."""
+
+    keyword: str
+    number: int
+    index: int
+    origin: str = ""
 
 
 def _check_value(kw: Keyword, pname: str, kind: str, value):
@@ -95,6 +106,9 @@ class Model:
         self._origin = ""      # input line being applied (file, line, keyword), for later messages
         self.output_stem = None  # stem of the MATASC files (None: input file name or "spacar")
         self._matasc_files = {}  # MATASC files created by this model's runs (later blocks append)
+        # State-space inputs and outputs (INPUTF, INPUTS; OUTX, OUTXP, OUTE, OUTEP, OUTS): {k: Signal}
+        self.state_space_inputs = {}
+        self.state_space_outputs = {}
 
     # --- dispatch used by the reader ---------------------------------------------------------
 
@@ -287,6 +301,51 @@ class Model:
         (v,) = self._call("GRAVITY", *g)
         self._core.set_gravity(v)
 
+    # --- state-space inputs and outputs (spacar.state_space) ----------------------------------
+
+    def _signal(self, name, args, table):
+        k, number, index = self._call(name, *args)
+        if k < 1:
+            raise InputError(f"the number k of an input or output must be 1 or more, got {k}")
+        on_node = name in ("INPUTF", "OUTX", "OUTXP")
+        items = self._core.nodes if on_node else self._core.elements
+        what = "node" if on_node else "element"
+        if number not in items:
+            raise InputError(f"{what} {number} does not exist (define it before this line)")
+        count = len(items[number].x if on_node else items[number].cls)
+        if not 1 <= index <= count:
+            part = "coordinate" if on_node else "deformation"
+            raise InputError(f"{what} {number} has {part}s 1..{count}, not {index}")
+        table[k] = Signal(name, number, index, self._origin)
+
+    def inputf(self, k, n, i):
+        """INPUTF k n i: state-space input k is a force on coordinate i of node n."""
+        self._signal("INPUTF", (k, n, i), self.state_space_inputs)
+
+    def inputs(self, k, e, i):
+        """INPUTS k e i: state-space input k is an actuator stress on deformation i of element e."""
+        self._signal("INPUTS", (k, e, i), self.state_space_inputs)
+
+    def outx(self, k, n, i):
+        """OUTX k n i: state-space output k is coordinate i of node n."""
+        self._signal("OUTX", (k, n, i), self.state_space_outputs)
+
+    def outxp(self, k, n, i):
+        """OUTXP k n i: state-space output k is the rate of coordinate i of node n."""
+        self._signal("OUTXP", (k, n, i), self.state_space_outputs)
+
+    def oute(self, k, e, i):
+        """OUTE k e i: state-space output k is deformation i of element e."""
+        self._signal("OUTE", (k, e, i), self.state_space_outputs)
+
+    def outep(self, k, e, i):
+        """OUTEP k e i: state-space output k is the rate of deformation i of element e."""
+        self._signal("OUTEP", (k, e, i), self.state_space_outputs)
+
+    def outs(self, k, e, i):
+        """OUTS k e i: state-space output k is the stress of deformation i of element e."""
+        self._signal("OUTS", (k, e, i), self.state_space_outputs)
+
     # --- settings ---------------------------------------------------------------------------
 
     def timestep(self, n, tp):
@@ -381,6 +440,8 @@ class Model:
         other.warnings = list(self.warnings)
         other._continue_step = self._continue_step
         other.output_stem = self.output_stem
+        other.state_space_inputs = dict(self.state_space_inputs)
+        other.state_space_outputs = dict(self.state_space_outputs)
         for name in ("urdf_joints", "urdf_links"):   # set by spacar.from_urdf
             if hasattr(self, name):
                 setattr(other, name, list(getattr(self, name)) if name == "urdf_joints" else dict(getattr(self, name)))

@@ -122,7 +122,11 @@ def dump(model, digits: int = 4) -> str:
                 out.add(keyword, [nid], getattr(n, attr))
     if core.gravity_given:
         out.add("GRAVITY", reals=core.gravity)
-    # 9. settings
+    # 9. state-space inputs and outputs
+    for table in (model.state_space_inputs, model.state_space_outputs):
+        for k, sig in sorted(table.items()):
+            out.add(sig.keyword, [k, sig.number, sig.index])
+    # 10. settings
     s = core.settings
     out.add("HMAX", reals=[s.hmax])
     out.add("MAXITERAT", [s.maxiterat])

@@ -1,0 +1,336 @@
+"""State-space models of the linearized equations with physical inputs and outputs (issue 22):
+
+    d/dt s = A s + B u,    y = C s + D u,    s = [δz; δy^k; δż]
+
+in the minimal coordinates of :mod:`spacar.linearize` — z the degrees of freedom (and LINE
+parameters), y^k the kinematic coordinates of nonholonomic constraints, no constraint states.
+The inputs u are forces on nodal coordinates (INPUTF) and actuator stresses on deformations
+(INPUTS); the outputs y are nodal coordinates (OUTX), deformations (OUTE), their rates (OUTXP,
+OUTEP) and the stresses of elastic deformations (OUTS). They enter through the first-order transfer functions DF = ∂x/∂z and DFe = ∂e/∂z: a
+force f on a coordinate does the virtual work f δx = f DF δz, so its generalized force is DFᵀ f;
+a stress σ does σ δe on the deformation and loads the coordinates by −DFeᵀ σ (the sign of the
+elements' own stresses: σ > 0 is tension).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+from ._util import show
+from .errors import InputError
+from .linearize import Linearization, linearized_simulation
+from .model import Model, Signal
+
+INPUT_KEYWORDS = ("INPUTF", "INPUTS")
+OUTPUT_KEYWORDS = ("OUTX", "OUTXP", "OUTE", "OUTEP", "OUTS")
+_NAMES = {"INPUTF": "f", "INPUTS": "sigma", "OUTX": "x", "OUTXP": "xd", "OUTE": "e", "OUTEP": "ed", "OUTS": "sigma"}
+
+
+class StateSpace:
+    """A linear time-invariant model ds/dt = A s + B u, y = C s + D u (NumPy arrays) with the
+    labels of its states, inputs and outputs (``"x(2,1)"``: coordinate 1 of node 2, ``"xd(2,1)"``
+    its rate, ``"e(3,2)"``/``"ed(3,2)"`` a deformation and its rate, ``"f(2,1)"`` a force input,
+    ``"sigma(3,2)"`` a stress input or output). ``t`` is the time of the state linearized about and
+    ``linearization`` the :class:`spacar.Linearization` it was built from. Time in seconds:
+    poles in rad/s."""
+
+    def __init__(self, A, B, C, D, state_labels, input_labels, output_labels, t=0.0, linearization=None,
+                 second_order=None):
+        """``second_order``: (M, Dm, K, Q) of the equations A and B come from, without kinematic
+        coordinates; the frequency response then solves them directly."""
+        self.A, self.B, self.C, self.D = (np.asarray(m, dtype=float) for m in (A, B, C, D))
+        self._mdk = None if second_order is None else (*second_order, self.A.copy(), self.B.copy())
+        self.state_labels = list(state_labels)
+        self.input_labels = list(input_labels)
+        self.output_labels = list(output_labels)
+        self.t = float(t)
+        self.linearization = linearization
+
+    def poles(self) -> np.ndarray:
+        """Eigenvalues of A in rad/s (complex), sorted by |Im| and then Re: the eigenvalues of
+        :meth:`spacar.Linearization.eigenvalues`."""
+        lam = np.linalg.eigvals(self.A)
+        return lam[np.lexsort((lam.real, np.abs(lam.imag)))]
+
+    def frequency_response(self, freqs, unit: str = "Hz") -> np.ndarray:
+        """The transfer matrix C (iω I − A)⁻¹ B + D at each frequency, complex, of shape
+        (len(freqs), outputs, inputs). ``freqs`` in Hz (``unit="Hz"``, ω = 2π f) or in rad/s
+        (``unit="rad/s"``)."""
+        w = _frequencies(freqs, unit)
+        out = np.empty((w.size, self.C.shape[0], self.B.shape[1]), dtype=complex)
+        second_order = self._second_order()
+        for j, wj in enumerate(w):
+            try:
+                if second_order:
+                    # s = [δz; iω δz] with (K − ω² M + iω Dm) δz = Q u: a system half the size,
+                    # without M⁻¹ (better conditioned for stiff models)
+                    M, Dm, K, Q = second_order
+                    X = np.linalg.solve(K - wj**2 * M + 1j * wj * Dm, Q)
+                    out[j] = self.C @ np.vstack([X, 1j * wj * X]) + self.D
+                else:
+                    out[j] = self.C @ np.linalg.solve(1j * wj * np.eye(self.A.shape[0]) - self.A, self.B) + self.D
+            except np.linalg.LinAlgError:
+                raise InputError(f"frequency_response: ω = {wj:g} rad/s is a pole of the model (e.g. ω = 0 "
+                                 "with a free rigid-body motion)") from None
+        return out
+
+    def _second_order(self):
+        """(M, Dm, K, Q) of M δz̈ + Dm δż + K δz = Q u when the model has no kinematic coordinates
+        and A, B are still those built from them; None otherwise."""
+        if self._mdk is None:
+            return None
+        *mdk, A, B = self._mdk
+        return mdk if np.array_equal(A, self.A) and np.array_equal(B, self.B) else None
+
+    def static_gain(self) -> np.ndarray:
+        """−C A⁻¹ B + D (outputs × inputs): the static response per unit input; needs a
+        non-singular A (no rigid-body motion, no free kinematic coordinates). Without kinematic
+        coordinates it is C [K⁻¹ Q; 0] + D, from the stiffness directly."""
+        second_order = self._second_order()
+        try:
+            if second_order:
+                _, _, K, Q = second_order
+                X = np.linalg.solve(K, Q)
+                return self.C @ np.vstack([X, np.zeros_like(X)]) + self.D
+            return -self.C @ np.linalg.solve(self.A, self.B) + self.D
+        except np.linalg.LinAlgError:
+            raise InputError("static_gain: A is singular (a free rigid-body motion or kinematic coordinate "
+                             "has no static response)") from None
+
+    def bode(self, freqs=None, unit: str = "Hz"):
+        """A matplotlib figure with the magnitude (log scale) and phase (degrees) of every
+        output/input pair over ``freqs`` (default: a decade below the slowest to a decade above
+        the fastest pole). Returns the figure."""
+        import matplotlib.pyplot as plt  # lazily: `import spacar` stays light
+
+        if freqs is None:
+            mag = np.abs(self.poles())
+            mag = mag[mag > 1e-9 * max(mag.max(initial=0.0), 1.0)]
+            lo, hi = (mag.min() / 10, mag.max() * 10) if mag.size else (0.1, 100.0)
+            freqs = np.logspace(np.log10(lo), np.log10(hi), 500) / (1.0 if unit == "rad/s" else 2 * np.pi)
+        w = _frequencies(freqs, unit)
+        x = w / (2 * np.pi) if unit == "Hz" else w
+        H = self.frequency_response(w, unit="rad/s")
+        fig, (ax_mag, ax_phase) = plt.subplots(2, 1, sharex=True)
+        for i, out in enumerate(self.output_labels):
+            for j, inp in enumerate(self.input_labels):
+                ax_mag.loglog(x, np.abs(H[:, i, j]), label=f"{out} / {inp}")
+                ax_phase.semilogx(x, np.degrees(np.unwrap(np.angle(H[:, i, j]))))
+        ax_mag.set_ylabel("magnitude")
+        ax_phase.set_ylabel("phase [deg]")
+        ax_phase.set_xlabel(f"frequency [{unit}]")
+        if self.input_labels and self.output_labels:
+            ax_mag.legend()
+        return fig
+
+    def to_scipy(self):
+        """The model as a ``scipy.signal.StateSpace``."""
+        import scipy.signal
+
+        return scipy.signal.StateSpace(self.A, self.B, self.C, self.D)
+
+    def to_control(self):
+        """The model as a ``control.StateSpace`` of python-control (the optional extra
+        ``spacar[control]``), with the labels as its signal names."""
+        try:
+            import control
+        except ImportError:
+            raise ImportError("to_control needs python-control: pip install 'spacar[control]'") from None
+        return control.ss(self.A, self.B, self.C, self.D, states=self.state_labels,
+                          inputs=self.input_labels, outputs=self.output_labels)
+
+    def __repr__(self):
+        return (f"<spacar.StateSpace at t = {self.t:g}: {len(self.state_labels)} states, "
+                f"{len(self.input_labels)} inputs, {len(self.output_labels)} outputs>")
+
+
+def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
+    """The state-space model of ``source`` linearized about a state.
+
+    ``source``: a :class:`spacar.Model`; a :class:`spacar.Linearization`; or a
+    :class:`spacar.Results` of a run with LINE or ``LINEAR 1``, whose linearization at the output
+    time nearest to ``at`` (default the last) is taken. For a Model, ``at`` is None for the
+    model's current state, ``(t, q, qd)`` as for :func:`spacar.linearize`, or ``(res, t)`` for
+    the state of the results ``res`` at its output time nearest to t.
+    ``inputs``/``outputs``: lists of ``(keyword, number, index)``, e.g. ``[("INPUTF", 2, 1)]``,
+    ``[("OUTX", 2, 1), ("OUTXP", 2, 1)]``; default the model's INPUTF/INPUTS and
+    OUTX/OUTXP/OUTE/OUTEP/OUTS lines in the order of their k.
+
+    Rate outputs at a moving state include the convective term ∂(DF ż)/∂z, and stress outputs
+    need ∂σ/∂z and ∂σ/∂ż: both come from central differences on the Model, for holonomic models
+    without LINE parameters; otherwise they are refused."""
+    if hasattr(source, "linearizations") and hasattr(source, "time_index"):  # a spacar.Results
+        if not source.linearizations:
+            raise InputError("state_space: these results have no linearizations (run with LINE or LINEAR 1), "
+                             "or pass the Model with at=(res, t)")
+        source, at = source.linearizations[source.time_index(source.t[-1] if at is None else at)], None
+    if isinstance(source, Linearization):
+        if at is not None:
+            raise InputError("state_space: `at` applies to a Model; a Linearization is already at its state")
+        if inputs is None or outputs is None:
+            raise InputError("state_space of a Linearization needs inputs= and outputs= (it has no input lines)")
+        lin, velocities = source, None
+    elif isinstance(source, Model):
+        inputs = _signals(source.state_space_inputs, "inputs") if inputs is None else inputs
+        outputs = _signals(source.state_space_outputs, "outputs") if outputs is None else outputs
+        lin, sim, state = linearized_simulation(source, _state(at))
+        velocities = (sim, state)
+    else:
+        raise InputError(f"state_space: a spacar.Model, Linearization or Results, got {show(source)}")
+    inputs = _checked(inputs, INPUT_KEYWORDS, "inputs")
+    outputs = _checked(outputs, OUTPUT_KEYWORDS, "outputs")
+    return _build(lin, inputs, outputs, velocities)
+
+
+def _state(at):
+    if at is None:
+        return None
+    if isinstance(at, tuple) and len(at) == 2 and hasattr(at[0], "time_index"):
+        res, t = at
+        k = res.time_index(t)
+        return res.t[k], res.q[k], res.qd[k]
+    return at
+
+
+def _signals(table: dict, what: str) -> list:
+    """The model's inputs or outputs in the order of k, which must run 1, 2, ... without gaps."""
+    ks = sorted(table)
+    if ks != list(range(1, len(ks) + 1)):
+        missing = sorted(set(range(1, ks[-1] + 1)) - set(ks))
+        raise InputError(f"state_space: the {what} must be numbered 1, 2, ... without gaps: "
+                         f"{', '.join(map(str, ks))} are defined, {missing[0]} is missing")
+    return [table[k] for k in ks]
+
+
+def _checked(signals, keywords, what) -> list:
+    if isinstance(signals, (str, bytes)) or not hasattr(signals, "__iter__"):
+        raise InputError(f"state_space: {what} must be a list of (keyword, number, index), got {show(signals)}")
+    out = []
+    for s in signals:
+        try:
+            keyword, number, index = s[:3]
+            keyword = str(keyword).upper()
+            ok = keyword in keywords and all(isinstance(v, (int, np.integer)) and not isinstance(v, bool)
+                                             for v in (number, index))
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise InputError(f"state_space: each of the {what} must be (keyword, number, index) with the keyword "
+                             f"one of {', '.join(keywords)}, got {show(s)}")
+        out.append(Signal(keyword, int(number), int(index), getattr(s, "origin", "")))
+    return out
+
+
+def _where(sig: Signal) -> str:
+    return sig.origin or f"{sig.keyword} {sig.number} {sig.index}"
+
+
+def _row(lin: Linearization, sig: Signal) -> tuple:
+    """(DF or DFe, the row of the signal's coordinate or deformation in it)."""
+    on_node = sig.keyword in ("INPUTF", "OUTX", "OUTXP")
+    labels = lin.coordinate_labels if on_node else lin.deformation_labels
+    key = (sig.number, sig.index)
+    if key not in labels:
+        what = "node {} has no coordinate {}" if on_node else "element {} has no deformation {}"
+        raise InputError(f"{_where(sig)}: {what.format(*key)}")
+    return (lin.DF if on_node else lin.DFe), labels.index(key)
+
+
+def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
+    n, k = lin.M0.shape[0], len(getattr(lin, "y_labels", []))
+    z_names = [f"{kind}({a},{b})" for kind, a, b in lin.z_labels]
+    # Generalized forces of the inputs (nz x m).
+    Q = np.zeros((n, len(inputs)))
+    for j, sig in enumerate(inputs):
+        T, r = _row(lin, sig)
+        if not np.any(T[r]):
+            raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
+                             "input coordinate, or a deformation that is not DYNE, released or LINE)")
+        Q[:, j] = T[r] if sig.keyword == "INPUTF" else -T[r]
+    A = lin.state_matrix()
+    B = np.vstack([np.zeros((n + k, len(inputs))), np.linalg.solve(lin.M0, Q)])
+    C = np.zeros((len(outputs), 2 * n + k))
+    sens = _sensitivities(lin, outputs, velocities)
+    for i, sig in enumerate(outputs):
+        T, r = _row(lin, sig)
+        if k and sig.keyword in ("OUTX", "OUTE", "OUTS"):
+            raise InputError(f"{_where(sig)}: position and stress outputs of a nonholonomic model are not "
+                             "available (their dependence on the kinematic coordinates is not computed); "
+                             "use a rate (OUTXP, OUTEP)")
+        if sig.keyword in ("OUTX", "OUTE"):
+            C[i, :n] = T[r]
+        elif sig.keyword in ("OUTXP", "OUTEP"):
+            C[i, n + k:] = T[r]
+            C[i, :n] = sens["xd" if sig.keyword == "OUTXP" else "ed"][r]
+        else:
+            C[i, :n], C[i, n + k:] = sens["sigma"][r], sens["sigma_d"][r]
+    states = z_names + [f"e({a},{b})" for _, a, b in getattr(lin, "y_labels", [])] + \
+        [name.replace("(", "d(", 1) for name in z_names]
+    return StateSpace(A, B, C, np.zeros((len(outputs), len(inputs))), states,
+                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
+                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin,
+                      None if k else (lin.M0, lin.damping, lin.stiffness, Q))
+
+
+def _sensitivities(lin, outputs, velocities) -> dict:
+    """What the outputs need beyond DF and DFe, at fixed ż: "xd", "ed" (∂ẋ/∂z, ∂ė/∂z, the
+    convective terms of the rates: zero at rest) and "sigma", "sigma_d" (∂σ/∂z, ∂σ/∂ż of the
+    stresses). Those not zero come from central differences over the degrees of freedom and
+    their rates, with the kinematics re-solved (sim.move_to) and the stresses evaluated."""
+    nx, ne, n = lin.DF.shape[0], lin.DFe.shape[0], lin.M0.shape[0]
+    out = {"xd": np.zeros((nx, n)), "ed": np.zeros((ne, n))}
+    stresses = [s for s in outputs if s.keyword == "OUTS"]
+    rates = [s for s in outputs if s.keyword in ("OUTXP", "OUTEP")]
+    # At rest (no coordinate moving: ż = 0 and the input motions still) the convective terms
+    # vanish; a Linearization alone does not say.
+    at_rest = velocities is not None and not np.any(np.asarray(velocities[0].data.xd))
+    needed = stresses + ([] if at_rest else rates)
+    if not needed:
+        return out
+    first = needed[0]
+    if velocities is None or lin.n_line or len(getattr(lin, "y_labels", [])):
+        what = "a stress output" if first.keyword == "OUTS" else "a rate output at a moving state"
+        why = ("a Linearization alone cannot be re-evaluated: pass the Model" if velocities is None else
+               "they are computed for holonomic models without LINE parameters only")
+        raise InputError(f"{_where(first)}: {what} needs differences of the velocities or stresses; {why}")
+    sim, (t, q, qd) = velocities
+    for sig in stresses:
+        c = sim.system.def_class[lin.deformation_labels.index((sig.number, sig.index))]
+        if c not in (_core.DefClass.released, _core.DefClass.dynamic):
+            raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
+                             "constitutive, σ = S e + D ė); this one is a reaction stress")
+
+    def at(qj, qdj):
+        sim.move_to(t, qj, qdj)
+        if stresses:
+            sim.forces()
+        return np.array(sim.data.xd), np.array(sim.data.ed), np.array(sim.data.sigma)
+
+    eps = np.finfo(float).eps ** (1 / 3)
+    out["sigma"], out["sigma_d"] = np.zeros((ne, n)), np.zeros((ne, n))
+    for j in range(n):
+        h = eps * max(abs(q[j]), 1.0)
+        dq = np.zeros(n)
+        dq[j] = h
+        plus, minus = at(q + dq, qd), at(q - dq, qd)
+        out["xd"][:, j], out["ed"][:, j], out["sigma"][:, j] = ((a - b) / (2 * h) for a, b in zip(plus, minus))
+        if stresses:
+            h = eps * max(abs(qd[j]), 1.0)
+            dq[j] = h
+            out["sigma_d"][:, j] = (at(q, qd + dq)[2] - at(q, qd - dq)[2]) / (2 * h)
+    sim.move_to(t, q, qd)
+    if at_rest:
+        out["xd"][:], out["ed"][:] = 0.0, 0.0
+    return out
+
+
+def _frequencies(freqs, unit) -> np.ndarray:
+    if unit not in ("Hz", "rad/s"):
+        raise InputError(f"unit must be 'Hz' or 'rad/s', got {show(unit)}")
+    try:
+        f = np.asarray(freqs, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError(f"freqs must be numbers, got {show(freqs)}") from None
+    if not np.isfinite(f).all():
+        raise InputError("freqs must be finite numbers")
+    return 2 * np.pi * f if unit == "Hz" else f
