@@ -31,26 +31,8 @@ Model model_from_pickle(const py::tuple& state) {
   return model_from_state(s);
 }
 
-const char* class_name(CoordClass c) {
-  switch (c) {
-    case CoordClass::Fixed: return "fixed";
-    case CoordClass::Input: return "input";
-    case CoordClass::Dynamic: return "dynamic";
-    default: return "calculable";
-  }
-}
-
-const char* class_name(DefClass c) {
-  switch (c) {
-    case DefClass::Released: return "released";
-    case DefClass::Input: return "input";
-    case DefClass::Dynamic: return "dynamic";
-    case DefClass::Linearization: return "linearization";
-    case DefClass::Nonholonomic: return "nonholonomic";
-    case DefClass::Kinematic: return "kinematic";
-    default: return "fixed";
-  }
-}
+const char* class_name(CoordClass c) { return coord_class_name(c); }
+const char* class_name(DefClass c) { return def_class_name(c); }
 
 // "(0.5, 0)" and "[fixed, dynamic]": the values and classes of a repr.
 template <class V>

@@ -18,11 +18,14 @@ import core.test_cross_spring_pivot as pivot_test  # noqa: E402
 import core.test_flexure_guide as guide_test  # noqa: E402
 
 
-def _with_mesh(module, n):
-    """The module's builder with n elements per leaf (its node numbers depend on N)."""
-    saved = module.N
-    module.N = n
-    return saved
+def _with_mesh(module, build, n):
+    """The model that build() makes with n elements per leaf (the test module's node numbers
+    follow its N)."""
+    saved, module.N = module.N, n
+    try:
+        return build()[0]
+    finally:
+        module.N = saved
 
 
 def _richardson(fine, coarse):
@@ -31,22 +34,13 @@ def _richardson(fine, coarse):
 
 
 def _guide(n, drive):
-    saved = _with_mesh(guide_test, n)
-    try:
-        m, _ = guide_test.leaf_guide("plbeamnl")
-    finally:
-        guide_test.N = saved
-    stage = 2 * n + 1
-    m.force(stage, drive, 0.0)
-    return m, stage
+    m = _with_mesh(guide_test, lambda: guide_test.leaf_guide("plbeamnl"), n)
+    m.force(2 * n + 1, drive, 0.0)
+    return m, 2 * n + 1
 
 
 def _pivot(n, moment):
-    saved = _with_mesh(pivot_test, n)
-    try:
-        m, _ = pivot_test.pivot("plbeamnl")
-    finally:
-        pivot_test.N = saved
+    m = _with_mesh(pivot_test, lambda: pivot_test.pivot("plbeamnl"), n)
     m.force(2 * n + 2, moment)
     return m, 2 * n + 1
 
