@@ -91,6 +91,9 @@ def __dir__():
 
 __all__ = [
     "Model",
+    "Table",
+    "Controller",
+    "Energy",
     "Results",
     "Geometry",
     "plot",
