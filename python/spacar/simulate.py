@@ -63,23 +63,35 @@ def _time_loads(sim, system, forces, inputs):
             if f.components != len(coords):
                 raise InputError(f"forces: node {node} has {len(coords)} coordinates, its table {f.components} "
                                  f"components (one per FORCE value)")
-            tables.append((coords, f._core))
+            tables.append((coords, f.core))
         elif callable(f):
             functions.append((np.array(coords), f, node))
         else:
             raise InputError(f"forces: node {node} needs a spacar.Table or a function f(t), got {show(f)}")
     index = {lbl: g for g, lbl in enumerate(labels)}
-    x_input = list(system.x_input)
+    deformations = {(int(e), int(k)): j for j, (e, k) in enumerate(system.def_label)}
+    x_input, e_input = list(system.x_input), list(system.e_input)
     motions = []
     for key, table in inputs.items():
-        if not (isinstance(key, tuple) and len(key) == 2 and tuple(key) in index):
-            raise InputError(f"inputs: {show(key)} is not a (node, coordinate) of the model")
-        g = index[tuple(key)]
-        if g not in x_input:
-            raise InputError(f"inputs: x{key} is not an input coordinate (INPUTX)")
+        # An input's index in the core: the INPUTX coordinates first, then the INPUTE deformations.
+        if isinstance(key, tuple) and len(key) == 3 and key[0] == "e":
+            name = f"e{key[1:]}"
+            k = deformations.get(tuple(key[1:]))
+            if k is None or k not in e_input:
+                raise InputError(f"inputs: {name} is not an input deformation (INPUTE)")
+            number = len(x_input) + e_input.index(k)
+        elif isinstance(key, tuple) and len(key) == 2 and tuple(key) in index:
+            name = f"x{key}"
+            g = index[tuple(key)]
+            if g not in x_input:
+                raise InputError(f"inputs: {name} is not an input coordinate (INPUTX)")
+            number = x_input.index(g)
+        else:
+            raise InputError(f"inputs: {show(key)} is neither a (node, coordinate) nor an ('e', element, "
+                             f"deformation) of the model")
         if not isinstance(table, Table) or table.components != 1:
-            raise InputError(f"inputs: x{key} needs a spacar.Table of one component (the position)")
-        motions.append((x_input.index(g), table._core))
+            raise InputError(f"inputs: {name} needs a spacar.Table of one component (the position)")
+        motions.append((number, table.core))
     load_function = None
     if functions:
         nx = len(labels)
@@ -140,8 +152,9 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     side: 12 calls per DOP853 step). ``inputs={(node, i): table}`` prescribes the motion of an
     INPUTX coordinate by a table of its position, the rate and acceleration from the table's
     derivatives (a cubic table has continuous accelerations), instead of the block's constant
-    acceleration. ``controller``: a :class:`spacar.Controller`, sampled at its rate with its
-    actuator loads held between samples. These runs take the general path (not ``recursive``).
+    acceleration; ``inputs={("e", e, i): table}`` likewise an INPUTE deformation.
+    ``controller``: a :class:`spacar.Controller`, sampled at its rate with its actuator loads
+    held between samples. These runs take the general path (not ``recursive``).
 
     ``energy=True``: ``res.energy`` (a :class:`spacar.energy.Energy`) holds the kinetic,
     potential, strain energy, the dissipated work and the external work at the output times;

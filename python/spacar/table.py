@@ -40,7 +40,7 @@ class Table:
         if vals.ndim != 2:
             raise InputError(f"Table: values must have one row per time, got shape {np.shape(values)}")
         self.t, self.values, self.kind = times, vals, kind
-        self._core = _core.Table(times, vals, kind)  # checks sizes, finiteness, increasing times
+        self.core = _core.Table(times, vals, kind)  # the C++ table (checks sizes, finiteness, increasing times)
 
     @property
     def components(self) -> int:
@@ -49,7 +49,7 @@ class Table:
     def __call__(self, t, derivative: int = 0):
         if derivative not in (0, 1, 2):
             raise InputError(f"Table: derivative must be 0, 1 or 2, got {show(derivative)}")
-        out = np.array([self._core(float(t), c, derivative) for c in range(self.components)])
+        out = np.array([self.core(float(t), c, derivative) for c in range(self.components)])
         return float(out[0]) if self.scalar else out
 
     def __repr__(self):
