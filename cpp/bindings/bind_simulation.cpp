@@ -6,6 +6,7 @@
 
 #include "bindings.hpp"
 #include "spacar/diagnosis.hpp"
+#include "spacar/errors.hpp"
 #include "spacar/simulate.hpp"
 
 namespace spacar::bindings {
@@ -35,6 +36,12 @@ py::dict block_results_to_dict(BlockResults&& r) {
     switches.append(py::make_tuple(w.t, method_name(w.from), method_name(w.to)));
   d["switches"] = switches;
   d["warnings"] = r.warnings;
+  if (r.energy.size() || r.energy.cols()) {
+    py::dict energy;
+    for (size_t c = 0; c < std::size(kEnergyColumns); ++c)
+      energy[kEnergyColumns[c]] = Eigen::VectorXd(r.energy.col(static_cast<Eigen::Index>(c)));
+    d["energy"] = energy;
+  }
   return d;
 }
 
@@ -42,6 +49,15 @@ py::dict block_results_to_dict(BlockResults&& r) {
 
 void bind_simulation(py::module_& m) {
   m.attr("linearization_arrays") = linearization_arrays();
+  py::class_<Table>(m, "Table", "Values over time interpolated in C++ (table.hpp); spacar.Table wraps it.")
+      .def(py::init([](std::vector<double> t, Eigen::MatrixXd values, const std::string& kind) {
+             if (kind != "linear" && kind != "cubic")
+               throw InputError("Table: kind must be 'linear' or 'cubic', got '" + kind + "'");
+             return Table(std::move(t), std::move(values), kind == "cubic" ? Table::Kind::CUBIC : Table::Kind::LINEAR);
+           }),
+           py::arg("t"), py::arg("values"), py::arg("kind"))
+      .def_property_readonly("components", &Table::components)
+      .def("__call__", &Table::operator(), py::arg("t"), py::arg("component"), py::arg("derivative") = 0);
   py::class_<System>(m, "System")
       .def_readonly("nx", &System::nx)
       .def_readonly("ne", &System::ne)
@@ -135,10 +151,40 @@ void bind_simulation(py::module_& m) {
            "Why the system takes the general path rather than the recursive one ('' if it is a rigid tree).")
       .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))
       .def(
+          "set_time_loads",
+          [](Simulation& s, const std::vector<std::pair<std::vector<int>, Table>>& load_tables,
+             const std::vector<std::pair<int, Table>>& input_tables, py::object load_function) {
+            TimeLoads loads;
+            for (const auto& [coords, table] : load_tables) loads.load_tables.push_back({coords, table});
+            for (const auto& [input, table] : input_tables) loads.input_tables.push_back({input, table});
+            if (!load_function.is_none()) {
+              loads.load_function = [load_function](double t, Eigen::VectorXd& load) {
+                py::gil_scoped_acquire gil;
+                const Eigen::VectorXd f = load_function(t).cast<Eigen::VectorXd>();
+                if (f.size() != load.size()) throw InputError("the load function must return one load per coordinate");
+                load += f;
+              };
+            }
+            s.set_time_loads(std::move(loads));
+          },
+          py::arg("load_tables"), py::arg("input_tables"), py::arg("load_function") = py::none(),
+          "Time-dependent loads ([(coordinates, Table)]), input motions ([(input index, Table)]) and a function "
+          "load_function(t) -> loads (nx) called at every right-hand side.")
+      .def(
           "run",
           [](Simulation& s, py::object on_output, double initial_step, const std::string& method,
-             double time_limit, bool recursive) {
+             double time_limit, bool recursive, double sample_period, py::object on_sample, bool energy) {
             RunOptions opt;
+            opt.energy = energy;
+            opt.sample_period = sample_period;
+            if (!on_sample.is_none()) {
+              opt.on_sample = [on_sample](double t, const Data& d, Eigen::VectorXd& held) {
+                py::gil_scoped_acquire gil;
+                const Eigen::VectorXd f = on_sample(t, d.x, d.xd, d.xdd).cast<Eigen::VectorXd>();
+                if (f.size() != held.size()) throw InputError("the controller must return one load per coordinate");
+                held = f;
+              };
+            }
             opt.recursive = recursive;
             opt.initial_step = initial_step;
             opt.method = parse_method(method);
@@ -167,7 +213,8 @@ void bind_simulation(py::module_& m) {
             return block_results_to_dict(std::move(r));
           },
           py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
-          py::arg("time_limit") = 0.0, py::arg("recursive") = true,
+          py::arg("time_limit") = 0.0, py::arg("recursive") = true, py::arg("sample_period") = 0.0,
+          py::arg("on_sample") = py::none(), py::arg("energy") = false,
           "Run the block; on failure the exception has the results up to the failure as `results`.");
 }
 

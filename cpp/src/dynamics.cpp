@@ -48,6 +48,7 @@ void constitutive_stresses(const System& sys, Data& data) {
 void compute_inertia_and_loads(const System& sys, Data& data) {
   data.h.setZero();
   data.f = sys.force;
+  if (data.time_load.size()) data.f += data.time_load;
   const bool gravity = sys.gravity.squaredNorm() > 0.0;
   if (gravity) {  // on point masses (position coordinates only)
     for (int g = 0; g < sys.nx; ++g) {
@@ -329,7 +330,7 @@ double kinetic_energy(const System& sys, const Data& data) {
   return 0.5 * data.xd.dot(Mv);
 }
 
-double potential_energy(const System& sys, const Data& data) {
+double strain_energy(const System& sys, const Data& data) {
   double V = 0.0;
   for (const SystemElement& se : sys.elements) {
     if (!se.has_constitutive) continue;
@@ -338,20 +339,53 @@ double potential_energy(const System& sys, const Data& data) {
       V += 0.5 * data.e[se.def_offset + a] * se.S.row(a).dot(data.e.segment(se.def_offset, se.nd));
     }
   }
-  if (sys.gravity.squaredNorm() > 0.0) {
-    // Gravity potential −Σ m g·x of point masses and of the element mass points.
-    for (int g = 0; g < sys.nx; ++g) {
-      const NodeKind k = sys.coord_node_kind[g];
-      if (k == NodeKind::XY || k == NodeKind::XYZ)
-        V -= sys.point_mass[g] * sys.gravity[sys.coord_label[g][1] - 1] * data.x[g];
-    }
-    for (size_t i = 0; i < sys.elements.size(); ++i) {
-      const SystemElement& se = sys.elements[i];
-      if (!se.has_mass) continue;
-      V += se.kernel->gravity_potential(data.work[i].x.data(), sys.gravity.data());
-    }
+  return V;
+}
+
+double gravity_potential(const System& sys, const Data& data) {
+  if (sys.gravity.squaredNorm() == 0.0) return 0.0;
+  double V = 0.0;
+  // Gravity potential −Σ m g·x of point masses and of the element mass points.
+  for (int g = 0; g < sys.nx; ++g) {
+    const NodeKind k = sys.coord_node_kind[g];
+    if (k == NodeKind::XY || k == NodeKind::XYZ) V -= sys.point_mass[g] * sys.gravity[sys.coord_label[g][1] - 1] * data.x[g];
+  }
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    if (!se.has_mass) continue;
+    V += se.kernel->gravity_potential(data.work[i].x.data(), sys.gravity.data());
   }
   return V;
+}
+
+double potential_energy(const System& sys, const Data& data) { return strain_energy(sys, data) + gravity_potential(sys, data); }
+
+EnergyRates energy_rates(const System& sys, const Data& data) {
+  EnergyRates r;
+  for (const SystemElement& se : sys.elements) {
+    if (!se.has_constitutive) continue;
+    const auto ed = data.ed.segment(se.def_offset, se.nd);
+    for (int a = 0; a < se.nd; ++a)
+      if (constitutive_class(sys.def_class[se.def_offset + a])) r.dissipated += ed[a] * se.D.row(a).dot(ed);
+  }
+  // Applied loads: FORCE, the time-dependent loads and the body-fixed torques.
+  r.external = sys.force.dot(data.xd);
+  if (data.time_load.size()) r.external += data.time_load.dot(data.xd);
+  for (const auto& [coord, T] : sys.torquel)
+    r.external += (2.0 * euler_G(data.x.data() + coord).transpose() * T).dot(data.xd.segment<4>(coord));
+  // Drivers of input deformations: their reaction stresses against the prescribed rates (fixed
+  // deformations do not move).
+  for (int k = 0; k < sys.ne; ++k)
+    if (!constitutive_class(sys.def_class[k])) r.external -= data.sigma[k] * data.ed[k];
+  // Drivers of input coordinates: the reaction M ẍ + h − f + Bᵀσ on them.
+  if (!sys.x_input.empty()) {
+    Eigen::VectorXd load;
+    inertia_times(sys, data, data.xdd, load);
+    load += data.h - data.f;
+    add_element_loads(sys, data, [](int) { return true; }, load);
+    for (int g : sys.x_input) r.external += load[g] * data.xd[g];
+  }
+  return r;
 }
 
 }  // namespace spacar

@@ -101,6 +101,7 @@ void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
 void Simulation::assemble() {
   const System& sys = *sys_;
   set_inputs(sys, *data_, sys.t0);
+  apply_time_loads(sys.t0);
   set_dofs(sys, *data_, sys.q0.data(), sys.qd0.data());
   check_constraint_counts(sys, *data_);
   solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, true);
@@ -113,6 +114,7 @@ void Simulation::assemble() {
 void Simulation::solve_state(double t, const double* q, const double* qd, bool transfer_predictor) {
   const System& sys = *sys_;
   set_inputs(sys, *data_, t);
+  apply_time_loads(t);
   set_dofs(sys, *data_, q, qd);
   // Predictor of the positions: the first-order transfer function applied to the change of the
   // independent coordinates (states given by the user, when DF of the last state is known), or
@@ -262,8 +264,9 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   check_time(t);
   // The recursive path: q̈ only; the coordinates follow where a general evaluation needs them.
-  if (tree_ && tree_->solve(Y.data(), Y.data() + nd, dY.data() + dY.size() - nd)) {
-    dY.head(nd) = Y.tail(nd);
+  // Y = (q, y, q̇[, energy]): trees have no integrated deformations and no energy states.
+  if (tree_ && tree_->solve(Y.data(), Y.data() + nd + ny, dY.data() + nd + ny)) {
+    dY.head(nd) = Y.segment(nd + ny, nd);
     return;
   }
   struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side
@@ -279,9 +282,55 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
     kinematic_failure_t_ = t;
     throw StepRejected(err.what());
   }
-  dY.head(nd) = Y.tail(nd);
+  dY.head(nd) = Y.segment(nd + ny, nd);
   for (int i = 0; i < ny; ++i) dY[nd + i] = data_->ed[sys_->y_defs[i]];
-  dY.tail(nd) = data_->qdd;
+  dY.segment(nd + ny, nd) = data_->qdd;
+  if (n_energy_) {  // the quadrature states: dissipated and external work
+    const EnergyRates r = energy_rates(*sys_, *data_);
+    dY[2 * nd + ny] = r.dissipated;
+    dY[2 * nd + ny + 1] = r.external;
+  }
+}
+
+void Simulation::set_time_loads(TimeLoads loads) {
+  const System& sys = *sys_;
+  for (const TimeLoads::LoadTable& l : loads.load_tables) {
+    if (static_cast<int>(l.coords.size()) != l.table.components())
+      throw InputError("a load table has " + std::to_string(l.table.components()) + " components for " +
+                       std::to_string(l.coords.size()) + " coordinates");
+    for (int g : l.coords)
+      if (g < 0 || g >= sys.nx) throw InputError("a load table names coordinate " + std::to_string(g) + " of " +
+                                                 std::to_string(sys.nx));
+  }
+  for (const TimeLoads::InputTable& in : loads.input_tables) {
+    if (in.input < 0 || in.input >= sys.n_input())
+      throw InputError("an input table names input " + std::to_string(in.input) + " of " +
+                       std::to_string(sys.n_input()));
+    if (in.table.components() != 1) throw InputError("an input table must have one component (the position)");
+  }
+  timed_ = std::move(loads);
+}
+
+void Simulation::apply_time_loads(double t) {
+  const System& sys = *sys_;
+  Data& d = *data_;
+  const int nxp = static_cast<int>(sys.x_input.size());
+  for (const TimeLoads::InputTable& in : timed_.input_tables) {
+    const int col = sys.input_cols[in.input];
+    d.qhat[col] = in.table(t, 0, 0);
+    d.qhat_d[col] = in.table(t, 0, 1);
+    d.qhat_dd[col] = in.table(t, 0, 2);
+    if (in.input < nxp) d.x[sys.x_input[in.input]] = d.qhat[col];
+  }
+  if (timed_.load_tables.empty() && !timed_.load_function && held_.size() == 0) {
+    d.time_load.resize(0);
+    return;
+  }
+  d.time_load.setZero(sys.nx);
+  for (const TimeLoads::LoadTable& l : timed_.load_tables)
+    for (size_t j = 0; j < l.coords.size(); ++j) d.time_load[l.coords[j]] += l.table(t, static_cast<int>(j));
+  if (timed_.load_function) timed_.load_function(t, d.time_load);
+  if (held_.size()) d.time_load += held_;
 }
 
 bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
@@ -391,6 +440,7 @@ std::string num(double v) {
 void cut_rows(BlockResults& res, int rows) {
   res.t.conservativeResize(rows);
   for (const OutputArray& a : kOutputArrays) (res.*a.rows).conservativeResize(rows, (res.*a.rows).cols());
+  if (res.energy.size()) res.energy.conservativeResize(rows, res.energy.cols());
 }
 
 }  // namespace
@@ -400,6 +450,8 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   res = BlockResults();
   res.warnings = sys_->warnings;
   const BlockPlan plan = plan_block(options, res.warnings);
+  n_energy_ = options.energy ? 2 : 0;
+  held_.resize(0);
   start_clock(options, start);
   allocate_results(res, plan);
   int k_out = 0;
@@ -409,6 +461,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     has_deadline_ = false;
     tree_.reset();
     chain_.reset();
+    held_.resize(0);
   };
   try {
     integrate_block(res, options, plan, k_out);
@@ -425,6 +478,8 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
 Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vector<std::string>& warnings) const {
   if (!(options.time_limit >= 0.0)) throw InputError("the time limit must not be negative");
   if (options.max_steps < 1) throw InputError("the step limit must be positive");
+  if (!(options.sample_period >= 0.0) || !std::isfinite(options.sample_period))
+    throw InputError("the controller's sample period must be a positive number of seconds");
   // The system may be recompiled during the run (repartition): keep copies, not references.
   BlockPlan plan;
   plan.st = sys_->settings;
@@ -441,6 +496,11 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
     throw InputError("TIMESTEP: the output interval Tp/n = " + num(st.timestep_tp / n_out) +
                      " is lost in the rounding of the time t = " + num(t0) + " (TIME)");
   plan.integrate = (sys_->n_dof() > 0 || !sys_->y_defs.empty()) && n_out > 0 && t_end > t0;
+  if (options.energy && !plan.integrate)
+    throw InputError("the energy balance needs an integrated block (degrees of freedom and a TIMESTEP period)");
+  if (options.sample_period > 0.0 && st.timestep_tp / options.sample_period > static_cast<double>(options.max_steps))
+    throw InputError("the controller's sample period " + num(options.sample_period) + " needs more than " +
+                     std::to_string(options.max_steps) + " samples in the block");
   if (plan.integrate) {
     const double h_min = Integrator::min_step(t_end);
     if (st.timestep_tp < h_min)
@@ -488,21 +548,30 @@ void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) cons
   res.t.resize(nt);
   for (const OutputArray& a : kOutputArrays) (res.*a.rows).resize(nt, a.per_deformation ? sys_->ne : sys_->nx);
   res.reaction.setZero();
+  if (n_energy_) res.energy.resize(nt, std::size(kEnergyColumns));
 }
 
 void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out) {
   assemble();
-  tree_ = plan.integrate && options.recursive ? RecursiveTree::detect(*sys_, *data_) : nullptr;
+  // The recursive and explicit-chain paths know neither time-dependent loads nor the energy's
+  // quadrature states.
+  const bool plain = timed_.empty() && !options.energy && options.sample_period == 0.0;
+  tree_ = plan.integrate && options.recursive && plain ? RecursiveTree::detect(*sys_, *data_) : nullptr;
   res.recursive = tree_ != nullptr;
-  chain_ = plan.integrate && options.recursive && !tree_ ? ExplicitChain::detect(*sys_) : nullptr;
+  chain_ = plan.integrate && options.recursive && plain && !tree_ ? ExplicitChain::detect(*sys_) : nullptr;
   if (tree_) {
     base_.xd = base_.xdd = Eigen::VectorXd::Zero(sys_->nx);
     base_.t = plan.t0;
   }
   const Settings& st = plan.st;
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   auto output = [&](double t, const Eigen::VectorXd& Y) {
     check_time(t);
     evaluate_state(t, Y);
+    if (n_energy_) {
+      res.energy.row(k_out) << kinetic_energy(*sys_, *data_), gravity_potential(*sys_, *data_),
+          strain_energy(*sys_, *data_), Y[2 * nd + ny], Y[2 * nd + ny + 1];
+    }
     if (st.forcemode >= 1 || plan.linear) forces();
     else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
     require_finite_state(t);
@@ -511,14 +580,26 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
     if (options.on_output) options.on_output(k_out, *data_, plan.linear ? &res.linearizations.back() : nullptr);
     ++k_out;
   };
-  // State Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
-  Eigen::VectorXd Y(2 * sys_->n_dof() + static_cast<int>(sys_->y_defs.size()));
-  Y << sys_->q0, sys_->y0, sys_->qd0;
+  // State Y = (q, y, q̇, w): DOFs, integrated deformations, DOF rates, and with the energy balance
+  // the dissipated and external work (quadrature states: integrated with the motion, under the
+  // same error control, from the power at every stage; nothing depends on them).
+  Eigen::VectorXd Y(2 * nd + ny + n_energy_);
+  Y << sys_->q0, sys_->y0, sys_->qd0, Eigen::VectorXd::Zero(n_energy_);
   if (!plan.integrate) {
     // Kinematic analysis (or a single analysis at the current time).
     for (double t : plan.times) output(t, Y);
     return;
   }
+  // A digital controller: its loads at a sample from the state there, held until the next.
+  const bool sampled = options.sample_period > 0.0 && options.on_sample;
+  long k_sample = 0;
+  auto sample = [&](double ts) {
+    evaluate_state(ts, Y);
+    Eigen::VectorXd held = Eigen::VectorXd::Zero(sys_->nx);
+    options.on_sample(ts, *data_, held);
+    held_ = held;
+  };
+  if (sampled) sample(plan.t0);
   double t = plan.t0, h = options.initial_step;
   kinematic_failure_.clear();
   // AUTO starts explicit: most mechanisms are not stiff, and DOP853 tells when one is.
@@ -526,18 +607,30 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   Method method = auto_switch ? Method::DOP853 : options.method;
   res.method = method;
   for (;;) {
-    // One segment: integrate until the end, until a free rotation must be repartitioned, or
-    // (AUTO) until the stiffness changes. The step limit holds for the block, whatever the
-    // number of segments.
+    // One segment: integrate until the end (or the next sample of the controller), until a free
+    // rotation must be repartitioned, or (AUTO) until the stiffness changes. The step limit
+    // holds for the block, whatever the number of segments.
     if (res.steps >= options.max_steps)
       throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
                              " steps in the block at t = " + num(t));
-    const std::vector<double> remaining(plan.times.begin() + k_out, plan.times.end());
+    double t_stop = plan.t_end;
+    if (sampled) {
+      const double next = plan.t0 + static_cast<double>(k_sample + 1) * options.sample_period;
+      if (next < plan.t_end - Integrator::min_step(plan.t_end)) t_stop = next;
+    }
+    auto last = plan.times.begin() + k_out;
+    while (last != plan.times.end() && *last <= t_stop) ++last;
+    const std::vector<double> remaining(plan.times.begin() + k_out, last);
     const SegmentEnd end =
-        integrate_segment(res, options, method, auto_switch, st, t, plan.t_end, h, Y, remaining, output);
+        integrate_segment(res, options, method, auto_switch, st, t, t_stop, h, Y, remaining, output);
     h = res.last_step;  // the other integrator continues with the step this one proposed
     if (end.t >= plan.t_end) break;
     t = end.t;
+    if (end.t >= t_stop) {  // a sample of the controller
+      ++k_sample;
+      sample(t);
+      continue;
+    }
     if (end.switch_method) {
       const Method other = method == Method::DOP853 ? Method::RADAU5 : Method::DOP853;
       res.switches.push_back({t, method, other});
@@ -554,8 +647,16 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
                                                      const Integrator::Output& output) {
   if (method == Method::RADAU5) {
     Radau5 integ(static_cast<int>(Y.size()));
-    integ.set_jacobian([this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) { jacobian(tt, y, J); });
-    integ.set_second_order(sys_->n_dof());  // Y = (q, y, q̇): q̇ = dq/dt (jacobian's first rows)
+    integ.set_jacobian([this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
+      jacobian(tt, y, J);
+      if (J.rows() < y.size()) {  // the energy's quadrature states: nothing depends on them
+        Eigen::MatrixXd full = Eigen::MatrixXd::Zero(y.size(), y.size());
+        full.topLeftCorner(J.rows(), J.cols()) = J;
+        J.swap(full);
+      }
+    });
+    // Y = (q, y, q̇): q̇ = dq/dt, the last components (not with the energy's states after them).
+    if (n_energy_ == 0) integ.set_second_order(sys_->n_dof());
     // The Jacobian (a linearization) costs several right-hand sides per DOF: keep it longer.
     integ.set_jacobian_reuse(0.1);
     // Back to DOP853 when its stability bound (|hλ| ≤ 6.1) would allow kExplicitGain times
@@ -578,8 +679,8 @@ Simulation::SegmentEnd Simulation::run_segment(Integ& integ, BlockResults& res, 
                                                const Integrator::Output& output) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   Eigen::VectorXd rtol(Y.size());
-  rtol.head(nd + ny).setConstant(st.epsint);
-  rtol.tail(nd).setConstant(st.epsind);
+  rtol.setConstant(st.epsint);
+  rtol.segment(nd + ny, nd).setConstant(st.epsind);
   integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
   integ.set_max_step(st.hmax);
   integ.set_max_steps(options.max_steps - res.steps);

@@ -20,6 +20,9 @@ from ._util import show as _show
 from . import section
 from .check import Check, Diagnosis, Summary, check, summary
 from .compliance import compliance, support_stiffness
+from .control import Controller
+from .energy import Energy
+from .table import Table
 from .errors import (
     InputError,
     IntegrationError,
@@ -89,6 +92,9 @@ def __dir__():
 
 __all__ = [
     "Model",
+    "Table",
+    "Controller",
+    "Energy",
     "Results",
     "Geometry",
     "plot",

@@ -225,6 +225,15 @@ class Results:
         self.geometry = geometry
 
     @property
+    def energy(self):
+        """The energy balance (a mapping of arrays over the output times, see
+        :class:`spacar.energy.Energy`) of a run with ``spacar.simulate(..., energy=True)``."""
+        energy = self.__dict__.get("_energy")
+        if energy is None:
+            raise InputError("no energy balance: run spacar.simulate(model, energy=True)")
+        return energy
+
+    @property
     def reactions(self) -> np.ndarray:
         """Alias of :attr:`reaction`."""
         return self.reaction

@@ -9,6 +9,9 @@ from .errors import InputError, SpacarError
 from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
 from .results import Results, dof_labels
+from .table import Table
+from .control import Controller
+from .energy import Energy
 
 
 def _method_used(arrays: dict) -> str:
@@ -31,11 +34,83 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear,
                   dof_labels(system, model.core))
     res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
+    if "energy" in arrays:
+        res._energy = Energy(res.t, arrays["energy"])
     return res
 
 
+def _node_coordinates(labels) -> dict:
+    """node → its global coordinate indices, in component order."""
+    out: dict = {}
+    for g, (n, _) in enumerate(labels):
+        out.setdefault(int(n), []).append(g)
+    return out
+
+
+def _time_loads(sim, system, forces, inputs):
+    """Hand the time-dependent loads and input motions to the core: tables as C++ tables, the
+    callables as one Python function of t called at every right-hand side."""
+    labels = [(int(n), int(i)) for n, i in system.coord_label]
+    nodes = _node_coordinates(labels)
+    if not isinstance(forces, dict) or not isinstance(inputs, dict):
+        raise InputError("forces and inputs must be dicts: forces={node: Table or f(t)}, inputs={(node, i): Table}")
+    tables, functions = [], []
+    for node, f in forces.items():
+        if node not in nodes:
+            raise InputError(f"forces: node {show(node)} is not a node of the model")
+        coords = nodes[node]
+        if isinstance(f, Table):
+            if f.components != len(coords):
+                raise InputError(f"forces: node {node} has {len(coords)} coordinates, its table {f.components} "
+                                 f"components (one per FORCE value)")
+            tables.append((coords, f.core))
+        elif callable(f):
+            functions.append((np.array(coords), f, node))
+        else:
+            raise InputError(f"forces: node {node} needs a spacar.Table or a function f(t), got {show(f)}")
+    index = {lbl: g for g, lbl in enumerate(labels)}
+    deformations = {(int(e), int(k)): j for j, (e, k) in enumerate(system.def_label)}
+    x_input, e_input = list(system.x_input), list(system.e_input)
+    motions = []
+    for key, table in inputs.items():
+        # An input's index in the core: the INPUTX coordinates first, then the INPUTE deformations.
+        if isinstance(key, tuple) and len(key) == 3 and key[0] == "e":
+            name = f"e{key[1:]}"
+            k = deformations.get(tuple(key[1:]))
+            if k is None or k not in e_input:
+                raise InputError(f"inputs: {name} is not an input deformation (INPUTE)")
+            number = len(x_input) + e_input.index(k)
+        elif isinstance(key, tuple) and len(key) == 2 and tuple(key) in index:
+            name = f"x{key}"
+            g = index[tuple(key)]
+            if g not in x_input:
+                raise InputError(f"inputs: {name} is not an input coordinate (INPUTX)")
+            number = x_input.index(g)
+        else:
+            raise InputError(f"inputs: {show(key)} is neither a (node, coordinate) nor an ('e', element, "
+                             f"deformation) of the model")
+        if not isinstance(table, Table) or table.components != 1:
+            raise InputError(f"inputs: {name} needs a spacar.Table of one component (the position)")
+        motions.append((number, table.core))
+    load_function = None
+    if functions:
+        nx = len(labels)
+
+        def load_function(t):
+            load = np.zeros(nx)
+            for coords, f, node in functions:
+                value = np.asarray(f(t), dtype=float).reshape(-1)
+                if value.shape != (len(coords),):
+                    raise InputError(f"forces: the function of node {node} must return {len(coords)} values "
+                                     f"(one per FORCE value), got {show(value)} at t = {t:g}")
+                load[coords] += value
+            return load
+    sim.set_time_loads(tables, motions, load_function)
+
+
 def simulate(model, *, method: str = "auto", on_output=None, progress=None, output_stem=None,
-             time_limit=None, recursive: bool = True) -> Results:
+             time_limit=None, recursive: bool = True, forces=None, inputs=None, controller=None,
+             energy: bool = False) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
     The mechanism is assembled at the current time; with degrees of freedom the reduced
@@ -72,6 +147,20 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     cheaper per right-hand side; the output times are solved by the general path). ``False``
     always takes the general path. ``res.stats["recursive"]`` says which path ran.
 
+    Time-dependent loads and inputs (docs/mechatronics.md): ``forces={node: f}`` adds to the
+    node's FORCE values either a :class:`spacar.Table` (interpolated in C++ at every stage, no
+    Python during the run) or a function ``f(t)`` returning them (called once per right-hand
+    side: 12 calls per DOP853 step). ``inputs={(node, i): table}`` prescribes the motion of an
+    INPUTX coordinate by a table of its position, the rate and acceleration from the table's
+    derivatives (a cubic table has continuous accelerations), instead of the block's constant
+    acceleration; ``inputs={("e", e, i): table}`` likewise an INPUTE deformation.
+    ``controller``: a :class:`spacar.Controller`, sampled at its rate with its actuator loads
+    held between samples. These runs take the general path (not ``recursive``).
+
+    ``energy=True``: ``res.energy`` (a :class:`spacar.energy.Energy`) holds the kinetic,
+    potential, strain energy, the dissipated work and the external work at the output times;
+    the two works are integrated as extra states of the integrator.
+
     Returns :class:`spacar.Results` (with ``res.geometry`` for drawing). If the analysis fails
     midway, the :class:`spacar.SpacarError` raised carries the results up to the failure as
     ``err.results`` (a :class:`spacar.Results` with the output times recorded before the failure,
@@ -88,8 +177,15 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
                          f"got {show(method)}")
     if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
+    if not isinstance(energy, (bool, np.bool_)):
+        raise InputError(f"energy must be True or False, got {show(energy)}")
+    if controller is not None and not isinstance(controller, Controller):
+        raise InputError(f"controller must be a spacar.Controller or None, got {show(controller)}")
     sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
     system = sim.system
+    if forces or inputs:
+        _time_loads(sim, system, forces or {}, inputs or {})
+    on_sample, finish_sampling = (None, None) if controller is None else controller._bind(system.coord_label)
     settings = model.core.settings
     callbacks = []
     writer = None
@@ -123,7 +219,9 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     step = 0.0 if restart else model._continue_step
     try:
         arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit,
-                         recursive=bool(recursive))  # numpy booleans too
+                         recursive=bool(recursive),  # numpy booleans too
+                         sample_period=0.0 if controller is None else 1.0 / controller.rate,
+                         on_sample=on_sample, energy=bool(energy))
     except SpacarError as err:
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):
@@ -131,6 +229,8 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
             err.results = _results(partial, sim.system, model, method)
         raise
     finally:
+        if finish_sampling is not None:
+            finish_sampling()
         if writer is not None:
             writer.close()
         if bar is not None:

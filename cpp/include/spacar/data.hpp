@@ -80,6 +80,7 @@ struct Data {
   // Dense dynamics of the reduced equations (full path, allocated on first use).
   Eigen::MatrixXd M;            // global mass matrix (nx x nx)
   Eigen::VectorXd h, f;         // convective inertia and applied forces (nx)
+  Eigen::VectorXd time_load;    // time-dependent loads at t added to FORCE (nx; empty: none)
   Eigen::MatrixXd DFq;          // DF restricted to the DOF columns (nx x n_dof)
   Eigen::MatrixXd Mbar;         // reduced mass matrix (n_dof x n_dof)
   Eigen::VectorXd rhs;          // reduced force (n_dof)

@@ -59,5 +59,15 @@ void nodal_reactions(const System& sys, Data& data);
 // the constitutive springs and of gravity; for tests and energy balances.
 double kinetic_energy(const System& sys, const Data& data);
 double potential_energy(const System& sys, const Data& data);
+// Its two parts: ½ eᵀ S e of the constitutive deformations, and the potential of gravity.
+double strain_energy(const System& sys, const Data& data);
+double gravity_potential(const System& sys, const Data& data);
+// The power dissipated by the dampers (ėᵀ D ė) and the power of the external loads and drivers
+// (FORCE, TORQUEL, Data::time_load, prescribed inputs through their reactions), at a solved state
+// with complete stresses (after solve_dynamics_direct): d(T + V + U)/dt = external − dissipated.
+struct EnergyRates {
+  double dissipated = 0.0, external = 0.0;
+};
+EnergyRates energy_rates(const System& sys, const Data& data);
 
 }  // namespace spacar

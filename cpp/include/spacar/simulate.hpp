@@ -18,6 +18,7 @@
 #include "spacar/linearize.hpp"
 #include "spacar/model.hpp"
 #include "spacar/system.hpp"
+#include "spacar/table.hpp"
 #include "spacar/tree.hpp"
 
 namespace spacar {
@@ -39,6 +40,32 @@ struct RunOptions {
   // side (tree.hpp, spatial_tree.hpp), other open chains the explicit positions (chain.hpp);
   // false: always the general constraint formulation.
   bool recursive = true;
+  // A digital controller (zero-order hold): at the block start and every sample_period after it,
+  // on_sample(t, data at t, held) sets the loads (nx) held constant until the next sample; the
+  // integrator restarts at every sample (the loads jump there). 0: no controller.
+  double sample_period = 0.0;
+  std::function<void(double, const Data&, Eigen::VectorXd&)> on_sample;
+  // Energy balance (BlockResults::energy): the dissipated power and the external power integrated
+  // as two extra states of the integrator, at the cost of O(n) per right-hand side.
+  bool energy = false;
+};
+
+// Loads and input motions that vary in time, beyond FORCE's constants and the inputs' constant
+// accelerations: evaluated at the time of every stage of the integrator (docs/mechatronics.md).
+struct TimeLoads {
+  struct LoadTable {  // component j of the table: the load on coordinate coords[j]
+    std::vector<int> coords;
+    Table table;
+  };
+  struct InputTable {  // the position of input i (as System::input_cols); rates from its derivatives
+    int input;
+    Table table;
+  };
+  std::vector<LoadTable> load_tables;
+  std::vector<InputTable> input_tables;
+  // Adds loads (nx) at time t, e.g. a Python function: one call per right-hand side.
+  std::function<void(double, Eigen::VectorXd&)> load_function;
+  bool empty() const { return load_tables.empty() && input_tables.empty() && !load_function; }
 };
 
 // Tolerances below this (100 machine epsilons) cannot be met in double precision: EPSINT and
@@ -58,6 +85,8 @@ struct BlockResults {
   RowMatrix e, ed, edd, sigma; // nt x ne (sigma complete with the reactions if FORCEMODE ≥ 1)
   RowMatrix reaction;          // nt x nx: reactions on fixed and input coordinates (FORCEMODE ≥ 1)
   std::vector<Linearization> linearizations;  // at every output time if LINE or LINEAR ≥ 1
+  // RunOptions::energy: nt x 5, the columns kEnergyColumns (else empty).
+  RowMatrix energy;
   long rhs_evaluations = 0, steps = 0, accepted = 0, rejected = 0, newton_iterations = 0;
   long jacobians = 0, decompositions = 0;  // implicit method (RADAU5) only
   Method method = Method::DOP853;          // the integrator the block started with
@@ -89,6 +118,11 @@ inline constexpr OutputArray kOutputArrays[] = {
     {"sigma", "stresses", true, &Data::sigma, &BlockResults::sigma},
     {"reaction", "reactions", false, &Data::reaction, &BlockResults::reaction},
 };
+
+// The columns of BlockResults::energy: kinetic + potential + strain + dissipated − external_work
+// is constant. Potential: of gravity; dissipated: ∫ ėᵀ D ė dt; external_work: ∫ of the power of
+// FORCE, TORQUEL, the time-dependent loads and the drivers of prescribed inputs (their reactions).
+inline constexpr const char* kEnergyColumns[] = {"kinetic", "potential", "strain", "dissipated", "external_work"};
 
 class Simulation {
  public:
@@ -140,6 +174,9 @@ class Simulation {
   void solve_state(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
   void evaluate(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
   void move_to(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+
+  // Time-dependent loads and input motions for the following runs (checked: InputError).
+  void set_time_loads(TimeLoads loads);
 
   BlockResults run(const RunOptions& options = {});
   // The same, into `res`. If the run fails (an exception), `res` holds what was computed up to
@@ -236,6 +273,12 @@ class Simulation {
   bool has_deadline_ = false;
   std::chrono::steady_clock::time_point deadline_;
   double time_limit_ = 0.0;
+  TimeLoads timed_;
+  Eigen::VectorXd held_;  // loads of the controller held since its last sample (nx), or empty
+  int n_energy_ = 0;      // 2 with RunOptions::energy: the last states of Y (dissipated, external work)
+  // The time-dependent loads and inputs at t into data (after set_inputs): input tables replace
+  // the inputs' constant-acceleration motion, loads go to Data::time_load.
+  void apply_time_loads(double t);
 };
 
 }  // namespace spacar

@@ -1,0 +1,54 @@
+"""The energy balance of a simulation: ``res.energy`` (docs/mechatronics.md)."""
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+KEYS = ("kinetic", "potential", "strain", "dissipated", "external_work")
+
+
+class Energy(Mapping):
+    """Arrays over the output times: ``kinetic`` (½ ẋᵀMẋ), ``potential`` (of gravity), ``strain``
+    (½ eᵀSe of the elastic deformations), ``dissipated`` (∫ ėᵀDė dt of EDAMPP and the other
+    damping) and ``external_work`` (∫ of the power of FORCE, TORQUEL, time-dependent loads,
+    controllers and the drivers of prescribed inputs). ``total`` = kinetic + potential + strain +
+    dissipated − external_work stays at its initial value; ``balance`` is its change."""
+
+    def __init__(self, t, arrays: dict):
+        self.t = np.asarray(t, dtype=float)
+        self._arrays = {k: np.asarray(arrays[k], dtype=float) for k in KEYS}
+
+    def __getitem__(self, key):
+        return self._arrays[key]
+
+    def __iter__(self):
+        return iter(KEYS)
+
+    def __len__(self):
+        return len(KEYS)
+
+    @property
+    def total(self) -> np.ndarray:
+        a = self._arrays
+        return a["kinetic"] + a["potential"] + a["strain"] + a["dissipated"] - a["external_work"]
+
+    @property
+    def balance(self) -> np.ndarray:
+        """total − total[0]: zero up to the integration error."""
+        return self.total - self.total[0]
+
+    def plot(self, ax=None, balance: bool = True):
+        """The five terms (and the balance) against time on a matplotlib axes; returns it."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots()
+        for k in KEYS:
+            ax.plot(self.t, self._arrays[k], label=k.replace("_", " "))
+        if balance:
+            ax.plot(self.t, self.balance, "k--", label="balance (total − initial)")
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel("energy [J]")
+        ax.legend()
+        return ax
