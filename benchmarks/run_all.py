@@ -9,8 +9,8 @@ static solve of a large-deflection cantilever against exudyn's SolveStatic (stat
 
 ``--quick`` runs tiny sizes in seconds (the smoke test of tests/peers/test_benchmarks.py; it writes
 nothing unless asked to, so the committed figures stay those of a full run). A full run takes
-about 10–15 minutes on the machine of docs/performance.md, most of it in the 1000-element
-cantilever and the 100-link chain.
+about 25–30 minutes on the machine of docs/performance.md: about 10 in the stiff integration's
+step-count series (stiff.py), most of the rest in the 1000-element cantilever and the chains.
 """
 from __future__ import annotations
 
