@@ -129,6 +129,9 @@ void bind_model(py::module_& m) {
       .def_property_readonly("frozen", &Model::frozen)
       .def_readonly("nodes", &Model::nodes)
       .def_readonly("elements", &Model::elements)
+      .def(
+          "element_type_name", [](const Model& m, int id) { return element_catalogue()[m.element(id).type].name; },
+          py::arg("id"), "The type of element id, without the copy of every element that `elements` makes.")
       .def_readonly("settings", &Model::settings)
       .def_readonly("time", &Model::time)
       .def_readonly("gravity", &Model::gravity)

@@ -71,12 +71,11 @@ def dof_labels(system, core) -> list:
     """Labels of the degrees of freedom of a compiled system (``_core.Simulation(...).system``) in
     its DOF order, the order of q in the core: the DYNX coordinates ascending (``"x(5,1)"``),
     then the DYNE deformations ascending, with their element type (``"e(3,1) HINGE"``)."""
-    out = [f"x({n},{c})" for n, c in (system.coord_label[g] for g in system.x_dyn)]
-    if len(system.e_dyn):
-        elements = core.elements  # a snapshot of all elements: taken once
-        for k in system.e_dyn:
-            e, i = system.def_label[k]
-            out.append(f"e({e},{i}) {elements[e].type_name}")
+    coords, defs = system.coord_label, system.def_label  # each access converts the whole list: once
+    out = [f"x({n},{c})" for n, c in (coords[g] for g in system.x_dyn)]
+    for k in system.e_dyn:
+        e, i = defs[k]
+        out.append(f"e({e},{i}) {core.element_type_name(e)}")
     return out
 
 
