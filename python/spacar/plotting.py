@@ -300,10 +300,10 @@ class Scene:
         return [ln for ln in self.lines if ln.get_gid() == f"element-{element}"]
 
 
-def _displaced(res: Results, k: int, mode, scale) -> Results:
-    """One-row results at row k displaced by ``scale`` times the nodal shape ``mode`` (nx); by
-    default scaled so that the largest displacement of a position is a tenth of the model's
-    extent. Euler parameters are normalised again."""
+def _displaced(res: Results, k: int, mode, scale, amplitudes=(1.0,)) -> Results:
+    """Results at row k displaced by ``scale`` times the nodal shape ``mode`` (nx), one row per
+    amplitude (default one row, amplitude 1); by default scaled so that the largest displacement
+    of a position is a tenth of the model's extent. Euler parameters are normalised again."""
     dx = np.real(np.asarray(mode)).astype(float).reshape(-1)
     if dx.shape != res.x[k].shape or not np.isfinite(dx).all():
         raise InputError(f"mode must hold {res.x.shape[1]} finite numbers (one per nodal coordinate, as "
@@ -317,14 +317,24 @@ def _displaced(res: Results, k: int, mode, scale) -> Results:
         extent = max(np.ptp(xy, axis=0).max(), 1e-300)
         largest = np.abs(dx[rows]).max() if rows.size else 0.0
         scale = 0.1 * extent / largest if largest > 0 else 1.0
-    x = res.x[k] + float(scale) * dx
+    x = res.x[k] + float(scale) * np.asarray(amplitudes, dtype=float)[:, None] * dx
     for n, c in cols.items():
         if kinds.get(n) == "LAMBDA":
-            x[c] /= np.linalg.norm(x[c])
-    one = lambda a: np.asarray(a)[k:k + 1]  # noqa: E731
-    arrays = {"t": one(res.t), "x": x[None, :], "xd": one(res.xd), "xdd": one(res.xdd), "e": one(res.e),
-              "ed": one(res.ed), "edd": one(res.edd), "sigma": one(res.sigma), "reaction": one(res.reaction)}
+            x[:, c] /= np.linalg.norm(x[:, c], axis=1, keepdims=True)
+    many = lambda a: np.repeat(np.asarray(a)[k:k + 1], len(x), axis=0)  # noqa: E731
+    arrays = {"t": many(res.t), "x": x, "xd": many(res.xd), "xdd": many(res.xdd), "e": many(res.e),
+              "ed": many(res.ed), "edd": many(res.edd), "sigma": many(res.sigma), "reaction": many(res.reaction)}
     return Results(arrays, res.coordinate_labels, res.deformation_labels, res.stats, geometry=res.geometry)
+
+
+def snapshot(sim, geometry) -> Results:
+    """One-row :class:`Results` of the current state of a ``_core.Simulation`` (for drawing a
+    state that no run recorded: a linearization's, or one the explorer solved)."""
+    d, system = sim.data, sim.system
+    arrays = {name: np.array(getattr(d, name), dtype=float)[None, ...]
+              for name in ("x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")}
+    arrays["t"] = np.array([float(d.t)])
+    return Results(arrays, system.coord_label, system.def_label, {}, geometry=geometry)
 
 
 def draw(res: Results, k: int = -1, *, time: float | None = None, ax=None, labels: bool = False,

@@ -603,3 +603,71 @@ def test_3d_tick_labels_do_not_collide():
         for i in range(len(boxes)):
             for j in range(i + 1, len(boxes)):
                 assert not overlaps(boxes[i], boxes[j])
+
+
+# --------------------------------------------------------------------------------------------
+# mode-shape animation, the offline player
+# --------------------------------------------------------------------------------------------
+
+def clamped_beam_mesh(n=4):
+    """A cantilever of n PLBEAMs (L = 1, EI = 1, m = 1 per length): f1 = 1.8751² / 2π Hz
+    (Euler-Bernoulli)."""
+    m = spacar.Model()
+    for i in range(n):
+        m.plbeam(i + 1, 2 * i + 1, 2 * i + 2, 2 * i + 3, 2 * i + 4)
+        m.x(2 * i + 3, (i + 1) / n, 0.0)
+        m.dyne(i + 1, 2, 3)
+        m.emass(i + 1, 1.0)
+        m.estiff(i + 1, 0.0, 1.0)
+    m.fix(1)
+    m.fix(2)
+    return m
+
+
+def test_mode_animation_swings_the_hermite_shape_of_the_mode():
+    model = clamped_beam_mesh()
+    anim = unrendered(spacar.animate_mode(model, 0, frames=8))
+    scene = anim.scene
+    f1 = 1.8751040687**2 / (2 * math.pi)
+    assert float(scene.ax.get_title().split()[2]) == pytest.approx(f1, rel=2e-3)
+    assert list(anim._iter_gen()) == list(range(8))
+    freqs, _, shapes_x = spacar.linearize(model).mode_shapes()
+    res = scene.res
+    tip = res.coordinate_index(9, 2)
+    amplitude = res.x[2, tip]                                       # sin(2π·2/8) = 1
+    assert abs(amplitude) > 0.05
+    for j in range(8):
+        scene.update(j)
+        s = math.sin(2 * math.pi * j / 8)
+        np.testing.assert_allclose(res.x[j], res.x[0] + s * (res.x[2] - res.x[0]), atol=1e-12)
+        # each beam: the cubic through its displaced nodes with its displaced end slopes
+        for el in range(1, 5):
+            p, rp, q, rq = 2 * el - 1, 2 * el, 2 * el + 1, 2 * el + 2
+            start, end, d0, d1, residual = cubic_ends(line_points(scene.element_lines(el)[0]))
+            assert residual < 1e-12
+            np.testing.assert_allclose(start, res.node(p).x[j], atol=1e-12)
+            np.testing.assert_allclose(end, res.node(q).x[j], atol=1e-12)
+            for d, b in ((d0, res.node(rp).x[j, 0]), (d1, res.node(rq).x[j, 0])):
+                np.testing.assert_allclose(d, 0.25 * np.array([math.cos(b), math.sin(b)]), atol=1e-12)
+    # the displacement is the mode's nodal shape
+    dx = res.x[2] - res.x[0]
+    np.testing.assert_allclose(dx / dx[tip], shapes_x[:, 0] / shapes_x[tip, 0], atol=1e-10)
+
+
+def test_mode_animation_errors(slidercrank):
+    with pytest.raises(spacar.InputError, match="no linearizations"):
+        spacar.animate_mode(slidercrank)
+    with pytest.raises(spacar.InputError, match="mode must be a mode number 0..3"):
+        spacar.animate_mode(clamped_beam_mesh(2), 4)
+    with pytest.raises(spacar.InputError, match="no geometry"):
+        spacar.animate_mode(spacar.linearize(clamped_beam_mesh(2)))
+
+
+def test_the_html_player_needs_no_network(slidercrank, tmp_path):
+    """matplotlib's player loads Font Awesome from a CDN; spacar's is self-contained."""
+    anim = spacar.animate(slidercrank, step=50)
+    for html in (anim.to_jshtml(), anim._repr_html_(),
+                 spacar.save_animation(anim, tmp_path / "a.html").read_text(encoding="utf-8")):
+        assert not re.search(r"https?://", html)
+        assert 'class="fa' not in html and "\u25b6" in html           # the play button: a Unicode triangle
+        assert len(html_frames(html)) == 3
