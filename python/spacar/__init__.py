@@ -72,7 +72,8 @@ _LAZY = {
     "animate": ("animation", "animate"),
     "save_animation": ("animation", "save_animation"),
     "animate_mode": ("animation", "animate_mode"),
-    "explore": ("explore", "explore"),
+    "explore": ("interactive", "explore"),
+    "view3d": ("interactive", "view3d"),
 }
 
 
@@ -105,6 +106,7 @@ __all__ = [
     "save_animation",
     "animate_mode",
     "explore",
+    "view3d",
     "Summary",
     "KEYWORDS",
     "read",
