@@ -157,16 +157,14 @@ class Explorer:
     def _rebuild(self):
         """Assemble the mechanism with the current parameters, sample the input's range (traces
         and the quantity's curve) and draw."""
-        from . import _core
         from .plotting import snapshot
 
         model = self._model_now()
-        self.sim = _core.Simulation(model.core)
-        self.sim.assemble()
-        self.t0 = float(self.sim.data.t)
+        self._assemble(model)
         self.geometry = Geometry.from_model(model)
         lo, hi = self.range
         rows, values = [], []
+        self.note = ""
         for v in np.linspace(lo, hi, self.points):
             if not self._move(v):
                 break
@@ -175,6 +173,9 @@ class Explorer:
         if not rows:
             raise InputError(f"explore: the mechanism cannot be assembled at x({self.input[0]},{self.input[1]}) = "
                              f"{lo:g}: {self.message.value}")
+        if len(rows) < self.points:
+            self.note = (f"x({self.input[0]},{self.input[1]}) moves from {lo:.4g} to {values[-1]:.4g} only: "
+                         f"{self.message.value}")
         self.samples = np.array(values)
         current = rows[0]
         arrays = {name: np.concatenate([getattr(r, name) for r in rows + [current]])
@@ -183,13 +184,22 @@ class Explorer:
                               geometry=self.geometry)
         self._draw(lambda k: f"x({self.input[0]},{self.input[1]}) = {self.value:.4g}")
 
+    def _assemble(self, model=None):
+        from . import _core
+
+        self.sim = _core.Simulation((model or self._model_now()).core)
+        self.sim.assemble()
+        self.t0 = float(self.sim.data.t)
+
     def _move(self, value) -> bool:
-        """Solve the kinematics at the input value; False (and a message) where it cannot."""
+        """Solve the kinematics at the input value; False (and a message) where it cannot, and
+        the mechanism assembled again (a simulation stuck at a dead position cannot move on)."""
         system = self.sim.system
         try:
             self.sim.move_to(self.t0 + (value - self.x_assembled), system.q0, system.qd0)
         except SpacarError as exc:
             self.message.value = f"x({self.input[0]},{self.input[1]}) = {value:.4g} not reached: {exc}"
+            self._assemble()
             return False
         return True
 
@@ -199,7 +209,7 @@ class Explorer:
 
         self.value = float(value)
         if self._move(self.value):
-            self.message.value = ""
+            self.message.value = self.note
             self.state = snapshot(self.sim, self.geometry)
             for name in ("x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction"):
                 getattr(self.states, name)[-1] = getattr(self.state, name)[0]

@@ -5,6 +5,7 @@ Independent references: the four-bar drawn at a crank angle is checked by its lo
 rigidly attached), not against spacar's own runs.
 """
 import math
+import re
 import sys
 
 import numpy as np
@@ -170,3 +171,18 @@ def test_view3d_falls_back_to_matplotlib(monkeypatch):
     monkeypatch.setitem(sys.modules, "plotly.graph_objects", None)
     scene = spacar.view3d(spatial_cantilever())
     assert scene.ax.name == "3d" and scene.element_lines(1)
+
+
+def test_a_dead_position_is_named_and_the_explorer_moves_on(widgets):
+    """A crank of 0.2 (non-Grashof with these links: s + l = 0.55 > p + q = 0.43) cannot turn
+    fully: the range reached and the failing value are said; values inside it still solve."""
+    m = fourbar()
+    m.x(3, 0.2, 0.0)
+    ex = spacar.explore(m, points=41).explorer
+    assert ex.samples[-1] < 2 * math.pi - 1
+    assert re.match(r"x\(2,1\) moves from 0 to [\d.]+ only: x\(2,1\) = [\d.]+ not reached", ex.message.value)
+    ex.set_input(3.0)
+    assert "x(2,1) = 3 not reached" in ex.message.value
+    ex.set_input(0.5)
+    np.testing.assert_allclose(ex.state.node(3).x[0], 0.2 * np.array([math.cos(0.5), math.sin(0.5)]), atol=1e-9)
+    assert ex.message.value == ex.note          # back to the note on the range reached
