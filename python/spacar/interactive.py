@@ -63,7 +63,7 @@ class Explorer:
         if self.is_model:
             self.model = source
             self._choose_input(input, input_range)
-            name = f"x({self.input[0]},{self.input[1]})"
+            name = self.input_name
             lo, hi = self.range
             self.sliders[name] = widgets.FloatSlider(value=lo, min=lo, max=hi, step=(hi - lo) / 200,
                                                      description=name, continuous_update=False,
@@ -93,25 +93,36 @@ class Explorer:
 
     def _choose_input(self, input, input_range):
         from . import _core
+        from .geometry import family
 
         sim = _core.Simulation(self.model.copy().core)
         sim.assemble()
-        labels = [tuple(int(v) for v in lbl) for lbl in sim.system.coord_label]
-        classes = [c.name for c in sim.system.coord_class]
-        inputs = [lbl for lbl, c in zip(labels, classes) if c == "input"]
+        system = sim.system
+        inputs = [("x", int(n), int(i)) for (n, i), c in zip(system.coord_label, system.coord_class) if c.name == "input"]
+        inputs += [("e", int(n), int(i)) for (n, i), c in zip(system.def_label, system.def_class) if c.name == "input"]
         if input is None:
             if not inputs:
-                raise InputError("explore: the model has no input motion (INPUTX) to move")
+                raise InputError("explore: the model has no input motion (INPUTX, INPUTE) to move")
             input = inputs[0]
-        input = tuple(int(v) for v in input)
+        elif isinstance(input, str):
+            input = parse_spec(input)
+        else:
+            input = ("x", *input) if len(input) == 2 else input
+        input = (str(input[0]).lower(), int(input[1]), int(input[2]))
         if input not in inputs:
-            raise InputError(f"explore: x({input[0]},{input[1]}) is not an input coordinate (INPUTX) of the model; "
-                             f"its inputs: {', '.join(f'x({n},{i})' for n, i in inputs) or 'none'}")
+            raise InputError(f"explore: {input[0]}({input[1]},{input[2]}) is not an input motion (INPUTX, INPUTE) of "
+                             f"the model; its inputs: {', '.join(f'{q}({n},{i})' for q, n, i in inputs) or 'none'}")
         self.input, self.inputs = input, inputs
-        x0 = float(np.asarray(sim.data.x)[labels.index(input)])
-        kind = self.model.nodes[input[0]].kind.name
+        self.input_name = f"{input[0]}({input[1]},{input[2]})"
+        q, n, i = input
+        if q == "x":
+            x0 = float(np.asarray(sim.data.x)[[tuple(lbl) for lbl in system.coord_label].index((n, i))])
+            turning = self.model.nodes[n].kind.name == "BETA"
+        else:
+            x0 = float(np.asarray(sim.data.e)[[tuple(lbl) for lbl in system.def_label].index((n, i))])
+            turning = family(self.model.elements[n].type_name) == "Hinge" and i == 1
         if input_range is None:
-            input_range = (x0, x0 + 2 * math.pi) if kind == "BETA" else (x0 - 0.5, x0 + 0.5)
+            input_range = (x0, x0 + 2 * math.pi) if turning else (x0 - 0.5, x0 + 0.5)
         lo, hi = (float(v) for v in input_range)
         if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
             raise InputError(f"explore: input_range must be two finite numbers lo < hi, got {input_range!r}")
@@ -149,9 +160,9 @@ class Explorer:
         model = self.model.copy()
         for name, spec in self.parameters.items():
             self._parameter(name, spec)[2](model, self.sliders[name].value)
-        for n, i in self.inputs:
-            model.xd(n, i, 1.0 if (n, i) == self.input else 0.0)
-            model.xdd(n, i, 0.0)
+        for q, n, i in self.inputs:
+            (model.xd if q == "x" else model.ed)(n, i, 1.0 if (q, n, i) == self.input else 0.0)
+            (model.xdd if q == "x" else model.edd)(n, i, 0.0)
         return model
 
     def _rebuild(self):
@@ -171,10 +182,10 @@ class Explorer:
             rows.append(snapshot(self.sim, self.geometry))
             values.append(v)
         if not rows:
-            raise InputError(f"explore: the mechanism cannot be assembled at x({self.input[0]},{self.input[1]}) = "
+            raise InputError(f"explore: the mechanism cannot be assembled at {self.input_name} = "
                              f"{lo:g}: {self.message.value}")
         if len(rows) < self.points:
-            self.note = (f"x({self.input[0]},{self.input[1]}) moves from {lo:.4g} to {values[-1]:.4g} only: "
+            self.note = (f"{self.input_name} moves from {lo:.4g} to {values[-1]:.4g} only: "
                          f"{self.message.value}")
         self.samples = np.array(values)
         current = rows[0]
@@ -182,7 +193,7 @@ class Explorer:
                   for name in ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")}
         self.states = Results(arrays, current.coordinate_labels, current.deformation_labels, {},
                               geometry=self.geometry)
-        self._draw(lambda k: f"x({self.input[0]},{self.input[1]}) = {self.value:.4g}")
+        self._draw(lambda k: f"{self.input_name} = {self.value:.4g}")
 
     def _assemble(self, model=None):
         from . import _core
@@ -198,7 +209,7 @@ class Explorer:
         try:
             self.sim.move_to(self.t0 + (value - self.x_assembled), system.q0, system.qd0)
         except SpacarError as exc:
-            self.message.value = f"x({self.input[0]},{self.input[1]}) = {value:.4g} not reached: {exc}"
+            self.message.value = f"{self.input_name} = {value:.4g} not reached: {exc}"
             self._assemble()
             return False
         return True
@@ -244,7 +255,7 @@ class Explorer:
             x = self.samples if self.is_model else source.t
             ax.plot(x, y[:-1] if self.is_model else y, color="C0")
             (self.marker,) = ax.plot([x[0]], [y[0]], "o", color="C3")
-            ax.set_xlabel(f"x({self.input[0]},{self.input[1]})" if self.is_model else "t [s]")
+            ax.set_xlabel(self.input_name if self.is_model else "t [s]")
             ax.set_ylabel(Results.describe(self.quantity))
             ax.grid(True, alpha=0.3)
             self.curve_ax = ax
@@ -271,7 +282,7 @@ class Explorer:
         def handler(change):
             if not self.is_model:
                 self.set_frame(change["new"])
-            elif name == f"x({self.input[0]},{self.input[1]})":
+            elif name == self.input_name:
                 self.set_input(change["new"])
             else:
                 try:
@@ -288,8 +299,9 @@ def explore(source, *, input=None, input_range=None, parameters=None, trace=(), 
     """An ipywidgets widget to explore a mechanism in a notebook.
 
     ``source``: a :class:`spacar.Model` — a slider moves the input motion ``input`` (a node
-    coordinate ``(n, i)`` with INPUTX; default the model's first) over ``input_range`` (default a
-    full turn from its assembled value for a BETA coordinate, ±0.5 otherwise), solving the
+    coordinate ``(n, i)`` with INPUTX, or a label such as ``"e(4,1)"`` for an INPUTE deformation;
+    default the model's first) over ``input_range`` (default a full turn from its assembled value
+    for a BETA coordinate or a hinge angle, ±0.5 otherwise), solving the
     kinematics at each value; ``parameters`` adds sliders, ``{"x(3,1)": (lo, hi)}`` for a node's X
     coordinate (which sets the reference geometry: link lengths) or ``{name: (lo, hi,
     function(model, value))}``; other inputs stay at their assembled values. Or

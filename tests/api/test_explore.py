@@ -126,7 +126,7 @@ def test_explore_errors(widgets):
     no_input.fix(2)
     with pytest.raises(spacar.InputError, match="no input motion"):
         spacar.explore(no_input)
-    with pytest.raises(spacar.InputError, match=r"x\(10,1\) is not an input coordinate.*its inputs: x\(2,1\)"):
+    with pytest.raises(spacar.InputError, match=r"x\(10,1\) is not an input motion.*its inputs: x\(2,1\)"):
         spacar.explore(fourbar(), input=(10, 1))
     with pytest.raises(spacar.InputError, match="need a Model"):
         spacar.explore(spacar.simulate(fourbar(timestep=True)), parameters={"x(3,1)": (0.0, 1.0)})
@@ -140,6 +140,21 @@ def test_explore_without_ipywidgets_says_what_to_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "ipywidgets", None)
     with pytest.raises(ImportError, match=r"spacar\[notebooks\]"):
         Explorer(fourbar())
+
+
+def test_an_input_deformation_of_a_spatial_mechanism(widgets):
+    """The 3-D slider-crank is driven by its hinge angle (INPUTE 4 1): the slider turns it, the
+    crank end (crank 0.15) lies on the crank circle at that angle in the x-y plane, and the
+    slider follows from the rod's length (0.3, nodes 3-6-8 welded by LAMBDA 7)."""
+    from support.paths import EXAMPLES
+
+    ex = spacar.explore(spacar.read(EXAMPLES / "slidercrank3d.dat"), quantity="x(8,1)", trace=[6], points=9).explorer
+    assert list(ex.sliders) == ["e(4,1)"] and ex.scene.ax.name == "3d"
+    ex.sliders["e(4,1)"].value = 1.0
+    np.testing.assert_allclose(ex.state.node(3).x[0], [0.15 * math.cos(1.0), 0.15 * math.sin(1.0), 0.0], atol=1e-9)
+    x8 = ex.state.node(8).x[0, 0]                      # slider: 0.15 cos θ + sqrt(0.3² − (0.15 sin θ)²)
+    assert x8 == pytest.approx(0.15 * math.cos(1.0) + math.sqrt(0.3**2 - (0.15 * math.sin(1.0))**2), abs=1e-9)
+    assert ex.marker.get_data()[1][0] == pytest.approx(x8, abs=1e-12)
 
 
 # --------------------------------------------------------------------------------------------
