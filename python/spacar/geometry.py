@@ -16,6 +16,11 @@ consistent mass (formulation.md §4.2, §4.8)::
 
 with t = (cos(α0 + β), sin(α0 + β)) for PLBEAM(NL) and t = R(λ) e_x0 for BEAM(NL).
 
+Besides the elements: a fully fixed node whose elements end in fixed orientation nodes is a
+clamp (a hatched wall, :meth:`Geometry.clamps`), rigid links of three or more nodes are filled
+bodies (:meth:`Geometry.rigid_bodies`), and :func:`magnified` scales the deflections of the
+flexible beams relative to their rigid-body motion.
+
 Each element is drawn by the drawing of its family (``ElementType.family`` of the catalogue:
 beams, trusses, hinges, belts, wheels); a type of another family is drawn as a line through its
 position nodes (a point if it has one, nothing if it has none).
