@@ -12,8 +12,8 @@ Quick start::
     spacar.animate(res)                               # an animation, inline in Jupyter
 
 ``import spacar`` stays light: matplotlib, pandas and tqdm are imported only by the functions
-that use them (``plot``, ``draw``, ``animate``, ``save_animation``; ``Results.to_pandas``; the
-progress bar).
+that use them (``plot``, ``draw``, ``animate``, ``animate_mode``, ``save_animation``, ``explore``;
+``Results.to_pandas``; the progress bar).
 """
 from . import _core
 from ._util import show as _show
@@ -71,11 +71,14 @@ _LAZY = {
     "draw": ("plotting", "draw"),
     "animate": ("animation", "animate"),
     "save_animation": ("animation", "save_animation"),
+    "animate_mode": ("animation", "animate_mode"),
+    "explore": ("interactive", "explore"),
+    "view3d": ("interactive", "view3d"),
 }
 
 
 def __getattr__(name):
-    # The plotting functions import matplotlib: only when first used (PEP 562).
+    # The plotting functions import matplotlib (explore also ipywidgets): only when first used (PEP 562).
     if name in _LAZY:
         import importlib
 
@@ -101,6 +104,9 @@ __all__ = [
     "draw",
     "animate",
     "save_animation",
+    "animate_mode",
+    "explore",
+    "view3d",
     "Summary",
     "KEYWORDS",
     "read",

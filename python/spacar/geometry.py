@@ -16,6 +16,11 @@ consistent mass (formulation.md §4.2, §4.8)::
 
 with t = (cos(α0 + β), sin(α0 + β)) for PLBEAM(NL) and t = R(λ) e_x0 for BEAM(NL).
 
+Besides the elements: a fully fixed node whose elements end in fixed orientation nodes is a
+clamp (a hatched wall, :meth:`Geometry.clamps`), rigid links of three or more nodes are filled
+bodies (:meth:`Geometry.rigid_bodies`), and :func:`magnified` scales the deflections of the
+flexible beams relative to their rigid-body motion.
+
 Each element is drawn by the drawing of its family (``ElementType.family`` of the catalogue:
 beams, trusses, hinges, belts, wheels); a type of another family is drawn as a line through its
 position nodes (a point if it has one, nothing if it has none).
@@ -57,6 +62,17 @@ class ElementGeometry:
     l0: float | None = None
     lgeomy: tuple = ()
     params: tuple = ()
+    deformation_classes: tuple = ()   # ("fixed", "calculable", ...) per deformation; () if unknown
+
+    @property
+    def rigid(self) -> bool:
+        """All deformations fixed (known only for geometries made from a model)."""
+        return bool(self.deformation_classes) and all(c == "fixed" for c in self.deformation_classes)
+
+    @property
+    def flexible(self) -> bool:
+        """Some deformation not fixed (a geometry without deformation classes has no flexible element)."""
+        return bool(self.deformation_classes) and not self.rigid
 
 
 @dataclass
@@ -81,7 +97,8 @@ class Geometry:
             node_kinds={int(n): node.kind.name for n, node in sorted(nodes.items())},
             elements=[ElementGeometry(int(eid), el.type_name, tuple(int(n) for n in el.nodes),
                                       None if el.l0 is None else float(el.l0),
-                                      tuple(float(v) for v in el.lgeomy), tuple(float(v) for v in el.params))
+                                      tuple(float(v) for v in el.lgeomy), tuple(float(v) for v in el.params),
+                                      tuple(c.name for c in el.cls))
                       for eid, el in sorted(elements.items())],
             coordinate_classes={int(n): tuple(c.name for c in node.cls) for n, node in sorted(nodes.items())},
             masses={int(n): tuple(float(v) for v in node.mass) for n, node in sorted(nodes.items()) if node.mass},
@@ -91,7 +108,8 @@ class Geometry:
         return {
             "node_kinds": {str(n): k for n, k in self.node_kinds.items()},
             "elements": [dict(id=e.id, type=e.type, nodes=list(e.nodes), l0=e.l0, lgeomy=list(e.lgeomy),
-                              params=list(e.params)) for e in self.elements],
+                              params=list(e.params), deformation_classes=list(e.deformation_classes))
+                         for e in self.elements],
             "coordinate_classes": {str(n): list(c) for n, c in self.coordinate_classes.items()},
             "masses": {str(n): list(m) for n, m in self.masses.items()},
         }
@@ -101,7 +119,8 @@ class Geometry:
         return cls(
             node_kinds={int(n): k for n, k in d["node_kinds"].items()},
             elements=[ElementGeometry(e["id"], e["type"], tuple(e["nodes"]), e["l0"], tuple(e["lgeomy"]),
-                                      tuple(e["params"])) for e in d["elements"]],
+                                      tuple(e["params"]), tuple(e.get("deformation_classes", ())))
+                      for e in d["elements"]],
             coordinate_classes={int(n): tuple(c) for n, c in d.get("coordinate_classes", {}).items()},
             masses={int(n): tuple(m) for n, m in d.get("masses", {}).items()},
         )
@@ -181,6 +200,83 @@ class Geometry:
         """Some component of node n is fixed or an input motion."""
         return any(x in ("fixed", "input") for x in self.classes(n))
 
+    def _end_orientations(self, n) -> set:
+        """The orientation nodes that follow position node n on the lines of its elements."""
+        out = set()
+        for el in self.elements:
+            for j, m in enumerate(el.nodes[:-1]):
+                if m == n and self.node_kinds.get(el.nodes[j + 1]) in ORIENTATION_KINDS:
+                    out.add(el.nodes[j + 1])
+        return out
+
+    def clamps(self) -> list:
+        """Fully fixed position nodes whose elements all end there in fully fixed orientation
+        nodes: a clamp (a fixed position and a fixed rotation), drawn as a hatched wall, where
+        a pinned support gets a pin on a ground triangle."""
+        pins = set(self.joints())
+        out = []
+        for n in self.position_nodes:
+            orients = self._end_orientations(n)
+            if self.fully_fixed(n) and n not in pins and orients and all(self.fully_fixed(o) for o in orients):
+                out.append(n)
+        return out
+
+    def rigid_bodies(self) -> list:
+        """The moving rigid links of three or more position nodes (a coupler triangle): rigid
+        beams (all deformations fixed) whose orientation nodes are joined, by shared nodes or
+        rigid hinges, into one body (the core's grouping, ``_core.rigid_bodies``). Each entry is
+        (orientation nodes, position nodes); links of two nodes are bars and left out, and so is
+        the ground (all position nodes fully fixed)."""
+        from . import _core
+
+        beams = [el for el in self.elements if family(el.type) == "Beam" and el.rigid]
+        links = [[el.nodes[1], el.nodes[3]] for el in beams]
+        links += [list(el.nodes[:2]) for el in self.elements
+                  if family(el.type) == "Hinge" and el.rigid and len(el.nodes) >= 2]
+        orient = sorted({n for link in links for n in link})
+        out = []
+        for group in _core.rigid_bodies(orient, links):
+            members = set(group)
+            points = []
+            for el in beams:
+                if el.nodes[1] in members:
+                    points += [p for p in (el.nodes[0], el.nodes[2]) if p not in points]
+            if len(points) >= 3 and not all(self.fully_fixed(p) for p in points):
+                out.append((tuple(group), tuple(points)))
+        return out
+
+    def flexible_components(self) -> list:
+        """The flexible structures: beams with a deformation that is not fixed, joined by shared
+        nodes. Each entry is (root, beams) with root = (position node, orientation node) the
+        end whose motion is the structure's rigid-body motion: clamped to the ground if it can
+        be, else welded to a rigid link, else on a fixed point, else pinned to a rigid link, else
+        supported, else the first beam's first end."""
+        beams = [el for el in self.elements if family(el.type) == "Beam" and el.flexible]
+        rigid_orient = {n for el in self.elements if el.rigid for n in el.nodes
+                        if self.node_kinds.get(n) in ORIENTATION_KINDS}
+        rigid_points = {n for el in self.elements if el.rigid for n in el.nodes
+                        if self.node_kinds.get(n) in POSITION_KINDS}
+        parent = {}
+
+        def find(a):
+            while parent.setdefault(a, a) != a:
+                a = parent[a]
+            return a
+
+        for el in beams:
+            for n in el.nodes[1:]:
+                parent[find(n)] = find(el.nodes[0])
+        groups: dict = {}
+        for el in beams:
+            groups.setdefault(find(el.nodes[0]), []).append(el)
+        out = []
+        for members in groups.values():
+            ends = [(el.nodes[0], el.nodes[1]) for el in members] + [(el.nodes[2], el.nodes[3]) for el in members]
+            rank = lambda e: (not self.fully_fixed(e[1]), e[1] not in rigid_orient,  # noqa: E731
+                              not self.fully_fixed(e[0]), e[0] not in rigid_points, not self.supported(e[0]))
+            out.append((min(ends, key=rank), members))
+        return out
+
 
 def rotation(lam) -> np.ndarray:
     """R(λ) of Euler parameters λ = (λ0, λ1, λ2, λ3) (docs/formulation.md §2), body → global."""
@@ -253,8 +349,9 @@ def _circle(centre, u, v, r, n=41):
 
 class Shape(NamedTuple):
     """Something to draw: ``kind`` (beam, truss, link, belt, wheel, spoke, axis, triad-x/y/z,
-    pin, ground, slider, mass, point), the element or node it belongs to, and its points
-    (m × 2 or m × 3)."""
+    pin, ground, clamp, slider, mass, point, body), the element or node it belongs to (a body:
+    its first orientation node), and its points (m × 2 or m × 3; a clamp's strokes are
+    separated by rows of NaN, a body's outline is closed)."""
 
     kind: str
     element: int | None
@@ -277,6 +374,9 @@ def shapes(geometry: Geometry, coords: dict, scale: float = 1.0, beam_points: in
 
     anchors = geometry.anchors()
     context = _DrawContext(geometry, coords, pos, anchors, scale, beam_points)
+    # Rigid links of three or more nodes: a filled body (closed outline) under their bars.
+    for orient, points in geometry.rigid_bodies():
+        out.append(Shape("body", None, orient[0], _outline(np.array([pos(n) for n in points]))))
     for el in geometry.elements:
         out.extend(_DRAWINGS.get(family(el.type), _draw_default)(el, context))
     # Bodies: LAMBDA nodes with inertia get their body frame drawn (at their anchor or the origin).
@@ -290,14 +390,139 @@ def shapes(geometry: Geometry, coords: dict, scale: float = 1.0, beam_points: in
     # Supports, joints and masses at position nodes.
     for n in geometry.joints():
         out.append(Shape("pin", None, n, pos(n)[None, :]))
+    clamps = set(geometry.clamps())
     for n in geometry.position_nodes:
         cls = geometry.classes(n)
-        if geometry.fully_fixed(n):
+        if n in clamps:
+            out.append(Shape("clamp", None, n, _clamp(n, context)))
+        elif geometry.fully_fixed(n):
             out.append(Shape("ground", None, n, pos(n)[None, :]))
         elif "fixed" in cls:
             out.append(Shape("slider", None, n, pos(n)[None, :]))
         elif n in geometry.masses:
             out.append(Shape("mass", None, n, pos(n)[None, :]))
+    return out
+
+
+def _outline(points) -> np.ndarray:
+    """The closed convex outline of points (m × 2, or m × 3 near a plane: the outline in their
+    best-fitting plane), its first point repeated at the end."""
+    centre = points.mean(axis=0)
+    rel = points - centre
+    if points.shape[1] == 3:
+        rel = rel @ np.linalg.svd(rel)[2][:2].T
+    order = sorted(range(len(points)), key=lambda i: (rel[i, 0], rel[i, 1]))
+
+    def half(seq):  # Andrew's monotone chain
+        h = []
+        for i in seq:
+            while len(h) >= 2:
+                a, b = rel[h[-1]] - rel[h[-2]], rel[i] - rel[h[-2]]
+                if a[0] * b[1] - a[1] * b[0] > 0:
+                    break
+                h.pop()
+            h.append(i)
+        return h
+
+    hull = half(order)[:-1] + half(order[::-1])[:-1]
+    return points[hull + hull[:1]]
+
+
+def _clamp(n, f) -> np.ndarray:
+    """A clamp at position node n: a wall across the mean direction of the elements leaving n,
+    hatched on the side away from them (one polyline, strokes separated by NaN rows)."""
+    x = f.pos(n)
+    d = np.zeros(len(x))
+    for el in f.geometry.elements:
+        if n not in el.nodes:
+            continue
+        if family(el.type) == "Beam" and n in (el.nodes[0], el.nodes[2]):
+            c = {m: np.asarray(f.coords[m], dtype=float) for m in el.nodes}
+            c[el.nodes[0]], c[el.nodes[2]] = f.pos(el.nodes[0]), f.pos(el.nodes[2])
+            tp, tq = beam_tangents(el, c)
+            d += _unit(tp if n == el.nodes[0] else -np.asarray(tq))
+        else:
+            d += sum((_unit(f.pos(m) - x) for m in el.nodes
+                      if m != n and f.geometry.node_kinds.get(m) in POSITION_KINDS), np.zeros(len(x)))
+    d = _unit(d) if np.linalg.norm(d) > 0 else np.eye(len(x))[1]
+    w, h = 0.06 * f.scale, 0.035 * f.scale
+    nan = np.full((1, len(x)), np.nan)
+    if len(x) == 2:
+        u = np.array([-d[1], d[0]])
+        rows = [np.array([x - w * u, x + w * u])]
+        for s in np.linspace(-1.0, 1.0, 5):
+            a = x + s * w * u
+            rows += [nan, np.array([a, a - h * d - 0.6 * h * u])]
+        return np.vstack(rows)
+    u, v = _perpendicular_pair(d)
+    corners = [x + w * (a * u + b * v) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1), (-1, -1))]
+    rows = [np.array(corners)]
+    for a in corners[:4] + [x]:
+        rows += [nan, np.array([a, a - h * d])]
+    return np.vstack(rows)
+
+
+def _qmul(a, b) -> np.ndarray:
+    return np.concatenate([[a[0] * b[0] - a[1:] @ b[1:]], a[0] * b[1:] + b[0] * a[1:] + np.cross(a[1:], b[1:])])
+
+
+def _qpow(q, m: float) -> np.ndarray:
+    """The rotation of unit Euler parameters q with its angle multiplied by m."""
+    s = float(np.linalg.norm(q[1:]))
+    if s == 0.0:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    half = math.atan2(s, q[0]) * m
+    return np.concatenate([[math.cos(half)], math.sin(half) * q[1:] / s])
+
+
+def magnified(geometry: Geometry, coords: dict, factor: float) -> dict:
+    """Nodal coordinates with the deflections of the flexible beams scaled by ``factor``.
+
+    Each flexible structure (:meth:`Geometry.flexible_components`) moves with its root end
+    (position x_r, rotation R_r): its rigid-body motion puts node n at
+    x_r + R_r (X_n − X_r), with X_n − X_r summed from the beams' reference chords
+    (l0 (cos α0, sin α0), l0 e_x0), and turns every orientation node with the root. The
+    displacement from there (and the rotation relative to the root) is multiplied by
+    ``factor``; rigid parts are drawn between the nodes so moved."""
+    out = {n: np.asarray(c, dtype=float) for n, c in coords.items()}
+    for (root, root_o), beams in geometry.flexible_components():
+        if any(el.l0 is None for el in beams):
+            continue
+        planar = len(coords[root_o]) == 1
+        ref = {root: 0.0}
+        pending = list(beams)
+        while pending:
+            el = next((el for el in pending if el.nodes[0] in ref or el.nodes[2] in ref), None)
+            if el is None:
+                break
+            pending.remove(el)
+            if planar:
+                a0 = el.lgeomy[0] if el.lgeomy else 0.0
+                chord = el.l0 * np.array([math.cos(a0), math.sin(a0)])
+            else:
+                chord = el.l0 * _unit(el.lgeomy[:3])
+            p, q = el.nodes[0], el.nodes[2]
+            if p in ref:
+                ref.setdefault(q, ref[p] + chord)
+            else:
+                ref[p] = ref[q] - chord
+        x_r = np.asarray(coords[root], dtype=float)
+        if planar:
+            b = float(coords[root_o][0])
+            R = np.array([[math.cos(b), -math.sin(b)], [math.sin(b), math.cos(b)]])
+        else:
+            lam_r = np.asarray(coords[root_o], dtype=float)
+            R = rotation(lam_r)
+        for n, X in ref.items():
+            if n != root:
+                rigid = x_r + R @ X
+                out[n] = rigid + factor * (np.asarray(coords[n], dtype=float) - rigid)
+        for o in {m for el in beams for m in (el.nodes[1], el.nodes[3])} - {root_o}:
+            if planar:
+                out[o] = coords[root_o] + factor * (np.asarray(coords[o], dtype=float) - coords[root_o])
+            else:
+                conj = lam_r * np.array([1.0, -1.0, -1.0, -1.0])
+                out[o] = _qmul(lam_r, _qpow(_qmul(conj, np.asarray(coords[o], dtype=float)), factor))
     return out
 
 

@@ -3,9 +3,11 @@ is; ``import spacar`` does not import it).
 
 * :func:`plot` — any coordinate, deformation, stress or reaction against time or against another
   (``plot(res, "e(2,2)")``, ``plot(res, ("X", 8, 1), x=("X", 2, 1))``).
-* :func:`draw` — the mechanism at one output time: beams with their cubic deflection shape,
-  trusses as lines, joints and supports as symbols, wheels and pulleys as circles, rigid bodies
-  (LAMBDA nodes with inertia) as body-frame triads; 2-D for planar models, 3-D otherwise.
+* :func:`draw` — the mechanism at one output time: beams with their cubic deflection shape
+  (deflections of flexible beams magnified on request), trusses as lines, pins and supports as
+  symbols (a clamp as a hatched wall), rigid links of three or more nodes as filled bodies,
+  wheels and pulleys as circles, rigid bodies (LAMBDA nodes with inertia) as body-frame triads;
+  2-D for planar models, 3-D otherwise.
 * :func:`spacar.animate` (module :mod:`spacar.animation`) — the same drawing over all output times.
 """
 from __future__ import annotations
@@ -15,7 +17,7 @@ import numpy as np
 import matplotlib.pyplot as plt
 
 from .errors import InputError
-from .geometry import frame_coordinates, shapes
+from .geometry import frame_coordinates, magnified, shapes
 from .results import Results, require_results
 
 STYLE = {
@@ -31,6 +33,8 @@ STYLE = {
     "triad-z": dict(color="tab:blue", lw=2.0, zorder=4),
     "pin": dict(marker="o", ms=7, mfc="white", mec="k", mew=1.5, ls="none", zorder=6),
     "ground": dict(marker="^", ms=13, mfc="0.6", mec="0.3", ls="none", zorder=1),
+    "clamp": dict(color="0.15", lw=1.6, solid_capstyle="butt", zorder=1),
+    "body": dict(facecolor="C0", edgecolor="C0", alpha=0.25, lw=1.0, zorder=2),
     "slider": dict(marker="s", ms=13, mfc="0.75", mec="k", ls="none", zorder=5),
     "mass": dict(marker="o", ms=9, mfc="k", mec="k", ls="none", zorder=5),
     "point": dict(marker="x", ms=8, color="k", ls="none", zorder=5),
@@ -80,7 +84,8 @@ class Scene:
     """The artists of a mechanism drawing, updated frame by frame (:meth:`update`)."""
 
     def __init__(self, res: Results, ax=None, k: int = 0, *, labels: bool = False, trace=(),
-                 beam_points: int = 21, title: bool = True, figsize=None, dpi=None):
+                 beam_points: int = 21, title: bool = True, figsize=None, dpi=None, magnify: float = 1.0,
+                 caption=None):
         if res.geometry is None:
             raise InputError("these results have no geometry to draw (results of spacar.simulate have)")
         if len(res.t) == 0:
@@ -92,6 +97,10 @@ class Scene:
         self.node_columns = res.node_columns
         self.beam_points = beam_points
         self.labels = labels
+        if not (isinstance(magnify, (int, float)) and np.isfinite(magnify) and magnify > 0):
+            raise InputError(f"magnify must be a positive number, got {magnify!r}")
+        self.magnify = float(magnify)
+        self.caption = caption if caption is not None else (lambda i: f"t = {self.res.t[i]:.4g} s")
         if ax is None:
             fig = plt.figure(figsize=figsize, dpi=dpi)
             ax = fig.add_subplot(projection="3d") if self.spatial else fig.add_subplot()
@@ -101,26 +110,79 @@ class Scene:
         self.scale = self._scale()
         self.lines = []
         for sh in self._shapes(k):
-            style = STYLE.get(sh.kind, dict(color="k"))
-            (line,) = ax.plot(*sh.points.T, **style)
-            line.set_gid(f"element-{sh.element}" if sh.element is not None else f"node-{sh.node}")
-            line.spacar_kind = sh.kind
-            self.lines.append(line)
+            self.lines.append(self._artist(sh))
         self._static_decorations(trace)
         self.node_texts = {}
         if labels:
-            coords = self._coords(k)
-            for n in self.geometry.position_nodes:
-                if n in coords:
-                    self.node_texts[n] = ax.text(*self._pos(coords[n]), f" {n}", fontsize=8, color="0.2", zorder=7)
+            self._labels(k)
         self.title = ax.set_title("") if title else None
         self._limits()
         self.update(k)
 
+    def _artist(self, sh):
+        """A line for a shape; a filled polygon for a body (``spacar_kind`` and gid name it)."""
+        ax, style = self.ax, STYLE.get(sh.kind, dict(color="k"))
+        if sh.kind == "body":
+            if self.spatial:
+                from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+                artist = ax.add_collection3d(Poly3DCollection([sh.points], **style))
+            else:
+                (artist,) = ax.fill(*sh.points.T, **style)
+            artist.set_gid(f"body-{sh.node}")
+        else:
+            (artist,) = ax.plot(*sh.points.T, **style)
+            artist.set_gid(f"element-{sh.element}" if sh.element is not None else f"node-{sh.node}")
+        artist.spacar_kind = sh.kind
+        return artist
+
+    def _labels(self, k):
+        """Node numbers beside their nodes, off the symbols: shifted (in points, so at any zoom)
+        away from the elements that meet there — into the widest free angle in 2-D, up and to
+        the right in 3-D — and kept there as the mechanism moves."""
+        from matplotlib.transforms import ScaledTranslation
+
+        coords, ax = self._coords(k), self.ax
+        for n in self.geometry.position_nodes:
+            if n not in coords:
+                continue
+            direction = np.array([1.0, 1.0]) / np.sqrt(2.0)
+            if not self.spatial:
+                direction = self._free_direction(n, coords)
+            dx, dy = 11.0 * direction
+            offset = ax.transData + ScaledTranslation(dx / 72.0, dy / 72.0, ax.figure.dpi_scale_trans)
+            ha = "left" if dx > 3 else "right" if dx < -3 else "center"
+            va = "bottom" if dy > 3 else "top" if dy < -3 else "center"
+            self.node_texts[n] = ax.text(*self._pos(coords[n]), f"{n}", fontsize=8, color="0.2", zorder=7,
+                                         ha=ha, va=va, transform=offset)
+
+    def _free_direction(self, n, coords):
+        """The unit bisector of the widest angle between the directions from node n to the
+        position nodes it shares an element with (and, at a support, the support below it)."""
+        x = self._pos(coords[n])
+        angles = []
+        for el in self.geometry.elements:
+            if n in el.nodes:
+                for m in el.nodes:
+                    if m != n and m in coords and self.geometry.node_kinds.get(m) in ("XY", "XYZ"):
+                        d = self._pos(coords[m]) - x
+                        if np.hypot(*d) > 0:
+                            angles.append(np.arctan2(d[1], d[0]))
+        if self.geometry.supported(n):
+            angles.append(-np.pi / 2)   # the ground triangle, the slider block and the clamp's hatching
+        if not angles:
+            return np.array([1.0, 1.0]) / np.sqrt(2.0)
+        a = np.sort(np.mod(angles, 2 * np.pi))
+        gaps = np.diff(np.concatenate([a, [a[0] + 2 * np.pi]]))
+        i = int(np.argmax(gaps))
+        mid = a[i] + gaps[i] / 2
+        return np.array([np.cos(mid), np.sin(mid)])
+
     # --- geometry of frames ------------------------------------------------------------------
 
     def _coords(self, k):
-        return frame_coordinates(self.node_columns, self.res.x[k])
+        coords = frame_coordinates(self.node_columns, self.res.x[k])
+        return coords if self.magnify == 1.0 else magnified(self.geometry, coords, self.magnify)
 
     def _shapes(self, k):
         return shapes(self.geometry, self._coords(k), self.scale, self.beam_points)
@@ -157,7 +219,7 @@ class Scene:
         for k in self._frames_sample(100):
             pts.extend(sh.points for sh in self._shapes(k))
         pts = np.vstack(pts) if pts else np.zeros((1, self.dim))
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        lo, hi = np.nanmin(pts, axis=0), np.nanmax(pts, axis=0)
         centre, half = (lo + hi) / 2, (hi - lo) / 2
         pad = 0.08 * max(float(half.max()), 1e-9) + 0.02 * self.scale
         half = half + pad
@@ -168,6 +230,12 @@ class Scene:
             ax.set_ylim(centre[1] - r, centre[1] + r)
             ax.set_zlim(centre[2] - r, centre[2] + r)
             ax.set_box_aspect((1, 1, 1))
+            # Four ticks a side in a small font: the default's crowd into each other in 3-D.
+            from matplotlib.ticker import MaxNLocator
+
+            for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+                axis.set_major_locator(MaxNLocator(nbins=4))
+            ax.tick_params(labelsize=7, pad=0)
             ax.set_xlabel("x")
             ax.set_ylabel("y")
             ax.set_zlabel("z")
@@ -205,7 +273,12 @@ class Scene:
     def update(self, k: int):
         """Move every artist to output index k; returns the artists."""
         for line, sh in zip(self.lines, self._shapes(k)):
-            if self.spatial:
+            if sh.kind == "body":
+                if self.spatial:
+                    line.set_verts([sh.points])
+                else:
+                    line.set_xy(sh.points)
+            elif self.spatial:
                 line.set_data_3d(*sh.points.T)
             else:
                 line.set_data(*sh.points.T)
@@ -219,7 +292,7 @@ class Scene:
                 else:
                     text.set_position(p)
         if self.title is not None:
-            self.title.set_text(f"t = {self.res.t[k]:.4g} s")
+            self.title.set_text(self.caption(k))
         return self.lines
 
     def element_lines(self, element: int) -> list:
@@ -227,10 +300,10 @@ class Scene:
         return [ln for ln in self.lines if ln.get_gid() == f"element-{element}"]
 
 
-def _displaced(res: Results, k: int, mode, scale) -> Results:
-    """One-row results at row k displaced by ``scale`` times the nodal shape ``mode`` (nx); by
-    default scaled so that the largest displacement of a position is a tenth of the model's
-    extent. Euler parameters are normalised again."""
+def _displaced(res: Results, k: int, mode, scale, amplitudes=(1.0,)) -> Results:
+    """Results at row k displaced by ``scale`` times the nodal shape ``mode`` (nx), one row per
+    amplitude (default one row, amplitude 1); by default scaled so that the largest displacement
+    of a position is a tenth of the model's extent. Euler parameters are normalised again."""
     dx = np.real(np.asarray(mode)).astype(float).reshape(-1)
     if dx.shape != res.x[k].shape or not np.isfinite(dx).all():
         raise InputError(f"mode must hold {res.x.shape[1]} finite numbers (one per nodal coordinate, as "
@@ -244,24 +317,39 @@ def _displaced(res: Results, k: int, mode, scale) -> Results:
         extent = max(np.ptp(xy, axis=0).max(), 1e-300)
         largest = np.abs(dx[rows]).max() if rows.size else 0.0
         scale = 0.1 * extent / largest if largest > 0 else 1.0
-    x = res.x[k] + float(scale) * dx
+    x = res.x[k] + float(scale) * np.asarray(amplitudes, dtype=float)[:, None] * dx
     for n, c in cols.items():
         if kinds.get(n) == "LAMBDA":
-            x[c] /= np.linalg.norm(x[c])
-    one = lambda a: np.asarray(a)[k:k + 1]  # noqa: E731
-    arrays = {"t": one(res.t), "x": x[None, :], "xd": one(res.xd), "xdd": one(res.xdd), "e": one(res.e),
-              "ed": one(res.ed), "edd": one(res.edd), "sigma": one(res.sigma), "reaction": one(res.reaction)}
+            x[:, c] /= np.linalg.norm(x[:, c], axis=1, keepdims=True)
+    many = lambda a: np.repeat(np.asarray(a)[k:k + 1], len(x), axis=0)  # noqa: E731
+    arrays = {"t": many(res.t), "x": x, "xd": many(res.xd), "xdd": many(res.xdd), "e": many(res.e),
+              "ed": many(res.ed), "edd": many(res.edd), "sigma": many(res.sigma), "reaction": many(res.reaction)}
     return Results(arrays, res.coordinate_labels, res.deformation_labels, res.stats, geometry=res.geometry)
 
 
+def snapshot(sim, geometry) -> Results:
+    """One-row :class:`Results` of the current state of a ``_core.Simulation`` (for drawing a
+    state that no run recorded: a linearization's, or one the explorer solved)."""
+    d, system = sim.data, sim.system
+    arrays = {name: np.array(getattr(d, name), dtype=float)[None, ...]
+              for name in ("x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")}
+    arrays["t"] = np.array([float(d.t)])
+    return Results(arrays, system.coord_label, system.def_label, {}, geometry=geometry)
+
+
 def draw(res: Results, k: int = -1, *, time: float | None = None, ax=None, labels: bool = False,
-         trace=(), beam_points: int = 21, figsize=None, mode=None, scale: float | None = None):
+         trace=(), beam_points: int = 21, figsize=None, mode=None, scale: float | None = None,
+         magnify: float = 1.0):
     """Draw the mechanism at output index ``k`` (default the last) or at the output time nearest
     to ``time``. ``labels`` writes the node numbers; ``trace`` lists position nodes whose paths
     over the whole run are drawn (e.g. a coupler curve). ``mode``: a shape in the nodal
     coordinates (e.g. a buckling mode, ``Linearization.buckling_modes()[2][:, 0]``, or a
     vibration mode) added to that state, times ``scale`` (default: its largest displacement a
-    tenth of the model's size). Returns the :class:`Scene` (its ``ax`` is the axes)."""
+    tenth of the model's size); beams are drawn through the displaced nodes with the cubic
+    (Hermite) shape of their displaced end slopes. ``magnify`` multiplies the deflections of the
+    flexible beams, relative to their rigid-body motion (:func:`spacar.geometry.magnified`),
+    e.g. ``magnify=50`` to see a stiff leaf spring bend. Returns the :class:`Scene` (its ``ax``
+    is the axes)."""
     require_results(res, "draw")
     if time is not None:
         k = res.time_index(time)
@@ -270,4 +358,5 @@ def draw(res: Results, k: int = -1, *, time: float | None = None, ax=None, label
         if res.geometry is None:
             raise InputError("these results have no geometry to draw (results of spacar.simulate have)")
         res, k = _displaced(res, k, mode, scale), 0
-    return Scene(res, ax, k, labels=labels, trace=trace, beam_points=beam_points, figsize=figsize)
+    return Scene(res, ax, k, labels=labels, trace=trace, beam_points=beam_points, figsize=figsize,
+                 magnify=magnify)

@@ -177,8 +177,8 @@ def test_bent_beam_end_tangents_reproduce_its_bending_deformations():
     phi_p, phi_q = math.atan2(d0[1], d0[0]), math.atan2(d1[1], d1[0])
     assert math.sin(phi_p - alpha) == pytest.approx(e2, abs=1e-9)
     assert math.sin(alpha - phi_q) == pytest.approx(e3, abs=1e-9)
-    assert kinds(scene).count(("ground", "node-1")) == 1   # clamped: a support, no pin
-    assert ("pin", "node-1") not in kinds(scene)
+    assert kinds(scene).count(("clamp", "node-1")) == 1    # clamped: a clamp, no pin, no pin support
+    assert ("pin", "node-1") not in kinds(scene) and ("ground", "node-1") not in kinds(scene)
 
 
 def test_symbols_of_the_slidercrank(slidercrank):
@@ -462,3 +462,214 @@ def test_a_type_without_a_drawing_of_its_own_is_drawn_through_its_position_nodes
             drawn.setdefault(s.element, []).append((s.kind, s.points.tolist()))
     assert drawn == {1: [("link", [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])], 2: [("point", [[1.0, 1.0]])],
                      4: [("link", [[0.0, 0.0], [1.0, 0.0]])]}
+
+
+# --------------------------------------------------------------------------------------------
+# drawings that teach: clamps, rigid bodies, magnified deflections, labels off the symbols
+# --------------------------------------------------------------------------------------------
+
+def fourbar_with_coupler_triangle(n_out=24):
+    """A Grashof crank-rocker A(0,0) B(0.1,0) C(0.3,0.2) D(0.35,0) with the coupler point E
+    (0.25, 0.35) on a second rigid PLBEAM from B that shares the coupler's BETA node 5."""
+    m = spacar.Model()
+    m.plbeam(1, 1, 2, 3, 4)
+    m.plbeam(2, 3, 5, 6, 7)
+    m.plbeam(3, 6, 8, 9, 10)
+    m.plbeam(4, 3, 5, 11, 12)
+    m.x(3, 0.1, 0.0)
+    m.x(6, 0.3, 0.2)
+    m.x(9, 0.35, 0.0)
+    m.x(11, 0.25, 0.35)
+    m.fix(1)
+    m.fix(9)
+    m.inputx(2, 1)
+    m.xd(2, 1, 1.0)
+    m.timestep(n_out, 2 * math.pi)
+    return spacar.simulate(m)
+
+
+def test_a_rigid_coupler_triangle_is_one_filled_body_that_moves_with_its_nodes():
+    res = fourbar_with_coupler_triangle()
+    scene = spacar.draw(res, 5)
+    bodies = [a for a in scene.lines if a.spacar_kind == "body"]
+    assert [b.get_gid() for b in bodies] == ["body-5"]            # one body, named by its BETA node
+    assert isinstance(bodies[0], matplotlib.patches.Polygon) and bodies[0].get_fill()
+    for k in (5, 17):
+        scene.update(k)
+        outline = bodies[0].get_xy()
+        np.testing.assert_allclose(outline[0], outline[-1])          # closed
+        corners = np.array([res.node(n).x[k] for n in (3, 6, 11)])
+        assert len(outline) == 4
+        for c in corners:                                             # through B, C and E
+            assert np.min(np.linalg.norm(outline[:-1] - c, axis=1)) < 1e-12
+    # the two ground pivots are pins on ground triangles (their BETA nodes turn), not clamps
+    ks = kinds(scene)
+    assert {("pin", "node-1"), ("ground", "node-1"), ("pin", "node-9"), ("ground", "node-9")} <= set(ks)
+    assert not [k for k, _ in ks if k == "clamp"]
+
+
+def test_bars_of_two_nodes_and_the_slider_crank_have_no_body(slidercrank):
+    assert not [a for a in spacar.draw(slidercrank, 3).lines if a.spacar_kind == "body"]
+
+
+def test_a_clamp_is_a_wall_across_the_beam_hatched_on_the_far_side():
+    alpha0 = math.radians(30.0)
+    scene = spacar.draw(bent_plbeam(alpha0))
+    (clamp,) = [ln for ln in scene.lines if ln.spacar_kind == "clamp"]
+    pts = line_points(clamp)
+    pieces = [p for p in np.split(pts, np.where(np.isnan(pts[:, 0]))[0]) if len(p)]
+    pieces = [p[~np.isnan(p[:, 0])] for p in pieces]
+    wall, strokes = pieces[0], pieces[1:]
+    d = np.array([math.cos(alpha0), math.sin(alpha0)])               # the beam leaves the clamp along α0
+    assert abs((wall[1] - wall[0]) @ d) < 1e-12                       # the wall is across the beam
+    np.testing.assert_allclose(wall.mean(axis=0), [0.0, 0.0], atol=1e-12)
+    assert len(strokes) >= 4
+    for s in strokes:
+        assert (s[1] - s[0]) @ d < 0                                  # hatching behind the wall
+
+
+def test_magnified_deflection_of_a_clamped_beam():
+    """A clamped beam's rigid-body motion is none: the drawn tip is the reference tip plus
+    ``magnify`` times its displacement and the tip slope turns ``magnify`` times as far."""
+    alpha0, m = math.radians(30.0), 10.0
+    res = bent_plbeam(alpha0)
+    plain = line_points(spacar.draw(res).element_lines(1)[0])
+    scene = spacar.draw(res, magnify=m, beam_points=31)
+    start, end, d0, d1, residual = cubic_ends(line_points(scene.element_lines(1)[0]))
+    assert residual < 1e-12
+    reference_tip = np.array([math.cos(alpha0), math.sin(alpha0)])    # l0 = 1
+    np.testing.assert_allclose(start, 0.0, atol=1e-12)
+    np.testing.assert_allclose(end, reference_tip + m * (res.node(3).x[0] - reference_tip), atol=1e-12)
+    bq = alpha0 + m * res.node(4).x[0, 0]
+    np.testing.assert_allclose(d1 / np.linalg.norm(d1), [math.cos(bq), math.sin(bq)], atol=1e-10)
+    np.testing.assert_allclose(d0, [math.cos(alpha0), math.sin(alpha0)], atol=1e-10)
+    assert np.abs(plain - line_points(spacar.draw(res, magnify=1.0).element_lines(1)[0])).max() == 0.0
+    with pytest.raises(spacar.InputError, match="magnify must be a positive number"):
+        spacar.draw(res, magnify=0)
+
+
+def test_magnify_keeps_rigid_mechanisms_and_their_motion(slidercrank):
+    """The slider-crank's flexible coupler and rocker move with their root ends: magnified, the
+    crank (rigid) is unchanged and the magnified deflection is m times the drawn one's
+    deviation from the rigid motion."""
+    res = slidercrank
+    k, m = 40, 20.0
+    a = spacar.draw(res, k)
+    b = spacar.draw(res, k, magnify=m)
+    np.testing.assert_array_equal(line_points(a.element_lines(1)[0]), line_points(b.element_lines(1)[0]))
+    # element 2 (3 -> 6) moves with node 3 and BETA 5: rigid position of node 6 is 3 + R(β5) l0 e_x
+    x3, b5 = res.node(3).x[k], res.node(5).x[k, 0]
+    rigid6 = x3 + 0.15 * np.array([math.cos(b5), math.sin(b5)])
+    np.testing.assert_allclose(line_points(b.element_lines(2)[0])[-1], rigid6 + m * (res.node(6).x[k] - rigid6),
+                               atol=1e-12)
+
+
+def overlaps(a, b):
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+def test_node_labels_stay_off_the_symbols(slidercrank):
+    from matplotlib.transforms import Bbox
+
+    res = slidercrank
+    for k in (0, 30, 60):
+        scene = spacar.draw(res, k, labels=True)
+        fig = scene.ax.figure
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        symbols = [ln for ln in scene.lines if ln.get_marker() not in (None, "None", "")]
+        for n, text in scene.node_texts.items():
+            tb = text.get_window_extent(renderer)
+            for ln in symbols:
+                x, y = scene.ax.transData.transform(line_points(ln)[0])
+                half = ln.get_markersize() / 2 * fig.dpi / 72.0
+                assert not overlaps(tb, Bbox.from_extents(x - half, y - half, x + half, y + half)), (n, ln.get_gid())
+
+
+def test_3d_tick_labels_do_not_collide():
+    """The spatial slider-crank at the animation's figure size: matplotlib's default ticks put
+    the x labels -0.1 and 0.0 on top of each other; no two tick or axis labels overlap."""
+    res = spacar.simulate(spacar.read(EXAMPLES / "slidercrank3d.dat"))
+    for k in (0, -1):
+        scene = spacar.draw(res, k, figsize=(6.0, 4.5), labels=True)
+        fig = scene.ax.figure
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        boxes = []
+        for axis in (scene.ax.xaxis, scene.ax.yaxis, scene.ax.zaxis):
+            lo, hi = sorted(axis.get_view_interval())
+            shown = [t.label1 for t in axis.get_major_ticks() if lo - 1e-12 <= t.get_loc() <= hi + 1e-12]
+            assert len(shown) >= 2
+            boxes += [(axis.axis_name, t.get_text(), t.get_window_extent(renderer)) for t in shown]
+            boxes.append((axis.axis_name, "label", axis.label.get_window_extent(renderer)))
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                assert not overlaps(boxes[i][2], boxes[j][2]), (boxes[i][:2], boxes[j][:2])
+
+
+# --------------------------------------------------------------------------------------------
+# mode-shape animation, the offline player
+# --------------------------------------------------------------------------------------------
+
+def clamped_beam_mesh(n=4):
+    """A cantilever of n PLBEAMs (L = 1, EI = 1, m = 1 per length): f1 = 1.8751² / 2π Hz
+    (Euler-Bernoulli)."""
+    m = spacar.Model()
+    for i in range(n):
+        m.plbeam(i + 1, 2 * i + 1, 2 * i + 2, 2 * i + 3, 2 * i + 4)
+        m.x(2 * i + 3, (i + 1) / n, 0.0)
+        m.dyne(i + 1, 2, 3)
+        m.emass(i + 1, 1.0)
+        m.estiff(i + 1, 0.0, 1.0)
+    m.fix(1)
+    m.fix(2)
+    return m
+
+
+def test_mode_animation_swings_the_hermite_shape_of_the_mode():
+    model = clamped_beam_mesh()
+    anim = unrendered(spacar.animate_mode(model, 0, frames=8))
+    scene = anim.scene
+    f1 = 1.8751040687**2 / (2 * math.pi)
+    assert float(scene.ax.get_title().split()[2]) == pytest.approx(f1, rel=2e-3)
+    assert list(anim._iter_gen()) == list(range(8))
+    freqs, _, shapes_x = spacar.linearize(model).mode_shapes()
+    res = scene.res
+    tip = res.coordinate_index(9, 2)
+    amplitude = res.x[2, tip]                                       # sin(2π·2/8) = 1
+    assert abs(amplitude) > 0.05
+    for j in range(8):
+        scene.update(j)
+        s = math.sin(2 * math.pi * j / 8)
+        np.testing.assert_allclose(res.x[j], res.x[0] + s * (res.x[2] - res.x[0]), atol=1e-12)
+        # each beam: the cubic through its displaced nodes with its displaced end slopes
+        for el in range(1, 5):
+            p, rp, q, rq = 2 * el - 1, 2 * el, 2 * el + 1, 2 * el + 2
+            start, end, d0, d1, residual = cubic_ends(line_points(scene.element_lines(el)[0]))
+            assert residual < 1e-12
+            np.testing.assert_allclose(start, res.node(p).x[j], atol=1e-12)
+            np.testing.assert_allclose(end, res.node(q).x[j], atol=1e-12)
+            for d, b in ((d0, res.node(rp).x[j, 0]), (d1, res.node(rq).x[j, 0])):
+                np.testing.assert_allclose(d, 0.25 * np.array([math.cos(b), math.sin(b)]), atol=1e-12)
+    # the displacement is the mode's nodal shape
+    dx = res.x[2] - res.x[0]
+    np.testing.assert_allclose(dx / dx[tip], shapes_x[:, 0] / shapes_x[tip, 0], atol=1e-10)
+
+
+def test_mode_animation_errors(slidercrank):
+    with pytest.raises(spacar.InputError, match="no linearizations"):
+        spacar.animate_mode(slidercrank)
+    with pytest.raises(spacar.InputError, match="mode must be a mode number 0..3"):
+        spacar.animate_mode(clamped_beam_mesh(2), 4)
+    with pytest.raises(spacar.InputError, match="no geometry"):
+        spacar.animate_mode(spacar.linearize(clamped_beam_mesh(2)))
+
+
+def test_the_html_player_needs_no_network(slidercrank, tmp_path):
+    """matplotlib's player loads Font Awesome from a CDN; spacar's is self-contained."""
+    anim = spacar.animate(slidercrank, step=50)
+    for html in (anim.to_jshtml(), anim._repr_html_(),
+                 spacar.save_animation(anim, tmp_path / "a.html").read_text(encoding="utf-8")):
+        assert not re.search(r"https?://", html)
+        assert 'class="fa' not in html and "\u25b6" in html           # the play button: a Unicode triangle
+        assert len(html_frames(html)) == 3

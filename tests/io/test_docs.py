@@ -29,7 +29,8 @@ README_COMMANDS = [
     'python3 -m venv .venv && . .venv/bin/activate && pip install ".[test]" && pytest',
 ]
 NOTEBOOKS = ["01_slidercrank.ipynb", "02_fourbar.ipynb", "03_cantilever.ipynb", "04_rigid_body.ipynb",
-             "05_rolling_wheel_and_bicycle.ipynb", "06_peer_comparison.ipynb", "07_flexures.ipynb", "08_mechatronics.ipynb"]
+             "05_rolling_wheel_and_bicycle.ipynb", "06_peer_comparison.ipynb", "07_flexures.ipynb", "08_mechatronics.ipynb",
+             "09_explore.ipynb"]
 
 
 def read(name):
