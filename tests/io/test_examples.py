@@ -104,10 +104,42 @@ def check_stephenson_sixbar(res):
     np.testing.assert_allclose(xy(res, 14), F, atol=1e-7)
 
 
+def check_double_pendulum(res):
+    """Energy conservation: ½ m (|v3|² + |v6|²) + m g (y3 + y6) stays at its initial value
+    (0: at rest with both rods horizontal), computed here from the nodes' positions and rates."""
+    m, g = 1.0, 9.81
+    kinetic = 0.5 * m * sum((res.node(n).xd ** 2).sum(axis=1) for n in (3, 6))
+    potential = m * g * (res.node(3).x[:, 1] + res.node(6).x[:, 1])
+    energy = kinetic + potential
+    assert abs(energy).max() < 1e-5 * kinetic.max()
+    assert kinetic.max() > 10.0                         # it did swing
+
+
+def check_belt_drive(res):
+    """β1 = ½ T t² / (J1 + J2 (r1/r2)²) from rest under the torque T; β2 = (r1/r2) β1."""
+    T, J1, J2, ratio = 0.2, 1e-4, 2e-3, 0.05 / 0.10
+    beta1 = 0.5 * T / (J1 + J2 * ratio**2) * res.t**2
+    np.testing.assert_allclose(res.node(2).x[:, 0], beta1, rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(res.node(4).x[:, 0], ratio * beta1, rtol=1e-6, atol=1e-9)
+
+
+def check_stewart_platform(res):
+    """Pure heave: every platform node keeps its x, y and rises to sqrt(l² − 0.75) for the leg
+    length l = sqrt(1.75) + 0.2 t (the inverse kinematics of the symmetric platform)."""
+    height = np.sqrt((np.sqrt(1.75) + 0.2 * res.t) ** 2 - 0.75)
+    for n in (11, 12, 13):
+        x = res.node(n).x
+        np.testing.assert_allclose(x[:, :2], np.repeat(x[:1, :2], len(res.t), axis=0), atol=1e-9)
+        np.testing.assert_allclose(x[:, 2], height, rtol=1e-9)
+
+
 EXAMPLES_CHECKED = {
     "fourbar_coupler": ("run", check_fourbar_coupler),
     "watt_sixbar": ("run", check_watt_sixbar),
     "stephenson_sixbar": ("run", check_stephenson_sixbar),
+    "double_pendulum": ("run", check_double_pendulum),
+    "belt_drive": ("run", check_belt_drive),
+    "stewart_platform": ("run", check_stewart_platform),
 }
 EXISTING = ["andrews_squeezer", "bicycle", "slidercrank", "slidercrank3d"]
 
