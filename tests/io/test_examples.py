@@ -133,6 +133,23 @@ def check_stewart_platform(res):
         np.testing.assert_allclose(x[:, 2], height, rtol=1e-9)
 
 
+EI, L = 2.1e11 * 0.02 * 0.0005**3 / 12, 0.05      # the leaves of the flexure examples
+
+
+def check_parallel_leaf_guide(res):
+    """The stage moves F / (24 EI / L³) under the drive force F = 1 N (two clamped-guided
+    leaves; their axial compliance adds 3e-4), and it does not tilt (to first order)."""
+    u = res.node(9).x[-1, 0]
+    assert u == pytest.approx(1.0 / (24 * EI / L**3), rel=1e-3)
+    assert abs(res.node(10).x[-1, 0]) < 1e-3 * u / L
+
+
+def check_cross_spring_pivot(res):
+    """The body turns M / (2 EI / L) under the moment M (leaves crossing at their midpoints:
+    circular arcs, Haringx 1949)."""
+    assert res.node(10).x[-1, 0] == pytest.approx(0.0175 / (2 * EI / L), rel=1e-4)
+
+
 EXAMPLES_CHECKED = {
     "fourbar_coupler": ("run", check_fourbar_coupler),
     "watt_sixbar": ("run", check_watt_sixbar),
@@ -140,6 +157,8 @@ EXAMPLES_CHECKED = {
     "double_pendulum": ("run", check_double_pendulum),
     "belt_drive": ("run", check_belt_drive),
     "stewart_platform": ("run", check_stewart_platform),
+    "parallel_leaf_guide": ("static", check_parallel_leaf_guide),
+    "cross_spring_pivot": ("static", check_cross_spring_pivot),
 }
 EXISTING = ["andrews_squeezer", "bicycle", "slidercrank", "slidercrank3d"]
 
