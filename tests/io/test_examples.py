@@ -159,6 +159,30 @@ def check_flexible_arm(res):
     assert res.node(10).x[-1, 0] < 1.0
 
 
+def check_bricard_linkage(res):
+    """The loop closes as a chain of screw motions (product of exponentials, computed here
+    from the hinge angles: the ground link comes back to itself); the released misalignment
+    stays zero (the linkage is mobile although over-constrained); threefold symmetry
+    θ1 = θ3 = θ5, θ2 = θ4 = θ6."""
+    from scipy.spatial.transform import Rotation
+
+    points = np.array([(1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1), (1, 0, 1)], float)
+    axes = np.eye(3)[[0, 2, 1, 0, 2, 1]]
+    angles = np.array([res.deformation(e, 1) for e in range(7, 13)]).T
+    for theta in angles:
+        loop = np.eye(4)
+        for u, p, t in zip(axes, points, theta):
+            screw = np.eye(4)
+            screw[:3, :3] = Rotation.from_rotvec(u * t).as_matrix()
+            screw[:3, 3] = (np.eye(3) - screw[:3, :3]) @ p
+            loop = loop @ screw
+        np.testing.assert_allclose(loop, np.eye(4), atol=1e-7)
+    assert abs(res.deformation(12, 3)).max() < 1e-7
+    np.testing.assert_allclose(angles[:, [2, 4]], angles[:, [0, 0]], atol=1e-7)
+    np.testing.assert_allclose(angles[:, [3, 5]], angles[:, [1, 1]], atol=1e-7)
+    assert angles[-1, 0] == pytest.approx(0.5) and abs(angles[-1, 1]) > 1.0
+
+
 EXAMPLES_CHECKED = {
     "fourbar_coupler": ("run", check_fourbar_coupler),
     "watt_sixbar": ("run", check_watt_sixbar),
@@ -169,6 +193,7 @@ EXAMPLES_CHECKED = {
     "parallel_leaf_guide": ("static", check_parallel_leaf_guide),
     "cross_spring_pivot": ("static", check_cross_spring_pivot),
     "flexible_arm": ("energy", check_flexible_arm),
+    "bricard_linkage": ("run", check_bricard_linkage),
 }
 EXISTING = ["andrews_squeezer", "bicycle", "slidercrank", "slidercrank3d"]
 
@@ -196,6 +221,18 @@ def test_example(name):
     model, res, seconds = analyse(name, how)
     check(res)
     assert seconds < 5.0     # a short run (~2 s on a loaded 2-core machine)
+
+
+def test_bricard_without_its_release_is_over_constrained_and_check_release_names_it(tmp_path):
+    text = (EXAMPLES / "bricard_linkage.dat").read_text()
+    assert "\nRLSE 12 3\n" in text
+    path = tmp_path / "bricard.dat"
+    path.write_text(text.replace("\nRLSE 12 3\n", "\n"))
+    plain = cli("check", str(path))
+    assert plain.returncode == 1 and "over-constrained by 1" in plain.stdout
+    released = cli("check", "--release", str(path))
+    assert released.returncode == 0, released.stdout + released.stderr
+    assert "* RLSE 12 3 " in released.stdout
 
 
 @pytest.mark.parametrize("name", sorted(EXAMPLES_CHECKED))
