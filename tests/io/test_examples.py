@@ -7,6 +7,7 @@ formulas), or a conservation law (energy).
 Each example is a teaching file: the test also keeps it commented (`*` lines) and short."""
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import time
@@ -233,6 +234,17 @@ def test_bricard_without_its_release_is_over_constrained_and_check_release_names
     released = cli("check", "--release", str(path))
     assert released.returncode == 0, released.stdout + released.stderr
     assert "* RLSE 12 3 " in released.stdout
+
+
+def test_the_modelling_guide_runs_its_python_blocks_and_shows_every_example():
+    text = (ROOT / "docs" / "modelling.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    assert len(blocks) >= 2
+    for block in blocks:
+        out = subprocess.run([sys.executable, "-c", block], capture_output=True, text=True, cwd=ROOT)
+        assert out.returncode == 0, out.stderr
+    for name in set(EXAMPLES_CHECKED) | set(EXISTING):
+        assert f"`{name}.dat`" in text, name
 
 
 @pytest.mark.parametrize("name", sorted(EXAMPLES_CHECKED))
