@@ -220,6 +220,7 @@ def test_example(name):
     assert out.returncode == 0, out.stdout + out.stderr
     assert "warning" not in out.stdout
     model, res, seconds = analyse(name, how)
+    assert model.warnings == []           # the X positions close every loop, nothing is checked only
     check(res)
     assert seconds < 5.0     # a short run (~2 s on a loaded 2-core machine)
 
@@ -245,6 +246,35 @@ def test_the_modelling_guide_runs_its_python_blocks_and_shows_every_example():
         assert out.returncode == 0, out.stderr
     for name in set(EXAMPLES_CHECKED) | set(EXISTING):
         assert f"`{name}.dat`" in text, name
+
+
+ROUGH_FOURBAR = """PLBEAM 1 1 2 3 4
+PLBEAM 2 3 5 6 7
+PLBEAM 3 8 9 6 10
+X 3 0. 1.
+X 6 3.2 2.6
+X 8 4. 0.
+FIX 1
+FIX 8
+LENGTHO 2 3.605551
+LENGTHO 3 3.162278
+INPUTX 2
+END
+"""
+
+
+def test_a_loop_that_the_x_positions_do_not_close_warns_with_the_node_and_the_distance():
+    model = spacar.read_string(ROUGH_FOURBAR)
+    res = spacar.simulate(model)
+    np.testing.assert_allclose(res.node(6).x[0], [3.0, 3.0], atol=1e-5)
+    [warning] = model.warnings
+    assert "moved node 6 by 0.4472 from its X position (3.2, 2.6) to (3, 3)" in warning
+    # The crank's input starting at 0.5 rad from positions drawn at 0: B and C move.
+    turned = spacar.read_string(ROUGH_FOURBAR.replace("X 6 3.2 2.6", "X 6 3. 3.").replace("INPUTX 2", "INPUTX 2\nX 2 0.5"))
+    spacar.simulate(turned)
+    assert [w.split(" by ")[0] for w in turned.warnings] == ["the assembly moved node 3", "the assembly moved node 6"]
+    spacar.simulate(turned)                    # later blocks do not warn again
+    assert len(turned.warnings) == 2
 
 
 @pytest.mark.parametrize("name", sorted(EXAMPLES_CHECKED))
