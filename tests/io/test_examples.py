@@ -277,6 +277,22 @@ def test_a_loop_that_the_x_positions_do_not_close_warns_with_the_node_and_the_di
     assert len(turned.warnings) == 2
 
 
+def test_a_crank_driven_past_a_dead_position_says_so_and_names_the_input_reached():
+    """The four-bar of fourbar_coupler.dat with a crank of 3 (B = (0, 3)) and C = (2, 4): the
+    coupler (√5) is the shortest link, so the crank cannot turn fully; coupler and rocker fall in
+    line when |BD| = √5 + √20, i.e. at the crank turn θ with 25 + 24 sin θ = (√5 + √20)²."""
+    text = (EXAMPLES / "fourbar_coupler.dat").read_text()
+    model = spacar.read_string(text.replace("X 3 0. 1.", "X 3 0. 3.").replace("X 6 3. 3.", "X 6 2. 4."))
+    with pytest.raises(spacar.KinematicsError, match="did not converge") as info:
+        spacar.simulate(model)
+    message = str(info.value)
+    assert "dead (limit) position" in message and "Grashof" in message
+    toggle = np.arcsin(((np.sqrt(5) + np.sqrt(20)) ** 2 - 25) / 24)
+    reached = info.value.results.node(2).x[-1, 0]
+    assert f"inputs node 2 x1 = {reached:.6g} (heading for" in message
+    assert reached < toggle < reached + TWO_PI / 36
+
+
 @pytest.mark.parametrize("name", sorted(EXAMPLES_CHECKED))
 def test_example_is_commented(name):
     lines = (EXAMPLES / f"{name}.dat").read_text().splitlines()
