@@ -57,7 +57,7 @@ def rigid(point0, a0, b0, a, b):
     return a + turn(angle(b - a) - angle(b0 - a0)) @ (point0 - a0)
 
 
-def fourbar(res, A, B0, C0, D, crank_angle):
+def fourbar(A, B0, C0, D, crank_angle):
     """The crank-rocker A-B-C-D at every crank angle: B and C by position analysis."""
     B = [A + np.linalg.norm(B0 - A) * np.array([np.cos(t), np.sin(t)]) for t in crank_angle]
     C = [dyad(b, B0, D, C0) for b in B]
@@ -79,7 +79,7 @@ def check_fourbar_coupler(res):
     """The coupler curve of P against the four-bar's closed-form position analysis; the crank
     turns fully (Grashof crank-rocker)."""
     P0 = np.array([2.0, 4.0])
-    B, C = fourbar(res, A, B0, C0, D, np.pi / 2 + res.node(2).x[:, 0])
+    B, C = fourbar(A, B0, C0, D, np.pi / 2 + res.node(2).x[:, 0])
     P = np.array([rigid(P0, B0, C0, b, c) for b, c in zip(B, C)])
     np.testing.assert_allclose(xy(res, 11), P, atol=1e-7)
     assert res.node(2).x[-1, 0] == pytest.approx(TWO_PI)
@@ -90,7 +90,7 @@ def check_fourbar_coupler(res):
 def check_watt_sixbar(res):
     """The output rocker G-F: the rocker D-C-E of loop 1 (closed form) drives loop 2 (a dyad)."""
     E0, F0, G = np.array([5.5, 2.0]), np.array([7.5, 3.0]), np.array([8.0, 0.0])
-    B, C = fourbar(res, A, B0, C0, D, np.pi / 2 + res.node(2).x[:, 0])
+    B, C = fourbar(A, B0, C0, D, np.pi / 2 + res.node(2).x[:, 0])
     E = [rigid(E0, D, C0, D, c) for c in C]
     F = np.array([dyad(e, E0, G, F0) for e in E])
     np.testing.assert_allclose(xy(res, 14), F, atol=1e-7)
@@ -99,7 +99,7 @@ def check_watt_sixbar(res):
 def check_stephenson_sixbar(res):
     """The dyad's pin F follows from the coupler point E of the four-bar (closed form)."""
     E0, F0, G = np.array([2.0, 4.0]), np.array([0.0, 5.0]), np.array([-1.0, 3.0])
-    B, C = fourbar(res, A, B0, C0, D, np.pi / 2 + res.node(2).x[:, 0])
+    B, C = fourbar(A, B0, C0, D, np.pi / 2 + res.node(2).x[:, 0])
     E = [rigid(E0, B0, C0, b, c) for b, c in zip(B, C)]
     F = np.array([dyad(e, E0, G, F0) for e in E])
     np.testing.assert_allclose(xy(res, 14), F, atol=1e-7)
