@@ -4,7 +4,9 @@
 * ``docs/elements.md`` — the element catalogue (spacar.docgen.element_catalogue_markdown),
 * ``docs/figures/elements/<type>.svg`` — a small drawing of every element type with its nodes
   and deformations (matplotlib): its own (FIGURES_BY_TYPE) or, until it has one, the default
-  figure (its node slots and deformation names).
+  figure (its node slots and deformation names),
+* ``docs/img/modelling_<joint>.png`` — the figures of docs/modelling.md: example models run by
+  spacar and drawn by ``spacar.draw``, with a note on how each joint is modelled.
 
 Usage: ``python docs/generate.py`` (write), ``python docs/generate.py --check`` (exit 1 if a
 generated text file differs from the committed one). The SVG files are written reproducibly
@@ -25,6 +27,7 @@ from spacar.geometry import hermite, rotation
 
 DOCS = Path(__file__).resolve().parent
 FIGURES = DOCS / "figures" / "elements"
+EXAMPLES = DOCS.parent / "examples"
 
 
 # --------------------------------------------------------------------------------------------
@@ -396,6 +399,103 @@ def write_figures(directory: Path = FIGURES) -> list:
 
 
 # --------------------------------------------------------------------------------------------
+# The figures of the modelling guide (docs/modelling.md), drawn by spacar itself
+# --------------------------------------------------------------------------------------------
+
+# The four-bar of docs/modelling.md, "Closing a loop": C given roughly, the lengths by LENGTHO.
+ROUGH_FOURBAR = """\
+PLBEAM 1 1 2 3 4
+PLBEAM 2 3 5 6 7
+PLBEAM 3 8 9 6 10
+X 3 0. 1.
+X 6 3.2 2.6
+X 8 4. 0.
+FIX 1
+FIX 8
+LENGTHO 2 3.605551
+LENGTHO 3 3.162278
+INPUTX 2
+END
+"""
+
+
+def _example(name):
+    return spacar.read(EXAMPLES / f"{name}.dat")
+
+
+def _note(scene, text):
+    """How the joint is modelled, in a box under the drawing."""
+    scene.ax.text(0.0, -0.25, text, transform=scene.ax.transAxes, fontsize=8, va="top",
+                  bbox=dict(boxstyle="round", fc="white", ec="0.7"))
+    scene.ax.set_title(scene.ax.get_title(), fontsize=9)
+
+
+def guide_pin():
+    res = spacar.simulate(_example("double_pendulum"), progress=False)
+    scene = spacar.draw(res, time=0.3, labels=True, figsize=(4.6, 3.4))
+    _note(scene, "pin 3: rods 1 and 2 share XY node 3,\nBETA nodes 4 (rod 1) and 5 (rod 2)\n"
+                 "ground pin: FIX 1 (XY only)")
+    return scene
+
+
+def guide_slider():
+    res = spacar.simulate(_example("slidercrank"), progress=False)
+    scene = spacar.draw(res, time=1.0, labels=True, figsize=(4.6, 3.0))
+    _note(scene, "slider 8: FIX 8 2 (y fixed, x calculable)")
+    return scene
+
+
+def guide_weld():
+    res = spacar.simulate(_example("fourbar_coupler"), progress=False)
+    scene = spacar.draw(res, time=0.6, labels=True, trace=[11], figsize=(4.6, 3.6))
+    _note(scene, "weld: B-C (element 2) and B-P (element 4)\nshare BETA node 5 at B = node 3;\n"
+                 "trace=[11]: the coupler curve of P")
+    return scene
+
+
+def guide_ground():
+    model = _example("cross_spring_pivot")
+    model.force(10, 0.35)                     # a large moment: the clamped leaves visibly bent
+    scene = spacar.draw(spacar.static(model), figsize=(4.6, 3.4))
+    _note(scene, "clamps: FIX 1, FIX 2 and FIX 101, FIX 102\n(XY and BETA of each leaf's foot)")
+    return scene
+
+
+def guide_loop():
+    import numpy as np
+
+    model = spacar.read_string(ROUGH_FOURBAR)
+    rough = {n: np.array(model.nodes[n].x[:2]) for n in (1, 3, 6, 8)}
+    scene = spacar.draw(spacar.simulate(model, progress=False), labels=True, figsize=(4.6, 3.4))
+    for a, b in [(1, 3), (3, 6), (8, 6)]:
+        scene.ax.plot(*np.array([rough[a], rough[b]]).T, color="0.5", ls="--", lw=1.2)
+    _note(scene, "dashed: the rough X positions (C = node 6 at (3.2, 2.6))\n"
+                 "solid: assembled with LENGTHO 2 and 3")
+    return scene
+
+
+GUIDE_FIGURES = {"pin": guide_pin, "slider": guide_slider, "weld": guide_weld, "ground": guide_ground,
+                 "loop": guide_loop}
+
+
+def write_guide_figures(directory: Path = DOCS / "img") -> list:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, make in GUIDE_FIGURES.items():
+        fig = make().ax.figure
+        path = directory / f"modelling_{name}.png"
+        fig.savefig(path, dpi=100, bbox_inches="tight", metadata={"Software": None})
+        plt.close(fig)
+        written.append(path)
+    return written
+
+
+# --------------------------------------------------------------------------------------------
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -419,7 +519,7 @@ def main(argv=None) -> int:
         print("generated docs are up to date")
         return 0
     if not args.no_figures:
-        for path in write_figures():
+        for path in write_figures() + write_guide_figures():
             print(f"wrote {path}")
     return 0
 

@@ -1,11 +1,13 @@
 """Running an analysis block from Python."""
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from . import _core
 from ._util import seconds_or_none, show
-from .errors import InputError, SpacarError
+from .errors import InputError, KinematicsError, SpacarError
 from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
 from .results import Results, dof_labels
@@ -108,6 +110,59 @@ def _time_loads(sim, system, forces, inputs):
     sim.set_time_loads(tables, motions, load_function)
 
 
+def _assembly_moves(positions: dict, system, x0) -> list:
+    """Warnings for the position nodes that the first assembly moved far (more than 1e-3 of the
+    model's size) from where X put them: the X positions do not close a loop with the lengths
+    given (LENGTHO), the targets of E or the inputs' start values. An X position that was meant
+    exactly then changed the mechanism; a rough one was closed as intended."""
+    if not positions:
+        return []
+    points = np.concatenate([p for p in positions.values()])
+    size = float(np.ptp(points)) if points.size else 0.0
+    moved: dict = {}
+    for (n, i), value in zip(system.coord_label, x0):
+        if n in positions:
+            moved.setdefault(n, positions[n].copy())[i - 1] = value
+    warnings = []
+    for n, x in moved.items():
+        distance = float(np.linalg.norm(x - positions[n]))
+        if distance > 1e-3 * size:
+            warnings.append(f"the assembly moved node {n} by {distance:.4g} from its X position "
+                            f"({', '.join(f'{v:.6g}' for v in positions[n])}) to "
+                            f"({', '.join(f'{v:.6g}' for v in x)}): the X positions do not close the loop "
+                            f"with the lengths (LENGTHO), E targets and input values given")
+    return warnings
+
+
+
+def _dead_position_hint(err, res, system, model) -> str:
+    """For a kinematic Newton failure after some output times: the inputs at the last position
+    solved and where they were heading, with the usual cause — the mechanism passed a dead
+    (limit, toggle) position — and the Grashof condition of a four-bar's crank."""
+    failed = re.search(r"did not converge .*?at t = ([-+0-9.eE]+)", str(err))
+    if failed is None or res is None or len(res.t) == 0:
+        return ""
+    t, t0 = float(failed.group(1)), model.current_time
+    reached, heading = [], []
+    for (n, i), cls, value in zip(system.coord_label, system.coord_class, res.x[-1]):
+        if cls.name == "input":
+            node = model.nodes[n]
+            reached.append(f"node {n} x{i} = {value:.6g}")
+            dt = t - t0
+            heading.append(f"{node.x[i - 1] + node.xd[i - 1] * dt + 0.5 * node.xdd[i - 1] * dt * dt:.6g}")
+    for (e, i), cls, value in zip(system.def_label, system.def_class, res.e[-1]):
+        if cls.name == "input":
+            reached.append(f"element {e} e{i} = {value:.6g}")
+    if not reached:
+        return ""
+    towards = f" (heading for {', '.join(heading)} at t = {t:.6g})" if len(heading) == len(reached) else ""
+    return (f"\nThe last position solved: t = {res.t[-1]:.6g}, inputs {', '.join(reached)}{towards}. "
+            "If the mechanism has no position beyond it, the inputs drove it into a dead (limit) "
+            "position, where the driven link lines up with the link it drives (a toggle): a four-bar's "
+            "crank turns fully only if it is the shortest link and shortest + longest <= the sum of the "
+            "other two (Grashof). Check the link lengths, or keep the input within its range.")
+
+
 def simulate(model, *, method: str = "auto", on_output=None, progress=None, output_stem=None,
              time_limit=None, recursive: bool = True, forces=None, inputs=None, controller=None,
              energy: bool = False) -> Results:
@@ -181,6 +236,9 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         raise InputError(f"energy must be True or False, got {show(energy)}")
     if controller is not None and not isinstance(controller, Controller):
         raise InputError(f"controller must be a spacar.Controller or None, got {show(controller)}")
+    positions = ({} if model.core.frozen else   # the X positions, before the first assembly
+                 {n: np.array(node.x, dtype=float) for n, node in model.nodes.items()
+                  if node.kind.name in ("XY", "XYZ")})
     sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
     system = sim.system
     if forces or inputs:
@@ -227,6 +285,12 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         if isinstance(partial, dict):
             model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
             err.results = _results(partial, sim.system, model, method)
+        hint = _dead_position_hint(err, getattr(err, "results", None), sim.system, model) \
+            if isinstance(err, KinematicsError) and not inputs else ""
+        if hint:
+            explained = KinematicsError(f"{err}{hint}")
+            explained.results = err.results
+            raise explained from err
         raise
     finally:
         if finish_sampling is not None:
@@ -237,4 +301,5 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
             bar.close()
     model._continue_step = arrays["last_step"]
     model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
+    model.warnings.extend(_assembly_moves(positions, sim.system, arrays["x"][0]))
     return _results(arrays, sim.system, model, method)
