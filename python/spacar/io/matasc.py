@@ -34,6 +34,7 @@ stops with a :class:`spacar.SpacarError` naming the file.
 from __future__ import annotations
 
 import os
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +44,9 @@ from ..results import QUANTITIES
 from .files import open_output, reason, write_all
 
 FMT = "%.15E"
+# Held while an output time is written: `spacar run` takes it before it exits on Ctrl-C, so the
+# files it leaves hold whole output times.
+WRITING = threading.RLock()
 
 # file suffix: the quantity it holds (spacar.results.QUANTITIES: attribute, coordinates or
 # deformations, column label prefix) and the description in its header
@@ -97,6 +101,7 @@ class MatascWriter:
         self._columns = {}
         self._marks = {}      # suffix: the file's size before the current output time
         self._last_t = None   # the last output time written completely
+        self._held = False    # WRITING held between write and write_linearization
         try:
             self._open_state_files(supported, forcemode)
         except BaseException:
@@ -153,6 +158,10 @@ class MatascWriter:
     def _commit(self, files: dict, lines: dict) -> None:
         """Write one output time's lines ({suffix: text}); on a failure cut every file back to
         its size before this output time and raise a SpacarError naming the file."""
+        with WRITING:
+            self._write_lines(files, lines)
+
+    def _write_lines(self, files: dict, lines: dict) -> None:
         for suffix, text in lines.items():
             try:
                 write_all(files[suffix], text.encode("ascii"))
@@ -164,6 +173,10 @@ class MatascWriter:
                                   f"{done}") from None
 
     def _roll_back(self) -> None:
+        with WRITING:
+            self._cut_back()
+
+    def _cut_back(self) -> None:
         for suffix, fd in (*self._files.items(), *self._lin_files.items()):
             if suffix in self._marks:
                 try:
@@ -187,6 +200,11 @@ class MatascWriter:
             key, cols = self._columns[suffix]
             values = np.asarray(state[key], dtype=float)[cols]
             lines[suffix] = format_line(np.concatenate(([t], values)))
+        if "linearization" in state:
+            # The linearization's lines follow (write_linearization): the output time is one
+            # transaction, so WRITING stays held until they are written.
+            WRITING.acquire()
+            self._held = True
         self._commit(self._files, lines)
         if "linearization" not in state:
             self._last_t = t
@@ -195,6 +213,17 @@ class MatascWriter:
         """``_lin``, ``_eig`` (and ``_buck`` for LINEAR 2): a line for the output time just
         written by :meth:`write` (the same transaction); the files are opened at the first
         linearization."""
+        try:
+            self._write_linearization(lin, linear_mode)
+        finally:
+            self._release()
+
+    def _release(self) -> None:
+        if self._held:
+            self._held = False
+            WRITING.release()
+
+    def _write_linearization(self, lin, linear_mode) -> None:
         nz, nk = len(lin.z_labels), len(lin.y_labels)
         if "lin" not in self._lin_files:
             try:
@@ -240,6 +269,7 @@ class MatascWriter:
                 extra=[f"z: {z}", "real parts, sorted by absolute value; NaN pads missing (infinite) multipliers"])
 
     def close(self) -> None:
+        self._release()
         for fd in (*self._files.values(), *self._lin_files.values()):
             os.close(fd)
         self._files = {}
