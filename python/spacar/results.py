@@ -565,20 +565,6 @@ def _check_sizes(headers: dict, path: str) -> None:
                          f"{memory_limit() / 1e9:.3g} GB (spacar.set_memory_limit)")
 
 
-def _array(f, headers, name, kinds, path):
-    if name not in headers:
-        raise InputError(f"{path}: the array {name!r} is missing (not a spacar results file?)")
-    shape, dtype = headers[name]
-    if dtype.kind not in kinds:
-        raise InputError(f"{path}: the array {name!r} has the type {dtype}, expected {'floats' if 'f' in kinds else 'integers'}")
-    return f[name]
-
-
-def _check_shape(path, name, array, expected: tuple):
-    if array.shape != expected:
-        raise InputError(f"{path}: the array {name!r} has the shape {array.shape}, expected {expected}")
-
-
 def _is_label(value, kinds) -> bool:
     return isinstance(value, list) and len(value) == len(kinds) and all(
         isinstance(v, k) and not isinstance(v, bool) for v, k in zip(value, kinds))
@@ -611,6 +597,56 @@ def _meta(f, headers, path) -> dict:
     return meta
 
 
+def _header_shape(headers, name, kinds, path, expected=None) -> tuple:
+    """The shape of array ``name`` from its header, after checking its presence, type and (with
+    ``expected``) shape: nothing is decompressed for a wrong file."""
+    if name not in headers:
+        raise InputError(f"{path}: the array {name!r} is missing (not a spacar results file?)")
+    shape, dtype = headers[name]
+    if dtype.kind not in kinds:
+        raise InputError(f"{path}: the array {name!r} has the type {dtype}, expected "
+                         f"{'floats' if 'f' in kinds else 'integers'}")
+    if expected is not None and tuple(shape) != tuple(expected):
+        raise InputError(f"{path}: the array {name!r} has the shape {tuple(shape)}, expected {tuple(expected)}")
+    return tuple(shape)
+
+
+_META_MAX_BYTES = 256 * 2**20  # the JSON description (geometry of a large model: a few MB)
+
+
+def _check_header_shapes(headers, meta, path) -> None:
+    sizes = {}
+    for name, key in (("coordinate_labels", "nx"), ("deformation_labels", "ne")):
+        shape = _header_shape(headers, name, "iu", path)
+        if len(shape) != 2 or shape[1] != 2:
+            raise InputError(f"{path}: the array {name!r} has the shape {shape}, expected (n, 2)")
+        sizes[key] = shape[0]
+    shape = _header_shape(headers, "t", "f", path)
+    if len(shape) != 1:
+        raise InputError(f"{path}: the array 't' has the shape {shape}, expected (n,)")
+    sizes["nt"] = shape[0]
+    for name, dims in _FLOAT_ARRAYS.items():
+        _header_shape(headers, name, "f", path, tuple(sizes[d] for d in dims))
+    n_lins = len(meta["linearizations"])
+    for name in headers:
+        m = _LIN_RE.match(name)
+        if m and (int(m.group(1)) >= n_lins or m.group(2) not in MATRICES):
+            raise InputError(f"{path}: unexpected array {name!r}")
+    for k, lm in enumerate(meta["linearizations"]):
+        nz, nk = len(lm["z_labels"]), len(lm.get("y_labels") or ())
+        expected = {"M0": (nz, nz), "C0": (nz, nz), "D0": (nz, nz), "K0": (nz, nz), "N0": (nz, nz),
+                    "G0": (nz, nz), "r0": (nz,), "DF": (sizes["nx"], nz), "DFe": (sizes["ne"], nz)}
+        for name, shape in expected.items():
+            _header_shape(headers, f"lin{k}_{name}", "f", path, shape)
+        # (files of version 1 lack Kk, AK0 and BK0; an empty one may come without its shape)
+        for name, size in (("Kk", nz * nk), ("AK0", nk * nz), ("BK0", nk * (nz + nk))):
+            if f"lin{k}_{name}" in headers:
+                shape = _header_shape(headers, f"lin{k}_{name}", "f", path)
+                if math.prod(shape) != size:
+                    raise InputError(f"{path}: the array 'lin{k}_{name}' has the shape {shape}, expected "
+                                     f"{size} values")
+
+
 def _load(cls, path: str) -> "Results":
     try:
         mode = os.stat(path).st_mode
@@ -621,39 +657,19 @@ def _load(cls, path: str) -> "Results":
     with zipfile.ZipFile(path) as zf:
         headers = _headers(zf, path)
     _check_sizes(headers, path)
+    if "meta" in headers and headers["meta"][1].itemsize > _META_MAX_BYTES:
+        raise InputError(f"{path}: the description 'meta' is larger than {_META_MAX_BYTES} bytes")
     with np.load(path, allow_pickle=False) as f:
         meta = _meta(f, headers, path)
-        coord = _array(f, headers, "coordinate_labels", "iu", path)
-        defs = _array(f, headers, "deformation_labels", "iu", path)
+        _check_header_shapes(headers, meta, path)  # before any array is decompressed
+        coord, defs = f["coordinate_labels"], f["deformation_labels"]
         for name, labels in (("coordinate_labels", coord), ("deformation_labels", defs)):
-            if labels.ndim != 2 or labels.shape[1] != 2:
-                raise InputError(f"{path}: the array {name!r} has the shape {labels.shape}, expected (n, 2)")
             if labels.size and not (np.abs(labels) < 2**31).all():
                 raise InputError(f"{path}: the array {name!r} holds numbers out of range")
-        arrays = {name: _array(f, headers, name, "f", path) for name in _ARRAYS}
-        sizes = {"nt": arrays["t"].shape[0] if arrays["t"].ndim == 1 else -1, "nx": len(coord), "ne": len(defs)}
-        for name, dims in _FLOAT_ARRAYS.items():
-            _check_shape(path, name, arrays[name], tuple(sizes[d] for d in dims))
-            arrays[name] = arrays[name].astype(float, copy=False)
+        arrays = {name: f[name].astype(float, copy=False) for name in _ARRAYS}
         lins = []
-        n_lins = len(meta["linearizations"])
-        for name in headers:
-            m = _LIN_RE.match(name)
-            if m and (int(m.group(1)) >= n_lins or m.group(2) not in MATRICES):
-                raise InputError(f"{path}: unexpected array {name!r}")
         for k, lm in enumerate(meta["linearizations"]):
-            # (files of version 1 lack y_labels, Kk, AK0 and BK0)
-            mats = {name: _array(f, headers, f"lin{k}_{name}", "f", path)
-                    for name in MATRICES if f"lin{k}_{name}" in headers}
-            nz, nk = len(lm["z_labels"]), len(lm.get("y_labels") or ())
-            expected = {"M0": (nz, nz), "C0": (nz, nz), "D0": (nz, nz), "K0": (nz, nz), "N0": (nz, nz),
-                        "G0": (nz, nz), "r0": (nz,), "DF": (sizes["nx"], nz), "DFe": (sizes["ne"], nz),
-                        "Kk": (nz * nk,), "AK0": (nk * nz,), "BK0": (nk * (nz + nk),)}
-            for name, shape in expected.items():
-                if name in mats and name in ("Kk", "AK0", "BK0"):
-                    _check_shape(path, f"lin{k}_{name}", mats[name].reshape(-1), shape)
-                elif name in mats or name not in ("Kk", "AK0", "BK0"):
-                    _check_shape(path, f"lin{k}_{name}", mats.get(name, np.zeros(0)), shape)
+            mats = {name: f[f"lin{k}_{name}"] for name in MATRICES if f"lin{k}_{name}" in headers}
             lins.append(Linearization.from_arrays(lm["t"], lm["z_labels"], lm["n_line"], mats, coord, defs,
                                                   lm.get("y_labels")))
     geometry = None if meta["geometry"] is None else Geometry.from_dict(meta["geometry"])
