@@ -9,7 +9,9 @@ from collections import Counter
 from dataclasses import dataclass
 
 from . import _core
+from ._util import show
 from .errors import InputError
+from .model import Model
 
 COORD_CLASSES = ("fixed", "input", "dynamic", "calculable")
 DEF_CLASSES = ("fixed", "released", "input", "dynamic", "linearization", "nonholonomic", "kinematic")
@@ -93,6 +95,8 @@ class Check:
 
 def check(model) -> Check:
     """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly)."""
+    if not isinstance(model, Model):
+        raise InputError(f"check: model must be a spacar.Model, got {show(model)}")
     if not model.nodes and not model.elements:
         why = " (no input block ended with END)" if getattr(model, "source", None) and not model.blocks else ""
         return Check(summary(model), Diagnosis(0, 0, 0, [], [], f"  the model is empty{why}"))
@@ -135,6 +139,8 @@ def summary(model) -> Summary:
     """Counts for ``model`` as it will be analysed: the automatic L2MIN1 elements of the LAMBDA
     nodes are included (they are created at the first END). An empty model (e.g. an input of
     comments only) has all counts zero."""
+    if not isinstance(model, Model):
+        raise InputError(f"summary: model must be a spacar.Model, got {show(model)}")
     core = model.core.copy()
     if not core.nodes and not core.elements:
         return Summary(Counter(), Counter(), Counter(), Counter())

@@ -26,6 +26,7 @@ import argparse
 import itertools
 import os
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +34,7 @@ import numpy as np
 from . import __version__
 from .errors import SpacarError
 from .io.reader import read
-from .io.matasc import default_stem
+from .io.matasc import WRITING, default_stem
 from .io.writer import dump
 from .results import Results
 
@@ -262,11 +263,39 @@ def main(argv=None) -> int:
     check.set_defaults(func=_check)
     args = parser.parse_args(argv)
     try:
-        return args.func(args)
+        return _interruptible(args.func, args)
     except SpacarError as err:
         sys.stdout.flush()
         print(f"spacar: {type(err).__name__}: {err}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        # Ctrl-C: one line, no traceback, the shell's status for SIGINT (128 + 2). The analysis
+        # thread cannot be stopped inside C++: the process ends here, once an output time being
+        # written is complete (the MATASC files hold whole output times).
+        with WRITING:
+            sys.stdout.flush()
+            print("spacar: interrupted", file=sys.stderr, flush=True)
+            os._exit(130)
+
+
+def _interruptible(func, args):
+    """func(args) in a thread while this (the main) thread waits: the C++ core does not poll
+    for signals during a run, so Ctrl-C would otherwise wait for the block to end."""
+    outcome = {}
+
+    def target():
+        try:
+            outcome["value"] = func(args)
+        except BaseException as err:  # noqa: BLE001 - handed to the main thread unchanged
+            outcome["error"] = err
+
+    worker = threading.Thread(target=target, name="spacar-analysis", daemon=True)
+    worker.start()
+    while worker.is_alive():
+        worker.join(0.1)
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["value"]
 
 
 if __name__ == "__main__":

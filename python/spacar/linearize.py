@@ -16,7 +16,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
+from ._util import show
 from .errors import InputError
+from .model import Model
 
 
 # The arrays of a linearization, by the names of its attributes (formulation.md §7): the core's
@@ -179,6 +181,8 @@ def linearized_simulation(model, state=None):
     """(Linearization, the simulation moved to the state, (t, q, qd) of the state): what
     :func:`linearize` computes, with the simulation kept for further evaluations about the same
     state (spacar.state_space differentiates the velocities there)."""
+    if not isinstance(model, Model):
+        raise InputError(f"linearize: model must be a spacar.Model, got {show(model)}")
     sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
     sim.assemble()
     system = sim.system

@@ -20,7 +20,13 @@ element numbers and by the input keyword names::
 from __future__ import annotations
 
 import json
+import math
+import os
 import re
+import stat
+import tempfile
+import zipfile
+import zlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -374,7 +380,13 @@ class Results:
 
     def save(self, path) -> None:
         """Save to a NumPy ``.npz`` file (arrays, labels, statistics, geometry and
-        linearizations); read back with :meth:`Results.load`."""
+        linearizations); read back with :meth:`Results.load`. ``.npz`` is appended to a name
+        without it (as NumPy does). An existing file is replaced (written to a temporary file
+        next to it, then renamed: a failed save leaves the old file); a symbolic link or a
+        non-regular file in its place is refused."""
+        path = _path_argument(path, "Results.save")
+        if not path.endswith(".npz"):
+            path += ".npz"
         data = {name: np.asarray(getattr(self, name)) for name in _ARRAYS}
         data["coordinate_labels"] = np.asarray(self.coordinate_labels, dtype=np.int64).reshape(-1, 2)
         data["deformation_labels"] = np.asarray(self.deformation_labels, dtype=np.int64).reshape(-1, 2)
@@ -395,35 +407,55 @@ class Results:
             "linearizations": lin_meta,
         }
         data["meta"] = np.array(json.dumps(meta))
-        np.savez_compressed(path, **data)
+        from .io.files import open_output, reason
+
+        os.close(open_output(path, append=True))  # refuses a link or a non-regular file (appending: not emptied)
+        directory, name = os.path.split(os.path.abspath(path))
+        fd, temporary = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.savez_compressed(fh, **data)
+            os.replace(temporary, path)
+        except OSError as err:
+            os.unlink(temporary)
+            raise SpacarError(f"{path}: cannot save the results ({reason(err)})") from None
+        except BaseException:
+            os.unlink(temporary)
+            raise
 
     @classmethod
     def load(cls, path) -> "Results":
-        """Read a file written by :meth:`save`."""
-        with np.load(path, allow_pickle=False) as f:
-            meta = json.loads(str(f["meta"]))
-            if meta.get("format") != "spacar.Results":
-                raise InputError(f"{path}: not a spacar results file")
-            arrays = {name: f[name] for name in _ARRAYS}
-            coord, defs = f["coordinate_labels"], f["deformation_labels"]
-            lins = []
-            for k, lm in enumerate(meta["linearizations"]):
-                # (files of version 1 lack y_labels, Kk, AK0 and BK0)
-                mats = {name: f[f"lin{k}_{name}"] for name in MATRICES if f"lin{k}_{name}" in f}
-                lins.append(Linearization.from_arrays(lm["t"], lm["z_labels"], lm["n_line"], mats, coord, defs,
-                                                      lm.get("y_labels")))
-        geometry = None if meta["geometry"] is None else Geometry.from_dict(meta["geometry"])
-        return cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"],
-                   meta.get("dof_labels", ()))  # (files written before the DOFs were saved lack them)
+        """Read a file written by :meth:`save`. The file is checked before it is used: its
+        arrays' sizes (from their headers, before anything is decompressed) against
+        :func:`spacar.memory_limit`, then the names, types and shapes of its arrays and its
+        description; every failure is an :class:`spacar.InputError` naming the file."""
+        path = _path_argument(path, "Results.load")
+        try:
+            return _load(cls, path)
+        except InputError as err:
+            if str(err).startswith(f"{path}: "):
+                raise
+            raise InputError(f"{path}: {err}") from None  # e.g. a DOF label of no coordinate
+        except (OSError, EOFError) as err:
+            raise InputError(f"{path}: cannot read the results file ({getattr(err, 'strerror', None) or err})") from None
+        except (ValueError, TypeError, KeyError, IndexError, AttributeError, RecursionError, zipfile.BadZipFile,
+                zlib.error, NotImplementedError, OverflowError) as err:
+            raise InputError(f"{path}: not a valid spacar results file ({type(err).__name__}: "
+                             f"{show(str(err))})") from None
 
     @classmethod
     def concatenate(cls, results) -> "Results":
         """One Results of several consecutive blocks of the same model (a block boundary time
         appears twice, as in the MATASC files). If the blocks' degrees of freedom differ (a block
         changed the classes), the whole has none (``dof_labels`` empty)."""
+        if isinstance(results, (str, bytes, Results)) or not hasattr(results, "__iter__"):
+            raise InputError(f"concatenate(): results must be a list of spacar.Results, got {show(results)}")
         results = list(results)
         if not results:
             raise InputError("concatenate() needs at least one Results")
+        for i, r in enumerate(results):
+            if not isinstance(r, Results):
+                raise InputError(f"concatenate(): results[{i}] is not a spacar.Results, got {show(r)}")
         first = results[0]
         for r in results[1:]:
             if r.coordinate_labels != first.coordinate_labels or r.deformation_labels != first.deformation_labels:
@@ -482,3 +514,163 @@ class Results:
                     f"{self.e.shape[1]} deformations>")
         return (f"<spacar.Results: {len(self.t)} output times from t = {self.t[0]:g} to {self.t[-1]:g}, "
                 f"{self.x.shape[1]} coordinates, {self.e.shape[1]} deformations>")
+
+
+# --- reading a saved file -------------------------------------------------------------------------
+
+_FLOAT_ARRAYS = {"t": ("nt",), "x": ("nt", "nx"), "xd": ("nt", "nx"), "xdd": ("nt", "nx"), "reaction": ("nt", "nx"),
+                 "e": ("nt", "ne"), "ed": ("nt", "ne"), "edd": ("nt", "ne"), "sigma": ("nt", "ne")}
+_LIN_RE = re.compile(r"^lin(\d+)_([A-Za-z0-9]+)$")
+
+
+def _path_argument(path, what: str) -> str:
+    try:
+        path = os.fspath(path)
+    except TypeError:
+        raise InputError(f"{what}: path must be a file name or path, got {show(path)}") from None
+    return os.fsdecode(path) if isinstance(path, bytes) else path
+
+
+def _headers(zf: zipfile.ZipFile, path: str) -> dict:
+    """{array name: (shape, dtype)} from the .npy headers, nothing decompressed beyond them."""
+    from numpy.lib import format as npy
+
+    out = {}
+    for info in zf.infolist():
+        if not info.filename.endswith(".npy"):
+            raise InputError(f"{path}: unexpected member {show(info.filename)} (a spacar results file holds .npy arrays only)")
+        with zf.open(info) as fh:
+            version = npy.read_magic(fh)
+            if version == (1, 0):
+                shape, _, dtype = npy.read_array_header_1_0(fh)
+            elif version == (2, 0):
+                shape, _, dtype = npy.read_array_header_2_0(fh)
+            else:
+                raise InputError(f"{path}: {info.filename}: unsupported .npy format version {version}")
+        out[info.filename[:-4]] = (shape, dtype)
+    return out
+
+
+def _check_sizes(headers: dict, path: str) -> None:
+    from . import memory_limit
+
+    total = 0
+    for name, (shape, dtype) in headers.items():
+        if dtype.hasobject:
+            raise InputError(f"{path}: array {show(name)} holds Python objects (not written by Results.save)")
+        total += math.prod(shape) * dtype.itemsize
+    if total > memory_limit():
+        raise InputError(f"{path}: its arrays would need {total / 1e9:.3g} GB, more than the memory limit of "
+                         f"{memory_limit() / 1e9:.3g} GB (spacar.set_memory_limit)")
+
+
+def _is_label(value, kinds) -> bool:
+    return isinstance(value, list) and len(value) == len(kinds) and all(
+        isinstance(v, k) and not isinstance(v, bool) for v, k in zip(value, kinds))
+
+
+def _meta(f, headers, path) -> dict:
+    if "meta" not in headers or headers["meta"][0] != () or headers["meta"][1].kind != "U":
+        raise InputError(f"{path}: not a spacar results file (no description 'meta')")
+    meta = json.loads(str(f["meta"]))
+    if not isinstance(meta, dict) or meta.get("format") != "spacar.Results":
+        raise InputError(f"{path}: not a spacar results file")
+    checks = {
+        "version": lambda v: isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 2,
+        "stats": lambda v: isinstance(v, dict),
+        "settings_linear": lambda v: v is None or isinstance(v, int) and not isinstance(v, bool),
+        "dof_labels": lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v),
+        "geometry": lambda v: v is None or isinstance(v, dict),
+        "linearizations": lambda v: isinstance(v, list) and all(
+            isinstance(lm, dict) and isinstance(lm.get("t"), (int, float)) and not isinstance(lm.get("t"), bool)
+            and isinstance(lm.get("n_line"), int) and isinstance(lm.get("z_labels"), list)
+            and all(_is_label(z, (str, int, int)) for z in lm["z_labels"])
+            and (lm.get("y_labels") is None or isinstance(lm["y_labels"], list)
+                 and all(_is_label(y, (str, int, int)) for y in lm["y_labels"])) for lm in v),
+    }
+    for key, ok in checks.items():
+        if key not in meta and key in ("version", "dof_labels"):
+            continue  # files of version 1 lack the DOFs
+        if not ok(meta.get(key)):
+            raise InputError(f"{path}: the description's {key!r} is malformed: {show(meta.get(key))}")
+    return meta
+
+
+def _header_shape(headers, name, kinds, path, expected=None) -> tuple:
+    """The shape of array ``name`` from its header, after checking its presence, type and (with
+    ``expected``) shape: nothing is decompressed for a wrong file."""
+    if name not in headers:
+        raise InputError(f"{path}: the array {name!r} is missing (not a spacar results file?)")
+    shape, dtype = headers[name]
+    if dtype.kind not in kinds:
+        raise InputError(f"{path}: the array {name!r} has the type {dtype}, expected "
+                         f"{'floats' if 'f' in kinds else 'integers'}")
+    if expected is not None and tuple(shape) != tuple(expected):
+        raise InputError(f"{path}: the array {name!r} has the shape {tuple(shape)}, expected {tuple(expected)}")
+    return tuple(shape)
+
+
+_META_MAX_BYTES = 256 * 2**20  # the JSON description (geometry of a large model: a few MB)
+
+
+def _check_header_shapes(headers, meta, path) -> None:
+    sizes = {}
+    for name, key in (("coordinate_labels", "nx"), ("deformation_labels", "ne")):
+        shape = _header_shape(headers, name, "iu", path)
+        if len(shape) != 2 or shape[1] != 2:
+            raise InputError(f"{path}: the array {name!r} has the shape {shape}, expected (n, 2)")
+        sizes[key] = shape[0]
+    shape = _header_shape(headers, "t", "f", path)
+    if len(shape) != 1:
+        raise InputError(f"{path}: the array 't' has the shape {shape}, expected (n,)")
+    sizes["nt"] = shape[0]
+    for name, dims in _FLOAT_ARRAYS.items():
+        _header_shape(headers, name, "f", path, tuple(sizes[d] for d in dims))
+    n_lins = len(meta["linearizations"])
+    for name in headers:
+        m = _LIN_RE.match(name)
+        if m and (int(m.group(1)) >= n_lins or m.group(2) not in MATRICES):
+            raise InputError(f"{path}: unexpected array {name!r}")
+    for k, lm in enumerate(meta["linearizations"]):
+        nz, nk = len(lm["z_labels"]), len(lm.get("y_labels") or ())
+        expected = {"M0": (nz, nz), "C0": (nz, nz), "D0": (nz, nz), "K0": (nz, nz), "N0": (nz, nz),
+                    "G0": (nz, nz), "r0": (nz,), "DF": (sizes["nx"], nz), "DFe": (sizes["ne"], nz)}
+        for name, shape in expected.items():
+            _header_shape(headers, f"lin{k}_{name}", "f", path, shape)
+        # (files of version 1 lack Kk, AK0 and BK0; an empty one may come without its shape)
+        for name, size in (("Kk", nz * nk), ("AK0", nk * nz), ("BK0", nk * (nz + nk))):
+            if f"lin{k}_{name}" in headers:
+                shape = _header_shape(headers, f"lin{k}_{name}", "f", path)
+                if math.prod(shape) != size:
+                    raise InputError(f"{path}: the array 'lin{k}_{name}' has the shape {shape}, expected "
+                                     f"{size} values")
+
+
+def _load(cls, path: str) -> "Results":
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as err:
+        raise InputError(f"{path}: cannot read the results file ({err.strerror})") from None
+    if not stat.S_ISREG(mode):
+        raise InputError(f"{path}: not a regular file")
+    with zipfile.ZipFile(path) as zf:
+        headers = _headers(zf, path)
+    _check_sizes(headers, path)
+    if "meta" in headers and headers["meta"][1].itemsize > _META_MAX_BYTES:
+        raise InputError(f"{path}: the description 'meta' is larger than {_META_MAX_BYTES} bytes")
+    with np.load(path, allow_pickle=False) as f:
+        meta = _meta(f, headers, path)
+        _check_header_shapes(headers, meta, path)  # before any array is decompressed
+        coord, defs = f["coordinate_labels"], f["deformation_labels"]
+        for name, labels in (("coordinate_labels", coord), ("deformation_labels", defs)):
+            if labels.size and not (np.abs(labels) < 2**31).all():
+                raise InputError(f"{path}: the array {name!r} holds numbers out of range")
+        arrays = {name: f[name].astype(float, copy=False) for name in _ARRAYS}
+        lins = []
+        for k, lm in enumerate(meta["linearizations"]):
+            mats = {name: f[f"lin{k}_{name}"] for name in MATRICES if f"lin{k}_{name}" in headers}
+            lins.append(Linearization.from_arrays(lm["t"], lm["z_labels"], lm["n_line"], mats, coord, defs,
+                                                  lm.get("y_labels")))
+    geometry = None if meta["geometry"] is None else Geometry.from_dict(meta["geometry"])
+    return cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"],
+               meta.get("dof_labels", ()))  # (files written before the DOFs were saved lack them)

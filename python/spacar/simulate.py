@@ -10,6 +10,7 @@ from ._util import seconds_or_none, show
 from .errors import InputError, KinematicsError, SpacarError
 from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
+from .model import Model
 from .results import Results, dof_labels
 from .table import Table
 from .control import Controller
@@ -224,6 +225,8 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     """
     from . import __version__, progress as _progress
 
+    if not isinstance(model, Model):
+        raise InputError(f"simulate: model must be a spacar.Model, got {show(model)}")
     limit = seconds_or_none(time_limit, "time_limit") or 0.0
     if on_output is not None and not callable(on_output):
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")

@@ -269,9 +269,18 @@ class _Task:
     outputs: _Outputs
     method: str = "auto"
     time_limit: float | None = None
+    n_cases: int = 1
 
 
-def _run_case(task: _Task, params: dict):
+def _case_stem(model, index: int, n_cases: int) -> str:
+    """The MATASC stem of case ``index``: the model's own stem with ``_case<index>`` appended
+    (zero-padded to the number of cases), so that parallel cases never share a file."""
+    from .io.matasc import default_stem
+
+    return f"{default_stem(model)}_case{index:0{len(str(max(n_cases - 1, 0)))}d}"
+
+
+def _run_case(task: _Task, params: dict, index: int = 0):
     if isinstance(task.model, Model):
         model = task.model.copy()
         for name, value in params.items():
@@ -284,6 +293,8 @@ def _run_case(task: _Task, params: dict):
         model = task.model(dict(params))
         if not isinstance(model, Model):
             raise InputError(f"the factory returned {type(model).__name__}, not a spacar.Model")
+    if model.core.settings.matasc == 1:
+        model.output_stem = _case_stem(model, index, task.n_cases)
     n_warnings = len(model.warnings)
     if task.analysis == "simulate":
         from .simulate import simulate
@@ -309,7 +320,7 @@ def _run_cases(task: _Task, cases: list) -> list:
     for index, params in cases:
         start = time.perf_counter()
         try:
-            payload = _run_case(task, params)
+            payload = _run_case(task, params, index)
             ok = True
         except Exception as err:  # noqa: BLE001 - every failure is reported with its case
             ok = False
@@ -580,6 +591,11 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     for a bar in an interactive session (a terminal or a Jupyter kernel, unless
     ``SPACAR_PROGRESS=0``; as :func:`spacar.simulate`), or a function ``progress(done, total)``.
 
+    A model that writes MATASC files (``MATASC 1``) writes each case's files under its own
+    stem, the model's stem with ``_case<k>`` appended (``slidercrank_case07_x.asc``; k is the
+    case's index, zero-padded: its parameters are ``result.cases[k]``), so that cases running
+    in parallel never write the same file.
+
     Failed cases do not stop the sweep: they are listed in ``result.errors`` with their
     parameters, exception type and message, and their values are NaN. Returns a
     :class:`SweepResult`.
@@ -597,8 +613,8 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     if not isinstance(method, str) or method not in ("dop853", "dopri5", "radau5", "auto"):
         raise InputError(f"sweep: unknown integration method {show(method)} (dop853, dopri5, radau5, auto)")
     names, cases, grid, lines = _cases(parameters, by_lines=isinstance(model, Model))
-    task = _Task(model, lines, analysis, _Outputs(outputs, analysis), method, time_limit)
     n = len(cases)
+    task = _Task(model, lines, analysis, _Outputs(outputs, analysis), method, time_limit, n)
     indexed = list(enumerate(cases))
 
     for name, value in (("workers", workers), ("chunksize", chunksize)):

@@ -45,6 +45,7 @@ import sys
 import tempfile
 import time
 import traceback
+import warnings
 from collections import Counter
 from dataclasses import dataclass, field
 from decimal import Decimal
@@ -544,6 +545,256 @@ def run_case(case: Case, max_outputs=4) -> str:
     if elapsed > SLOW_CASE:
         raise Finding(f"the case took {elapsed:.1f} s")
     return outcome
+
+
+# --- files: spacar.read of a file and Results.load (issue 24) -------------------------------------------
+#
+# The reader's file path (regular files only, size and line caps, line by line) must agree with
+# read_string on every text; Results.load must refuse every malformed file with an InputError naming
+# it, and a file whose arrays would exceed the memory limit before decompressing it. Cases that
+# ended differently from each other are kept as a corpus in tests/data/fuzz/ and replayed by
+# tests/io/test_hostile_fuzz.py.
+
+CORPUS = ROOT / "tests" / "data" / "fuzz"
+FILE_SLOW_CASE = 5.0  # seconds: reading or loading one file slower than this is a finding
+CORPUS_MAX_BYTES = 100_000  # larger cases are run but not kept
+RESULTS_MEMORY_LIMIT = 16 * 2**20  # while loading fuzzed results files: bombs stay cheap to make
+
+
+def _outcome_of(call, path) -> str:
+    """"ok" or "<error type>: <message with the path and numbers removed>"."""
+    try:
+        call()
+        return "ok"
+    except SpacarError as err:
+        message = str(err).replace(str(path), "<file>")
+        # the kind of error: its first words, without numbers, names and quoted values
+        message = re.sub(r"'[^']*'|\"[^\"]*\"|\([^)]*\)|[0-9]+", "_", message)
+        return f"{type(err).__name__}: {message[:48]}"
+
+
+def run_reader_file(text: str, directory: Path) -> str:
+    """Write ``text`` to a file and read it with spacar.read: the outcome must equal read_string's
+    (the same dump, or the same error); only SpacarErrors; bounded time."""
+    path = Path(directory) / "fuzz.dat"
+    path.write_bytes(text.encode("utf-8", "surrogatepass"))
+    start = time.perf_counter()
+    try:
+        from_file = spacar.read(path).dump(digits=17)
+    except SpacarError as err:
+        from_file = f"{type(err).__name__}: {err}"
+    except Exception as err:  # noqa: BLE001
+        raise Finding(f"spacar.read raised {type(err).__name__}: {err}") from err
+    if time.perf_counter() - start > FILE_SLOW_CASE:
+        raise Finding(f"reading the file took {time.perf_counter() - start:.1f} s")
+    try:
+        from_text = spacar.read_string(path.read_text("utf-8", "replace"), str(path)).dump(digits=17)
+    except SpacarError as err:
+        from_text = f"{type(err).__name__}: {err}"
+    if from_file != from_text:
+        raise Finding(f"spacar.read and read_string differ:\n{from_file[:500]}\n---\n{from_text[:500]}")
+    if len(from_file) > 2000 and from_file.startswith(("InputError", "SpacarError")):
+        raise Finding(f"a reader message of {len(from_file)} characters")
+    return "read" if not from_file.startswith(("InputError", "SpacarError")) else "read:InputError"
+
+
+_GOOD_RESULTS = {}
+
+
+def good_results_file() -> bytes:
+    """A saved spacar.Results with linearizations (3 output times of the slider-crank)."""
+    if "data" not in _GOOD_RESULTS:
+        model = spacar.read_string(EXAMPLE)
+        model.apply("LINEAR", 1)
+        model.apply("FORCEMODE", 1)
+        model.timestep(2, 0.1)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "good.npz"
+            spacar.simulate(model, progress=False).save(path)
+            _GOOD_RESULTS["data"] = path.read_bytes()
+    return _GOOD_RESULTS["data"]
+
+
+def _npz(arrays: dict, compressed=True) -> bytes:
+    import io
+
+    buf = io.BytesIO()
+    (np.savez_compressed if compressed else np.savez)(buf, **arrays)
+    return buf.getvalue()
+
+
+def _arrays_of(data: bytes) -> dict:
+    import io
+
+    with np.load(io.BytesIO(data), allow_pickle=False) as f:
+        return {name: f[name] for name in f.files}
+
+
+RESULTS_EDITS = ["flip bytes", "truncate", "insert bytes", "drop array", "retype array", "reshape array",
+                 "replace array", "meta value", "meta text", "bomb", "lying header", "extra member"]
+_ODD_VALUES = [None, True, -1, 0, 2**31, 10**30, 1.5, float("nan"), "x", [], {}, [1, "a"], {"a": 1}, "\u2028"]
+_ODD_DTYPES = ["<U3", "|S2", "<c16", "<i8", "<f4", "|b1", "<u2", "<m8[s]", "<M8[D]", "<f8"]
+
+
+@st.composite
+def results_file(draw):
+    """A saved results file with one to three hostile edits, at the level of bytes, zip members,
+    arrays or the JSON description."""
+    data = good_results_file()
+    for _ in range(draw(st.integers(1, 3))):
+        edit = draw(st.sampled_from(RESULTS_EDITS))
+        if edit in ("flip bytes", "truncate", "insert bytes"):
+            n = len(data)
+            if n == 0:
+                continue
+            at = draw(st.integers(0, n - 1))
+            if edit == "flip bytes":
+                data = data[:at] + bytes([data[at] ^ draw(st.integers(1, 255))]) + data[at + 1:]
+            elif edit == "truncate":
+                data = data[:at]
+            else:
+                data = data[:at] + draw(st.binary(min_size=1, max_size=64)) + data[at:]
+            continue
+        try:
+            arrays = _arrays_of(data)
+        except Exception:  # noqa: BLE001 - already broken by an earlier byte edit
+            continue
+        names = sorted(arrays)
+        name = draw(st.sampled_from(names))
+        if edit == "drop array":
+            arrays.pop(name)
+        elif edit == "retype array":
+            try:
+                with np.errstate(all="ignore"), warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    arrays[name] = arrays[name].astype(draw(st.sampled_from(_ODD_DTYPES)))
+            except (TypeError, ValueError, OverflowError):
+                arrays[name] = np.array(["x"] * max(arrays[name].size, 1))
+        elif edit == "reshape array":
+            shape = tuple(draw(st.lists(st.integers(0, 5), max_size=3)))
+            arrays[name] = np.zeros(shape)
+        elif edit == "replace array":
+            arrays[name] = np.array(draw(st.sampled_from([np.nan, np.inf, -1, 2**62, "abc", 0.5])))
+        elif edit in ("meta value", "meta text"):
+            try:
+                meta = json.loads(str(arrays["meta"])) if "meta" in arrays else {}
+            except (ValueError, RecursionError):  # already broken by an earlier edit
+                meta = {}
+            if edit == "meta value" and isinstance(meta, dict):
+                key = draw(st.sampled_from(sorted(meta) + ["format", "linearizations", "geometry", "stats"]))
+                meta[key] = draw(st.sampled_from(_ODD_VALUES))
+                arrays["meta"] = np.array(json.dumps(meta))
+            else:
+                arrays["meta"] = np.array(draw(st.sampled_from(["", "{", "[]", "null", "1e999", "[" * 5000,
+                                                                '{"format": "spacar.Results"}'])))
+        elif edit == "bomb":
+            rows = draw(st.sampled_from([10**5, 10**6, 2 * 10**6]))  # 3 to 64 MB against RESULTS_MEMORY_LIMIT
+            arrays[draw(st.sampled_from(["t", "x", "e", "lin0_M0"]))] = np.zeros((rows, 4))
+            data = _npz(arrays, compressed=True)  # small on disk, large when inflated
+            continue
+        elif edit == "lying header":
+            # a header that declares far more data than the member holds
+            from numpy.lib import format as npy
+
+            import io
+            import zipfile
+
+            buf = io.BytesIO()
+            header = {"descr": "<f8", "fortran_order": False, "shape": (draw(st.integers(10**6, 10**12)),)}
+            npy.write_array_header_1_0(buf, header)
+            zbuf = io.BytesIO(_npz(arrays))
+            with zipfile.ZipFile(zbuf, "a") as zf:
+                zf.writestr("big.npy", buf.getvalue() + b"\0" * 64)
+            data = zbuf.getvalue()
+            continue
+        elif edit == "extra member":
+            arrays[draw(st.sampled_from(["lin7_M0", "lin0_XX", "other", "lin0_M0"]))] = np.zeros((2, 2))
+        data = _npz(arrays, compressed=draw(st.booleans()))
+    return data
+
+
+def run_results_file(data: bytes, directory: Path) -> str:
+    """Results.load of ``data``: a Results whose arrays have consistent shapes, or an InputError
+    naming the file, within FILE_SLOW_CASE seconds, under RESULTS_MEMORY_LIMIT."""
+    spacar.set_memory_limit(RESULTS_MEMORY_LIMIT)
+    path = Path(directory) / "fuzz.npz"
+    path.write_bytes(data)
+    start = time.perf_counter()
+    try:
+        res = spacar.Results.load(path)
+    except spacar.InputError as err:
+        if not str(err).startswith(str(path)):
+            raise Finding(f"a Results.load error does not name the file: {err}") from None
+        if len(str(err)) > 1000:
+            raise Finding(f"a Results.load message of {len(str(err))} characters")
+        outcome = "refused"
+    except Exception as err:  # noqa: BLE001
+        raise Finding(f"Results.load raised {type(err).__module__}.{type(err).__name__}: {show(str(err))}\n"
+                      f"{''.join(traceback.format_exception(err)[-4:])}") from err
+    else:
+        nt, nx, ne = len(res.t), len(res.coordinate_labels), len(res.deformation_labels)
+        for name, cols in (("x", nx), ("xd", nx), ("xdd", nx), ("reaction", nx), ("e", ne), ("ed", ne),
+                           ("edd", ne), ("sigma", ne)):
+            if getattr(res, name).shape != (nt, cols):
+                raise Finding(f"Results.load accepted {name} of shape {getattr(res, name).shape}")
+        for lin in res.linearizations:
+            lin.eigenfrequencies()
+        outcome = "loaded"
+    if time.perf_counter() - start > FILE_SLOW_CASE:
+        raise Finding(f"loading took {time.perf_counter() - start:.1f} s")
+    return outcome
+
+
+def corpus_files(kind: str) -> list:
+    """The corpus of ``kind`` ("reader" or "results") kept in tests/data/fuzz/<kind>/."""
+    return sorted((CORPUS / kind).glob("*"))
+
+
+def grow_corpus(kind: str, cases: int, seed_: int = 0) -> dict:
+    """Run ``cases`` hypothesis cases of ``kind`` and keep in the corpus the first case of every
+    distinct outcome (error messages without numbers) not yet in it. Returns the tallies."""
+    (CORPUS / kind).mkdir(parents=True, exist_ok=True)
+    seen = set()
+    with tempfile.TemporaryDirectory() as tmp:
+        for f in corpus_files(kind):
+            seen.add(_corpus_outcome(kind, f.read_bytes(), Path(tmp)))
+        tally = Counter()
+        strategy = results_file() if kind == "results" else cases_text()
+
+        @seed(seed_)
+        @settings(max_examples=cases, database=None, deadline=None, phases=[Phase.generate],
+                  suppress_health_check=list(HealthCheck))
+        @given(strategy)
+        def one(data):
+            if kind == "reader":
+                data = data.encode("utf-8", "surrogatepass")
+            outcome = _corpus_outcome(kind, data, Path(tmp))
+            tally[outcome.split(":")[0]] += 1
+            if outcome not in seen and len(data) <= CORPUS_MAX_BYTES:
+                seen.add(outcome)
+                name = f"{len(list((CORPUS / kind).glob('*'))):04d}.{'npz' if kind == 'results' else 'dat'}"
+                (CORPUS / kind / name).write_bytes(data)
+
+        one()
+    return dict(tally)
+
+
+def _corpus_outcome(kind: str, data: bytes, directory: Path) -> str:
+    if kind == "results":
+        run_results_file(data, directory)
+        path = directory / "fuzz.npz"
+        return _outcome_of(lambda: spacar.Results.load(path), path)
+    run_reader_file(data.decode("utf-8", "replace"), directory)
+    path = directory / "fuzz.dat"
+    return _outcome_of(lambda: spacar.read(path), path)
+
+
+def cases_text():
+    """Input texts only (the text generators of cases(), decorated)."""
+    generators = {"mutated example": mutated_example(), "random model": random_model(),
+                  "small random model": random_model(max_elements=4), "line soup": line_soup(),
+                  "chain": chain_model(max_size=60)}
+    return st.sampled_from(sorted(generators)).flatmap(lambda name: generators[name].flatmap(decorate))
 
 
 # --- the long campaign ------------------------------------------------------------------------------

@@ -23,18 +23,30 @@ file              columns after t                                             wr
 
 Numbers are written ``%.15E``, one space apart; column 1 is t. The files are created (emptied)
 at the first MATASC 1 block of a model and appended to by later blocks, so a block boundary
-time appears twice.
+time appears twice. An existing file is overwritten, as SPACAR does, but never through a
+symbolic link (spacar.io.files).
+
+Each output time is one transaction over all the files: its lines are written whole, and if
+any write fails (a full disk, a file size limit) every file is cut back to where it was before
+that output time, so the files always hold the same output times in whole lines, and the run
+stops with a :class:`spacar.SpacarError` naming the file.
 """
 from __future__ import annotations
 
 import os
+import threading
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import SpacarError
 from ..results import QUANTITIES
+from .files import open_output, reason, write_all
 
 FMT = "%.15E"
+# Held while an output time is written: `spacar run` takes it before it exits on Ctrl-C, so the
+# files it leaves hold whole output times.
+WRITING = threading.RLock()
 
 # file suffix: the quantity it holds (spacar.results.QUANTITIES: attribute, coordinates or
 # deformations, column label prefix) and the description in its header
@@ -84,9 +96,19 @@ class MatascWriter:
         self.deformation_labels = [tuple(c) for c in deformation_labels]
         self.created = created
         supported = [i for i, c in enumerate(coordinate_classes) if c in ("fixed", "input")]
-        self._files = {}
+        self._files = {}      # suffix: file descriptor
         self._lin_files = {}  # _lin, _eig, _buck: opened at the first linearization
         self._columns = {}
+        self._marks = {}      # suffix: the file's size before the current output time
+        self._last_t = None   # the last output time written completely
+        self._held = False    # WRITING held between write and write_linearization
+        try:
+            self._open_state_files(supported, forcemode)
+        except BaseException:
+            self.close()
+            raise
+
+    def _open_state_files(self, supported, forcemode):
         for suffix, (quantity, text) in STATE_FILES.items():
             key, over, prefix, _ = QUANTITIES[quantity]
             if suffix == "rx" and forcemode < 1 or suffix == "sig" and forcemode < 2:
@@ -102,79 +124,153 @@ class MatascWriter:
 
     @property
     def paths(self) -> list:
-        return [fh.name for fh in self._files.values()]
+        return [self.path(suffix) for suffix in self._files]
 
     def _open(self, suffix, text, header, extra=()):
         path = self.path(suffix)
         columns = "% columns: " + " ".join(header) + "\n"
         key = os.path.abspath(path)
+        lines = []
         if key in self.created:
-            fh = open(path, "a", encoding="ascii")
+            append = True
             if self.created[key] != columns:  # e.g. other supports in this block
-                fh.write(columns)
-                self.created[key] = columns
+                lines.append(columns)
         else:
-            Path(path).parent.mkdir(parents=True, exist_ok=True)
-            fh = open(path, "w", encoding="ascii")
-            fh.write(f"% spacar {self.version} MATASC file {Path(path).name}: {text}\n")
-            fh.write(f"% input: {self.source or '(model built in Python)'}\n")
-            fh.write(f"% JOBID: {'none' if self.jobid is None else self.jobid}\n")
-            for line in extra:
-                fh.write(f"% {line}\n")
-            fh.write(columns)
-            self.created[key] = columns
-        fh.flush()
-        return fh
+            append = False
+            try:
+                Path(path).parent.mkdir(parents=True, exist_ok=True)
+            except OSError as err:
+                raise SpacarError(f"{path}: cannot create the directory of the MATASC file ({reason(err)})") from None
+            lines.append(f"% spacar {self.version} MATASC file {Path(path).name}: {text}\n")
+            lines.append(f"% input: {self.source or '(model built in Python)'}\n")
+            lines.append(f"% JOBID: {'none' if self.jobid is None else self.jobid}\n")
+            lines.extend(f"% {line}\n" for line in extra)
+            lines.append(columns)
+        fd = open_output(path, append=append)
+        try:
+            write_all(fd, "".join(lines).encode("ascii", "replace"))
+        except OSError as err:
+            os.close(fd)
+            raise SpacarError(f"{path}: cannot write the MATASC file ({reason(err)})") from None
+        self.created[key] = columns
+        return fd
+
+    def _commit(self, files: dict, lines: dict) -> None:
+        """Write one output time's lines ({suffix: text}); on a failure cut every file back to
+        its size before this output time and raise a SpacarError naming the file."""
+        with WRITING:
+            self._write_lines(files, lines)
+
+    def _write_lines(self, files: dict, lines: dict) -> None:
+        for suffix, text in lines.items():
+            try:
+                write_all(files[suffix], text.encode("ascii"))
+            except OSError as err:
+                self._roll_back()
+                done = "none" if self._last_t is None else f"those up to t = {self._last_t:g}"
+                raise SpacarError(f"{self.path(suffix)}: cannot write the MATASC file ({reason(err)}); the "
+                                  f"MATASC files {self.stem}_*.asc hold whole lines of the same output times: "
+                                  f"{done}") from None
+
+    def _roll_back(self) -> None:
+        with WRITING:
+            self._cut_back()
+
+    def _cut_back(self) -> None:
+        for suffix, fd in (*self._files.items(), *self._lin_files.items()):
+            if suffix in self._marks:
+                try:
+                    os.ftruncate(fd, self._marks[suffix])
+                except OSError:  # nothing better to do: the write error is reported
+                    pass
+
+    def _mark(self, files: dict) -> None:
+        for suffix, fd in files.items():
+            self._marks[suffix] = os.fstat(fd).st_size
 
     def write(self, k: int, state: dict) -> None:
-        """One output time: a line in every state file, flushed (the linearization files are
-        written by write_linearization)."""
+        """One output time: a line in every state file (the linearization files are written by
+        write_linearization, in the same transaction)."""
         t = float(state["t"])
-        for suffix, fh in self._files.items():
+        self._marks = {}
+        self._mark(self._files)
+        self._mark(self._lin_files)
+        lines = {}
+        for suffix in self._files:
             key, cols = self._columns[suffix]
             values = np.asarray(state[key], dtype=float)[cols]
-            fh.write(format_line(np.concatenate(([t], values))))
-            fh.flush()
+            lines[suffix] = format_line(np.concatenate(([t], values)))
+        if "linearization" in state:
+            # The linearization's lines follow (write_linearization): the output time is one
+            # transaction, so WRITING stays held until they are written.
+            WRITING.acquire()
+            self._held = True
+        self._commit(self._files, lines)
+        if "linearization" not in state:
+            self._last_t = t
 
     def write_linearization(self, lin, linear_mode) -> None:
-        """``_lin``, ``_eig`` (and ``_buck`` for LINEAR 2): a line for one output time, flushed;
-        the files are opened at the first linearization."""
+        """``_lin``, ``_eig`` (and ``_buck`` for LINEAR 2): a line for the output time just
+        written by :meth:`write` (the same transaction); the files are opened at the first
+        linearization."""
+        try:
+            self._write_linearization(lin, linear_mode)
+        finally:
+            self._release()
+
+    def _release(self) -> None:
+        if self._held:
+            self._held = False
+            WRITING.release()
+
+    def _write_linearization(self, lin, linear_mode) -> None:
         nz, nk = len(lin.z_labels), len(lin.y_labels)
         if "lin" not in self._lin_files:
-            z = " ".join(f"{k}({a},{b})" for k, a, b in lin.z_labels)
-            y = " ".join(f"{k}({a},{b})" for k, a, b in lin.y_labels)
-            n_eig = 2 * nz + nk
-            self._lin_files["lin"] = self._open(
-                "lin", "linearized equations",
-                ["t", "nz", "nk", "M0", "C0", "D0", "K0", "N0", "G0", "K_k", "AK0", "BK0", "r0"],
-                extra=[f"z: {z}", f"kinematic coordinates: {y or 'none'}",
-                       "M0..G0 nz x nz, K_k nz x nk, AK0 nk x nz, BK0 nk x (nz + nk), column-major"])
-            self._lin_files["eig"] = self._open(
-                "eig", "eigenvalues of the linearized equations",
-                ["t"] + [f"{p}{i}" for i in range(1, n_eig + 1) for p in ("re", "im")],
-                extra=[f"z: {z}", "eigenvalues of the first-order system, sorted by |Im|, then Re"])
-            if linear_mode == 2:
-                self._lin_files["buck"] = self._open(
-                    "buck", "buckling multipliers", ["t"] + [f"mu{i}" for i in range(1, nz + 1)],
-                    extra=[f"z: {z}", "real parts, sorted by absolute value; NaN pads missing (infinite) multipliers"])
+            try:
+                self._open_linearization_files(lin, linear_mode)
+            except BaseException:
+                self._roll_back()  # this output time's state lines
+                raise
+            self._mark(self._lin_files)  # (after their headers)
         files = self._lin_files
+        lines = {}
         row = [lin.t, nz, nk]
         for name in ("M0", "C0", "D0", "K0", "N0", "G0", "Kk", "AK0", "BK0"):
             row.extend(np.asarray(getattr(lin, name)).ravel(order="F"))
         row.extend(np.asarray(lin.r0).ravel())
-        files["lin"].write(format_line(row))
+        lines["lin"] = format_line(row)
         lam = lin.eigenvalues()
-        files["eig"].write(format_line([lin.t] + [v for z_ in lam for v in (z_.real, z_.imag)]))
+        lines["eig"] = format_line([lin.t] + [v for z_ in lam for v in (z_.real, z_.imag)])
         if "buck" in files:
             mu = np.real(lin.buckling_factors())
             pad = np.full(nz, np.nan)
             pad[: min(len(mu), nz)] = mu[:nz]
-            files["buck"].write(format_line([lin.t, *pad]))
-        for fh in files.values():
-            fh.flush()
+            lines["buck"] = format_line([lin.t, *pad])
+        self._commit(files, lines)
+        self._last_t = float(lin.t)
+
+    def _open_linearization_files(self, lin, linear_mode) -> None:
+        nz, nk = len(lin.z_labels), len(lin.y_labels)
+        z = " ".join(f"{k}({a},{b})" for k, a, b in lin.z_labels)
+        y = " ".join(f"{k}({a},{b})" for k, a, b in lin.y_labels)
+        n_eig = 2 * nz + nk
+        self._lin_files["lin"] = self._open(
+            "lin", "linearized equations",
+            ["t", "nz", "nk", "M0", "C0", "D0", "K0", "N0", "G0", "K_k", "AK0", "BK0", "r0"],
+            extra=[f"z: {z}", f"kinematic coordinates: {y or 'none'}",
+                   "M0..G0 nz x nz, K_k nz x nk, AK0 nk x nz, BK0 nk x (nz + nk), column-major"])
+        self._lin_files["eig"] = self._open(
+            "eig", "eigenvalues of the linearized equations",
+            ["t"] + [f"{p}{i}" for i in range(1, n_eig + 1) for p in ("re", "im")],
+            extra=[f"z: {z}", "eigenvalues of the first-order system, sorted by |Im|, then Re"])
+        if linear_mode == 2:
+            self._lin_files["buck"] = self._open(
+                "buck", "buckling multipliers", ["t"] + [f"mu{i}" for i in range(1, nz + 1)],
+                extra=[f"z: {z}", "real parts, sorted by absolute value; NaN pads missing (infinite) multipliers"])
 
     def close(self) -> None:
-        for fh in (*self._files.values(), *self._lin_files.values()):
-            fh.close()
+        self._release()
+        for fd in (*self._files.values(), *self._lin_files.values()):
+            os.close(fd)
         self._files = {}
         self._lin_files = {}

@@ -10,6 +10,7 @@ import numbers
 from .. import _core
 from .._util import show
 from ..errors import InputError
+from ..model import Model
 
 _CLASS_KEYWORD_X = {
     _core.CoordClass.fixed: "FIX",
@@ -50,6 +51,8 @@ def dump(model, digits: int = 4) -> str:
     Before the first analysis the model is dumped as it will be analysed (a prepared copy: with
     the reference geometry ``LENGTHO``/``LGEOMY`` and the automatic ``L2MIN1`` elements), so the
     layout is the same before and after a run."""
+    if not isinstance(model, Model):
+        raise InputError(f"dump: model must be a spacar.Model, got {show(model)}")
     core = model.core
     if not core.frozen:
         core = core.copy()
