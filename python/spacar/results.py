@@ -71,11 +71,14 @@ def dof_labels(system, core) -> list:
     """Labels of the degrees of freedom of a compiled system (``_core.Simulation(...).system``) in
     its DOF order, the order of q in the core: the DYNX coordinates ascending (``"x(5,1)"``),
     then the DYNE deformations ascending, with their element type (``"e(3,1) HINGE"``)."""
-    out = [f"x({n},{c})" for n, c in (system.coord_label[g] for g in system.x_dyn)]
+    # Each attribute of the compiled system is a fresh copy of the whole list: taken once
+    # (inside the loops, a chain of 4000 beams took minutes).
+    coord_label, def_label = system.coord_label, system.def_label
+    out = [f"x({n},{c})" for n, c in (coord_label[g] for g in system.x_dyn)]
     if len(system.e_dyn):
         elements = core.elements  # a snapshot of all elements: taken once
         for k in system.e_dyn:
-            e, i = system.def_label[k]
+            e, i = def_label[k]
             out.append(f"e({e},{i}) {elements[e].type_name}")
     return out
 
