@@ -77,7 +77,9 @@ def dof_labels(system, core) -> list:
     """Labels of the degrees of freedom of a compiled system (``_core.Simulation(...).system``) in
     its DOF order, the order of q in the core: the DYNX coordinates ascending (``"x(5,1)"``),
     then the DYNE deformations ascending, with their element type (``"e(3,1) HINGE"``)."""
-    coords, defs = system.coord_label, system.def_label  # each access converts the whole list: once
+    # Each attribute of the compiled system is a fresh copy of the whole list: taken once
+    # (inside the loops, a chain of 4000 beams took minutes).
+    coords, defs = system.coord_label, system.def_label
     out = [f"x({n},{c})" for n, c in (coords[g] for g in system.x_dyn)]
     for k in system.e_dyn:
         e, i = defs[k]
