@@ -2,7 +2,6 @@
 argument (before, AttributeError/TypeError from inside), and Ctrl-C in `spacar run` prints one
 line and exits with status 130 (before, a traceback; and it waited for the C++ run to end).
 """
-import os
 import signal
 import subprocess
 import sys
@@ -13,7 +12,7 @@ import pytest
 
 import spacar
 from spacar import Results
-from support.paths import EXAMPLES, ROOT
+from support.paths import EXAMPLES, spacar_env
 
 EXAMPLE = EXAMPLES / "slidercrank.dat"
 WRONG = [42, None, "slidercrank.dat", 1.5, [1], object()]
@@ -67,7 +66,7 @@ def test_sweep_value_lists_of_the_wrong_kind(values):
 def _start_long_run(tmp_path, extra=""):
     path = tmp_path / "long.dat"
     path.write_text(EXAMPLE.read_text().replace("Timestep 100 5.0", f"TIMESTEP 100000 100000.0\n{extra}"))
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
+    env = spacar_env()
     return subprocess.Popen([sys.executable, "-m", "spacar", "run", str(path)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=env)
 

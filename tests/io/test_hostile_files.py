@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import spacar
-from support.paths import EXAMPLES, ROOT
+from support.paths import EXAMPLES, spacar_env
 
 EXAMPLE = EXAMPLES / "slidercrank.dat"
 SUFFIXES = ("x", "xd", "xdd", "e", "ed", "edd", "rx")
@@ -46,7 +46,7 @@ def _limit_file_size(nbytes):
 @pytest.mark.parametrize("limit", [3000, 20000, 60000])
 def test_a_write_error_leaves_the_matasc_files_consistent(tmp_path, limit):
     path = example(tmp_path)
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
+    env = spacar_env()
     out = subprocess.run([sys.executable, "-m", "spacar", "run", str(path)], capture_output=True, text=True,
                          cwd=tmp_path, env=env, preexec_fn=_limit_file_size(limit), timeout=120)
     assert out.returncode == 1, out.stderr
@@ -77,7 +77,7 @@ def test_a_write_error_in_python_is_a_spacar_error(tmp_path):
             "try:\n    spacar.simulate(m, progress=False)\n"
             "except spacar.SpacarError as err:\n"
             "    print(type(err).__name__, err.__cause__, err.__suppress_context__)\n")
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
+    env = spacar_env()
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env,
                          preexec_fn=_limit_file_size(10000), timeout=120)
     assert out.returncode == 0, out.stderr
