@@ -18,6 +18,16 @@ import pytest
 import spacar
 from support.paths import EXAMPLES, ROOT
 
+
+def _guide_figures():
+    """docs/generate.py, which holds the models of the guide's figures (importing it draws nothing)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("spacar_docs_generate", ROOT / "docs" / "generate.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
 TWO_PI = 2 * np.pi
 
 
@@ -248,19 +258,8 @@ def test_the_modelling_guide_runs_its_python_blocks_and_shows_every_example():
         assert f"`{name}.dat`" in text, name
 
 
-ROUGH_FOURBAR = """PLBEAM 1 1 2 3 4
-PLBEAM 2 3 5 6 7
-PLBEAM 3 8 9 6 10
-X 3 0. 1.
-X 6 3.2 2.6
-X 8 4. 0.
-FIX 1
-FIX 8
-LENGTHO 2 3.605551
-LENGTHO 3 3.162278
-INPUTX 2
-END
-"""
+# The guide's rough four-bar, as docs/generate.py draws it for docs/modelling.md.
+ROUGH_FOURBAR = _guide_figures().ROUGH_FOURBAR
 
 
 def test_a_loop_that_the_x_positions_do_not_close_warns_with_the_node_and_the_distance():
