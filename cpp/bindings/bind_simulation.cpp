@@ -173,7 +173,8 @@ void bind_simulation(py::module_& m) {
       .def(
           "run",
           [](Simulation& s, py::object on_output, double initial_step, const std::string& method,
-             double time_limit, bool recursive, double sample_period, py::object on_sample, bool energy) {
+             double time_limit, bool recursive, double sample_period, py::object on_sample, bool energy,
+             double rho_inf, double fixed_step) {
             RunOptions opt;
             opt.energy = energy;
             opt.sample_period = sample_period;
@@ -188,6 +189,17 @@ void bind_simulation(py::module_& m) {
             opt.recursive = recursive;
             opt.initial_step = initial_step;
             opt.method = parse_method(method);
+            if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
+              throw InputError("rho_inf (the spectral radius of generalized_alpha) must be in [0, 1], not " +
+                               std::to_string(rho_inf));
+            opt.rho_inf = rho_inf;
+            if (!(fixed_step >= 0.0 && std::isfinite(fixed_step)))
+              throw InputError("fixed_step must be a finite step size >= 0 (0: error control), not " +
+                               std::to_string(fixed_step));
+            if (fixed_step > 0.0 && opt.method != Method::GENERALIZED_ALPHA)
+              throw InputError("fixed_step is an option of method generalized_alpha only (the other methods control "
+                               "their error)");
+            opt.fixed_step = fixed_step;
             if (!on_output.is_none()) {
               opt.on_output = [on_output](int k, const Data& d, const Linearization* lin) {
                 py::gil_scoped_acquire gil;
@@ -214,7 +226,7 @@ void bind_simulation(py::module_& m) {
           },
           py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
           py::arg("time_limit") = 0.0, py::arg("recursive") = true, py::arg("sample_period") = 0.0,
-          py::arg("on_sample") = py::none(), py::arg("energy") = false,
+          py::arg("on_sample") = py::none(), py::arg("energy") = false, py::arg("rho_inf") = 0.9, py::arg("fixed_step") = 0.0,
           "Run the block; on failure the exception has the results up to the failure as `results`.");
 }
 

@@ -19,8 +19,9 @@ Method parse_method(const std::string& name) {
   if (name == "dop853") return Method::DOP853;
   if (name == "dopri5") return Method::DOPRI5;
   if (name == "radau5") return Method::RADAU5;
+  if (name == "generalized_alpha") return Method::GENERALIZED_ALPHA;
   if (name == "auto") return Method::AUTO;
-  throw InputError("unknown integration method '" + name + "' (auto, dop853, dopri5, radau5)");
+  throw InputError("unknown integration method '" + name + "' (auto, dop853, dopri5, radau5, generalized_alpha)");
 }
 
 const char* method_name(Method m) {
@@ -28,6 +29,7 @@ const char* method_name(Method m) {
     case Method::DOP853: return "dop853";
     case Method::DOPRI5: return "dopri5";
     case Method::RADAU5: return "radau5";
+    case Method::GENERALIZED_ALPHA: return "generalized_alpha";
     case Method::AUTO: return "auto";
   }
   return "?";
@@ -222,7 +224,7 @@ Integrator::Integrator(int n, Method method)
       atol_(Eigen::VectorXd::Constant(std::max(n, 0), 1e-6)),
       hmax_(std::numeric_limits<double>::infinity()) {
   if (n < 1) throw std::invalid_argument("Integrator: the system needs at least one state");
-  if (method == Method::RADAU5 || method == Method::AUTO)
+  if (method != Method::DOP853 && method != Method::DOPRI5)
     throw std::invalid_argument("Integrator: only DOP853 and DOPRI5 (RADAU5 is the class Radau5)");
   const Scheme& sc = scheme(method);
   k_.assign(sc.total, Eigen::VectorXd::Zero(n));

@@ -11,6 +11,7 @@
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
 #include "spacar/limits.hpp"
+#include "spacar/generalized_alpha.hpp"
 #include "spacar/radau5.hpp"
 
 namespace spacar {
@@ -88,13 +89,22 @@ bool Simulation::continuous_with_step_start(std::string& why) const {
   return false;
 }
 
+bool Simulation::solved_dofs(const Solved& s, const Eigen::VectorXd& Y) const {
+  const System& sys = *sys_;
+  for (int j = 0; j < sys.n_dof(); ++j)
+    if (s.qhat[sys.dof_cols[j]] != Y[j]) return false;
+  return true;
+}
+
 void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
   if (t > kinematic_failure_t_) kinematic_failure_.clear();  // passed: the failure is history
   if (tree_) return;  // explicit positions: no Newton start to anchor, no branch to leave
   if (anchor_.valid && anchor_.t == t) return;                // the same step again, smaller
   // The integrator has just evaluated the right-hand side at the accepted state, unless an
-  // output time was evaluated since: then solve it again.
-  if (!(base_.valid && base_.t == t)) evaluate_state(t, Y);
+  // output time was evaluated since, or the accepted state is the last Newton iterate of an
+  // implicit method (generalized-α) and not the state last evaluated: then solve it again. An
+  // explicit chain needs no anchor of the right state: its positions follow without Newton.
+  if (!(base_.valid && base_.t == t && (chain_ || solved_dofs(base_, Y)))) evaluate_state(t, Y);
   anchor_ = base_;
 }
 
@@ -132,7 +142,8 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
     positions.xd = positions.xdd = Eigen::VectorXd::Zero(sys.nx);
     predict_from(positions, t, q);
   }
-  const bool check = in_rhs_ && anchor_.valid;
+  // (Explicit chain positions need no check: there is no Newton iteration to leave a branch.)
+  const bool check = in_rhs_ && anchor_.valid && !chain_;
   // Right-hand sides of an open chain: positions and velocities element by element (chain.hpp);
   // other evaluations also factorize the velocity block, which the forces and transfer use.
   ExplicitChain* chain = in_rhs_ ? chain_.get() : nullptr;
@@ -645,16 +656,25 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
                                                      bool auto_switch, const Settings& st, double t, double t_end,
                                                      double h, Eigen::VectorXd& Y, const std::vector<double>& times,
                                                      const Integrator::Output& output) {
+  auto jacobian_of_state = [this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
+    jacobian(tt, y, J);
+    if (J.rows() < y.size()) {  // the energy's quadrature states: nothing depends on them
+      Eigen::MatrixXd full = Eigen::MatrixXd::Zero(y.size(), y.size());
+      full.topLeftCorner(J.rows(), J.cols()) = J;
+      J.swap(full);
+    }
+  };
+  if (method == Method::GENERALIZED_ALPHA) {
+    const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+    if (nd == 0) throw InputError("method generalized_alpha: the model has no degrees of freedom to integrate");
+    GeneralizedAlpha integ(static_cast<int>(Y.size()), nd, nd + ny, options.rho_inf);
+    integ.set_jacobian(jacobian_of_state);
+    integ.set_fixed_step(options.fixed_step);
+    return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
+  }
   if (method == Method::RADAU5) {
     Radau5 integ(static_cast<int>(Y.size()));
-    integ.set_jacobian([this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
-      jacobian(tt, y, J);
-      if (J.rows() < y.size()) {  // the energy's quadrature states: nothing depends on them
-        Eigen::MatrixXd full = Eigen::MatrixXd::Zero(y.size(), y.size());
-        full.topLeftCorner(J.rows(), J.cols()) = J;
-        J.swap(full);
-      }
-    });
+    integ.set_jacobian(jacobian_of_state);
     // Y = (q, y, q̇): q̇ = dq/dt, the last components (not with the energy's states after them).
     if (n_energy_ == 0) integ.set_second_order(sys_->n_dof());
     // The Jacobian (a linearization) costs several right-hand sides per DOF: keep it longer.
@@ -697,7 +717,7 @@ Simulation::SegmentEnd Simulation::run_segment(Integ& integ, BlockResults& res, 
     res.steps += s.nsteps;
     res.accepted += s.naccept;
     res.rejected += s.nreject;
-    if constexpr (std::is_same_v<Integ, Radau5>) {
+    if constexpr (!std::is_same_v<Integ, Integrator>) {
       res.jacobians += s.njev;
       res.decompositions += s.ndec;
     }
@@ -716,7 +736,8 @@ Simulation::SegmentEnd Simulation::run_segment(Integ& integ, BlockResults& res, 
   add_stats();
   res.last_step = integ.last_step();
   if constexpr (std::is_same_v<Integ, Radau5>) return {t_reached, integ.nonstiffness_detected()};
-  else return {t_reached, integ.stiffness_detected()};
+  else if constexpr (std::is_same_v<Integ, Integrator>) return {t_reached, integ.stiffness_detected()};
+  else return {t_reached, false};
 }
 
 void Simulation::explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y) {

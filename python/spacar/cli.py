@@ -110,7 +110,8 @@ def _run(args) -> int:
         model.output_stem = args.output_stem
     animated = []
     n_warn = len(model.warnings)
-    blocks = model.run_blocks(method=args.method, progress=args.progress, time_limit=args.time_limit)
+    implicit = {"rho_inf": args.rho_inf, "fixed_step": args.fixed_step} if args.method == "generalized_alpha" else {}
+    blocks = model.run_blocks(method=args.method, progress=args.progress, time_limit=args.time_limit, **implicit)
     for k in itertools.count():
         try:
             res = next(blocks)
@@ -229,9 +230,14 @@ def main(argv=None) -> int:
     run.add_argument("file")
     run.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                      help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
-    run.add_argument("--method", choices=["dop853", "dopri5", "radau5", "auto"], default="auto",
+    run.add_argument("--method", choices=["dop853", "dopri5", "radau5", "generalized_alpha", "auto"], default="auto",
                      help="integration method (default auto: dop853, radau5 where it detects stiffness; "
-                          "radau5: implicit, for stiff flexible systems)")
+                          "radau5: implicit, for stiff flexible systems; generalized_alpha: implicit, second order)")
+    run.add_argument("--rho-inf", type=float, default=0.9, metavar="RHO",
+                     help="generalized_alpha: spectral radius at infinite frequency, 0..1 (default 0.9; 1: no "
+                          "numerical damping)")
+    run.add_argument("--fixed-step", type=float, default=None, metavar="H",
+                     help="generalized_alpha: fixed steps of H seconds without error control")
     run.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                      help="progress bar over simulated time on standard error (default: in a terminal, "
                           "for runs longer than a second; needs tqdm)")

@@ -31,7 +31,7 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     stats["method"] = _method_used(arrays)
     stats["switches"] = [tuple(s) for s in arrays["switches"]]
     # The implicit method's work, where it ran: Jacobians (linearizations), LU factorizations.
-    if method == "radau5" or arrays["switches"]:
+    if method in ("radau5", "generalized_alpha") or arrays["switches"]:
         stats.update(jacobians=arrays["jacobians"], decompositions=arrays["decompositions"])
     lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
     res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear,
@@ -166,7 +166,7 @@ def _dead_position_hint(err, res, system, model) -> str:
 
 def simulate(model, *, method: str = "auto", on_output=None, progress=None, output_stem=None,
              time_limit=None, recursive: bool = True, forces=None, inputs=None, controller=None,
-             energy: bool = False) -> Results:
+             energy: bool = False, rho_inf: float = 0.9, fixed_step=None) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
     The mechanism is assembled at the current time; with degrees of freedom the reduced
@@ -186,9 +186,14 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     ``model.output_stem``, else the input file name without extension, else ``spacar``.
 
     ``method``: ``"auto"`` (default: DOP853 until it detects stiffness, then radau5 until the
-    stiffness goes; docs/stiff-integration.md), ``"dop853"``, ``"dopri5"`` or ``"radau5"``
-    (implicit Radau IIA for stiff systems, its Newton matrix from the linearized equations;
-    ``res.stats`` then also holds ``jacobians`` and ``decompositions``, as after a switch).
+    stiffness goes; docs/stiff-integration.md), ``"dop853"``, ``"dopri5"``, ``"radau5"``
+    (implicit Radau IIA of order 5 for stiff systems, its Newton matrix from the linearized
+    equations) or ``"generalized_alpha"`` (implicit, second order, one right-hand side per Newton
+    iteration, the positions under error control; for flexible links at loose tolerances, with
+    ``rho_inf`` its spectral radius at infinite frequency: 1 keeps every mode's amplitude, smaller
+    values damp the highest modes; ``fixed_step``: steps of this size without error control,
+    EPSINT/EPSIND then only stop its Newton iterations). The implicit methods add ``jacobians``
+    and ``decompositions`` to ``res.stats``, as does a switch.
     ``res.stats["method"]`` names the integrator(s) used (``"dop853"``, ``"radau5"``,
     ``"auto: dop853→radau5 at t=0.0123"``), ``res.stats["switches"]`` lists the changes as
     ``(t, from, to)``.
@@ -231,8 +236,15 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     if on_output is not None and not callable(on_output):
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
     if not isinstance(method, str):
-        raise InputError(f"method must be 'dop853' or 'dopri5' (explicit), 'radau5' (implicit) or 'auto', "
-                         f"got {show(method)}")
+        raise InputError(f"method must be 'dop853' or 'dopri5' (explicit), 'radau5' or 'generalized_alpha' "
+                         f"(implicit) or 'auto', got {show(method)}")
+    if isinstance(rho_inf, (bool, np.bool_)) or not isinstance(rho_inf, (int, float, np.number)) \
+            or not 0.0 <= rho_inf <= 1.0:
+        raise InputError(f"rho_inf (the spectral radius of generalized_alpha) must be a number in [0, 1], "
+                         f"got {show(rho_inf)}")
+    step_size = seconds_or_none(fixed_step, "fixed_step") or 0.0
+    if step_size and method != "generalized_alpha":
+        raise InputError(f"fixed_step is an option of method 'generalized_alpha' only, not of {show(method)}")
     if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
     if not isinstance(energy, (bool, np.bool_)):
@@ -282,7 +294,8 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit,
                          recursive=bool(recursive),  # numpy booleans too
                          sample_period=0.0 if controller is None else 1.0 / controller.rate,
-                         on_sample=on_sample, energy=bool(energy))
+                         on_sample=on_sample, energy=bool(energy), rho_inf=float(rho_inf),
+                         fixed_step=step_size)
     except SpacarError as err:
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):

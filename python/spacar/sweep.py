@@ -610,8 +610,9 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     if not (analysis in ("simulate", "linearize") or callable(analysis)):
         raise InputError(f"sweep: analysis must be 'simulate', 'linearize' or a function, got {show(analysis)}")
     time_limit = seconds_or_none(time_limit, "sweep: time_limit")
-    if not isinstance(method, str) or method not in ("dop853", "dopri5", "radau5", "auto"):
-        raise InputError(f"sweep: unknown integration method {show(method)} (dop853, dopri5, radau5, auto)")
+    if not isinstance(method, str) or method not in ("dop853", "dopri5", "radau5", "generalized_alpha", "auto"):
+        raise InputError(f"sweep: unknown integration method {show(method)} "
+                         "(dop853, dopri5, radau5, generalized_alpha, auto)")
     names, cases, grid, lines = _cases(parameters, by_lines=isinstance(model, Model))
     n = len(cases)
     task = _Task(model, lines, analysis, _Outputs(outputs, analysis), method, time_limit, n)

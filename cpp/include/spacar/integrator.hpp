@@ -25,11 +25,12 @@ struct IntegrationError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// RADAU5 is the implicit Radau IIA method of radau5.hpp (its own class, not Integrator's). AUTO is
+// RADAU5 is the implicit Radau IIA method of radau5.hpp and GENERALIZED_ALPHA the second-order
+// method of generalized_alpha.hpp (classes of their own, not Integrator's). AUTO is
 // a choice of the analysis, not an integrator: DOP853 until it detects stiffness, then RADAU5
 // until the stiffness goes (simulate.cpp, Simulation::integrate_block).
-enum class Method { DOP853, DOPRI5, RADAU5, AUTO };
-// The method of its name ("dop853", "dopri5", "radau5", "auto"), the one parser of every entry
+enum class Method { DOP853, DOPRI5, RADAU5, GENERALIZED_ALPHA, AUTO };
+// The method of its name ("dop853", "dopri5", "radau5", "generalized_alpha", "auto"), the one parser of every entry
 // point; InputError for any other name.
 Method parse_method(const std::string& name);
 // The name parse_method reads.

@@ -28,6 +28,12 @@ using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::R
 struct RunOptions {
   // AUTO: DOP853 until it detects stiffness, RADAU5 until the stiffness goes (integrate_block).
   Method method = Method::DOP853;
+  // GENERALIZED_ALPHA: the spectral radius at infinite frequency, in [0, 1] (1: no numerical
+  // damping; generalized_alpha.hpp).
+  double rho_inf = 0.9;
+  // GENERALIZED_ALPHA: > 0 fixed steps of this size, no error control (EPSINT/EPSIND then stop the
+  // Newton iterations only); 0: error control.
+  double fixed_step = 0.0;
   double initial_step = 0.0;  // > 0: continue with this step (RESTART 0 across blocks)
   // Called after every output time is recorded (index k, data of that state, its linearization
   // or nullptr): progress bars, files written as the run proceeds.
@@ -242,6 +248,7 @@ class Simulation {
   bool continuous_with_step_start(std::string& why) const;
   // The integrator starts a step at (t, Y): that accepted state becomes the anchor.
   void step_start(double t, const Eigen::VectorXd& Y);
+  bool solved_dofs(const Solved& s, const Eigen::VectorXd& Y) const;  // s solved at Y's DOFs
   Model& model_;
   std::map<int, int> dependent_;  // dependent Euler parameter of free rotations, by node
   std::unique_ptr<System> sys_;

@@ -1,0 +1,105 @@
+// Generalized-α integration of second-order equations of motion (Chung & Hulbert 1993) in the
+// form Arnold & Brüls (2007) give it for y' = f(t, y) written as first-order equations, with
+// local-error step control in the manner of Zienkiewicz & Xie (1991).
+//
+// The state y holds m positions q (its first m components), their rates v (the m components from
+// rate_offset on, as (q, y, q̇) of the reduced equations of motion) and any other first-order
+// states; Z = y[m:n] collects all but the positions, with derivatives D = f_Z(t, y). A step
+// solves for D at its end, with an acceleration-like variable A (of Z) carried between steps:
+//   (1 − αm) A⁺ + αm A = (1 − αf) D⁺ + αf D
+//   Z⁺ = Z + h ((1 − γ) A + γ A⁺)
+//   q⁺ = q + h v + h² ((½ − β) a + β a⁺)          (a: the rate part of A)
+// with D⁺ = f_Z(t + h, q⁺, Z⁺). The parameters follow from the spectral radius ρ∞ at infinite
+// frequency: ρ∞ = 1 conserves the amplitude of every mode (the trapezoidal rule), smaller values
+// damp the highest ones (ρ∞ = 0: annihilated in one step) while keeping second order.
+//
+// The interface has the shape of Radau5's (radau5.hpp): per-component tolerances, maximum step,
+// step limit, initial step, stop condition, step-start callback, dense output at the output
+// times, and the Jacobian ∂f/∂y from a callback, reused over steps while the simplified Newton
+// iterations converge well. The Newton matrix I − γ' h ∂f_Z/∂Z − β' h² ∂f_Z/∂q (size n − m) is
+// factorized once per step size.
+//
+// Error control: the local error of the positions, q⁺ minus the cubic Taylor step
+// q + h v + h² (D/3 + D⁺/6) of their accelerations, and of the first-order states other than the
+// rates, the trapezoidal rule's h³ y'''/12 from divided differences of D. The rates themselves are
+// not controlled (their error appears in the positions one step later); this is what lets the
+// step grow past the periods of high-frequency modes of negligible amplitude, the point of the
+// method for flexible links.
+#pragma once
+
+#include <Eigen/Dense>
+#include <string>
+
+#include "spacar/integrator.hpp"
+#include "spacar/radau5.hpp"
+
+namespace spacar {
+
+class GeneralizedAlpha {
+ public:
+  using Rhs = Integrator::Rhs;
+  using Output = Integrator::Output;
+  using StopCondition = Integrator::StopCondition;
+  using StepStart = Integrator::StepStart;
+  using Jacobian = Radau5::Jacobian;
+
+  // n states, of which the first m are positions with rates at rate_offset .. rate_offset + m − 1
+  // (m ≤ rate_offset ≤ n − m); rho_inf in [0, 1].
+  GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf);
+
+  // Per component, sc = atol + rtol |y|, as for Integrator (not mapped: the method has order 2
+  // and the global error follows rtol roughly in proportion).
+  void set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol);
+  void set_max_step(double hmax);
+  void set_max_steps(long n);
+  void set_initial_step(double h);  // 0 = automatic
+  double last_step() const;
+  void set_stop_condition(StopCondition stop);
+  void set_step_start(StepStart start);
+  void set_jacobian(Jacobian jac);  // required before integrate()
+  // Fixed steps of size h (the last one shortened to t_end) without error control, as structural
+  // dynamics codes are used; the tolerances then only stop the Newton iterations. A step whose
+  // Newton iterations fail is retried in halves. 0 (the default): error control.
+  void set_fixed_step(double h);
+
+  // As Integrator::integrate, with outputs from cubic Hermite interpolation over the step.
+  double integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
+                   const std::vector<double>& touts, const Output& out);
+
+  const Radau5Stats& stats() const;  // cumulative over all integrate calls; nnewton: iterations
+
+ private:
+  enum class Attempt { Accepted, ErrorTooLarge, SlowNewton, Failed };
+
+  bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
+  void factorize(double h);
+  void shift_acceleration(double h);                  // a_use_: A for a step of size h
+  void state_at(double h, const Eigen::VectorXd& y);  // y_new_, a_new_ from d_new_
+  Attempt newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y);
+  double error_norm(double h, const Eigen::VectorXd& y);
+  size_t emit_outputs(const std::vector<double>& touts, size_t next, double t, double h, double t_new,
+                      const Eigen::VectorXd& y, const Output& out);
+
+  int n_, m_, r0_, nz_;
+  double alpha_m_, alpha_f_, gamma_, beta_;
+  Eigen::VectorXd rtol_, atol_;
+  double hmax_;
+  long max_steps_ = Integrator::kMaxSteps;
+  double h_initial_ = 0.0, h_last_ = 0.0, h_fixed_ = 0.0;
+  StopCondition stop_;
+  StepStart step_start_;
+  Jacobian jac_;
+  Radau5Stats stats_;
+  std::string failure_;
+  double theta_ = 0.0, faccon_ = 1.0, slow_factor_ = 0.5;
+  int newton_its_ = 0;
+  bool have_previous_ = false;  // d_prev_ and h_prev_ hold the step before (error of Z)
+  double h_prev_ = 0.0;
+
+  // Work space, allocated once. d_: D at the step start, a_: A there; d_new_, a_new_: at its end.
+  Eigen::MatrixXd J_, N_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  Eigen::VectorXd d_, a_, a_use_, d_new_, a_new_, d_prev_, dd_, y_new_, fy_, res_, scale_, y_out_;
+};
+
+}  // namespace spacar

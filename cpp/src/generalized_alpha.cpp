@@ -1,0 +1,355 @@
+// Generalized-α with local-error step control (see generalized_alpha.hpp).
+#include "spacar/generalized_alpha.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace spacar {
+namespace {
+
+constexpr int kMaxNewton = 7;
+constexpr double kSafety = 0.9;
+constexpr double kMinError = 1e-10;
+// Newton stops when the predicted remaining error of the states is below this fraction of the
+// tolerance (the scaled norm in which the local error must stay below 1).
+constexpr double kNewtonTolerance = 0.02;
+const double kRound = std::numeric_limits<double>::epsilon();
+
+std::string describe(double t, double h) {
+  std::ostringstream s;
+  s.precision(12);
+  s << "t = " << t << ", step size h = " << h;
+  return s.str();
+}
+
+}  // namespace
+
+GeneralizedAlpha::GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf)
+    : n_(n), m_(m), r0_(rate_offset), nz_(n - m), hmax_(std::numeric_limits<double>::infinity()) {
+  if (n < 1 || m < 1 || rate_offset < m || rate_offset + m > n)
+    throw std::invalid_argument("GeneralizedAlpha: needs m >= 1 positions with their rates among the n states");
+  if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
+    throw std::invalid_argument("GeneralizedAlpha: the spectral radius rho_inf must be in [0, 1]");
+  // Chung & Hulbert's parameters: second order, ρ∞ at infinite frequency, the least low-frequency
+  // dissipation for that ρ∞.
+  alpha_m_ = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+  alpha_f_ = rho_inf / (rho_inf + 1.0);
+  gamma_ = 0.5 - alpha_m_ + alpha_f_;
+  beta_ = 0.25 * (1.0 - alpha_m_ + alpha_f_) * (1.0 - alpha_m_ + alpha_f_);
+  set_tolerances(Eigen::VectorXd::Constant(n, 1e-6), Eigen::VectorXd::Constant(n, 1e-6));
+  J_.setZero(n, n);
+  N_.setZero(nz_, nz_);
+  lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(nz_);
+  for (Eigen::VectorXd* v : {&d_, &a_, &a_use_, &d_new_, &a_new_, &d_prev_, &dd_, &res_}) v->setZero(nz_);
+  for (Eigen::VectorXd* v : {&y_new_, &fy_, &scale_, &y_out_}) v->setZero(n);
+  failure_.reserve(256);
+}
+
+void GeneralizedAlpha::set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
+  if (rtol.size() != n_ || atol.size() != n_)
+    throw std::invalid_argument("GeneralizedAlpha: tolerances need one entry per state");
+  for (int i = 0; i < n_; ++i)
+    if (!(std::isfinite(rtol[i]) && std::isfinite(atol[i]) && rtol[i] >= 0 && atol[i] >= 0 && rtol[i] + atol[i] > 0))
+      throw std::invalid_argument("GeneralizedAlpha: tolerances must be finite, non-negative and not both zero (state " +
+                                  std::to_string(i) + ")");
+  rtol_ = rtol;
+  atol_ = atol;
+}
+
+void GeneralizedAlpha::set_max_step(double hmax) {
+  if (!(hmax > 0)) throw std::invalid_argument("GeneralizedAlpha: the maximum step must be positive");
+  hmax_ = hmax;
+}
+
+void GeneralizedAlpha::set_max_steps(long n) {
+  if (n < 1) throw std::invalid_argument("GeneralizedAlpha: the step limit must be positive");
+  max_steps_ = n;
+}
+
+void GeneralizedAlpha::set_initial_step(double h) {
+  if (!(h >= 0) || !std::isfinite(h)) throw std::invalid_argument("GeneralizedAlpha: the initial step must be finite and >= 0");
+  h_initial_ = h;
+}
+
+void GeneralizedAlpha::set_fixed_step(double h) {
+  if (!(h >= 0) || !std::isfinite(h)) throw std::invalid_argument("GeneralizedAlpha: the fixed step must be finite and >= 0");
+  h_fixed_ = h;
+}
+
+double GeneralizedAlpha::last_step() const { return h_last_; }
+void GeneralizedAlpha::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
+void GeneralizedAlpha::set_step_start(StepStart start) { step_start_ = std::move(start); }
+void GeneralizedAlpha::set_jacobian(Jacobian jac) { jac_ = std::move(jac); }
+const Radau5Stats& GeneralizedAlpha::stats() const { return stats_; }
+
+bool GeneralizedAlpha::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
+  ++stats_.nfev;
+  f(t, y, dy);
+  if (dy.size() != n_)
+    throw std::invalid_argument("GeneralizedAlpha: the rhs returned " + std::to_string(dy.size()) +
+                                " derivatives for " + std::to_string(n_) + " states");
+  if (dy.allFinite()) return true;
+  failure_ = "non-finite rhs value";
+  return false;
+}
+
+// N = I − γ' h ∂f_Z/∂Z − β' h² ∂f_Z/∂q, with γ' = γ c and β' = β c, c = ∂A⁺/∂D⁺ = (1−αf)/(1−αm):
+// the derivative of the residual D⁺ − f_Z(q⁺, Z⁺) with respect to D⁺.
+void GeneralizedAlpha::factorize(double h) {
+  const double c = (1.0 - alpha_f_) / (1.0 - alpha_m_);
+  const double gh = gamma_ * c * h, bh2 = beta_ * c * h * h;
+  N_ = -gh * J_.bottomRightCorner(nz_, nz_);
+  N_.diagonal().array() += 1.0;
+  N_.middleCols(r0_ - m_, m_) -= bh2 * J_.bottomLeftCorner(nz_, m_);
+  lu_.compute(N_);
+  ++stats_.ndec;
+}
+
+void GeneralizedAlpha::state_at(double h, const Eigen::VectorXd& y) {
+  const double c = 1.0 / (1.0 - alpha_m_);
+  a_new_ = c * ((1.0 - alpha_f_) * d_new_ + alpha_f_ * d_ - alpha_m_ * a_use_);
+  y_new_.tail(nz_) = y.tail(nz_) + h * ((1.0 - gamma_) * a_use_ + gamma_ * a_new_);
+  const int r = r0_ - m_;  // the rates' place in Z
+  y_new_.head(m_) = y.head(m_) + h * y.segment(r0_, m_) +
+                    (h * h) * ((0.5 - beta_) * a_use_.segment(r, m_) + beta_ * a_new_.segment(r, m_));
+}
+
+// A approximates D at t + (αm − αf) h of the step that made it (Arnold & Brüls): after a change of
+// the step size it is moved to the new step's shift along the last divided difference of D, or
+// the method drops to first order wherever the step changes (ρ∞ < 1; at ρ∞ = 1, A = D).
+void GeneralizedAlpha::shift_acceleration(double h) {
+  a_use_ = a_;
+  if (have_previous_ && h != h_prev_)
+    a_use_ += ((alpha_m_ - alpha_f_) * (h - h_prev_) / h_prev_) * (d_ - d_prev_);
+}
+
+// Simplified Newton iterations for D⁺ from the predictor D⁺ = D (the Jacobian and the
+// factorization for h in place), with the convergence monitoring of Hairer's RADAU5. On success
+// y_new_, a_new_ and d_new_ hold the end of the step: D⁺ is the converged iterate, not a new
+// evaluation of f (one right-hand side per iteration, none more per step).
+GeneralizedAlpha::Attempt GeneralizedAlpha::newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y) {
+  const double c = (1.0 - alpha_f_) / (1.0 - alpha_m_);
+  const double gh = gamma_ * c * h, bh2 = beta_ * c * h * h;
+  const int r = r0_ - m_;
+  scale_ = atol_.array() + rtol_.array() * y.array().abs();
+  shift_acceleration(h);
+  d_new_ = d_;
+  faccon_ = std::pow(std::max(faccon_, kRound), 0.8);
+  theta_ = 0.0;  // converged in one iteration: the Jacobian serves well
+  double dn_old = 0.0, thq_old = 0.0;
+  for (int it = 1; it <= kMaxNewton; ++it) {
+    ++stats_.nnewton;
+    newton_its_ = it;
+    state_at(h, y);
+    if (!eval(f, t + h, y_new_, fy_)) return Attempt::Failed;
+    res_ = fy_.tail(nz_) - d_new_;
+    dd_ = lu_.solve(res_);
+    // The increment's effect on the states, in units of the tolerance.
+    const double sq = (bh2 * dd_.segment(r, m_).array() / scale_.head(m_).array()).square().sum() +
+                      (gh * dd_.array() / scale_.tail(nz_).array()).square().sum();
+    const double dn = std::sqrt(sq / n_);
+    if (!std::isfinite(dn)) {
+      failure_ = "singular Newton matrix";
+      return Attempt::Failed;
+    }
+    if (it > 1) {
+      const double thq = dn / dn_old;
+      theta_ = it == 2 ? thq : std::sqrt(thq * thq_old);
+      thq_old = thq;
+      if (!(theta_ < 0.99)) {
+        failure_ = "Newton iterations diverge";
+        return Attempt::Failed;
+      }
+      faccon_ = theta_ / (1.0 - theta_);
+      const double predicted = faccon_ * dn * std::pow(theta_, kMaxNewton - 1 - it) / kNewtonTolerance;
+      if (predicted >= 1.0) {
+        slow_factor_ = 0.8 * std::pow(std::clamp(predicted, 1e-4, 20.0), -1.0 / (4.0 + kMaxNewton - 1 - it));
+        failure_ = "Newton iterations converge too slowly";
+        return Attempt::SlowNewton;
+      }
+    }
+    dn_old = std::max(dn, kRound);
+    d_new_ += dd_;
+    if (faccon_ * dn <= kNewtonTolerance) {
+      state_at(h, y);
+      return Attempt::Accepted;
+    }
+  }
+  failure_ = "Newton iterations did not converge";
+  return Attempt::Failed;
+}
+
+// Scaled RMS of the local error estimate over the positions and the first-order states other
+// than the rates (see the header), filtered through the Newton matrix as in Hairer's RADAU5: a
+// mode of frequency ω is weighted by 1 / (1 + β' (ω h)²), so that the modes the step does not
+// resolve count with their amplitude, not with their acceleration times h².
+double GeneralizedAlpha::error_norm(double h, const Eigen::VectorXd& y) {
+  const int r = r0_ - m_;
+  scale_ = atol_.array() + rtol_.array() * y.array().abs().max(y_new_.array().abs());
+  // res_ (in the layout of Z): the positions' estimates in the rates' places, the others' in theirs.
+  res_.setZero();
+  for (int i = 0; i < m_; ++i)
+    res_[r + i] = h * h * ((0.5 - beta_) * a_use_[r + i] + beta_ * a_new_[r + i] - d_[r + i] / 3.0 - d_new_[r + i] / 6.0);
+  if (have_previous_) {
+    const double k = h * h * h / 6.0 / (h + h_prev_);
+    for (int j = 0; j < nz_; ++j)
+      if (j < r || j >= r + m_) res_[j] = k * ((d_new_[j] - d_[j]) / h - (d_[j] - d_prev_[j]) / h_prev_);
+  }
+  dd_ = lu_.solve(res_);
+  double sum = 0.0;
+  for (int j = 0; j < nz_; ++j) {
+    const double sc = j >= r && j < r + m_ ? scale_[j - r] : scale_[m_ + j];
+    sum += (dd_[j] / sc) * (dd_[j] / sc);
+  }
+  return std::max(std::sqrt(sum / nz_), kMinError);  // nz_ = m positions + the others, rates left out
+}
+
+// Cubic Hermite interpolation over the step [t, t + h] from the values and derivatives at its ends.
+size_t GeneralizedAlpha::emit_outputs(const std::vector<double>& touts, size_t next, double t, double h,
+                                      double t_new, const Eigen::VectorXd& y, const Output& out) {
+  for (; next < touts.size() && touts[next] <= t_new; ++next) {
+    if (touts[next] == t_new) {
+      out(t_new, y_new_);
+      continue;
+    }
+    const double s = (touts[next] - t) / h;
+    const double h00 = (1 + 2 * s) * (1 - s) * (1 - s), h01 = s * s * (3 - 2 * s);
+    const double h10 = s * (1 - s) * (1 - s) * h, h11 = s * s * (s - 1) * h;
+    y_out_ = h00 * y + h01 * y_new_;
+    y_out_.head(m_) += h10 * y.segment(r0_, m_) + h11 * y_new_.segment(r0_, m_);
+    y_out_.tail(nz_) += h10 * d_ + h11 * d_new_;
+    out(touts[next], y_out_);
+  }
+  return next;
+}
+
+double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
+                                   const std::vector<double>& touts, const Output& out) {
+  if (y.size() != n_) throw std::invalid_argument("GeneralizedAlpha: the state has the wrong size");
+  if (!(t_end >= t0)) throw std::invalid_argument("GeneralizedAlpha: t_end must not be before t0");
+  if (!jac_) throw std::invalid_argument("GeneralizedAlpha: no Jacobian callback set");
+  for (size_t i = 0; i < touts.size(); ++i)
+    if (!(touts[i] >= t0 && touts[i] <= t_end) || (i > 0 && touts[i] < touts[i - 1]))
+      throw std::invalid_argument("GeneralizedAlpha: output times must be sorted and within [t0, t_end]");
+  if (!y.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite initial state at " + describe(t0, 0.0));
+
+  failure_ = "none";
+  size_t next = 0;
+  for (; next < touts.size() && touts[next] == t0; ++next) out(t0, y);
+  if (t_end == t0) return t0;
+
+  bool ok = false;
+  try {
+    ok = eval(f, t0, y, fy_);
+  } catch (const StepRejected& e) {
+    failure_ = e.what();
+  }
+  if (!ok)
+    throw IntegrationError("GeneralizedAlpha: cannot start, rhs failed at the initial state (" + failure_ + ") at " +
+                           describe(t0, 0.0));
+  d_ = fy_.tail(nz_);
+  a_ = d_;  // A = D at the start (Arnold & Brüls): second order from the first step
+  have_previous_ = false;
+
+  double h = h_fixed_ > 0 ? h_fixed_ : h_initial_;
+  if (!(h > 0)) {
+    // Hairer's starting step for a method of order 2.
+    scale_ = atol_.array() + rtol_.array() * y.array().abs();
+    const double d0 = std::sqrt((y.array() / scale_.array()).square().mean());
+    const double d1 = std::sqrt((fy_.array() / scale_.array()).square().mean());
+    const double h0 = std::min((d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1, t_end - t0);
+    double dmax = d1;
+    y_new_ = y + h0 * fy_;
+    try {
+      if (eval(f, t0 + h0, y_new_, y_out_))
+        dmax = std::max(d1, std::sqrt(((y_out_ - fy_).array() / scale_.array()).square().mean()) / h0);
+    } catch (const StepRejected&) {
+    }
+    const double h1 = dmax <= 1e-15 ? std::max(1e-6, 1e-3 * h0) : std::pow(0.01 / dmax, 1.0 / 3.0);
+    h = std::min(100.0 * h0, h1);
+  }
+  h = std::min({h, hmax_, t_end - t0});
+  bool rejected = false, need_jacobian = true, jacobian_fresh = false;
+  double h_factorized = 0.0;
+  faccon_ = 1.0;
+  double t = t0;
+  for (long steps = 0; t < t_end; ++steps) {
+    if (steps >= max_steps_)
+      throw IntegrationError("GeneralizedAlpha: more than " + std::to_string(max_steps_) + " steps at " + describe(t, h));
+    if (!(h >= Integrator::min_step(t)))
+      throw IntegrationError("GeneralizedAlpha: step size underflow at " + describe(t, h) + " (last rejection: " +
+                             failure_ + ")");
+    const bool last = t + std::min(1.01 * h, hmax_) >= t_end;
+    const double h_try = last ? t_end - t : h;
+    ++stats_.nsteps;
+    if (step_start_) step_start_(t, y);
+    Attempt result = Attempt::Failed;
+    double err = 0.0;
+    try {
+      if (need_jacobian) {
+        ++stats_.njev;
+        jac_(t, y, J_);
+        if (J_.rows() != n_ || J_.cols() != n_) throw std::invalid_argument("GeneralizedAlpha: the Jacobian has the wrong size");
+        if (!J_.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite Jacobian at " + describe(t, h_try));
+        need_jacobian = false;
+        jacobian_fresh = true;
+        h_factorized = 0.0;
+      }
+      if (h_try != h_factorized) {
+        factorize(h_try);
+        h_factorized = h_try;
+      }
+      result = newton(f, t, h_try, y);
+      if (result == Attempt::Accepted && h_fixed_ > 0) {
+        err = 1.0;  // no control: keep the step
+      } else if (result == Attempt::Accepted) {
+        err = error_norm(h_try, y);
+        if (!std::isfinite(err)) {
+          failure_ = "non-finite error estimate";
+          result = Attempt::Failed;
+        } else if (err >= 1.0) {
+          failure_ = "local error above tolerance";
+          result = Attempt::ErrorTooLarge;
+        }
+      }
+    } catch (const StepRejected& e) {
+      failure_ = e.what();
+      result = Attempt::Failed;
+    }
+    // The local error behaves as h³.
+    const double quot = std::clamp(std::cbrt(err) / kSafety, 0.2, 5.0);
+    if (result != Attempt::Accepted) {
+      ++stats_.nreject;
+      rejected = true;
+      if (result == Attempt::ErrorTooLarge) h = h_try / quot;
+      else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
+      else h = 0.5 * h_try;
+      need_jacobian = !jacobian_fresh && result != Attempt::ErrorTooLarge;
+      continue;
+    }
+    ++stats_.naccept;
+    double h_new = std::min(h_try / quot, hmax_);
+    if (rejected) h_new = std::min(h_new, h_try);
+    if (h_fixed_ > 0) h_new = std::min(2.0 * h_try, h_fixed_);  // back to the fixed step after halvings
+    const double t_new = last ? t_end : t + h_try;
+    next = emit_outputs(touts, next, t, h_try, t_new, y, out);
+    d_prev_ = d_;
+    h_prev_ = h_try;
+    have_previous_ = true;
+    d_ = d_new_;
+    a_ = a_new_;
+    y = y_new_;
+    t = t_new;
+    rejected = jacobian_fresh = false;
+    need_jacobian = theta_ > 0.1;  // a Jacobian is a linearization: keep it while Newton contracts
+    if (!need_jacobian && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;  // keep the factorization
+    h = last ? std::max(h_new, std::min(h, hmax_)) : h_new;
+    if (stop_ && t < t_end && stop_(t, y)) break;
+  }
+  h_last_ = h;
+  return t;
+}
+
+}  // namespace spacar

@@ -1,0 +1,155 @@
+"""The generalized-α integrator (method="generalized_alpha"): its order and numerical damping on
+the linear oscillator in closed form (through spacar._testing), and in the analysis the same
+motion as a tight DOP853 solution on a flexible cantilever, the manual's slider-crank (inputs,
+closed loop), a rolling wheel (ENHC) and with the energy balance."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import spacar
+from spacar import _testing
+from spacar.compare import models
+
+from test_damped_oscillator import check_against_closed_form, oscillator
+from test_radau5_simulate import incline_wheel
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "slidercrank.dat"
+
+
+def linear_oscillator(omega, zeta=0.0):
+    f = lambda t, y: np.array([y[1], -omega**2 * y[0] - 2 * zeta * omega * y[1]])
+    jac = lambda t, y: np.array([[0.0, 1.0], [-omega**2, -2 * zeta * omega]])
+    return f, jac
+
+
+def fixed_step_error(rho, h, omega=10.0, zeta=0.1, t_end=2.0):
+    f, jac = linear_oscillator(omega, zeta)
+    out = _testing.generalized_alpha_solve(f, jac, 0.0, np.array([1.0, 0.0]), t_end, [t_end], 1e-12, 1e-12, 1,
+                                           rho_inf=rho, fixed_step=h)
+    wd = omega * np.sqrt(1 - zeta**2)
+    exact = np.exp(-zeta * omega * t_end) * (np.cos(wd * t_end) + zeta * omega / wd * np.sin(wd * t_end))
+    return abs(out["y"][0, 0] - exact), out
+
+
+@pytest.mark.parametrize("rho", [1.0, 0.8, 0.5, 0.0])
+def test_second_order_at_fixed_steps(rho):
+    # Halving the step divides the error by 4 (2nd order) for every spectral radius: 1e-3 ... 2.5e-4.
+    errors = [fixed_step_error(rho, h)[0] for h in (4e-3, 2e-3, 1e-3)]
+    for coarse, fine in zip(errors, errors[1:]):
+        assert 3.6 < coarse / fine < 4.4, errors
+
+
+@pytest.mark.parametrize("rho", [1.0, 0.8, 0.5, 0.0])
+def test_spectral_radius_at_infinite_frequency(rho):
+    # ω h = 10⁴: the amplification matrix has the spectral radius ρ∞ (Chung & Hulbert; a double
+    # eigenvalue −ρ∞, so the amplitude falls as (a + b n) ρ∞ⁿ): ρ∞ = 1 keeps it, 0 removes it at once.
+    f, jac = linear_oscillator(1e5)
+    h, steps = 0.1, 30
+    out = _testing.generalized_alpha_solve(f, jac, 0.0, np.array([1.0, 0.0]), steps * h,
+                                           [k * h for k in range(1, steps + 1)], 1e-10, 1e-10, 1, rho_inf=rho,
+                                           fixed_step=h)
+    q = np.abs(out["y"][:, 0])
+    if rho == 1.0:
+        assert np.allclose(q, 1.0, atol=1e-3), q
+    elif rho == 0.0:
+        assert (q[2:] < 1e-3).all(), q
+    else:
+        n0, n1 = 20, 29
+        rate = (q[n1] / q[n0]) ** (1.0 / (n1 - n0)) / ((1 + n1) / (1 + n0)) ** (1.0 / (n1 - n0))
+        assert rho * 0.99 < rate < rho * 1.1, (rate, q)
+
+
+def test_error_control_follows_the_tolerance():
+    # Undamped 10 rad/s over three periods: the error falls with the tolerance (about as tol^(2/3),
+    # the global error of a second-order method under control of the local one), one right-hand side
+    # per step or little more (simplified Newton on an exact Jacobian).
+    f, jac = linear_oscillator(10.0)
+    errors = []
+    for tol in (1e-4, 1e-6, 1e-8):
+        out = _testing.generalized_alpha_solve(f, jac, 0.0, np.array([1.0, 0.0]), 2.0, [2.0], tol, tol, 1,
+                                               rho_inf=1.0)
+        errors.append(abs(out["y"][0, 0] - np.cos(20.0)))
+        assert out["nfev"] < 1.3 * out["nsteps"] + 5, out
+    assert errors[0] > 10 * errors[1] > 100 * errors[2], errors
+    assert errors[2] < 1e-4
+
+
+@pytest.mark.parametrize("zeta", [0.1, 2.0], ids=["underdamped", "overdamped"])
+def test_truss_oscillator_follows_the_closed_form(zeta):
+    # The analysis's closed-form oscillator (test_damped_oscillator): the motion, rates and stresses.
+    omega = 2.0 * np.pi
+    res = spacar.simulate(oscillator(omega, zeta, t_end=3.0, n_out=30, eps=1e-9), method="generalized_alpha",
+                          progress=False)
+    check_against_closed_form(res, omega, zeta, tol=1e-4)
+    assert res.stats["method"] == "generalized_alpha" and res.stats["jacobians"] >= 1
+
+
+def test_cantilever_agrees_with_dop853():
+    ref = spacar.simulate(models.cantilever(4, t_end=0.2, n_out=10, eps=1e-10), progress=False)
+    scale = np.abs(ref.x - ref.x[0]).max()
+    for kwargs in ({}, {"rho_inf": 1.0}, {"rho_inf": 0.5}):
+        res = spacar.simulate(models.cantilever(4, t_end=0.2, n_out=10, eps=1e-7), method="generalized_alpha",
+                              progress=False, **kwargs)
+        assert np.abs(res.x - ref.x).max() < 2e-3 * scale, kwargs
+    # Fixed steps: second order in the step.
+    errors = []
+    for h in (1e-3, 5e-4, 2.5e-4):
+        res = spacar.simulate(models.cantilever(4, t_end=0.2, n_out=10, eps=1e-8), method="generalized_alpha",
+                              rho_inf=1.0, fixed_step=h, progress=False)
+        assert res.stats["steps"] == pytest.approx(0.2 / h, abs=2)
+        errors.append(np.abs(res.x - ref.x).max())
+    # (Not exactly 4 per halving: the phases of the unresolved high modes add up differently.)
+    assert errors[0] > 5 * errors[2] and errors[2] < 1e-2 * scale, errors
+
+
+def test_slider_crank_agrees_with_dop853():
+    # Prescribed crank (INPUTX), a closed loop solved by Newton at every evaluation.
+    ref_model = spacar.read(EXAMPLE)
+    ref_model.epsint(1e-10)
+    ref_model.epsind(1e-10)
+    ref = spacar.simulate(ref_model, progress=False)
+    tight = spacar.read(EXAMPLE)
+    tight.epsint(1e-9)
+    tight.epsind(1e-9)
+    res = spacar.simulate(tight, method="generalized_alpha", progress=False)
+    amplitude = np.abs(ref.e).max()
+    assert np.abs(res.e - ref.e).max() < 1e-4 * amplitude
+
+
+def test_nonholonomic_wheel_agrees_with_dop853():
+    # ENHC: the slips' kinematic coordinates are first-order states beside the positions and rates.
+    ref = spacar.simulate(incline_wheel(1e-10), progress=False)
+    res = spacar.simulate(incline_wheel(1e-9), method="generalized_alpha", progress=False)
+    assert np.abs(res.x - ref.x).max() < 1e-6
+    assert np.abs(res.sigma - ref.sigma).max() < 1e-5 * np.abs(ref.sigma).max()
+
+
+def test_energy_balance_under_generalized_alpha():
+    # The energy's quadrature states are first-order states too: the balance closes.
+    res = spacar.simulate(oscillator(2 * np.pi, 0.1, t_end=1.0, n_out=10, eps=1e-9), method="generalized_alpha",
+                          energy=True, progress=False)
+    en = res.energy
+    total = en.balance  # total − initial
+    assert np.abs(total).max() < 1e-5 * np.abs(en["kinetic"] + en["strain"]).max()
+
+
+def test_options_are_checked():
+    with pytest.raises(spacar.InputError, match="rho_inf"):
+        spacar.simulate(spacar.read(EXAMPLE), method="generalized_alpha", rho_inf=1.5, progress=False)
+    with pytest.raises(spacar.InputError, match="fixed_step"):
+        spacar.simulate(spacar.read(EXAMPLE), method="dop853", fixed_step=1e-3, progress=False)
+    with pytest.raises(spacar.InputError, match="fixed_step"):
+        spacar.simulate(spacar.read(EXAMPLE), method="generalized_alpha", fixed_step=-1.0, progress=False)
+
+
+def test_cli_and_sweep_accept_generalized_alpha(capsys):
+    from spacar.cli import main
+
+    assert main(["run", str(EXAMPLE), "--method", "generalized_alpha", "--no-progress"]) == 0
+    assert "block 1" in capsys.readouterr().out
+    out = spacar.sweep(spacar.read(EXAMPLE), {"EPSINT": [1e-3, 1e-4]}, method="generalized_alpha",
+                       outputs={"steps": lambda res: res.stats["steps"]}, workers=1, progress=False)
+    assert not out.errors
+    assert (out["steps"] > 0).all()
