@@ -41,6 +41,7 @@ Simulation::Simulation(Model& model)
 
 void Simulation::remember(Solved& s) const {
   s.valid = true;
+  s.exact = true;
   s.t = data_->t;
   s.x = data_->x;
   s.xd = data_->xd;
@@ -99,13 +100,23 @@ bool Simulation::solved_dofs(const Solved& s, const Eigen::VectorXd& Y) const {
 void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
   if (t > kinematic_failure_t_) kinematic_failure_.clear();  // passed: the failure is history
   if (tree_) return;  // explicit positions: no Newton start to anchor, no branch to leave
-  if (anchor_.valid && anchor_.t == t) return;                // the same step again, smaller
+  if (anchor_.valid && anchor_.t == t) {  // the same step again, smaller
+    // A step from an approximate anchor failed: solve the accepted state itself, so that the
+    // smaller steps are not held to a mismatch of the size of a Newton increment.
+    if (!anchor_.exact) {
+      evaluate_state(t, Y);
+      anchor_ = base_;
+    }
+    return;
+  }
   // The integrator has just evaluated the right-hand side at the accepted state, unless an
-  // output time was evaluated since, or the accepted state is the last Newton iterate of an
-  // implicit method (generalized-α) and not the state last evaluated: then solve it again. An
-  // explicit chain needs no anchor of the right state: its positions follow without Newton.
-  if (!(base_.valid && base_.t == t && (chain_ || solved_dofs(base_, Y)))) evaluate_state(t, Y);
+  // output time was evaluated since: then solve it again. Generalized-α accepts its last Newton
+  // iterate after the last update, next to the state last evaluated: that state is the anchor
+  // (its positions differ by the size of that update, far below the motion of a step) until a
+  // step fails.
+  if (!(base_.valid && base_.t == t)) evaluate_state(t, Y);
   anchor_ = base_;
+  anchor_.exact = solved_dofs(base_, Y);
 }
 
 void Simulation::assemble() {
@@ -142,8 +153,7 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
     positions.xd = positions.xdd = Eigen::VectorXd::Zero(sys.nx);
     predict_from(positions, t, q);
   }
-  // (Explicit chain positions need no check: there is no Newton iteration to leave a branch.)
-  const bool check = in_rhs_ && anchor_.valid && !chain_;
+  const bool check = in_rhs_ && anchor_.valid;
   // Right-hand sides of an open chain: positions and velocities element by element (chain.hpp);
   // other evaluations also factorize the velocity block, which the forces and transfer use.
   ExplicitChain* chain = in_rhs_ ? chain_.get() : nullptr;

@@ -237,6 +237,9 @@ class Simulation {
   // A solved state: the starting point of the Newton iterations of later evaluations.
   struct Solved {
     bool valid = false;
+    // As an anchor: solved at the accepted state itself, not at the last Newton iterate of an
+    // implicit integrator next to it (generalized-α accepts the iterate after its last update).
+    bool exact = true;
     double t = 0.0;
     Eigen::VectorXd x, xd, xdd, qhat, angle_ref;
   };
