@@ -28,6 +28,19 @@ class Energy(Mapping):
     def __len__(self):
         return len(KEYS)
 
+    @classmethod
+    def concatenate(cls, energies) -> "Energy":
+        """The balance of consecutive blocks: the works of every block (integrated from its start)
+        continue from the end of the block before."""
+        t = np.concatenate([e.t for e in energies])
+        arrays, offset = {k: [] for k in KEYS}, {"dissipated": 0.0, "external_work": 0.0}
+        for e in energies:
+            for k in KEYS:
+                arrays[k].append(e[k] + offset.get(k, 0.0))
+            for k in offset:
+                offset[k] = arrays[k][-1][-1] if len(arrays[k][-1]) else offset[k]
+        return cls(t, {k: np.concatenate(v) for k, v in arrays.items()})
+
     @property
     def total(self) -> np.ndarray:
         a = self._arrays

@@ -33,6 +33,7 @@ import numpy as np
 
 from . import _core
 from ._util import show
+from .energy import KEYS as ENERGY_KEYS, Energy
 from .errors import InputError, SpacarError
 from .geometry import Geometry, euler_e
 from .linearize import MATRICES, Linearization
@@ -392,6 +393,10 @@ class Results:
         data = {name: np.asarray(getattr(self, name)) for name in _ARRAYS}
         data["coordinate_labels"] = np.asarray(self.coordinate_labels, dtype=np.int64).reshape(-1, 2)
         data["deformation_labels"] = np.asarray(self.deformation_labels, dtype=np.int64).reshape(-1, 2)
+        energy = self.__dict__.get("_energy")
+        if energy is not None:
+            for key in ENERGY_KEYS:
+                data[f"energy_{key}"] = np.asarray(energy[key], dtype=float)
         lin_meta = []
         for k, lin in enumerate(self.linearizations):
             lin_meta.append({"t": float(lin.t), "z_labels": [list(z) for z in lin.z_labels], "n_line": int(lin.n_line),
@@ -407,6 +412,7 @@ class Results:
             "dof_labels": self.dof_labels,
             "geometry": None if self.geometry is None else self.geometry.to_dict(),
             "linearizations": lin_meta,
+            "energy": energy is not None,
         }
         data["meta"] = np.array(json.dumps(meta))
         from .io.files import open_output, reason
@@ -473,9 +479,13 @@ class Results:
         lins = [lin for r in results for lin in r.linearizations]
         # Blocks that change the classes have different DOFs: then no q over the whole.
         same_dofs = all(r.dof_labels == first.dof_labels for r in results)
-        return cls(arrays, first.coordinate_labels, first.deformation_labels, stats,
-                   results[-1].geometry or first.geometry, lins, results[-1].settings_linear,
-                   first.dof_labels if same_dofs else ())
+        whole = cls(arrays, first.coordinate_labels, first.deformation_labels, stats,
+                    results[-1].geometry or first.geometry, lins, results[-1].settings_linear,
+                    first.dof_labels if same_dofs else ())
+        energies = [r.__dict__.get("_energy") for r in results]
+        if all(e is not None for e in energies):  # the energy balance of every block: of the whole
+            whole._energy = Energy.concatenate(energies)
+        return whole
 
     # --- plots (matplotlib, imported when used) ------------------------------------------------
 
@@ -583,6 +593,7 @@ def _meta(f, headers, path) -> dict:
         "settings_linear": lambda v: v is None or isinstance(v, int) and not isinstance(v, bool),
         "dof_labels": lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v),
         "geometry": lambda v: v is None or isinstance(v, dict),
+        "energy": lambda v: v is None or isinstance(v, bool),
         "linearizations": lambda v: isinstance(v, list) and all(
             isinstance(lm, dict) and isinstance(lm.get("t"), (int, float)) and not isinstance(lm.get("t"), bool)
             and isinstance(lm.get("n_line"), int) and isinstance(lm.get("z_labels"), list)
@@ -628,6 +639,9 @@ def _check_header_shapes(headers, meta, path) -> None:
     sizes["nt"] = shape[0]
     for name, dims in _FLOAT_ARRAYS.items():
         _header_shape(headers, name, "f", path, tuple(sizes[d] for d in dims))
+    if meta.get("energy"):
+        for key in ENERGY_KEYS:
+            _header_shape(headers, f"energy_{key}", "f", path, (sizes["nt"],))
     n_lins = len(meta["linearizations"])
     for name in headers:
         m = _LIN_RE.match(name)
@@ -673,6 +687,10 @@ def _load(cls, path: str) -> "Results":
             mats = {name: f[f"lin{k}_{name}"] for name in MATRICES if f"lin{k}_{name}" in headers}
             lins.append(Linearization.from_arrays(lm["t"], lm["z_labels"], lm["n_line"], mats, coord, defs,
                                                   lm.get("y_labels")))
+        energy = Energy(arrays["t"], {key: f[f"energy_{key}"] for key in ENERGY_KEYS}) if meta.get("energy") else None
     geometry = None if meta["geometry"] is None else Geometry.from_dict(meta["geometry"])
-    return cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"],
-               meta.get("dof_labels", ()))  # (files written before the DOFs were saved lack them)
+    res = cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"],
+              meta.get("dof_labels", ()))  # (files written before the DOFs were saved lack them)
+    if energy is not None:
+        res._energy = energy
+    return res

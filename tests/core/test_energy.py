@@ -137,3 +137,33 @@ def test_energy_needs_the_request():
     res = spacar.simulate(spring_pendulum(t_end=0.1), progress=False)
     with pytest.raises(spacar.InputError, match="energy=True"):
         res.energy
+
+
+def test_energy_survives_save_load_and_concatenate(tmp_path):
+    # res.energy is written by Results.save and read back; Results.concatenate joins the blocks'
+    # balances, the works of each block continuing from the block before.
+    import spacar
+    from test_damped_oscillator import oscillator
+
+    m = oscillator(2 * np.pi, 0.1, t_end=0.5, n_out=5, eps=1e-9)
+    first = spacar.simulate(m, energy=True, progress=False)
+    second = spacar.simulate(m, energy=True, progress=False)  # the next block, from where the first ended
+    path = tmp_path / "run.npz"
+    first.save(path)
+    loaded = spacar.Results.load(path)
+    for key in first.energy:
+        assert np.array_equal(loaded.energy[key], first.energy[key])
+    whole = spacar.Results.concatenate([first, second])
+    assert len(whole.energy.t) == len(first.t) + len(second.t)
+    assert whole.energy["dissipated"][-1] == pytest.approx(first.energy["dissipated"][-1]
+                                                         + second.energy["dissipated"][-1])
+    # One balance over both blocks: its total stays at the start's.
+    scale = np.abs(whole.energy["kinetic"] + whole.energy["strain"]).max()
+    assert np.abs(whole.energy.balance).max() < 1e-6 * scale
+    # Without a balance in every block, the whole has none.
+    plain = spacar.simulate(m, progress=False)
+    with pytest.raises(spacar.InputError, match="energy=True"):
+        spacar.Results.concatenate([first, plain]).energy
+    plain.save(tmp_path / "plain.npz")
+    with pytest.raises(spacar.InputError, match="energy=True"):
+        spacar.Results.load(tmp_path / "plain.npz").energy
