@@ -76,6 +76,8 @@ void bind_simulation(py::module_& m) {
       .def_readonly("dof_cols", &System::dof_cols)
       .def_readonly("input_cols", &System::input_cols)
       .def_readonly("q0", &System::q0)
+      .def_readonly("y_defs", &System::y_defs)
+      .def_readonly("y0", &System::y0)
       .def_readonly("qd0", &System::qd0)
       .def_readonly("warnings", &System::warnings)
       .def_property_readonly("n_dof", &System::n_dof)
@@ -90,6 +92,7 @@ void bind_simulation(py::module_& m) {
       .def_readonly("ed", &Data::ed)
       .def_readonly("edd", &Data::edd)
       .def_readonly("sigma", &Data::sigma)
+      .def_readonly("e_integrated", &Data::e_integrated)
       .def_readonly("qhat", &Data::qhat)
       .def_readonly("qhat_d", &Data::qhat_d)
       .def_readonly("qhat_dd", &Data::qhat_dd)
@@ -150,6 +153,19 @@ void bind_simulation(py::module_& m) {
       .def("recursive_refusal", &Simulation::recursive_refusal,
            "Why the system takes the general path rather than the recursive one ('' if it is a rigid tree).")
       .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))
+      .def(
+          "evaluate_state",
+          [](Simulation& s, double t, const Eigen::VectorXd& Y) {
+            const int n = 2 * s.system().n_dof() + static_cast<int>(s.system().y_defs.size());
+            if (Y.size() != n)
+              throw InputError("evaluate_state: the state (q, y, q̇) needs " + std::to_string(n) + " values, got " +
+                               std::to_string(Y.size()));
+            s.evaluate_state(t, Y);
+          },
+          py::arg("t"), py::arg("Y"),
+          "The state of the integrator, Y = (q, y, q̇) with y the integrated deformations (system.y_defs): "
+          "positions, velocities, q̈ and stresses, the integrated values set from y (for differences over the "
+          "kinematic coordinates of nonholonomic constraints).")
       .def(
           "set_time_loads",
           [](Simulation& s, const std::vector<std::pair<std::vector<int>, Table>>& load_tables,

@@ -156,9 +156,10 @@ def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
     ``[("OUTX", 2, 1), ("OUTXP", 2, 1)]``; default the model's INPUTF/INPUTS and
     OUTX/OUTXP/OUTE/OUTEP/OUTS lines in the order of their k.
 
-    Rate outputs at a moving state include the convective term ∂(DF ż)/∂z, and stress outputs
-    need ∂σ/∂z and ∂σ/∂ż: both come from central differences on the Model, for holonomic models
-    without LINE parameters; otherwise they are refused."""
+    Rate outputs at a moving state include the convective term ∂(DF ż)/∂z, stress outputs need
+    ∂σ/∂z and ∂σ/∂ż, and the outputs of a nonholonomic model their derivatives over its kinematic
+    coordinates y^k: these come from central differences on the Model, for models without LINE
+    parameters; otherwise they are refused."""
     if hasattr(source, "linearizations") and hasattr(source, "time_index"):  # a spacar.Results
         if not source.linearizations:
             raise InputError("state_space: these results have no linearizations (run with LINE or LINEAR 1), "
@@ -253,17 +254,16 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
     sens = _sensitivities(lin, outputs, velocities)
     for i, sig in enumerate(outputs):
         T, r = _row(lin, sig)
-        if k and sig.keyword in ("OUTX", "OUTE", "OUTS"):
-            raise InputError(f"{_where(sig)}: position and stress outputs of a nonholonomic model are not "
-                             "available (their dependence on the kinematic coordinates is not computed); "
-                             "use a rate (OUTXP, OUTEP)")
+        # Columns: δz, the kinematic coordinates δy^k (nonholonomic models), δż.
         if sig.keyword in ("OUTX", "OUTE"):
-            C[i, :n] = T[r]
+            C[i, :n] = sens["x" if sig.keyword == "OUTX" else "e"][r]
+            C[i, n:n + k] = sens["x_y" if sig.keyword == "OUTX" else "e_y"][r]
         elif sig.keyword in ("OUTXP", "OUTEP"):
             C[i, n + k:] = T[r]
             C[i, :n] = sens["xd" if sig.keyword == "OUTXP" else "ed"][r]
+            C[i, n:n + k] = sens["xd_y" if sig.keyword == "OUTXP" else "ed_y"][r]
         else:
-            C[i, :n], C[i, n + k:] = sens["sigma"][r], sens["sigma_d"][r]
+            C[i, :n], C[i, n:n + k], C[i, n + k:] = sens["sigma"][r], sens["sigma_y"][r], sens["sigma_d"][r]
     states = z_names + [f"e({a},{b})" for _, a, b in getattr(lin, "y_labels", [])] + \
         [name.replace("(", "d(", 1) for name in z_names]
     return StateSpace(A, B, C, np.zeros((len(outputs), len(inputs))), states,
@@ -274,53 +274,81 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
 
 def _sensitivities(lin, outputs, velocities) -> dict:
     """What the outputs need beyond DF and DFe, at fixed ż: "xd", "ed" (∂ẋ/∂z, ∂ė/∂z, the
-    convective terms of the rates: zero at rest) and "sigma", "sigma_d" (∂σ/∂z, ∂σ/∂ż of the
-    stresses). Those not zero come from central differences over the degrees of freedom and
-    their rates, with the kinematics re-solved (sim.move_to) and the stresses evaluated."""
+    convective terms of the rates: zero at rest), "sigma", "sigma_d" (∂σ/∂z, ∂σ/∂ż of the
+    stresses), "x", "e" (∂x/∂z, ∂e/∂z of the positions: DF and DFe, except with nonholonomic
+    constraints, whose DF and DFe are the velocity transfer ẋ = DF ż, not the positions'
+    derivatives at fixed y^k) and, with nonholonomic constraints, the derivatives over their
+    kinematic coordinates y^k at fixed z and ż: "x_y", "e_y", "xd_y", "ed_y", "sigma_y". Those not zero come from central
+    differences, with the kinematics re-solved (sim.move_to, or sim.evaluate_state with y^k) and
+    the stresses evaluated."""
     nx, ne, n = lin.DF.shape[0], lin.DFe.shape[0], lin.M0.shape[0]
-    out = {"xd": np.zeros((nx, n)), "ed": np.zeros((ne, n))}
+    k = len(getattr(lin, "y_labels", []))
+    out = {"xd": np.zeros((nx, n)), "ed": np.zeros((ne, n)), "sigma": np.zeros((ne, n)), "sigma_d": np.zeros((ne, n)),
+           "x": np.array(lin.DF), "e": np.array(lin.DFe), "x_y": np.zeros((nx, k)), "e_y": np.zeros((ne, k)), "xd_y": np.zeros((nx, k)),
+           "ed_y": np.zeros((ne, k)), "sigma_y": np.zeros((ne, k))}
     stresses = [s for s in outputs if s.keyword == "OUTS"]
     rates = [s for s in outputs if s.keyword in ("OUTXP", "OUTEP")]
+    positions = [s for s in outputs if s.keyword in ("OUTX", "OUTE")]
     # At rest (no coordinate moving: ż = 0 and the input motions still) the convective terms
     # vanish; a Linearization alone does not say.
     at_rest = velocities is not None and not np.any(np.asarray(velocities[0].data.xd))
-    needed = stresses + ([] if at_rest else rates)
+    needed = stresses + ([] if at_rest else rates) + (positions if k else [])
     if not needed:
         return out
     first = needed[0]
-    if velocities is None or lin.n_line or len(getattr(lin, "y_labels", [])):
-        what = "a stress output" if first.keyword == "OUTS" else "a rate output at a moving state"
+    if velocities is None or lin.n_line:
+        what = {"OUTS": "a stress output", "OUTX": "a position output of a nonholonomic model",
+                "OUTE": "a position output of a nonholonomic model"}.get(first.keyword, "a rate output at a moving state")
         why = ("a Linearization alone cannot be re-evaluated: pass the Model" if velocities is None else
-               "they are computed for holonomic models without LINE parameters only")
-        raise InputError(f"{_where(first)}: {what} needs differences of the velocities or stresses; {why}")
+               "they are computed for models without LINE parameters only")
+        raise InputError(f"{_where(first)}: {what} needs differences of the kinematics or stresses; {why}")
     sim, (t, q, qd) = velocities
     for sig in stresses:
         c = sim.system.def_class[lin.deformation_labels.index((sig.number, sig.index))]
         if c not in (_core.DefClass.released, _core.DefClass.dynamic):
             raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
                              "constitutive, σ = S e + D ė); this one is a reaction stress")
+    y_defs = list(sim.system.y_defs)
+    y = np.array([sim.data.e_integrated[d] for d in y_defs])
+    # The kinematic coordinates' places in y (the integrated deformations, slips among them).
+    ky = [y_defs.index(lin.deformation_labels.index((a, b))) for _, a, b in getattr(lin, "y_labels", [])]
 
-    def at(qj, qdj):
-        sim.move_to(t, qj, qdj)
+    def at(qj, qdj, yj=y):
+        if y_defs:  # the integrated deformations held at yj
+            sim.evaluate_state(t, np.concatenate([qj, yj, qdj]))
+        else:
+            sim.move_to(t, qj, qdj)
         if stresses:
             sim.forces()
-        return np.array(sim.data.xd), np.array(sim.data.ed), np.array(sim.data.sigma)
+        d = sim.data
+        return {"x": np.array(d.x), "e": np.array(d.e), "xd": np.array(d.xd), "ed": np.array(d.ed),
+                "sigma": np.array(d.sigma)}
+
+    def central(plus, minus, h, names):
+        return ((plus[a] - minus[a]) / (2 * h) for a in names)
 
     eps = np.finfo(float).eps ** (1 / 3)
-    out["sigma"], out["sigma_d"] = np.zeros((ne, n)), np.zeros((ne, n))
     for j in range(n):
         h = eps * max(abs(q[j]), 1.0)
         dq = np.zeros(n)
         dq[j] = h
         plus, minus = at(q + dq, qd), at(q - dq, qd)
-        out["xd"][:, j], out["ed"][:, j], out["sigma"][:, j] = ((a - b) / (2 * h) for a, b in zip(plus, minus))
+        out["xd"][:, j], out["ed"][:, j], out["sigma"][:, j] = central(plus, minus, h, ("xd", "ed", "sigma"))
+        if k:
+            out["x"][:, j], out["e"][:, j] = central(plus, minus, h, ("x", "e"))
         if stresses:
             h = eps * max(abs(qd[j]), 1.0)
             dq[j] = h
-            out["sigma_d"][:, j] = (at(q, qd + dq)[2] - at(q, qd - dq)[2]) / (2 * h)
-    sim.move_to(t, q, qd)
+            out["sigma_d"][:, j] = next(central(at(q, qd + dq), at(q, qd - dq), h, ("sigma",)))
+    for i, p in enumerate(ky):
+        h = eps * max(abs(y[p]), 1.0)
+        dy = np.zeros(len(y))
+        dy[p] = h
+        out["x_y"][:, i], out["e_y"][:, i], out["xd_y"][:, i], out["ed_y"][:, i], out["sigma_y"][:, i] = central(
+            at(q, qd, y + dy), at(q, qd, y - dy), h, ("x", "e", "xd", "ed", "sigma"))
+    at(q, qd)  # back to the state itself
     if at_rest:
-        out["xd"][:], out["ed"][:] = 0.0, 0.0
+        out["xd"][:], out["ed"][:], out["xd_y"][:], out["ed_y"][:] = 0.0, 0.0, 0.0, 0.0
     return out
 
 

@@ -254,8 +254,28 @@ def test_nonholonomic_model_inputs_and_rate_outputs():
     assert ss.A.shape == (2 * nz + nk,) * 2
     np.testing.assert_allclose(ss.poles(), lin.eigenvalues(), rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(ss.B[nz + nk:, 0], np.linalg.solve(lin.M0, lin.DF[lin.coordinate_labels.index((node, comp))]))
-    with pytest.raises(spacar.InputError, match="position and stress outputs of a nonholonomic model"):
+    with pytest.raises(spacar.InputError, match="a position output of a nonholonomic model needs differences.*"
+                                                "a Linearization alone cannot be re-evaluated: pass the Model"):
         spacar.state_space(lin, inputs=[], outputs=[("OUTX", node, comp)])
+
+
+def test_nonholonomic_position_outputs_at_a_moving_state():
+    # The wheel rolling down the incline (tests/core/test_radau5_simulate.py): its centre (node 3)
+    # is at the kinematic coordinates y^k = (e1, e2) of PLBEAR 1 from the origin, its spin x(5,1)
+    # is the DOF z. With y^k fixed the centre does not move with z: x(3,1) = y1, x(3,2) = y2,
+    # x(5,1) = z; its velocity follows the spin by the rolling, ẋ(3,1) = DF ż (not ∂x/∂z).
+    from test_radau5_simulate import incline_wheel
+
+    m = incline_wheel(1e-10)
+    spacar.simulate(m, progress=False)  # to a moving state: rolling at t = 2 s
+    outputs = [("OUTX", 3, 1), ("OUTX", 3, 2), ("OUTX", 5, 1), ("OUTE", 1, 1), ("OUTXP", 3, 1)]
+    ss = spacar.state_space(m, inputs=[("INPUTF", 3, 1)], outputs=outputs)
+    assert ss.state_labels == ["x(5,1)", "e(1,1)", "e(1,2)", "xd(5,1)"]
+    lin = ss.linearization
+    rolling = lin.DF[lin.coordinate_labels.index((3, 1)), 0]
+    assert abs(rolling) > 0.1
+    expected = np.array([[0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, rolling]], float)
+    np.testing.assert_allclose(ss.C, expected, atol=1e-7)
 
 
 def test_signal_numbers_without_gaps():
