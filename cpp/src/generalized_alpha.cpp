@@ -316,7 +316,7 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
       }
     } catch (const StepRejected& e) {
       failure_ = e.what();
-      result = Attempt::Failed;
+      result = Attempt::Rejected;
     }
     // The local error behaves as h³.
     const double quot = std::clamp(std::cbrt(err) / kSafety, 0.2, 5.0);
@@ -326,7 +326,9 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
       if (result == Attempt::ErrorTooLarge) h = h_try / quot;
       else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
       else h = 0.5 * h_try;
-      need_jacobian = !jacobian_fresh && result != Attempt::ErrorTooLarge;
+      // A Jacobian from an earlier state may be why Newton failed; not when the step converged
+      // (its error was too large) or the right-hand side refused the state (the kinematics).
+      need_jacobian = !jacobian_fresh && result != Attempt::ErrorTooLarge && result != Attempt::Rejected;
       continue;
     }
     ++stats_.naccept;

@@ -69,7 +69,8 @@ class GeneralizedAlpha {
   const Radau5Stats& stats() const;  // cumulative over all integrate calls; nnewton: iterations
 
  private:
-  enum class Attempt { Accepted, ErrorTooLarge, SlowNewton, Failed };
+  // Rejected: the right-hand side refused a state (StepRejected, e.g. its kinematics).
+  enum class Attempt { Accepted, ErrorTooLarge, SlowNewton, Failed, Rejected };
 
   bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
   void factorize(double h);
