@@ -53,7 +53,7 @@ def test_both_entry_points_refuse_an_unknown_integration_method_alike():
             errors.append(err)
     assert len(errors) == 2
     assert [type(e) for e in errors] == [spacar.InputError, spacar.InputError]
-    assert str(errors[0]) == str(errors[1]) == "unknown integration method 'rk4' (auto, dop853, dopri5, radau5)"
+    assert str(errors[0]) == str(errors[1]) == "unknown integration method 'rk4' (auto, dop853, dopri5, radau5, generalized_alpha)"
     assert isinstance(errors[0], ValueError)
 
 
