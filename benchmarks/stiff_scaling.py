@@ -19,6 +19,8 @@ from spacar.compare import models
 
 METHODS = ["dop853", "radau5", "auto"]
 RHO = [0.6, 0.8, 1.0]                 # exudyn generalized-α spectral radii ρ∞ (its default: 0.9)
+GA_RHO = [0.8, 1.0]                   # spacar's generalized-α: the spectral radii tried (best reported)
+GA_FIXED_EPS = 1e-7                   # its fixed-step runs: EPSINT = EPSIND, which only stop its Newton iterations
 EI_ROD = 0.0012723                    # the manual's rod
 
 FULL = {
@@ -92,18 +94,23 @@ def _sweep(settings, run_one, target, budget):
     return out
 
 
-def _spacar_series(case, cfg, variant, method, ref, target, quick, eps_list):
-    def one(eps):
+def _spacar_series(case, cfg, variant, method, ref, target, quick, eps_list, fixed=False, **options):
+    """A sweep of EPS (fixed=False) or, for generalized_alpha with fixed=True, of the fixed step h
+    at EPS = GA_FIXED_EPS; options: further arguments of simulate (rho_inf)."""
+    def one(setting):
+        eps = GA_FIXED_EPS if fixed else setting
+        run_options = dict(options, **({"fixed_step": setting} if fixed else {}))
         m = BUILD[case](variant, cfg["t_end"], eps)
+        label = f"{method} {' '.join(f'{k}={v:g}' for k, v in run_options.items())} {'h' if fixed else 'eps'}={setting:g}"
         try:
             res, wall = C.simulate_best(m, repeat=1 if quick else 3, budget=0.2 if quick else 2 * RUN_BUDGET,
-                                        method=method, progress=False, time_limit=RUN_LIMIT)
+                                        method=method, progress=False, time_limit=RUN_LIMIT, **run_options)
         except spacar.TimeLimitError:
-            C.log(f"stiff scaling {case} {variant} {method} eps={eps:g}: over {RUN_LIMIT:g} s")
+            C.log(f"stiff scaling {case} {variant} {label}: over {RUN_LIMIT:g} s")
             return None
         err = float(np.abs(tip(case, variant, res.x[-1], res.coordinate_labels) - ref).max())
         st = res.stats
-        C.log(f"stiff scaling {case} {variant} {method} eps={eps:g}: {wall:.3g} s, error {err:.2e}, "
+        C.log(f"stiff scaling {case} {variant} {label}: {wall:.3g} s, error {err:.2e}, "
               f"{st['steps']} steps, {st.get('method', method)}")
         return {"wall": wall, "error": err, "steps": st["steps"], "rhs": st["rhs_evaluations"],
                 "method": st.get("method", method)}
@@ -179,6 +186,11 @@ def run_case(case, quick):
         row = {"target": target, "amplitude": amplitude,
                "spacar": {m: _spacar_series(case, cfg, variant, m, ref, target, quick, cfg_all["eps"])
                           for m in METHODS}}
+        row["spacar_ga"] = {f"ρ∞={rho:g}": _spacar_series(case, cfg, variant, "generalized_alpha", ref, target, quick,
+                                                          cfg_all["eps"], rho_inf=rho) for rho in GA_RHO}
+        row["spacar_ga_fixed"] = {f"ρ∞={rho:g}": _spacar_series(case, cfg, variant, "generalized_alpha", ref, target,
+                                                                quick, cfg_all["steps"], fixed=True, rho_inf=rho)
+                                  for rho in GA_RHO}
         em = sx.build(BUILD[case](variant, cfg["t_end"], 1e-6),
                       **({"axial_stiffness": 1e4 * 175.0} if case == "cantilever" else {}))
         ex_ref, row["exudyn_reference_newton_rtol"] = _exudyn_reference(em, case, cfg, variant)
@@ -227,25 +239,37 @@ def _steps_at(series, eps):
     return "—" if r is None or r.get("over_limit") else str(r["steps"])
 
 
+def _best_of(series_by_key, target):
+    """The steady run of the fastest series (key, run), or (None, None)."""
+    ok = {k: steady(v, target) for k, v in series_by_key.items()}
+    ok = {k: v for k, v in ok.items() if v is not None}
+    key = min(ok, key=lambda k: ok[k]["wall"]) if ok else None
+    return key, ok.get(key)
+
+
 def _table(res, case, cfg):
     head = "k (rod EI × k)" if case == "slidercrank" else "n (elements)"
     eps0 = cfg["eps"][0]
-    lines = [f"| {head} | target [m] | dop853 | radau5 | auto | exudyn GA, best ρ∞ | exudyn trapezoidal | exudyn best / spacar best | "
-             f"dop853 / spacar best | model difference [m] | steps at EPS {eps0:g}: dop853 / radau5 / auto |", "|---" * 11 + "|"]
+    lines = [f"| {head} | target [m] | dop853 | radau5 | auto | generalized_alpha (EPS), best ρ∞ | generalized_alpha "
+             f"(fixed h), best ρ∞ | exudyn GA, best ρ∞ | exudyn trapezoidal | exudyn best / spacar best | "
+             f"dop853 / spacar best | model difference [m] | steps at EPS {eps0:g}: dop853 / radau5 / auto |",
+             "|---" * 13 + "|"]
     for variant, row in res[case].items():
         target = row["target"]
         sp = {m: steady(row["spacar"][m], target) for m in METHODS}
-        ga = {k: steady(v, target) for k, v in row["exudyn"].items() if k != "trapezoidal"}
-        ga_ok = {k: v for k, v in ga.items() if v is not None}
-        ga_key = min(ga_ok, key=lambda k: ga_ok[k]["wall"]) if ga_ok else None
+        sga_key, sga = _best_of(row.get("spacar_ga", {}), target)
+        sgf_key, sgf = _best_of(row.get("spacar_ga_fixed", {}), target)
+        ga_key, ga = _best_of({k: v for k, v in row["exudyn"].items() if k != "trapezoidal"}, target)
         tr = steady(row["exudyn"]["trapezoidal"], target)
-        best_sp = min((v["wall"] for k, v in sp.items() if v is not None and k != "dop853"), default=None)
-        best_ex = min((v["wall"] for v in (ga_ok.get(ga_key), tr) if v is not None), default=None)
+        best_sp = min((v["wall"] for v in [*(v for k, v in sp.items() if k != "dop853"), sga, sgf] if v is not None),
+                      default=None)
+        best_ex = min((v["wall"] for v in (ga, tr) if v is not None), default=None)
         eps = lambda s: f"EPS {s:g}"   # noqa: E731
         step = lambda s: f"h {s:g}"    # noqa: E731
-        ga_cell = "—" if ga_key is None else f"{_cell(ga_ok[ga_key], step)} ({ga_key[3:]})"
+        keyed = lambda r, k, fmt: "—" if r is None else f"{_cell(r, fmt)} ({k.replace('GA ', '')})"  # noqa: E731
         lines.append(f"| {variant} | {target:.1e} | {_cell(sp['dop853'], eps)} | {_cell(sp['radau5'], eps)} | {_cell(sp['auto'], eps)} | "
-                     f"{ga_cell} | {_cell(tr, step)} | {C.fmt_ratio(best_ex, best_sp)} | "
+                     f"{keyed(sga, sga_key, eps)} | {keyed(sgf, sgf_key, step)} | "
+                     f"{keyed(ga, ga_key, step)} | {_cell(tr, step)} | {C.fmt_ratio(best_ex, best_sp)} | "
                      f"{C.fmt_ratio(sp['dop853'] and sp['dop853']['wall'], best_sp)} | "
                      f"{C.fmt_err(row['model_difference'])} | {' / '.join(_steps_at(row['spacar'][m], eps0) for m in METHODS)} |")
     return lines
@@ -273,8 +297,10 @@ def section_lines(res) -> list:
              "reported) and the trapezoidal rule (`TrapezoidalIndex2`). A series ends after two settings in a row "
              f"reach the target, after a run of {RUN_BUDGET:g} s, or before a run beyond {RUN_LIMIT:g} s. Cell: the "
              "*steady* time to the target (the fastest run from which on every tighter run of the series reaches it) "
-             "/ its steps / its setting; \"—\": the series did not reach the target within the limits. Ratios against "
-             "the faster of radau5 and auto. The last column, the steps at the loosest setting (reached "
+             "/ its steps / its setting; \"—\": the series did not reach the target within the limits. spacar's "
+             f"generalized-α: ρ∞ = {', '.join(f'{r:g}' for r in GA_RHO)} (the best reported), with its error control "
+             f"(EPS as above) and with fixed steps h as exudyn's (EPS = {GA_FIXED_EPS:g} then only stops its Newton "
+             "iterations). Ratios against the fastest of radau5, auto and generalized-α. The last column, the steps at the loosest setting (reached "
              "by every series), shows the growth with the stiffness itself: DOP853's steps are set by "
              "stability there.", ""]
     loose = [f"{case} {v}" for case in ("slidercrank", "cantilever") for v, row in res[case].items()
