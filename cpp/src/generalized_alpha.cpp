@@ -17,12 +17,7 @@ constexpr double kMinError = 1e-10;
 constexpr double kNewtonTolerance = 0.02;
 const double kRound = std::numeric_limits<double>::epsilon();
 
-std::string describe(double t, double h) {
-  std::ostringstream s;
-  s.precision(12);
-  s << "t = " << t << ", step size h = " << h;
-  return s.str();
-}
+std::string describe(double t, double h) { return describe_step(t, h); }
 
 }  // namespace
 
@@ -48,12 +43,7 @@ GeneralizedAlpha::GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf
 }
 
 void GeneralizedAlpha::set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
-  if (rtol.size() != n_ || atol.size() != n_)
-    throw std::invalid_argument("GeneralizedAlpha: tolerances need one entry per state");
-  for (int i = 0; i < n_; ++i)
-    if (!(std::isfinite(rtol[i]) && std::isfinite(atol[i]) && rtol[i] >= 0 && atol[i] >= 0 && rtol[i] + atol[i] > 0))
-      throw std::invalid_argument("GeneralizedAlpha: tolerances must be finite, non-negative and not both zero (state " +
-                                  std::to_string(i) + ")");
+  check_tolerances("GeneralizedAlpha", n_, rtol, atol);
   rtol_ = rtol;
   atol_ = atol;
 }
@@ -227,13 +217,8 @@ size_t GeneralizedAlpha::emit_outputs(const std::vector<double>& touts, size_t n
 
 double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
                                    const std::vector<double>& touts, const Output& out) {
-  if (y.size() != n_) throw std::invalid_argument("GeneralizedAlpha: the state has the wrong size");
-  if (!(t_end >= t0)) throw std::invalid_argument("GeneralizedAlpha: t_end must not be before t0");
+  check_integration("GeneralizedAlpha", n_, t0, t_end, y, touts);
   if (!jac_) throw std::invalid_argument("GeneralizedAlpha: no Jacobian callback set");
-  for (size_t i = 0; i < touts.size(); ++i)
-    if (!(touts[i] >= t0 && touts[i] <= t_end) || (i > 0 && touts[i] < touts[i - 1]))
-      throw std::invalid_argument("GeneralizedAlpha: output times must be sorted and within [t0, t_end]");
-  if (!y.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite initial state at " + describe(t0, 0.0));
 
   failure_ = "none";
   size_t next = 0;

@@ -208,14 +208,40 @@ void weighted_sum(const Row& row, int count, const std::vector<Eigen::VectorXd>&
     if (row[j] != 0.0) out += row[j] * k[j];
 }
 
-std::string describe(double t, double h) {
+std::string describe(double t, double h) { return describe_step(t, h); }
+
+}  // namespace
+
+std::string describe_step(double t, double h) {
   std::ostringstream s;
   s.precision(12);
   s << "t = " << t << ", step size h = " << h;
   return s.str();
 }
 
-}  // namespace
+void check_tolerances(const char* who, int n, const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
+  if (rtol.size() != n || atol.size() != n)
+    throw std::invalid_argument(std::string(who) + ": tolerances need one entry per state");
+  for (int i = 0; i < n; ++i) {
+    const bool valid = std::isfinite(rtol[i]) && std::isfinite(atol[i]) && rtol[i] >= 0 && atol[i] >= 0 &&
+                       rtol[i] + atol[i] > 0;
+    if (!valid)
+      throw std::invalid_argument(std::string(who) +
+                                  ": tolerances must be finite, non-negative and not both zero (state " +
+                                  std::to_string(i) + ")");
+  }
+}
+
+void check_integration(const char* who, int n, double t0, double t_end, const Eigen::VectorXd& y,
+                       const std::vector<double>& touts) {
+  const std::string w(who);
+  if (y.size() != n) throw std::invalid_argument(w + ": the state has the wrong size");
+  if (!(t_end >= t0)) throw std::invalid_argument(w + ": t_end must not be before t0");
+  for (size_t i = 0; i < touts.size(); ++i)
+    if (!(touts[i] >= t0 && touts[i] <= t_end) || (i > 0 && touts[i] < touts[i - 1]))
+      throw std::invalid_argument(w + ": output times must be sorted and within [t0, t_end]");
+  if (!y.allFinite()) throw IntegrationError(w + ": non-finite initial state at " + describe_step(t0, 0.0));
+}
 
 Integrator::Integrator(int n, Method method)
     : n_(n),
@@ -235,16 +261,7 @@ Integrator::Integrator(int n, Method method)
 }
 
 void Integrator::set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
-  if (rtol.size() != n_ || atol.size() != n_)
-    throw std::invalid_argument("Integrator: tolerances need one entry per state");
-  for (int i = 0; i < n_; ++i) {
-    const bool valid = std::isfinite(rtol[i]) && std::isfinite(atol[i]) && rtol[i] >= 0 &&
-                       atol[i] >= 0 && rtol[i] + atol[i] > 0;
-    if (!valid)
-      throw std::invalid_argument(
-          "Integrator: tolerances must be finite, non-negative and not both zero (state " +
-          std::to_string(i) + ")");
-  }
+  check_tolerances("Integrator", n_, rtol, atol);
   rtol_ = rtol;
   atol_ = atol;
 }
@@ -454,13 +471,7 @@ void Integrator::set_step_start(StepStart start) { step_start_ = std::move(start
 
 double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
                              const std::vector<double>& touts, const Output& out) {
-  if (y.size() != n_) throw std::invalid_argument("Integrator: the state has the wrong size");
-  if (!(t_end >= t0)) throw std::invalid_argument("Integrator: t_end must not be before t0");
-  for (size_t i = 0; i < touts.size(); ++i)
-    if (!(touts[i] >= t0 && touts[i] <= t_end) || (i > 0 && touts[i] < touts[i - 1]))
-      throw std::invalid_argument("Integrator: output times must be sorted and within [t0, t_end]");
-  if (!y.allFinite()) throw IntegrationError("Integrator: non-finite initial state at " +
-                                             describe(t0, 0.0));
+  check_integration("Integrator", n_, t0, t_end, y, touts);
 
   failure_ = "none";
   stiff_ = false;

@@ -64,12 +64,7 @@ constexpr double kSafety = 0.9;
 constexpr double kMinError = 1e-10;
 const double kRound = std::numeric_limits<double>::epsilon();
 
-std::string describe(double t, double h) {
-  std::ostringstream s;
-  s.precision(12);
-  s << "t = " << t << ", step size h = " << h;
-  return s.str();
-}
+std::string describe(double t, double h) { return describe_step(t, h); }
 
 double scaled_rms(const Eigen::VectorXd& v, const Eigen::VectorXd& scale) {
   return std::sqrt((v.array() / scale.array()).square().sum() / static_cast<double>(v.size()));
@@ -91,17 +86,10 @@ Radau5::Radau5(int n)
 }
 
 void Radau5::set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
-  if (rtol.size() != n_ || atol.size() != n_)
-    throw std::invalid_argument("Radau5: tolerances need one entry per state");
+  check_tolerances("Radau5", n_, rtol, atol);
   Eigen::VectorXd r(n_), a(n_);
   double rmin = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n_; ++i) {
-    const bool valid = std::isfinite(rtol[i]) && std::isfinite(atol[i]) && rtol[i] >= 0 &&
-                       atol[i] >= 0 && rtol[i] + atol[i] > 0;
-    if (!valid)
-      throw std::invalid_argument(
-          "Radau5: tolerances must be finite, non-negative and not both zero (state " +
-          std::to_string(i) + ")");
     if (rtol[i] > 0) {
       r[i] = 0.1 * std::pow(rtol[i], 2.0 / 3.0);
       a[i] = atol[i] * r[i] / rtol[i];
@@ -426,13 +414,8 @@ size_t Radau5::emit_outputs(const std::vector<double>& touts, size_t next, doubl
 
 double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
                          const std::vector<double>& touts, const Output& out) {
-  if (y.size() != n_) throw std::invalid_argument("Radau5: the state has the wrong size");
-  if (!(t_end >= t0)) throw std::invalid_argument("Radau5: t_end must not be before t0");
+  check_integration("Radau5", n_, t0, t_end, y, touts);
   if (!jac_) throw std::invalid_argument("Radau5: no Jacobian callback set");
-  for (size_t i = 0; i < touts.size(); ++i)
-    if (!(touts[i] >= t0 && touts[i] <= t_end) || (i > 0 && touts[i] < touts[i - 1]))
-      throw std::invalid_argument("Radau5: output times must be sorted and within [t0, t_end]");
-  if (!y.allFinite()) throw IntegrationError("Radau5: non-finite initial state at " + describe(t0, 0.0));
 
   failure_ = "none";
   size_t next = 0;

@@ -15,30 +15,8 @@ namespace py = pybind11;
 
 namespace {
 
-py::dict solve(const py::function& f, const py::function& jac, double t0, const Eigen::VectorXd& y0,
-               double t_end, const std::vector<double>& touts, double rtol, double atol, double hmax,
-               double first_step, double nonstiff_bound) {
-  const int n = static_cast<int>(y0.size());
-  spacar::Radau5 integrator(n);
-  integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol), Eigen::VectorXd::Constant(n, atol));
-  integrator.set_max_step(hmax);
-  integrator.set_initial_step(first_step);
-  integrator.set_nonstiffness_detection(nonstiff_bound);
-  integrator.set_jacobian([&jac](double t, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
-    J = jac(t, y).cast<Eigen::MatrixXd>();
-  });
-  const spacar::Radau5::Rhs rhs = [&f](double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
-    dy = f(t, y).cast<Eigen::VectorXd>();
-  };
-  Eigen::MatrixXd ys = Eigen::MatrixXd::Constant(touts.size(), n, std::numeric_limits<double>::quiet_NaN());
-  Eigen::Index row = 0;
-  const spacar::Radau5::Output out = [&ys, &row](double, const Eigen::VectorXd& y) {
-    ys.row(row++) = y.transpose();
-  };
-  Eigen::VectorXd y = y0;
-  const double t_reached = integrator.integrate(rhs, t0, t_end, y, touts, out);
-
-  const spacar::Radau5Stats& s = integrator.stats();
+// The output times, the dense output at them and the counters of an implicit integrator.
+py::dict outputs(const std::vector<double>& touts, const Eigen::MatrixXd& ys, const spacar::Radau5Stats& s) {
   py::dict result;
   result["t"] = py::array_t<double>(static_cast<py::ssize_t>(touts.size()), touts.data());
   result["y"] = ys;
@@ -49,6 +27,40 @@ py::dict solve(const py::function& f, const py::function& jac, double t0, const 
   result["nsteps"] = s.nsteps;
   result["naccept"] = s.naccept;
   result["nreject"] = s.nreject;
+  return result;
+}
+
+// y(t0) → y(t_end) by an implicit integrator (Radau5 or GeneralizedAlpha) on Python callbacks,
+// the rows of ys filled at the output times.
+template <class Integ>
+double integrate_python(Integ& integrator, const py::function& f, const py::function& jac, double t0, Eigen::VectorXd& y,
+                      double t_end, const std::vector<double>& touts, Eigen::MatrixXd& ys) {
+  integrator.set_jacobian([&jac](double t, const Eigen::VectorXd& yy, Eigen::MatrixXd& J) {
+    J = jac(t, yy).template cast<Eigen::MatrixXd>();
+  });
+  const spacar::Radau5::Rhs rhs = [&f](double t, const Eigen::VectorXd& yy, Eigen::VectorXd& dy) {
+    dy = f(t, yy).template cast<Eigen::VectorXd>();
+  };
+  ys = Eigen::MatrixXd::Constant(touts.size(), y.size(), std::numeric_limits<double>::quiet_NaN());
+  Eigen::Index row = 0;
+  const spacar::Radau5::Output out = [&ys, &row](double, const Eigen::VectorXd& yy) { ys.row(row++) = yy.transpose(); };
+  return integrator.integrate(rhs, t0, t_end, y, touts, out);
+}
+
+py::dict solve(const py::function& f, const py::function& jac, double t0, const Eigen::VectorXd& y0,
+               double t_end, const std::vector<double>& touts, double rtol, double atol, double hmax,
+               double first_step, double nonstiff_bound) {
+  const int n = static_cast<int>(y0.size());
+  spacar::Radau5 integrator(n);
+  integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol), Eigen::VectorXd::Constant(n, atol));
+  integrator.set_max_step(hmax);
+  integrator.set_initial_step(first_step);
+  integrator.set_nonstiffness_detection(nonstiff_bound);
+  Eigen::VectorXd y = y0;
+  Eigen::MatrixXd ys;
+  const double t_reached = integrate_python(integrator, f, jac, t0, y, t_end, touts, ys);
+
+  py::dict result = outputs(touts, ys, integrator.stats());
   result["t_reached"] = t_reached;
   result["nonstiff"] = integrator.nonstiffness_detected();
   result["rho"] = integrator.spectral_radius();
@@ -64,31 +76,10 @@ py::dict solve_generalized_alpha(const py::function& f, const py::function& jac,
   integrator.set_max_step(hmax);
   integrator.set_initial_step(first_step);
   integrator.set_fixed_step(fixed_step);
-  integrator.set_jacobian([&jac](double t, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
-    J = jac(t, y).cast<Eigen::MatrixXd>();
-  });
-  const spacar::GeneralizedAlpha::Rhs rhs = [&f](double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
-    dy = f(t, y).cast<Eigen::VectorXd>();
-  };
-  Eigen::MatrixXd ys = Eigen::MatrixXd::Constant(touts.size(), n, std::numeric_limits<double>::quiet_NaN());
-  Eigen::Index row = 0;
-  const spacar::GeneralizedAlpha::Output out = [&ys, &row](double, const Eigen::VectorXd& y) {
-    ys.row(row++) = y.transpose();
-  };
   Eigen::VectorXd y = y0;
-  integrator.integrate(rhs, t0, t_end, y, touts, out);
-  const spacar::Radau5Stats& s = integrator.stats();
-  py::dict result;
-  result["t"] = py::array_t<double>(static_cast<py::ssize_t>(touts.size()), touts.data());
-  result["y"] = ys;
-  result["nfev"] = s.nfev;
-  result["njev"] = s.njev;
-  result["ndec"] = s.ndec;
-  result["nnewton"] = s.nnewton;
-  result["nsteps"] = s.nsteps;
-  result["naccept"] = s.naccept;
-  result["nreject"] = s.nreject;
-  return result;
+  Eigen::MatrixXd ys;
+  integrate_python(integrator, f, jac, t0, y, t_end, touts, ys);
+  return outputs(touts, ys, integrator.stats());
 }
 
 }  // namespace

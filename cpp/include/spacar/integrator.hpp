@@ -36,6 +36,15 @@ Method parse_method(const std::string& name);
 // The name parse_method reads.
 const char* method_name(Method m);
 
+// Shared by the integrators (Integrator, Radau5, GeneralizedAlpha), `who` naming the one in the
+// messages: the checks of per-component tolerances (finite, non-negative, not both zero) and of
+// the arguments of integrate() (std::invalid_argument; IntegrationError for a non-finite initial
+// state), and the "t = ..., step size h = ..." of their error messages.
+void check_tolerances(const char* who, int n, const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol);
+void check_integration(const char* who, int n, double t0, double t_end, const Eigen::VectorXd& y,
+                       const std::vector<double>& touts);
+std::string describe_step(double t, double h);
+
 struct IntegratorStats {
   long nfev = 0, nsteps = 0, naccept = 0, nreject = 0;
 };
