@@ -26,7 +26,14 @@ void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd, bool
     q[order_[i]] = z[i];
     qd[order_[i]] = zd[i];
   }
-  set_inputs(L, *ld_, ld_->t);
+  const int nxp = static_cast<int>(L.x_input.size());
+  for (int i = 0; i < L.n_input(); ++i) {
+    const int col = L.input_cols[i];
+    ld_->qhat[col] = inputs_(i, 0);
+    ld_->qhat_d[col] = inputs_(i, 1);
+    ld_->qhat_dd[col] = inputs_(i, 2);
+    if (i < nxp) ld_->x[L.x_input[i]] = inputs_(i, 0);
+  }
   set_dofs(L, *ld_, q.data(), qd.data());
   const double tol = std::min(L.settings.epskin, 1e-10);
   solve_positions(L, *ld_, std::max(L.settings.maxiterat, 50), tol, false);
@@ -90,7 +97,15 @@ Linearization Linearizer::compute(const System& sys, const Data& data) {
   }
   const int nk = static_cast<int>(y.size());
 
-  // Nominal state.
+  // Nominal state, with the inputs and the time-dependent loads of the analysis at it (tables,
+  // load functions, a controller's held loads: formulation.md's constant block motion otherwise).
+  if (L.n_input() != sys.n_input()) throw Error("linearize: the inputs of the two systems differ");
+  inputs_.resize(sys.n_input(), 3);
+  for (int i = 0; i < sys.n_input(); ++i) {
+    const int col = sys.input_cols[i];
+    inputs_.row(i) << data.qhat[col], data.qhat_d[col], data.qhat_dd[col];
+  }
+  ld_->time_load = data.time_load;
   ld_->t = data.t;
   ld_->x = data.x;
   ld_->angle_ref = data.angle_ref;

@@ -214,3 +214,76 @@ def test_quadratic_input_deformation_table_equals_a_block():
     scale = max(np.abs(table.energy[k]).max() for k in table.energy)
     assert np.abs(table.energy.balance).max() < 1e-8 * scale
     assert np.abs(table.energy["external_work"]).max() > 1e-3 * scale
+
+
+def pulled_pendulum(force=None):
+    """A point mass m on a rigid massless bar of length l turning about the origin (PLBEAM 1, the
+    rotation of its root the DOF), hanging down; `force`: a constant FORCE pulling the mass down
+    (None: none, the load then comes from a table)."""
+    m = spacar.Model()
+    m.plbeam(1, 1, 2, 3, 4)
+    m.x(1, 0.0, 0.0)
+    m.x(3, 0.0, -0.8)
+    m.fix(1)
+    m.dynx(2)
+    m.mass(3, 1.5)
+    if force is not None:
+        m.force(3, 0.0, -force)
+    m.linear(1)
+    m.timestep(2, 0.1)
+    return m
+
+
+def test_linearization_at_output_times_sees_the_time_dependent_loads():
+    # The pendulum's only stiffness is the pull F on its mass: ω² = F / (m l). With F from a
+    # table, the linearizations at the output times must find the same as with FORCE (they used
+    # to leave the table out of the residual while its tension entered the geometric stiffness).
+    F, mass, length = 30.0, 1.5, 0.8
+    ref = spacar.simulate(pulled_pendulum(F), progress=False)
+    table = spacar.Table([0.0, 1.0], [[0.0, -F], [0.0, -F]], kind="linear")
+    res = spacar.simulate(pulled_pendulum(), forces={3: table}, progress=False)
+    expected = np.sqrt(F / (mass * length)) / (2 * np.pi)
+    for lin_ref, lin in zip(ref.linearizations, res.linearizations):
+        assert lin_ref.eigenfrequencies()[0] == pytest.approx(expected, rel=1e-8)
+        assert lin.eigenfrequencies()[0] == pytest.approx(expected, rel=1e-8)
+
+
+def test_linearization_at_output_times_follows_the_input_table():
+    # A spring-mass whose base (INPUTX) moves by a table: the linearization at the output times
+    # is taken with the base where the table has it, as the same state written as a block starting
+    # there (X, XD, XDD of the base at that time) gives it.
+    def spring(base=None):
+        m = spacar.Model()
+        m.pltruss(1, 1, 2)
+        m.x(1, 0.0, 0.0)
+        m.x(2, L0, 0.0)
+        m.fix(1, 2)
+        m.fix(2, 2)
+        m.inputx(1, 1)
+        m.dyne(1, 1)
+        m.mass(2, MASS)
+        m.estiff(1, 40.0 * L0)
+        m.linear(1)
+        m.timestep(1, 0.3)
+        if base is not None:
+            p, v, a, e, ed = base
+            m.x(1, p, 0.0)
+            m.x(2, L0 + p, 0.0)
+            m.xd(1, 1, v)
+            m.xdd(1, 1, a)
+            m.e(1, 1, e)
+            m.ed(1, 1, ed)
+        return m
+
+    ts = np.linspace(0.0, 1.0, 41)
+    table = spacar.Table(ts, 0.05 * np.sin(3 * ts)[:, None], kind="cubic")
+    res = spacar.simulate(spring(), inputs={(1, 1): table}, progress=False)
+    lin = res.linearizations[-1]
+    t = res.t[-1]
+    block = spring((table(t)[0], table(t, 1)[0], table(t, 2)[0], res.deformation(1, 1)[-1],
+                    res.deformation(1, 1, "ed")[-1]))
+    block.timestep(1, 1e-9)
+    ref = spacar.simulate(block, progress=False).linearizations[0]
+    assert ref.t == pytest.approx(0.0)
+    np.testing.assert_allclose(lin.r0, ref.r0, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(lin.M0, ref.M0, rtol=1e-9)

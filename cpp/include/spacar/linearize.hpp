@@ -55,6 +55,9 @@ class Linearizer {
   // perturbed states of the finite differences need the residual only).
   void set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd, bool transfer);
   std::unique_ptr<System> lin_;
+  // The inputs' position, rate and acceleration at the analysed state (rows ordered as
+  // input_cols): their block motion or a table's, as the analysis had them.
+  Eigen::MatrixXd inputs_;
   std::unique_ptr<Data> ld_;
   std::vector<int> order_;      // z index → DOF index of the linearization system
 };
