@@ -1,6 +1,8 @@
 #include "spacar/limits.hpp"
 
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "spacar/errors.hpp"
@@ -9,6 +11,30 @@ namespace spacar {
 
 namespace {
 std::atomic<std::size_t> g_memory_limit{std::size_t(4) << 30};
+
+struct ThreadDeadline {
+  bool active = false;
+  double seconds = 0.0;
+  std::chrono::steady_clock::time_point at;
+};
+thread_local ThreadDeadline t_deadline;
+}  // namespace
+
+void set_thread_deadline(double seconds, double limit) {
+  t_deadline.active = seconds > 0.0 && std::isfinite(seconds);
+  t_deadline.seconds = limit;
+  if (t_deadline.active)
+    t_deadline.at = std::chrono::steady_clock::now() +
+                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+void clear_thread_deadline() { t_deadline.active = false; }
+
+void check_thread_deadline(const char* where) {
+  if (!t_deadline.active || std::chrono::steady_clock::now() <= t_deadline.at) return;
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", t_deadline.seconds);
+  throw TimeLimitError(std::string("the time limit of ") + buf + " s was exceeded (" + where + ")");
 }
 
 std::size_t memory_limit() { return g_memory_limit.load(); }

@@ -485,6 +485,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     res.newton_iterations = data_->total_newton_iterations;
     res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     has_deadline_ = false;
+    clear_thread_deadline();
     tree_.reset();
     chain_.reset();
     held_.resize(0);
@@ -556,6 +557,10 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
 void Simulation::start_clock(const RunOptions& options, std::chrono::steady_clock::time_point start) {
   has_deadline_ = options.time_limit > 0.0 && std::isfinite(options.time_limit);
   time_limit_ = options.time_limit;
+  // The same deadline for the factorizations inside (limits.hpp); already reached: a moment.
+  const double left = options.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (has_deadline_) set_thread_deadline(std::max(left, 1e-9), options.time_limit);
+  else clear_thread_deadline();
   if (has_deadline_)
     deadline_ = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                             std::chrono::duration<double>(options.time_limit));

@@ -21,4 +21,14 @@ void require_memory(double bytes, const std::string& what, const std::string& hi
 // "1.5 GB", "12 kB", ...
 std::string format_bytes(double bytes);
 
+// The wall-clock deadline of the analysis running on this thread (a run's time_limit), checked
+// also inside the long computations that no step of the integrator interrupts — the sparse
+// factorizations of large systems — so that a time limit bounds a run whatever its size.
+// Thread-local: the sweep runs analyses in threads side by side.
+// `seconds` from now (<= 0 or not finite: none); `limit`: the time limit the message names.
+void set_thread_deadline(double seconds, double limit);
+void clear_thread_deadline();
+// Throws TimeLimitError "the time limit of <s> s was exceeded (<where>)" past the deadline.
+void check_thread_deadline(const char* where);
+
 }  // namespace spacar
