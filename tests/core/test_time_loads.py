@@ -253,18 +253,8 @@ def test_linearization_at_output_times_follows_the_input_table():
     # is taken with the base where the table has it, as the same state written as a block starting
     # there (X, XD, XDD of the base at that time) gives it.
     def spring(base=None):
-        m = spacar.Model()
-        m.pltruss(1, 1, 2)
-        m.x(1, 0.0, 0.0)
-        m.x(2, L0, 0.0)
-        m.fix(1, 2)
-        m.fix(2, 2)
-        m.inputx(1, 1)
-        m.dyne(1, 1)
-        m.mass(2, MASS)
-        m.estiff(1, 40.0 * L0)
+        m = base_driven(0.3, 1)
         m.linear(1)
-        m.timestep(1, 0.3)
         if base is not None:
             p, v, a, e, ed = base
             m.x(1, p, 0.0)
