@@ -11,19 +11,20 @@
 
 namespace spacar {
 
+void set_input(const System& sys, Data& data, int i, double p, double pd, double pdd) {
+  const int col = sys.input_cols[i];
+  data.qhat[col] = p;
+  data.qhat_d[col] = pd;
+  data.qhat_dd[col] = pdd;
+  if (i < static_cast<int>(sys.x_input.size())) data.x[sys.x_input[i]] = p;
+}
+
 void set_inputs(const System& sys, Data& data, double t) {
   const double tau = t - sys.t0;
   data.t = t;
-  const int nxp = static_cast<int>(sys.x_input.size());
-  for (int i = 0; i < sys.n_input(); ++i) {
-    const double p = sys.p0[i] + sys.pd0[i] * tau + 0.5 * sys.pdd0[i] * tau * tau;
-    const double pd = sys.pd0[i] + sys.pdd0[i] * tau;
-    const int col = sys.input_cols[i];
-    data.qhat[col] = p;
-    data.qhat_d[col] = pd;
-    data.qhat_dd[col] = sys.pdd0[i];
-    if (i < nxp) data.x[sys.x_input[i]] = p;
-  }
+  for (int i = 0; i < sys.n_input(); ++i)
+    set_input(sys, data, i, sys.p0[i] + sys.pd0[i] * tau + 0.5 * sys.pdd0[i] * tau * tau,
+              sys.pd0[i] + sys.pdd0[i] * tau, sys.pdd0[i]);
 }
 
 void set_dofs(const System& sys, Data& data, const double* q, const double* qd) {

@@ -26,14 +26,7 @@ void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd, bool
     q[order_[i]] = z[i];
     qd[order_[i]] = zd[i];
   }
-  const int nxp = static_cast<int>(L.x_input.size());
-  for (int i = 0; i < L.n_input(); ++i) {
-    const int col = L.input_cols[i];
-    ld_->qhat[col] = inputs_(i, 0);
-    ld_->qhat_d[col] = inputs_(i, 1);
-    ld_->qhat_dd[col] = inputs_(i, 2);
-    if (i < nxp) ld_->x[L.x_input[i]] = inputs_(i, 0);
-  }
+  for (int i = 0; i < L.n_input(); ++i) set_input(L, *ld_, i, inputs_(i, 0), inputs_(i, 1), inputs_(i, 2));
   set_dofs(L, *ld_, q.data(), qd.data());
   const double tol = std::min(L.settings.epskin, 1e-10);
   solve_positions(L, *ld_, std::max(L.settings.maxiterat, 50), tol, false);

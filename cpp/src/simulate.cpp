@@ -340,14 +340,8 @@ void Simulation::set_time_loads(TimeLoads loads) {
 void Simulation::apply_time_loads(double t) {
   const System& sys = *sys_;
   Data& d = *data_;
-  const int nxp = static_cast<int>(sys.x_input.size());
-  for (const TimeLoads::InputTable& in : timed_.input_tables) {
-    const int col = sys.input_cols[in.input];
-    d.qhat[col] = in.table(t, 0, 0);
-    d.qhat_d[col] = in.table(t, 0, 1);
-    d.qhat_dd[col] = in.table(t, 0, 2);
-    if (in.input < nxp) d.x[sys.x_input[in.input]] = d.qhat[col];
-  }
+  for (const TimeLoads::InputTable& in : timed_.input_tables)
+    set_input(sys, d, in.input, in.table(t, 0, 0), in.table(t, 0, 1), in.table(t, 0, 2));
   if (timed_.load_tables.empty() && !timed_.load_function && held_.size() == 0) {
     d.time_load.resize(0);
     return;

@@ -12,6 +12,9 @@ namespace spacar {
 
 // Prescribed inputs at time t: p, ṗ, p̈ into x^p / targets of e^p and the input part of q̂.
 void set_inputs(const System& sys, Data& data, double t);
+// Input i (ordered as input_cols) at position p, rate pd, acceleration pdd: its column of q̂ and,
+// for an input coordinate, x.
+void set_input(const System& sys, Data& data, int i, double p, double pd, double pdd);
 // Degrees of freedom q and their rates: x^d into x, e^d into the targets, q̂ parts.
 void set_dofs(const System& sys, Data& data, const double* q, const double* qd);
 
