@@ -1,9 +1,8 @@
 #include "spacar/limits.hpp"
 
 #include <atomic>
-#include <chrono>
-#include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "spacar/errors.hpp"
 
@@ -20,21 +19,24 @@ struct ThreadDeadline {
 thread_local ThreadDeadline t_deadline;
 }  // namespace
 
-void set_thread_deadline(double seconds, double limit) {
-  t_deadline.active = seconds > 0.0 && std::isfinite(seconds);
+void set_thread_deadline(std::chrono::steady_clock::time_point at, double limit) {
+  t_deadline.active = true;
   t_deadline.seconds = limit;
-  if (t_deadline.active)
-    t_deadline.at = std::chrono::steady_clock::now() +
-                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+  t_deadline.at = at;
 }
 
 void clear_thread_deadline() { t_deadline.active = false; }
 
+bool thread_deadline_passed() { return t_deadline.active && std::chrono::steady_clock::now() > t_deadline.at; }
+
+void throw_time_limit(const std::string& where) {
+  std::ostringstream os;
+  os << "the time limit of " << t_deadline.seconds << " s was exceeded " << where;
+  throw TimeLimitError(os.str());
+}
+
 void check_thread_deadline(const char* where) {
-  if (!t_deadline.active || std::chrono::steady_clock::now() <= t_deadline.at) return;
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", t_deadline.seconds);
-  throw TimeLimitError(std::string("the time limit of ") + buf + " s was exceeded (" + where + ")");
+  if (thread_deadline_passed()) throw_time_limit(where);
 }
 
 std::size_t memory_limit() { return g_memory_limit.load(); }

@@ -431,11 +431,10 @@ void Simulation::require_finite_state(double t) const {
 }
 
 void Simulation::check_time(double t) {
-  if (has_deadline_ && std::chrono::steady_clock::now() > deadline_) {
-    std::ostringstream os;
-    os << "the time limit of " << time_limit_ << " s was exceeded at t = " << t;
-    throw TimeLimitError(os.str());
-  }
+  if (!thread_deadline_passed()) return;
+  std::ostringstream os;
+  os << "at t = " << t;
+  throw_time_limit(os.str());
 }
 
 namespace {
@@ -478,7 +477,6 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   auto finish = [&]() {
     res.newton_iterations = data_->total_newton_iterations;
     res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    has_deadline_ = false;
     clear_thread_deadline();
     tree_.reset();
     chain_.reset();
@@ -549,15 +547,14 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
 }
 
 void Simulation::start_clock(const RunOptions& options, std::chrono::steady_clock::time_point start) {
-  has_deadline_ = options.time_limit > 0.0 && std::isfinite(options.time_limit);
-  time_limit_ = options.time_limit;
-  // The same deadline for the factorizations inside (limits.hpp); already reached: a moment.
-  const double left = options.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (has_deadline_) set_thread_deadline(std::max(left, 1e-9), options.time_limit);
-  else clear_thread_deadline();
-  if (has_deadline_)
-    deadline_ = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(options.time_limit));
+  // One deadline (limits.hpp), checked at every right-hand side and output time and inside the
+  // sparse factorizations.
+  if (options.time_limit > 0.0 && std::isfinite(options.time_limit))
+    set_thread_deadline(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                    std::chrono::duration<double>(options.time_limit)),
+                        options.time_limit);
+  else
+    clear_thread_deadline();
 }
 
 void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) const {

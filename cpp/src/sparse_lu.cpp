@@ -110,7 +110,7 @@ bool SparseLU::factorize_pivoting(const Eigen::SparseMatrix<double>& A, const st
   for (int k = 0; k < n_; ++k) {
     // A large system's first factorization (or a singular one's, whose fill can grow without
     // bound before a zero pivot shows) is the one long computation between the integrator's steps.
-    if ((k & 255) == 255) check_thread_deadline("in a sparse factorization");
+    if ((k & 255) == 255) check_thread_deadline("(in a sparse factorization)");
     const int col = q_[k];
     const int top = reach(A, col);
     for (Eigen::SparseMatrix<double>::InnerIterator it(A, col); it; ++it) w_[it.row()] = it.value();

@@ -5,6 +5,7 @@
 // refused with an InputError that says what needs the memory and how to reduce it.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <string>
 
@@ -25,10 +26,13 @@ std::string format_bytes(double bytes);
 // also inside the long computations that no step of the integrator interrupts — the sparse
 // factorizations of large systems — so that a time limit bounds a run whatever its size.
 // Thread-local: the sweep runs analyses in threads side by side.
-// `seconds` from now (<= 0 or not finite: none); `limit`: the time limit the message names.
-void set_thread_deadline(double seconds, double limit);
+// The deadline `at`; `limit`: the time limit in seconds that the message names.
+void set_thread_deadline(std::chrono::steady_clock::time_point at, double limit);
 void clear_thread_deadline();
-// Throws TimeLimitError "the time limit of <s> s was exceeded (<where>)" past the deadline.
+bool thread_deadline_passed();
+// TimeLimitError "the time limit of <limit> s was exceeded <where>".
+[[noreturn]] void throw_time_limit(const std::string& where);
+// throw_time_limit(where) if the deadline has passed.
 void check_thread_deadline(const char* where);
 
 }  // namespace spacar

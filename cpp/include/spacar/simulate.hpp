@@ -280,9 +280,6 @@ class Simulation {
   double kinematic_failure_t_ = 0.0;
   void check_time(double t);       // TimeLimitError past the deadline of the running block
   void require_finite_state(double t) const;  // SpacarError if an output would hold inf or NaN
-  bool has_deadline_ = false;
-  std::chrono::steady_clock::time_point deadline_;
-  double time_limit_ = 0.0;
   TimeLoads timed_;
   Eigen::VectorXd held_;  // loads of the controller held since its last sample (nx), or empty
   int n_energy_ = 0;      // 2 with RunOptions::energy: the last states of Y (dissipated, external work)
