@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 namespace spacar {
 namespace {
@@ -17,7 +16,6 @@ constexpr double kMinError = 1e-10;
 constexpr double kNewtonTolerance = 0.02;
 const double kRound = std::numeric_limits<double>::epsilon();
 
-std::string describe(double t, double h) { return describe_step(t, h); }
 
 }  // namespace
 
@@ -33,6 +31,10 @@ GeneralizedAlpha::GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf
   alpha_f_ = rho_inf / (rho_inf + 1.0);
   gamma_ = 0.5 - alpha_m_ + alpha_f_;
   beta_ = 0.25 * (1.0 - alpha_m_ + alpha_f_) * (1.0 - alpha_m_ + alpha_f_);
+  // γ′, β′: the derivatives of Z⁺ (per h) and q⁺ (per h²) with respect to D⁺, through A⁺.
+  const double c = (1.0 - alpha_f_) / (1.0 - alpha_m_);
+  gamma_d_ = gamma_ * c;
+  beta_d_ = beta_ * c;
   set_tolerances(Eigen::VectorXd::Constant(n, 1e-6), Eigen::VectorXd::Constant(n, 1e-6));
   J_.setZero(n, n);
   N_.setZero(nz_, nz_);
@@ -85,11 +87,10 @@ bool GeneralizedAlpha::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Ei
   return false;
 }
 
-// N = I − γ' h ∂f_Z/∂Z − β' h² ∂f_Z/∂q, with γ' = γ c and β' = β c, c = ∂A⁺/∂D⁺ = (1−αf)/(1−αm):
-// the derivative of the residual D⁺ − f_Z(q⁺, Z⁺) with respect to D⁺.
+// N = I − γ′ h ∂f_Z/∂Z − β′ h² ∂f_Z/∂q: the derivative of the residual D⁺ − f_Z(q⁺, Z⁺) with
+// respect to D⁺.
 void GeneralizedAlpha::factorize(double h) {
-  const double c = (1.0 - alpha_f_) / (1.0 - alpha_m_);
-  const double gh = gamma_ * c * h, bh2 = beta_ * c * h * h;
+  const double gh = gamma_d_ * h, bh2 = beta_d_ * h * h;
   N_ = -gh * J_.bottomRightCorner(nz_, nz_);
   N_.diagonal().array() += 1.0;
   N_.middleCols(r0_ - m_, m_) -= bh2 * J_.bottomLeftCorner(nz_, m_);
@@ -120,8 +121,7 @@ void GeneralizedAlpha::shift_acceleration(double h) {
 // y_new_, a_new_ and d_new_ hold the end of the step: D⁺ is the converged iterate, not a new
 // evaluation of f (one right-hand side per iteration, none more per step).
 GeneralizedAlpha::Attempt GeneralizedAlpha::newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y) {
-  const double c = (1.0 - alpha_f_) / (1.0 - alpha_m_);
-  const double gh = gamma_ * c * h, bh2 = beta_ * c * h * h;
+  const double gh = gamma_d_ * h, bh2 = beta_d_ * h * h;
   const int r = r0_ - m_;
   scale_ = atol_.array() + rtol_.array() * y.array().abs();
   shift_acceleration(h);
@@ -221,19 +221,10 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
   if (!jac_) throw std::invalid_argument("GeneralizedAlpha: no Jacobian callback set");
 
   failure_ = "none";
-  size_t next = 0;
-  for (; next < touts.size() && touts[next] == t0; ++next) out(t0, y);
+  size_t next = outputs_at_start(touts, t0, y, out);
   if (t_end == t0) return t0;
 
-  bool ok = false;
-  try {
-    ok = eval(f, t0, y, fy_);
-  } catch (const StepRejected& e) {
-    failure_ = e.what();
-  }
-  if (!ok)
-    throw IntegrationError("GeneralizedAlpha: cannot start, rhs failed at the initial state (" + failure_ + ") at " +
-                           describe(t0, 0.0));
+  evaluate_start("GeneralizedAlpha", t0, failure_, [&] { return eval(f, t0, y, fy_); });
   d_ = fy_.tail(nz_);
   a_ = d_;  // A = D at the start (Arnold & Brüls): second order from the first step
   have_previous_ = false;
@@ -262,9 +253,9 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
   double t = t0;
   for (long steps = 0; t < t_end; ++steps) {
     if (steps >= max_steps_)
-      throw IntegrationError("GeneralizedAlpha: more than " + std::to_string(max_steps_) + " steps at " + describe(t, h));
+      throw IntegrationError("GeneralizedAlpha: more than " + std::to_string(max_steps_) + " steps at " + describe_step(t, h));
     if (!(h >= Integrator::min_step(t)))
-      throw IntegrationError("GeneralizedAlpha: step size underflow at " + describe(t, h) + " (last rejection: " +
+      throw IntegrationError("GeneralizedAlpha: step size underflow at " + describe_step(t, h) + " (last rejection: " +
                              failure_ + ")");
     const bool last = t + std::min(1.01 * h, hmax_) >= t_end;
     const double h_try = last ? t_end - t : h;
@@ -277,7 +268,7 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
         ++stats_.njev;
         jac_(t, y, J_);
         if (J_.rows() != n_ || J_.cols() != n_) throw std::invalid_argument("GeneralizedAlpha: the Jacobian has the wrong size");
-        if (!J_.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite Jacobian at " + describe(t, h_try));
+        if (!J_.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite Jacobian at " + describe_step(t, h_try));
         need_jacobian = false;
         jacobian_fresh = true;
         h_factorized = 0.0;

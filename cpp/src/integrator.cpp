@@ -208,8 +208,6 @@ void weighted_sum(const Row& row, int count, const std::vector<Eigen::VectorXd>&
     if (row[j] != 0.0) out += row[j] * k[j];
 }
 
-std::string describe(double t, double h) { return describe_step(t, h); }
-
 }  // namespace
 
 std::string describe_step(double t, double h) {
@@ -477,20 +475,11 @@ double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::Vecto
   stiff_ = false;
   hlamb_ = 0.0;
   stiff_steps_ = nonstiff_steps_ = 0;
-  size_t next = 0;
-  for (; next < touts.size() && touts[next] == t0; ++next) out(t0, y);
+  size_t next = outputs_at_start(touts, t0, y, out);
   if (t_end == t0) return t0;
 
   const Scheme& sc = scheme(method_);
-  bool ok = false;
-  try {
-    ok = eval(f, t0, y, k_[0]);
-  } catch (const StepRejected& e) {
-    failure_ = e.what();
-  }
-  if (!ok)
-    throw IntegrationError("Integrator: cannot start, rhs failed at the initial state (" +
-                           failure_ + ") at " + describe(t0, 0.0));
+  evaluate_start("Integrator", t0, failure_, [&] { return eval(f, t0, y, k_[0]); });
 
   double h = std::min(h_initial_ > 0 ? h_initial_ : initial_step(f, t0, t_end, y), hmax_);
   bool rejected = false;   // the previous attempt failed: do not grow the step right after
@@ -498,10 +487,10 @@ double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::Vecto
   for (long steps = 0; t < t_end; ++steps) {
     if (steps >= max_steps_)
       throw IntegrationError("Integrator: more than " + std::to_string(max_steps_) +
-                             " steps at " + describe(t, h));
+                             " steps at " + describe_step(t, h));
     const double h_min = min_step(t);
     if (!(h >= h_min))  // also a NaN step (from a non-finite error estimate)
-      throw IntegrationError("Integrator: step size underflow at " + describe(t, h) +
+      throw IntegrationError("Integrator: step size underflow at " + describe_step(t, h) +
                              " (last rejection: " + failure_ + ")");
 
     // Stretch the step by up to 1% (within hmax) rather than leave a tiny last step before t_end.

@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 namespace spacar {
 namespace {
@@ -64,7 +63,6 @@ constexpr double kSafety = 0.9;
 constexpr double kMinError = 1e-10;
 const double kRound = std::numeric_limits<double>::epsilon();
 
-std::string describe(double t, double h) { return describe_step(t, h); }
 
 double scaled_rms(const Eigen::VectorXd& v, const Eigen::VectorXd& scale) {
   return std::sqrt((v.array() / scale.array()).square().sum() / static_cast<double>(v.size()));
@@ -418,19 +416,10 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
   if (!jac_) throw std::invalid_argument("Radau5: no Jacobian callback set");
 
   failure_ = "none";
-  size_t next = 0;
-  for (; next < touts.size() && touts[next] == t0; ++next) out(t0, y);
+  size_t next = outputs_at_start(touts, t0, y, out);
   if (t_end == t0) return t0;
 
-  bool ok = false;
-  try {
-    ok = eval(f, t0, y, f0_);
-  } catch (const StepRejected& e) {
-    failure_ = e.what();
-  }
-  if (!ok)
-    throw IntegrationError("Radau5: cannot start, rhs failed at the initial state (" + failure_ + ") at " +
-                           describe(t0, 0.0));
+  evaluate_start("Radau5", t0, failure_, [&] { return eval(f, t0, y, f0_); });
 
   double h = std::min(h_initial_ > 0 ? h_initial_ : initial_step(f, t0, t_end, y), hmax_);
   bool first = true, rejected = false;
@@ -446,9 +435,9 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
   double t = t0;
   for (long steps = 0; t < t_end; ++steps) {
     if (steps >= max_steps_)
-      throw IntegrationError("Radau5: more than " + std::to_string(max_steps_) + " steps at " + describe(t, h));
+      throw IntegrationError("Radau5: more than " + std::to_string(max_steps_) + " steps at " + describe_step(t, h));
     if (!(h >= Integrator::min_step(t)))
-      throw IntegrationError("Radau5: step size underflow at " + describe(t, h) + " (last rejection: " +
+      throw IntegrationError("Radau5: step size underflow at " + describe_step(t, h) + " (last rejection: " +
                              failure_ + ")");
     const bool last = t + std::min(1.01 * h, hmax_) >= t_end;
     const double h_try = last ? t_end - t : h;
@@ -462,7 +451,7 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
         jac_(t, y, J_);
         if (J_.rows() != n_ || J_.cols() != n_)
           throw std::invalid_argument("Radau5: the Jacobian has the wrong size");
-        if (!J_.allFinite()) throw IntegrationError("Radau5: non-finite Jacobian at " + describe(t, h_try));
+        if (!J_.allFinite()) throw IntegrationError("Radau5: non-finite Jacobian at " + describe_step(t, h_try));
         need_jacobian = false;
         jacobian_fresh = true;
         if (nonstiff_bound_ > 0) {

@@ -82,7 +82,7 @@ class GeneralizedAlpha {
                       const Eigen::VectorXd& y, const Output& out);
 
   int n_, m_, r0_, nz_;
-  double alpha_m_, alpha_f_, gamma_, beta_;
+  double alpha_m_, alpha_f_, gamma_, beta_, gamma_d_, beta_d_;
   Eigen::VectorXd rtol_, atol_;
   double hmax_;
   long max_steps_ = Integrator::kMaxSteps;

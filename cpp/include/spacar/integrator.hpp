@@ -148,4 +148,29 @@ class Integrator {
   Eigen::VectorXd y_stage_, y_new_, scale_, err_a_, err_b_, y_out_;
 };
 
+// The start of integrate(), shared by the integrators: the outputs at t0 (returns the index of
+// the first output time after it), ...
+inline size_t outputs_at_start(const std::vector<double>& touts, double t0, const Eigen::VectorXd& y,
+                               const Integrator::Output& out) {
+  size_t next = 0;
+  for (; next < touts.size() && touts[next] == t0; ++next) out(t0, y);
+  return next;
+}
+
+// ... and the right-hand side at the initial state: `evaluate()` makes it (false: non-finite
+// values, the reason in `failure`); that, or a StepRejected from the right-hand side, ends the
+// integration with IntegrationError "<who>: cannot start, ...".
+template <class Evaluate>
+void evaluate_start(const char* who, double t0, std::string& failure, Evaluate&& evaluate) {
+  bool ok = false;
+  try {
+    ok = evaluate();
+  } catch (const StepRejected& e) {
+    failure = e.what();
+  }
+  if (!ok)
+    throw IntegrationError(std::string(who) + ": cannot start, rhs failed at the initial state (" + failure + ") at " +
+                           describe_step(t0, 0.0));
+}
+
 }  // namespace spacar
