@@ -15,13 +15,24 @@
 
 namespace spacar {
 
+namespace {
+constexpr Method kMethods[] = {Method::AUTO, Method::DOP853, Method::DOPRI5, Method::RADAU5,
+                               Method::GENERALIZED_ALPHA};
+}  // namespace
+
+std::vector<std::string> method_names() {
+  std::vector<std::string> names;
+  for (Method m : kMethods) names.emplace_back(method_name(m));
+  return names;
+}
+
 Method parse_method(const std::string& name) {
-  if (name == "dop853") return Method::DOP853;
-  if (name == "dopri5") return Method::DOPRI5;
-  if (name == "radau5") return Method::RADAU5;
-  if (name == "generalized_alpha") return Method::GENERALIZED_ALPHA;
-  if (name == "auto") return Method::AUTO;
-  throw InputError("unknown integration method '" + name + "' (auto, dop853, dopri5, radau5, generalized_alpha)");
+  std::string known;
+  for (Method m : kMethods) {
+    if (name == method_name(m)) return m;
+    known += (known.empty() ? "" : ", ") + std::string(method_name(m));
+  }
+  throw InputError("unknown integration method '" + name + "' (" + known + ")");
 }
 
 const char* method_name(Method m) {

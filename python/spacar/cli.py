@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from . import __version__, _core
 from .errors import SpacarError
 from .io.reader import read
 from .io.matasc import WRITING, default_stem
@@ -230,7 +230,7 @@ def main(argv=None) -> int:
     run.add_argument("file")
     run.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                      help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
-    run.add_argument("--method", choices=["dop853", "dopri5", "radau5", "generalized_alpha", "auto"], default="auto",
+    run.add_argument("--method", choices=_core.integration_methods, default="auto",
                      help="integration method (default auto: dop853, radau5 where it detects stiffness; "
                           "radau5: implicit, for stiff flexible systems; generalized_alpha: implicit, second order)")
     run.add_argument("--rho-inf", type=float, default=0.9, metavar="RHO",

@@ -32,7 +32,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from . import progress as bars  # named so: sweep()'s argument is `progress`
+from . import _core, progress as bars  # named so: sweep()'s argument is `progress`
 from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
 from .keywords import INT, LOOKUP, SETTINGS, Keyword
@@ -610,9 +610,8 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     if not (analysis in ("simulate", "linearize") or callable(analysis)):
         raise InputError(f"sweep: analysis must be 'simulate', 'linearize' or a function, got {show(analysis)}")
     time_limit = seconds_or_none(time_limit, "sweep: time_limit")
-    if not isinstance(method, str) or method not in ("dop853", "dopri5", "radau5", "generalized_alpha", "auto"):
-        raise InputError(f"sweep: unknown integration method {show(method)} "
-                         "(dop853, dopri5, radau5, generalized_alpha, auto)")
+    if not isinstance(method, str) or method not in _core.integration_methods:
+        raise InputError(f"sweep: unknown integration method {show(method)} ({', '.join(_core.integration_methods)})")
     names, cases, grid, lines = _cases(parameters, by_lines=isinstance(model, Model))
     n = len(cases)
     task = _Task(model, lines, analysis, _Outputs(outputs, analysis), method, time_limit, n)

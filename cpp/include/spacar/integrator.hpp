@@ -35,6 +35,9 @@ enum class Method { DOP853, DOPRI5, RADAU5, GENERALIZED_ALPHA, AUTO };
 Method parse_method(const std::string& name);
 // The name parse_method reads.
 const char* method_name(Method m);
+// Every method's name, in the order of the error message ("auto" first): the entry points'
+// lists of choices (spacar run, spacar.sweep) come from here.
+std::vector<std::string> method_names();
 
 // Shared by the integrators (Integrator, Radau5, GeneralizedAlpha), `who` naming the one in the
 // messages: the checks of per-component tolerances (finite, non-negative, not both zero) and of
