@@ -110,8 +110,8 @@ def _run(args) -> int:
         model.output_stem = args.output_stem
     animated = []
     n_warn = len(model.warnings)
-    implicit = {"rho_inf": args.rho_inf, "fixed_step": args.fixed_step} if args.method == "generalized_alpha" else {}
-    blocks = model.run_blocks(method=args.method, progress=args.progress, time_limit=args.time_limit, **implicit)
+    blocks = model.run_blocks(method=args.method, progress=args.progress, time_limit=args.time_limit,
+                              rho_inf=args.rho_inf, fixed_step=args.fixed_step)
     for k in itertools.count():
         try:
             res = next(blocks)
@@ -233,7 +233,7 @@ def main(argv=None) -> int:
     run.add_argument("--method", choices=_core.integration_methods, default="auto",
                      help="integration method (default auto: dop853, radau5 where it detects stiffness; "
                           "radau5: implicit, for stiff flexible systems; generalized_alpha: implicit, second order)")
-    run.add_argument("--rho-inf", type=float, default=0.9, metavar="RHO",
+    run.add_argument("--rho-inf", type=float, default=None, metavar="RHO",
                      help="generalized_alpha: spectral radius at infinite frequency, 0..1 (default 0.9; 1: no "
                           "numerical damping)")
     run.add_argument("--fixed-step", type=float, default=None, metavar="H",

@@ -166,7 +166,7 @@ def _dead_position_hint(err, res, system, model) -> str:
 
 def simulate(model, *, method: str = "auto", on_output=None, progress=None, output_stem=None,
              time_limit=None, recursive: bool = True, forces=None, inputs=None, controller=None,
-             energy: bool = False, rho_inf: float = 0.9, fixed_step=None) -> Results:
+             energy: bool = False, rho_inf=None, fixed_step=None) -> Results:
     """Run the analysis of the model's current block, as SPACAR does at an END.
 
     The mechanism is assembled at the current time; with degrees of freedom the reduced
@@ -190,7 +190,7 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     (implicit Radau IIA of order 5 for stiff systems, its Newton matrix from the linearized
     equations) or ``"generalized_alpha"`` (implicit, second order, one right-hand side per Newton
     iteration, the positions under error control; for flexible links at loose tolerances, with
-    ``rho_inf`` its spectral radius at infinite frequency: 1 keeps every mode's amplitude, smaller
+    ``rho_inf`` its spectral radius at infinite frequency (default 0.9): 1 keeps every mode's amplitude, smaller
     values damp the highest modes; ``fixed_step``: steps of this size without error control,
     EPSINT/EPSIND then only stop its Newton iterations). The implicit methods add ``jacobians``
     and ``decompositions`` to ``res.stats``, as does a switch.
@@ -238,13 +238,14 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     if not isinstance(method, str):
         raise InputError(f"method must be 'dop853' or 'dopri5' (explicit), 'radau5' or 'generalized_alpha' "
                          f"(implicit) or 'auto', got {show(method)}")
-    if isinstance(rho_inf, (bool, np.bool_)) or not isinstance(rho_inf, (int, float, np.number)) \
-            or not 0.0 <= rho_inf <= 1.0:
+    if rho_inf is not None and (isinstance(rho_inf, (bool, np.bool_))
+                                or not isinstance(rho_inf, (int, float, np.number)) or not 0.0 <= rho_inf <= 1.0):
         raise InputError(f"rho_inf (the spectral radius of generalized_alpha) must be a number in [0, 1], "
                          f"got {show(rho_inf)}")
     step_size = seconds_or_none(fixed_step, "fixed_step") or 0.0
-    if step_size and method != "generalized_alpha":
-        raise InputError(f"fixed_step is an option of method 'generalized_alpha' only, not of {show(method)}")
+    for name, given in (("fixed_step", step_size), ("rho_inf", rho_inf is not None)):
+        if given and method != "generalized_alpha":
+            raise InputError(f"{name} is an option of method 'generalized_alpha' only, not of {show(method)}")
     if not isinstance(recursive, (bool, np.bool_)):
         raise InputError(f"recursive must be True or False, got {show(recursive)}")
     if not isinstance(energy, (bool, np.bool_)):
@@ -294,7 +295,7 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit,
                          recursive=bool(recursive),  # numpy booleans too
                          sample_period=0.0 if controller is None else 1.0 / controller.rate,
-                         on_sample=on_sample, energy=bool(energy), rho_inf=float(rho_inf),
+                         on_sample=on_sample, energy=bool(energy), rho_inf=0.9 if rho_inf is None else float(rho_inf),
                          fixed_step=step_size)
     except SpacarError as err:
         partial = getattr(err, "results", None)

@@ -142,6 +142,8 @@ def test_options_are_checked():
         spacar.simulate(spacar.read(EXAMPLE), method="dop853", fixed_step=1e-3, progress=False)
     with pytest.raises(spacar.InputError, match="fixed_step"):
         spacar.simulate(spacar.read(EXAMPLE), method="generalized_alpha", fixed_step=-1.0, progress=False)
+    with pytest.raises(spacar.InputError, match="rho_inf is an option of method 'generalized_alpha' only"):
+        spacar.simulate(spacar.read(EXAMPLE), method="radau5", rho_inf=0.5, progress=False)
 
 
 def test_cli_and_sweep_accept_generalized_alpha(capsys):
@@ -149,6 +151,9 @@ def test_cli_and_sweep_accept_generalized_alpha(capsys):
 
     assert main(["run", str(EXAMPLE), "--method", "generalized_alpha", "--no-progress"]) == 0
     assert "block 1" in capsys.readouterr().out
+    # Its options with another method: refused, not ignored.
+    assert main(["run", str(EXAMPLE), "--method", "dop853", "--fixed-step", "1e-3", "--no-progress"]) != 0
+    assert "fixed_step is an option of method 'generalized_alpha' only" in capsys.readouterr().err
     out = spacar.sweep(spacar.read(EXAMPLE), {"EPSINT": [1e-3, 1e-4]}, method="generalized_alpha",
                        outputs={"steps": lambda res: res.stats["steps"]}, workers=1, progress=False)
     assert not out.errors
