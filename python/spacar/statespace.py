@@ -278,14 +278,16 @@ def _sensitivities(lin, outputs, velocities) -> dict:
     stresses), "x", "e" (∂x/∂z, ∂e/∂z of the positions: DF and DFe, except with nonholonomic
     constraints, whose DF and DFe are the velocity transfer ẋ = DF ż, not the positions'
     derivatives at fixed y^k) and, with nonholonomic constraints, the derivatives over their
-    kinematic coordinates y^k at fixed z and ż: "x_y", "e_y", "xd_y", "ed_y", "sigma_y". Those not zero come from central
-    differences, with the kinematics re-solved (sim.move_to, or sim.evaluate_state with y^k) and
-    the stresses evaluated."""
+    kinematic coordinates y^k at fixed z and ż: "x_y", "e_y", "xd_y", "ed_y", "sigma_y". Those
+    not zero come from central differences, with the kinematics re-solved (sim.move_to, or
+    sim.evaluate_state with y^k) and the stresses evaluated."""
     nx, ne, n = lin.DF.shape[0], lin.DFe.shape[0], lin.M0.shape[0]
     k = len(getattr(lin, "y_labels", []))
-    out = {"xd": np.zeros((nx, n)), "ed": np.zeros((ne, n)), "sigma": np.zeros((ne, n)), "sigma_d": np.zeros((ne, n)),
-           "x": np.array(lin.DF), "e": np.array(lin.DFe), "x_y": np.zeros((nx, k)), "e_y": np.zeros((ne, k)), "xd_y": np.zeros((nx, k)),
-           "ed_y": np.zeros((ne, k)), "sigma_y": np.zeros((ne, k))}
+    rows = {"x": nx, "xd": nx, "e": ne, "ed": ne, "sigma": ne}  # of each quantity
+    out = {name: np.zeros((rows[name], n)) for name in ("xd", "ed", "sigma")}
+    out["sigma_d"] = np.zeros((ne, n))
+    out["x"], out["e"] = np.array(lin.DF), np.array(lin.DFe)
+    out.update({f"{name}_y": np.zeros((size, k)) for name, size in rows.items()})
     stresses = [s for s in outputs if s.keyword == "OUTS"]
     rates = [s for s in outputs if s.keyword in ("OUTXP", "OUTEP")]
     positions = [s for s in outputs if s.keyword in ("OUTX", "OUTE")]
@@ -297,8 +299,9 @@ def _sensitivities(lin, outputs, velocities) -> dict:
         return out
     first = needed[0]
     if velocities is None or lin.n_line:
-        what = {"OUTS": "a stress output", "OUTX": "a position output of a nonholonomic model",
-                "OUTE": "a position output of a nonholonomic model"}.get(first.keyword, "a rate output at a moving state")
+        position = "a position output of a nonholonomic model"
+        what = {"OUTS": "a stress output", "OUTX": position, "OUTE": position}.get(
+            first.keyword, "a rate output at a moving state")
         why = ("a Linearization alone cannot be re-evaluated: pass the Model" if velocities is None else
                "they are computed for models without LINE parameters only")
         raise InputError(f"{_where(first)}: {what} needs differences of the kinematics or stresses; {why}")
