@@ -7,6 +7,7 @@
 #include "bindings.hpp"
 #include "spacar/diagnosis.hpp"
 #include "spacar/errors.hpp"
+#include "spacar/limits.hpp"
 #include "spacar/simulate.hpp"
 
 namespace spacar::bindings {
@@ -109,7 +110,14 @@ void bind_simulation(py::module_& m) {
       .def_readonly("newton_iterations", &Data::newton_iterations);
 
   py::class_<Simulation>(m, "Simulation")
-      .def(py::init<Model&>(), py::keep_alive<1, 2>())
+      .def(py::init([](Model& model, double time_limit) {
+             // The set-up (the model's preparation, compilation and work arrays) is bounded by
+             // the analysis's time limit as the run is.
+             const DeadlineScope deadline(time_limit);
+             return std::make_unique<Simulation>(model);
+           }),
+           py::arg("model"), py::arg("time_limit") = 0.0, py::keep_alive<1, 2>(),
+           "Prepare and compile `model` for its analyses; `time_limit`: seconds the set-up may take (0: no limit).")
       .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", &Simulation::assemble)
@@ -117,7 +125,8 @@ void bind_simulation(py::module_& m) {
       .def("reduced_accelerations", &Simulation::reduced_accelerations)
       .def("linearize", [](Simulation& s) { return linearization_to_dict(s.linearize()); })
       .def("diagnose",
-           [](Simulation& s) {
+           [](Simulation& s, double time_limit, double time_spent) {
+             const DeadlineScope deadline(time_limit, time_spent);
              const ConstraintDiagnosis d = diagnose(s.system(), s.data());
              const System& sys = s.system();
              py::dict out;
@@ -131,7 +140,10 @@ void bind_simulation(py::module_& m) {
              out["undetermined"] = und;
              out["text"] = d.text;
              return out;
-           })
+           },
+           py::arg("time_limit") = 0.0, py::arg("time_spent") = 0.0,
+           "The constraint diagnosis at the current geometry, within `time_limit` seconds of which "
+           "`time_spent` are spent.")
       .def("evaluate", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::evaluate))
       .def("solve_state",
            py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::solve_state),
@@ -191,7 +203,7 @@ void bind_simulation(py::module_& m) {
           "run",
           [](Simulation& s, py::object on_output, double initial_step, const std::string& method,
              double time_limit, bool recursive, double sample_period, py::object on_sample, bool energy,
-             double rho_inf, double fixed_step) {
+             double rho_inf, double fixed_step, double time_spent) {
             RunOptions opt;
             opt.energy = energy;
             opt.sample_period = sample_period;
@@ -228,6 +240,7 @@ void bind_simulation(py::module_& m) {
               };
             }
             opt.time_limit = time_limit;
+            opt.time_spent = time_spent;
             BlockResults r;
             std::exception_ptr failure;
             {
@@ -244,7 +257,8 @@ void bind_simulation(py::module_& m) {
           py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
           py::arg("time_limit") = 0.0, py::arg("recursive") = true, py::arg("sample_period") = 0.0,
           py::arg("on_sample") = py::none(), py::arg("energy") = false, py::arg("rho_inf") = 0.9, py::arg("fixed_step") = 0.0,
-          "Run the block; on failure the exception has the results up to the failure as `results`.");
+          py::arg("time_spent") = 0.0,
+          "Run the block (`time_spent`: seconds of the analysis spent before it, counted against `time_limit`); on failure the exception has the results up to the failure as `results`.");
 }
 
 }  // namespace spacar::bindings

@@ -42,7 +42,7 @@ void bind_statics(py::module_& m) {
   m.def(
       "solve_static",
       [](Model& model, int steps, int max_iterations, int max_cuts, double tolerance, bool arc_length,
-         int max_steps) {
+         int max_steps, double time_limit) {
         StaticOptions opt;
         opt.steps = steps;
         opt.max_iterations = max_iterations;
@@ -50,13 +50,16 @@ void bind_statics(py::module_& m) {
         opt.tolerance = tolerance;
         opt.arc_length = arc_length;
         opt.max_steps = max_steps;
+        opt.time_limit = time_limit;
         StaticResults r;
         std::exception_ptr failure;
         {
           py::gil_scoped_release release;
           try {
             solve_static(model, r, opt);
-          } catch (const StaticError&) {
+          } catch (const StaticError&) {  // with the converged steps
+            failure = std::current_exception();
+          } catch (const TimeLimitError&) {
             failure = std::current_exception();
           }
         }
@@ -65,6 +68,7 @@ void bind_statics(py::module_& m) {
       },
       py::arg("model"), py::arg("steps") = 10, py::arg("max_iterations") = 30, py::arg("max_cuts") = 12,
       py::arg("tolerance") = 1e-10, py::arg("arc_length") = false, py::arg("max_steps") = 200,
+      py::arg("time_limit") = 0.0,
       "Static equilibrium of the model's block in load steps (or by the arc-length method past limit "
       "points); StaticError (with `results`, the converged steps) if no equilibrium is found.");
 

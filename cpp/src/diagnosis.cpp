@@ -61,6 +61,9 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
                    "");
     evaluate_elements(sys, data);
     assemble_block(sys, data, block, velocity ? data.AV_block : data.AP_block);
+    // The decomposition cannot be interrupted: it starts only within the time limit (at most
+    // kMaxDiagnosisSize rows, a few seconds).
+    check_thread_deadline("(before the constraint diagnosis)");
     const Eigen::MatrixXd A = Eigen::MatrixXd(block.matrix());
     Eigen::BDCSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const Eigen::VectorXd& s = svd.singularValues();
@@ -170,6 +173,7 @@ std::string weakest_constraint(const System& sys, Data& data) {
   const int nV = static_cast<int>(sys.defs_V.size()), nc = static_cast<int>(sys.x_calc.size());
   if (nV != nc || nc == 0 || nc > kMaxDiagnosisSize) return "";
   assemble_block(sys, data, data.AV, data.AV_block);
+  check_thread_deadline("(before the constraint diagnosis)");
   Eigen::BDCSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(data.AV.matrix()), Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd& s = svd.singularValues();
   const double ratio = s[nc - 1] / s[0];

@@ -1,6 +1,7 @@
 #include "spacar/limits.hpp"
 
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -38,6 +39,18 @@ void throw_time_limit(const std::string& where) {
 void check_thread_deadline(const char* where) {
   if (thread_deadline_passed()) throw_time_limit(where);
 }
+
+DeadlineScope::DeadlineScope(double limit, double spent) {
+  if (limit > 0.0 && std::isfinite(limit))
+    set_thread_deadline(std::chrono::steady_clock::now() +
+                            std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                std::chrono::duration<double>(limit - spent)),
+                        limit);
+  else
+    clear_thread_deadline();
+}
+
+DeadlineScope::~DeadlineScope() { clear_thread_deadline(); }
 
 std::size_t memory_limit() { return g_memory_limit.load(); }
 

@@ -18,9 +18,13 @@ namespace spacar {
 
 namespace {
 
+// The stages of the set-up are each linear in the model's size; the deadline of the analysis
+// (Simulation's binding, solve_static) is checked between them.
 std::unique_ptr<System> prepare_and_compile(Model& model) {
   model.prepare();
+  check_thread_deadline("(in the model's preparation)");
   std::unique_ptr<System> sys = compile(model);
+  check_thread_deadline("(in the model's compilation)");
   require_memory(Data::estimate_bytes(*sys),
                  "the analysis of " + std::to_string(sys->nx) + " nodal coordinates and " + std::to_string(sys->ne) +
                      " deformations",
@@ -32,6 +36,7 @@ std::unique_ptr<System> prepare_and_compile(Model& model) {
 
 Simulation::Simulation(Model& model)
     : model_(model), sys_(prepare_and_compile(model)), data_(std::make_unique<Data>(*sys_)) {
+  check_thread_deadline("(in the allocation of the work arrays)");
   predicted_ = Eigen::VectorXd::Zero(sys_->nx);
   for (const FreeRotation& fr : sys_->free_rotations) dependent_[fr.node] = fr.dependent;
   int g = 0;
@@ -471,13 +476,14 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   const BlockPlan plan = plan_block(options, res.warnings);
   n_energy_ = options.energy ? 2 : 0;
   held_.resize(0);
-  start_clock(options, start);
+  // One deadline (limits.hpp), checked at every right-hand side and output time and inside the
+  // sparse factorizations; the time the set-up took counts against it.
+  const DeadlineScope deadline(options.time_limit, options.time_spent);
   allocate_results(res, plan);
   int k_out = 0;
   auto finish = [&]() {
     res.newton_iterations = data_->total_newton_iterations;
     res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    clear_thread_deadline();
     tree_.reset();
     chain_.reset();
     held_.resize(0);
@@ -496,6 +502,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
 // Requests that cannot be carried out are refused before any work (formulation.md §8.1).
 Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vector<std::string>& warnings) const {
   if (!(options.time_limit >= 0.0)) throw InputError("the time limit must not be negative");
+  if (!(options.time_spent >= 0.0)) throw InputError("the time spent before the run must not be negative");
   if (options.max_steps < 1) throw InputError("the step limit must be positive");
   if (!(options.sample_period >= 0.0) || !std::isfinite(options.sample_period))
     throw InputError("the controller's sample period must be a positive number of seconds");
@@ -544,17 +551,6 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
   for (int k = 0; k < nt; ++k) plan.times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
   plan.times.back() = t_end;  // exactly the end of the block, whatever the rounding
   return plan;
-}
-
-void Simulation::start_clock(const RunOptions& options, std::chrono::steady_clock::time_point start) {
-  // One deadline (limits.hpp), checked at every right-hand side and output time and inside the
-  // sparse factorizations.
-  if (options.time_limit > 0.0 && std::isfinite(options.time_limit))
-    set_thread_deadline(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                    std::chrono::duration<double>(options.time_limit)),
-                        options.time_limit);
-  else
-    clear_thread_deadline();
 }
 
 void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) const {

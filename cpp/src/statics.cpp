@@ -157,6 +157,7 @@ class EquilibriumPath {
     int start_sign = 0;
     bool crossed = false;
     for (int it = 0;; ++it) {
+      check_thread_deadline("(in the static analysis)");
       try {
         place(qhat);
       } catch (const KinematicsError& err) {
@@ -453,6 +454,7 @@ class ArcLength {
     Eigen::VectorXd Fs;
     double last_correction = std::numeric_limits<double>::infinity();
     for (int it = 0;; ++it) {
+      check_thread_deadline("(in the static analysis)");
       double force = 0.0;
       try {
         force = path_.evaluate(qhat, lambda, Fs, gs_);
@@ -532,6 +534,7 @@ void check_options(const StaticOptions& o) {
     throw InputError("static: the tolerance must be between 0 and 1, got " + num(o.tolerance));
   if (o.max_steps < 1)
     throw InputError("static: max_steps must be at least 1, got " + std::to_string(o.max_steps));
+  if (!(o.time_limit >= 0.0)) throw InputError("static: the time limit must not be negative, got " + num(o.time_limit));
 }
 
 }  // namespace
@@ -731,6 +734,7 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
 void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   check_options(opt);
+  const DeadlineScope deadline(opt.time_limit);  // the set-up included
   res = StaticResults();
   Simulation sim(model);
   const System& sys = sim.system();

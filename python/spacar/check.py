@@ -5,11 +5,12 @@ undetermined (formulation.md §2.3) — and the release of the redundant ones
 (``spacar check --release``, :func:`release_overconstraints`)."""
 from __future__ import annotations
 
+import time
 from collections import Counter
 from dataclasses import dataclass
 
 from . import _core
-from ._util import show
+from ._util import seconds_or_none, show
 from .errors import InputError
 from .model import Model
 
@@ -93,16 +94,22 @@ class Check:
         return f"{self.summary}\nconstraints: {verdict}\n{self.diagnosis.text}"
 
 
-def check(model) -> Check:
-    """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly)."""
+def check(model, time_limit=None) -> Check:
+    """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly).
+    ``time_limit``: wall-clock seconds the set-up and the diagnosis may take (None: no limit);
+    beyond it :class:`spacar.TimeLimitError` (the diagnosis's decomposition itself, of at most
+    1500 rows, is not interrupted: it starts only within the limit)."""
     if not isinstance(model, Model):
         raise InputError(f"check: model must be a spacar.Model, got {show(model)}")
+    limit = seconds_or_none(time_limit, "time_limit") or 0.0
+    started = time.monotonic()
     if not model.nodes and not model.elements:
         why = " (no input block ended with END)" if getattr(model, "source", None) and not model.blocks else ""
         return Check(summary(model), Diagnosis(0, 0, 0, [], [], f"  the model is empty{why}"))
     copy = model.copy()
     copy.prepare()
-    d = _core.Simulation(copy.core).diagnose()
+    d = _core.Simulation(copy.core, time_limit=limit).diagnose(
+        time_limit=limit, time_spent=time.monotonic() - started if limit else 0.0)
     diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
                           list(d["undetermined"]), d["text"])
     return Check(summary(model), diagnosis)

@@ -170,7 +170,7 @@ def _static(args) -> int:
         return 1
     n_warn = len(model.warnings)
     blocks = static_blocks(model, steps=args.steps, max_cuts=args.max_cuts, tolerance=args.tolerance,
-                           arc_length=args.arc_length, max_steps=args.max_steps)
+                           arc_length=args.arc_length, max_steps=args.max_steps, time_limit=args.time_limit)
     for k, res in enumerate(blocks):
         for w in model.warnings[n_warn:]:
             _comment(f"warning: {w}")
@@ -200,7 +200,7 @@ def _check(args) -> int:
                  + (":" if released else " (none is over-constrained)"))
         for e, i in released:
             _comment(f"RLSE {e} {i}   (element {e} ({elements[e].type_name}) deformation {i})")
-    result = model.check()
+    result = model.check(time_limit=args.time_limit)
     _comment(result)
     return 0 if result.ok else 1   # a gate: 1 when the check reports problems
 
@@ -259,6 +259,8 @@ def main(argv=None) -> int:
                         help="arc-length steps per block before giving up (default 200)")
     static.add_argument("--tolerance", type=float, default=1e-10,
                         help="residual relative to the largest load balanced (default 1e-10)")
+    static.add_argument("--time-limit", type=_seconds, default=None, metavar="SECONDS",
+                        help="wall-clock limit per block (default: none); beyond it the analysis stops with an error")
     static.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                         help="significant digits of the dump (default 4; 17 for a lossless restart)")
     static.set_defaults(func=_static)
@@ -266,6 +268,8 @@ def main(argv=None) -> int:
     check.add_argument("file")
     check.add_argument("--release", action="store_true",
                        help="release (RLSE) the redundant constraints the diagnosis names, then check again")
+    check.add_argument("--time-limit", type=_seconds, default=None, metavar="SECONDS",
+                       help="wall-clock limit of the set-up and diagnosis (default: none)")
     check.set_defaults(func=_check)
     args = parser.parse_args(argv)
     try:

@@ -453,12 +453,12 @@ class Model:
 
         return summary(self)
 
-    def check(self):
-        """Summary and constraint diagnosis (redundant deformations, undetermined coordinates);
-        see :mod:`spacar.check`."""
+    def check(self, time_limit=None):
+        """Summary and constraint diagnosis (redundant deformations, undetermined coordinates)
+        within ``time_limit`` seconds (None: no limit); see :func:`spacar.check.check`."""
         from .check import check
 
-        return check(self)
+        return check(self, time_limit=time_limit)
 
     def release_overconstraints(self) -> list:
         """Release (RLSE) the redundant rigid deformations that :meth:`check` names; returns the

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import re
+import time
 
 import numpy as np
 
@@ -198,8 +199,8 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     ``"auto: dop853→radau5 at t=0.0123"``), ``res.stats["switches"]`` lists the changes as
     ``(t, from, to)``.
 
-    ``time_limit``: wall-clock seconds the block may take (None: no limit); beyond it
-    :class:`spacar.TimeLimitError`.
+    ``time_limit``: wall-clock seconds the block may take, the model's set-up included (None: no
+    limit); beyond it :class:`spacar.TimeLimitError`.
 
     ``recursive``: planar and spatial open trees of rigid bodies (rigid PLBEAMs joined by
     PLHINGEs, or rigid BEAMs joined by HINGEs, whose rotations are the degrees of freedom)
@@ -255,7 +256,8 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     positions = ({} if model.core.frozen else   # the X positions, before the first assembly
                  {n: np.array(node.x, dtype=float) for n, node in model.nodes.items()
                   if node.kind.name in ("XY", "XYZ")})
-    sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
+    started = time.monotonic()   # the time limit covers the set-up too
+    sim = _core.Simulation(model.core, time_limit=limit)  # prepares the model (the first END) and compiles it
     system = sim.system
     if forces or inputs:
         _time_loads(sim, system, forces or {}, inputs or {})
@@ -296,7 +298,7 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
                          recursive=bool(recursive),  # numpy booleans too
                          sample_period=0.0 if controller is None else 1.0 / controller.rate,
                          on_sample=on_sample, energy=bool(energy), rho_inf=0.9 if rho_inf is None else float(rho_inf),
-                         fixed_step=step_size)
+                         fixed_step=step_size, time_spent=time.monotonic() - started if limit else 0.0)
     except SpacarError as err:
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):

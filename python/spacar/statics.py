@@ -21,7 +21,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from . import _core
-from ._util import show
+from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError, StaticError  # noqa: F401  (StaticError: spacar.statics.StaticError)
 from .model import Model
 from .results import Results, dof_labels
@@ -62,7 +62,7 @@ def _count(value, name: str, low: int, high: int) -> int:
 
 
 def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int = 200,
-           max_iterations: int = 30, max_cuts: int = 12, tolerance: float = 1e-10) -> Results:
+           max_iterations: int = 30, max_cuts: int = 12, tolerance: float = 1e-10, time_limit=None) -> Results:
     """Static equilibrium of the model's current block: the configuration in which the degrees of
     freedom (DYNX, DYNE) are in equilibrium at rest under the block's loads (FORCE, TORQUEL,
     GRAVITY, and the prestress of deformations given with E), with the inputs (INPUTX, INPUTE)
@@ -100,7 +100,9 @@ def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int =
 
     Raises :class:`spacar.StaticError` if no equilibrium is found (loads beyond a limit point,
     a degree of freedom without stiffness), with the converged steps as ``err.results``; the
-    model is then not changed.
+    model is then not changed. ``time_limit``: wall-clock seconds the analysis may take, its
+    set-up included (None: no limit); beyond it :class:`spacar.TimeLimitError`, also with the
+    converged steps.
     """
     steps = _count(steps, "steps", 1, 10**7)
     max_iterations = _count(max_iterations, "max_iterations", 1, 1000)
@@ -110,9 +112,10 @@ def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int =
         raise InputError(f"arc_length must be True or False, got {show(arc_length)}")
     if isinstance(tolerance, bool) or not isinstance(tolerance, numbers.Real) or not 0 < tolerance < 1:
         raise InputError(f"tolerance must be a number between 0 and 1, got {show(tolerance)}")
+    limit = seconds_or_none(time_limit, "time_limit") or 0.0
     try:  # the core prepares the model (the first END) as a simulation does
         arrays = _core.solve_static(model.core, steps, max_iterations, max_cuts, float(tolerance), arc_length,
-                                    max_steps)
+                                    max_steps, limit)
     except SpacarError as err:
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):

@@ -4,9 +4,11 @@ files (.ci/sanitizers): its timings assume an uninstrumented build."""
 
 import time
 
+import numpy as np
 import pytest
 
 import spacar
+from spacar import cli
 from spacar import TimeLimitError
 
 
@@ -32,3 +34,71 @@ def test_a_time_limit_bounds_a_long_factorization():
     with pytest.raises(TimeLimitError, match=r"the time limit of 1 s was exceeded \(in a sparse factorization\)"):
         spacar.simulate(m, time_limit=1.0, progress=False)
     assert time.perf_counter() - start < 5.0
+
+
+def _massless_chain(n):
+    """A chain of n flexible PLBEAMs (set-up about 0.3 s at n = 20 000)."""
+    m = spacar.Model()
+    for i in range(1, n + 1):
+        m.plbeam(i, 2 * i - 1, 2 * i, 2 * i + 1, 2 * i + 2)
+        m.x(2 * i + 1, i / n, 0.0)
+        m.dyne(i, 2)
+        m.dyne(i, 3)
+        m.estiff(i, 0.0, 175.0)
+    m.fix(1)
+    m.fix(2)
+    m.timestep(1, 1e-4)
+    return m
+
+
+@pytest.fixture(scope="module")
+def long_chain():
+    return _massless_chain(20000)
+
+
+def test_the_time_limit_covers_the_set_up(long_chain):
+    # The model's preparation and compilation are inside the limit: a limit shorter than them
+    # stops the analysis there, before the first step.
+    for analysis in (lambda m: spacar.simulate(m, time_limit=1e-3, progress=False),
+                     lambda m: spacar.static(m, time_limit=1e-3),
+                     lambda m: spacar.check(m, time_limit=1e-3)):
+        start = time.perf_counter()
+        with pytest.raises(TimeLimitError, match=r"the time limit of 0\.001 s was exceeded \(in the model's "
+                                                 r"(preparation|compilation)\)"):
+            analysis(long_chain.copy())
+        assert time.perf_counter() - start < 2.0
+
+
+def test_the_set_up_counts_against_the_run():
+    # The run's clock starts at the set-up: `time_spent` seconds of it leave the run the rest.
+    m = _massless_chain(2)
+    for i in (1, 2):
+        m.emass(i, 1.0)
+    sim = spacar._core.Simulation(m.core, time_limit=10.0)
+    with pytest.raises(TimeLimitError, match=r"the time limit of 10 s was exceeded at t = 0"):
+        sim.run(time_limit=10.0, time_spent=10.0)
+    sim.run(time_limit=10.0, time_spent=9.0)   # the rest, a second, is enough
+
+
+def test_a_static_analysis_stopped_by_its_limit_keeps_its_load_steps():
+    m = _massless_chain(2)
+    m.force(5, 0.0, -1e-3)
+    with pytest.raises(TimeLimitError, match=r"\(in the static analysis\)") as err:
+        spacar.static(m, steps=10**6, time_limit=0.3)   # about 20 s of load steps
+    lam = err.value.results.t
+    assert 0 < len(lam) < 10**6 and np.allclose(np.diff(lam), 1e-6)
+
+
+def test_spacar_check_and_static_take_a_time_limit(tmp_path):
+    path = tmp_path / "chain.dat"
+    path.write_text(_chain_text(3))
+    assert cli.main(["check", str(path), "--time-limit", "30"]) == 0
+    assert cli.main(["static", str(path), "--time-limit", "30"]) == 0
+
+
+def _chain_text(n):
+    lines = [f"PLBEAM {i} {2 * i - 1} {2 * i} {2 * i + 1} {2 * i + 2}" for i in range(1, n + 1)]
+    lines += [f"X {2 * i + 1} {i / n} 0" for i in range(0, n + 1)]
+    lines += [f"DYNE {i} 2 3" for i in range(1, n + 1)] + [f"ESTIFF {i} 0 175" for i in range(1, n + 1)]
+    lines += ["FIX 1", "FIX 2", f"FORCE {2 * n + 1} 0 -1e-3", "END", "END"]
+    return "\n".join(lines) + "\n"

@@ -35,4 +35,14 @@ bool thread_deadline_passed();
 // throw_time_limit(where) if the deadline has passed.
 void check_thread_deadline(const char* where);
 
+// The deadline of `limit` seconds (0: none) from `spent` seconds ago, for the lifetime of the
+// scope: a model's set-up and diagnosis, which no run's clock covers.
+class DeadlineScope {
+ public:
+  explicit DeadlineScope(double limit, double spent = 0.0);
+  ~DeadlineScope();
+  DeadlineScope(const DeadlineScope&) = delete;
+  DeadlineScope& operator=(const DeadlineScope&) = delete;
+};
+
 }  // namespace spacar

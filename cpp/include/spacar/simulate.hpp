@@ -40,6 +40,9 @@ struct RunOptions {
   std::function<void(int, const Data&, const Linearization*)> on_output;
   // Wall-clock seconds the block may take (0: no limit); beyond it TimeLimitError.
   double time_limit = 0.0;
+  // Seconds of the same analysis already spent before the run (the model's set-up), counted
+  // against time_limit.
+  double time_spent = 0.0;
   // Integration steps (accepted and rejected) over the whole block.
   long max_steps = Integrator::kMaxSteps;
   // Planar and spatial trees of rigid bodies take the recursive (articulated-body) right-hand
@@ -204,7 +207,6 @@ class Simulation {
     std::vector<double> times;   // the output times, the last exactly t_end
   };
   BlockPlan plan_block(const RunOptions& options, std::vector<std::string>& warnings) const;
-  void start_clock(const RunOptions& options, std::chrono::steady_clock::time_point start);
   void allocate_results(BlockResults& res, const BlockPlan& plan) const;
   // k_out: the output times recorded (also when it throws).
   void integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out);

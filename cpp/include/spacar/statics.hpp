@@ -35,6 +35,7 @@ struct StaticOptions {
   double tolerance = 1e-10;  // residual relative to the largest generalized force balanced
   bool arc_length = false;   // follow the path in (q, λ) past limit points (see follow_arc_length)
   int max_steps = 200;       // arc-length steps before giving up (one result row each)
+  double time_limit = 0.0;   // wall-clock seconds (0: no limit); beyond it TimeLimitError
 };
 
 struct StaticResults {
