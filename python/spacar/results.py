@@ -551,14 +551,21 @@ def _headers(zf: zipfile.ZipFile, path: str) -> dict:
     for info in zf.infolist():
         if not info.filename.endswith(".npy"):
             raise InputError(f"{path}: unexpected member {show(info.filename)} (a spacar results file holds .npy arrays only)")
+        if info.flag_bits & 0x1:  # zipfile raises RuntimeError asking for a password (found by fuzzing)
+            raise InputError(f"{path}: {info.filename} is encrypted (Results.save writes no encrypted members)")
         with zf.open(info) as fh:
             version = npy.read_magic(fh)
-            if version == (1, 0):
-                shape, _, dtype = npy.read_array_header_1_0(fh)
-            elif version == (2, 0):
-                shape, _, dtype = npy.read_array_header_2_0(fh)
-            else:
+            if version not in ((1, 0), (2, 0)):
                 raise InputError(f"{path}: {info.filename}: unsupported .npy format version {version}")
+            read_header = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
+            try:
+                shape, _, dtype = read_header(fh)
+            except (OSError, EOFError, zipfile.BadZipFile, zlib.error):
+                raise
+            except Exception as err:  # noqa: BLE001  numpy's parser of an untrusted header: any failure
+                # (ValueError, SyntaxError, and tokenize.TokenError from its filter, found by fuzzing)
+                raise InputError(f"{path}: {info.filename}: not a valid .npy header ({type(err).__name__}: "
+                                 f"{show(str(err))})") from None
         out[info.filename[:-4]] = (shape, dtype)
     return out
 
@@ -584,7 +591,12 @@ def _is_label(value, kinds) -> bool:
 def _meta(f, headers, path) -> dict:
     if "meta" not in headers or headers["meta"][0] != () or headers["meta"][1].kind != "U":
         raise InputError(f"{path}: not a spacar results file (no description 'meta')")
-    meta = json.loads(str(f["meta"]))
+    text = f["meta"]
+    # UCS-4 code units beyond U+10FFFF make str() an invalid Python string (json then raises
+    # SystemError; found by fuzzing): the description is checked as numbers first.
+    if np.atleast_1d(text).astype(text.dtype.newbyteorder("<")).view("<u4").max(initial=0) > 0x10FFFF:
+        raise InputError(f"{path}: the description 'meta' holds invalid characters (not written by Results.save)")
+    meta = json.loads(str(text))
     if not isinstance(meta, dict) or meta.get("format") != "spacar.Results":
         raise InputError(f"{path}: not a spacar results file")
     checks = {
@@ -685,6 +697,10 @@ def _load(cls, path: str) -> "Results":
         lins = []
         for k, lm in enumerate(meta["linearizations"]):
             mats = {name: f[f"lin{k}_{name}"] for name in MATRICES if f"lin{k}_{name}" in headers}
+            for name, matrix in mats.items():  # Results.save writes the finite matrices of a run
+                if not np.isfinite(matrix).all():
+                    raise InputError(f"{path}: the array 'lin{k}_{name}' holds values that are not finite "
+                                     f"(not written by Results.save)")
             lins.append(Linearization.from_arrays(lm["t"], lm["z_labels"], lm["n_line"], mats, coord, defs,
                                                   lm.get("y_labels")))
         energy = Energy(arrays["t"], {key: f[f"energy_{key}"] for key in ENERGY_KEYS}) if meta.get("energy") else None

@@ -7,9 +7,15 @@
 - then a fixed budget of new hypothesis cases of each (derandomized: the same every run).
 
 The corpus grows with `python -c "from support import fuzzing; fuzzing.grow_corpus('results', N, seed)"`
-(from tests/); see docs/robustness.md.
+(from tests/) and by coverage-guided fuzzing (`python tests/support/coverage_fuzz.py results
+-max_total_time=300 --keep`, atheris); a short coverage-guided run of each is part of the suite
+where atheris is installed (the `fuzz` extra). See docs/robustness.md.
 """
 import faulthandler
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -57,3 +63,17 @@ def test_200_fuzzed_results_files(tmp_path_factory, data):
 @given(cases_text())
 def test_200_fuzzed_input_files(tmp_path_factory, text):
     run_reader_file(text, tmp_path_factory.mktemp("fuzz"))
+
+
+@pytest.mark.parametrize("kind", ["reader", "results"])
+def test_a_short_coverage_guided_run(kind, tmp_path):
+    # libFuzzer over the instrumented reader or loader, from the corpus: 3000 mutated inputs
+    # with the same oracle; a finding would end it with a non-zero status and a crash file.
+    pytest.importorskip("atheris")
+    harness = Path(__file__).resolve().parents[1] / "support" / "coverage_fuzz.py"
+    run = subprocess.run([sys.executable, str(harness), kind, "-runs=3000", "-seed=1", "--work", str(tmp_path / "new")],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=600,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(   # the spacar imported here
+                             [str(Path(spacar.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])})
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert "Done 3000 runs" in run.stderr

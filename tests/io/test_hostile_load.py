@@ -87,6 +87,10 @@ def meta_with(saved, **changes):
     ("extra lin array", "unexpected array"),
     ("bad geometry", "not a valid spacar results file"),
     ("dof label", "."),
+    ("unterminated header", r"x.npy: not a valid .npy header \(TokenError"),
+    ("encrypted member", r"\.npy is encrypted"),
+    ("lin matrix nan", r"'lin0_K0' holds values that are not finite"),
+    ("meta beyond unicode", r"the description 'meta' holds invalid characters"),
 ])
 def test_malformed_files_are_input_errors(saved, tmp_path, case, match):
     path = tmp_path / "bad.npz"
@@ -137,6 +141,25 @@ def test_malformed_files_are_input_errors(saved, tmp_path, case, match):
         write(path, meta_with(saved, geometry={"nodes": 5}))
     elif case == "dof label":
         write(path, meta_with(saved, dof_labels=["x(99,1)"]))
+    elif case == "unterminated header":  # found by the coverage-guided fuzzing: numpy's filter raised TokenError
+        header = b"{'descr': '<f8', 'fortran_order': False, 'shape': (1000"
+        write(path, {k: v for k, v in good.items() if k != "x"},
+              **{"x.npy": b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header})
+    elif case == "encrypted member":  # found by the coverage-guided fuzzing: zipfile raised RuntimeError
+        write(path, good)
+        data = bytearray(path.read_bytes())
+        for signature, offset in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):  # local and central headers
+            at = data.find(signature)
+            while at >= 0:
+                data[at + offset] |= 0x1
+                at = data.find(signature, at + 4)
+        path.write_bytes(bytes(data))
+    elif case == "lin matrix nan":  # found by the coverage-guided fuzzing: eigenfrequencies() raised ValueError
+        write(path, {**good, "lin0_K0": np.full_like(good["lin0_K0"], np.nan)})
+    elif case == "meta beyond unicode":  # found by the coverage-guided fuzzing: json raised SystemError
+        codes = np.frombuffer(str(good["meta"]).encode("utf-32-le"), "<u4").copy()
+        codes[3] = 0x7FFFFFFF
+        write(path, {**good, "meta": codes.view(f"<U{codes.size}").reshape(())})
     refused(path, match)
 
 
