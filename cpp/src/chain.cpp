@@ -68,6 +68,34 @@ int position_rows(const System& sys, int i) {
 
 }  // namespace
 
+ExplicitChain::Block ExplicitChain::make_block(const System& sys, const std::vector<int>& group,
+                                              const std::vector<int>& U) {
+  Block b;
+  b.elements = group;
+  b.coords = U;
+  for (size_t s = 0; s < group.size(); ++s) {
+    const SystemElement& se = sys.elements[group[s]];
+    for (int a = 0; a < se.nd; ++a) {
+      const int k = se.def_offset + a;
+      if (sys.row_P[k] < 0) continue;
+      const int j = static_cast<int>(b.rows.size());
+      b.rows.push_back({k, sys.row_P[k]});
+      for (size_t l = 0; l < se.coords.size(); ++l) {
+        const auto at = std::find(U.begin(), U.end(), se.coords[l]);
+        const Block::Term term{j, static_cast<int>(s), a, static_cast<int>(l),
+                               at != U.end() ? static_cast<int>(at - U.begin()) : se.coords[l]};
+        (at != U.end() ? b.unknown_terms : b.known_terms).push_back(term);
+      }
+    }
+  }
+  b.closed_end = closed_end(sys, b);
+  const int n = static_cast<int>(U.size());
+  b.A.setZero(n, n);
+  b.r.setZero(n);
+  b.dx.setZero(n);
+  return b;
+}
+
 std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
   // Nonholonomic rows (velocity rows that are not position rows) and velocity-level values among
   // the position rows have no explicit position path.
@@ -91,62 +119,49 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
   }
   // Greedy: an element whose rows, with those of the pending elements whose unknowns lie within
   // its own (the L2MIN1 of a rotation it reaches), are as many as its unknowns determines them.
-  // Any order of such steps gives the same blocks; none left while elements are pending means a
-  // closed loop or a group of elements that only determine their coordinates together.
-  for (bool progress = true; progress && !pending.empty();) {
-    progress = false;
-    for (size_t p = 0; p < pending.size(); ++p) {
-      const int i = pending[p];
-      const std::vector<int> U = unknown_coords(sys, known, i);
-      if (U.empty()) return nullptr;  // rows on known coordinates only: a loop closes here
-      std::vector<int> group{i};
-      int rows = position_rows(sys, i);
-      for (int g : U)
-        for (int j : touching[g]) {
-          if (j == i || !is_pending[j] || std::find(group.begin(), group.end(), j) != group.end()) continue;
-          const std::vector<int> Uj = unknown_coords(sys, known, j);
-          const bool inside = !Uj.empty() && std::all_of(Uj.begin(), Uj.end(), [&](int c) {
-            return std::find(U.begin(), U.end(), c) != U.end();
-          });
-          if (inside) {
-            group.push_back(j);
-            rows += position_rows(sys, j);
-          }
-        }
-      if (rows != static_cast<int>(U.size())) continue;
-      Block b;
-      b.elements = group;
-      b.coords = U;
-      for (size_t s = 0; s < group.size(); ++s) {
-        const SystemElement& se = sys.elements[group[s]];
-        for (int a = 0; a < se.nd; ++a) {
-          const int k = se.def_offset + a;
-          if (sys.row_P[k] < 0) continue;
-          const int j = static_cast<int>(b.rows.size());
-          b.rows.push_back({k, sys.row_P[k]});
-          for (size_t l = 0; l < se.coords.size(); ++l) {
-            const auto at = std::find(U.begin(), U.end(), se.coords[l]);
-            const Block::Term term{j, static_cast<int>(s), a, static_cast<int>(l),
-                                   at != U.end() ? static_cast<int>(at - U.begin()) : se.coords[l]};
-            (at != U.end() ? b.unknown_terms : b.known_terms).push_back(term);
-          }
+  // None left while elements are pending means a closed loop or a group of elements that only
+  // determine their coordinates together. group_of: that group, empty if the rows do not match
+  // the unknowns; alone: the element by itself.
+  auto group_of = [&](int i, const std::vector<int>& U, bool alone) {
+    std::vector<int> group{i};
+    int rows = position_rows(sys, i);
+    for (int g : U)
+      for (int j : touching[g]) {
+        if (alone || j == i || !is_pending[j] || std::find(group.begin(), group.end(), j) != group.end()) continue;
+        const std::vector<int> Uj = unknown_coords(sys, known, j);
+        const bool inside = !Uj.empty() && std::all_of(Uj.begin(), Uj.end(), [&](int c) {
+          return std::find(U.begin(), U.end(), c) != U.end();
+        });
+        if (inside) {
+          group.push_back(j);
+          rows += position_rows(sys, j);
         }
       }
-      const int n = static_cast<int>(U.size());
-      b.A.setZero(n, n);
-      b.r.setZero(n);
-      b.dx.setZero(n);
-      chain->blocks_.push_back(std::move(b));
-      for (int g : U) known[g] = 1;
-      for (int j : group) is_pending[j] = 0;
-      pending.erase(std::remove_if(pending.begin(), pending.end(),
-                                   [&](int j) { return std::find(group.begin(), group.end(), j) != group.end(); }),
-                    pending.end());
-      progress = true;
-      break;
-    }
+    return rows == static_cast<int>(U.size()) ? group : std::vector<int>{};
+  };
+  // Elements that determine their unknowns alone are taken first: small blocks, and a beam after
+  // the hinge that turns its end is solved in closed form.
+  for (bool progress = true; progress && !pending.empty();) {
+    progress = false;
+    for (int pass = 0; pass < 2 && !progress; ++pass)
+      for (size_t p = 0; p < pending.size() && !progress; ++p) {
+        const int i = pending[p];
+        const std::vector<int> U = unknown_coords(sys, known, i);
+        if (U.empty()) return nullptr;  // rows on known coordinates only: a loop closes here
+        const std::vector<int> group = group_of(i, U, pass == 0);
+        if (group.empty()) continue;
+        chain->blocks_.push_back(make_block(sys, group, U));
+        for (int g : U) known[g] = 1;
+        for (int j : group) is_pending[j] = 0;
+        pending.erase(std::remove_if(pending.begin(), pending.end(),
+                                     [&](int j) { return std::find(group.begin(), group.end(), j) != group.end(); }),
+                      pending.end());
+        progress = true;
+      }
   }
   if (!pending.empty()) return nullptr;
+  chain->all_closed_ = std::all_of(chain->blocks_.begin(), chain->blocks_.end(),
+                                   [](const Block& b) { return b.closed_end >= 0; });
   for (int g : sys.x_calc)
     if (!known[g]) return nullptr;
   return chain;
@@ -163,8 +178,59 @@ void ExplicitChain::add_known(const Data& data, Block& b, const Eigen::VectorXd&
     b.r[t.j] += sign * data.work[b.elements[t.slot]].B(t.local, t.coord) * v[t.target];
 }
 
+int ExplicitChain::closed_end(const System& sys, const Block& b) {
+  if (b.elements.size() != 1) return -1;
+  const SystemElement& se = sys.elements[b.elements.front()];
+  const int n = static_cast<int>(se.coords.size()), half = n / 2;
+  if (!se.kernel->has_closed_form() || static_cast<int>(b.rows.size()) != se.nd || n != 2 * half ||
+      static_cast<int>(b.coords.size()) != half)
+    return -1;
+  auto is_end = [&](int first) {
+    return std::all_of(se.coords.begin() + first, se.coords.begin() + first + half, [&](int g) {
+      return std::find(b.coords.begin(), b.coords.end(), g) != b.coords.end();
+    });
+  };
+  return is_end(half) ? 1 : is_end(0) ? 0 : -1;
+}
+
+bool ExplicitChain::solve_closed(const System& sys, Data& data, Block& b) const {
+  const int i = b.elements.front();
+  const SystemElement& se = sys.elements[i];
+  b.local_x.resize(se.coords.size());
+  b.local_e.resize(b.rows.size());
+  for (size_t l = 0; l < se.coords.size(); ++l) b.local_x[l] = data.x[se.coords[l]];
+  for (size_t j = 0; j < b.rows.size(); ++j) b.local_e[j] = data.target[b.rows[j].row];  // rows in local order
+  if (!se.kernel->solve_end(b.closed_end, b.local_e.data(), b.guess.data(), b.local_x.data())) return false;
+  for (size_t l = 0; l < se.coords.size(); ++l) data.x[se.coords[l]] = b.local_x[l];
+  evaluate_element(sys, data, i);
+  return true;
+}
+
 void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter, double tol) {
   set_targets(sys, data);
+  // The closed-form blocks keep the branches of their starting positions: taken before the
+  // blocks before them move their known end.
+  for (Block& b : blocks_) {
+    if (b.closed_end < 0) continue;
+    const std::vector<int>& coords = sys.elements[b.elements.front()].coords;
+    b.guess.resize(coords.size());
+    for (size_t l = 0; l < coords.size(); ++l) b.guess[l] = data.x[coords[l]];
+  }
+  if (!all_closed_) first_step(sys, data);
+  int most = 0;
+  for (Block& b : blocks_) {
+    if (b.closed_end >= 0 && solve_closed(sys, data, b)) continue;
+    most = std::max(most, iterate(sys, data, b, max_iter, tol));
+  }
+  for (int i : rest_) evaluate_element(sys, data, i);
+  for (size_t r = 0; r < sys.defs_P.size(); ++r) data.residual[r] = data.e[sys.defs_P[r]] - data.target[r];
+  data.newton_iterations = (all_closed_ ? 0 : 1) + most;  // the first step counts as one
+  data.total_newton_iterations += data.newton_iterations;
+  data.jacobian_reusable = false;  // no factorization of the velocity block made
+  check_auto_released(sys, data, tol);
+}
+
+void ExplicitChain::first_step(const System& sys, Data& data) {
   // First one Newton step of all calculable coordinates from the starting positions, as the
   // general path makes it: the Jacobian of an open chain is block triangular, so the step
   // follows block by block, each block's rows taking the steps of the coordinates before it.
@@ -183,42 +249,35 @@ void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter,
   }
   if (!step_.allFinite()) throw singular(sys, data, blocks_.front(), "position");
   for (int g : sys.x_calc) data.x[g] += step_[g];
-  int most = 0;
-  for (Block& b : blocks_) {
-    // Newton on the block's coordinates until the residual is below tol, then one polish
-    // iteration, as solve_positions() on all of them; none if the residual is already a
-    // thousandth of tol (the general path's criterion when it reuses a factorization).
-    bool converged = false;
-    for (int it = 0;; ++it) {
-      for (int i : b.elements) evaluate_element(sys, data, i);
-      double rmax = 0.0;
-      for (size_t j = 0; j < b.rows.size(); ++j) {
-        b.r[static_cast<int>(j)] = data.e[b.rows[j].def] - data.target[b.rows[j].row];
-        rmax = std::max(rmax, std::abs(b.r[static_cast<int>(j)]));
-      }
-      const bool finite = b.r.allFinite();
-      if (finite && (converged || rmax <= 1e-3 * tol)) break;  // polished
-      converged = finite && rmax <= tol;
-      if (!finite || (it >= max_iter && !converged)) {
-        std::ostringstream os;
-        os << "Newton iteration on the positions of " << sys.def_name(b.rows.front().def) << " and the "
-           << b.coords.size() - 1 << " other coordinates it determines (explicit chain) did not converge in "
-           << max_iter << " iterations at t = " << data.t << " (EPSKIN " << tol << "; residual "
-           << (finite ? rmax : INFINITY) << ")";
-        throw KinematicsError(os.str());
-      }
-      assemble(data, b);
-      if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "position");
-      for (size_t j = 0; j < b.coords.size(); ++j) data.x[b.coords[j]] -= b.dx[static_cast<int>(j)];
-      most = std::max(most, it + 1);
+}
+
+// Newton on the block's coordinates until the residual is below tol, then one polish iteration,
+// as solve_positions() on all of them; none if the residual is already a thousandth of tol (the
+// general path's criterion when it reuses a factorization). Returns the iterations taken.
+int ExplicitChain::iterate(const System& sys, Data& data, Block& b, int max_iter, double tol) const {
+  bool converged = false;
+  for (int it = 0;; ++it) {
+    for (int i : b.elements) evaluate_element(sys, data, i);
+    double rmax = 0.0;
+    for (size_t j = 0; j < b.rows.size(); ++j) {
+      b.r[static_cast<int>(j)] = data.e[b.rows[j].def] - data.target[b.rows[j].row];
+      rmax = std::max(rmax, std::abs(b.r[static_cast<int>(j)]));
     }
+    const bool finite = b.r.allFinite();
+    if (finite && (converged || rmax <= 1e-3 * tol)) return it;  // polished
+    converged = finite && rmax <= tol;
+    if (!finite || (it >= max_iter && !converged)) {
+      std::ostringstream os;
+      os << "Newton iteration on the positions of " << sys.def_name(b.rows.front().def) << " and the "
+         << b.coords.size() - 1 << " other coordinates it determines (explicit chain) did not converge in "
+         << max_iter << " iterations at t = " << data.t << " (EPSKIN " << tol << "; residual "
+         << (finite ? rmax : INFINITY) << ")";
+      throw KinematicsError(os.str());
+    }
+    assemble(data, b);
+    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "position");
+    for (size_t j = 0; j < b.coords.size(); ++j) data.x[b.coords[j]] -= b.dx[static_cast<int>(j)];
   }
-  for (int i : rest_) evaluate_element(sys, data, i);
-  for (size_t r = 0; r < sys.defs_P.size(); ++r) data.residual[r] = data.e[sys.defs_P[r]] - data.target[r];
-  data.newton_iterations = 1 + most;
-  data.total_newton_iterations += 1 + most;
-  data.jacobian_reusable = false;  // no factorization of the velocity block made
-  check_auto_released(sys, data, tol);
 }
 
 void ExplicitChain::solve_velocities(const System& sys, Data& data) {

@@ -331,3 +331,65 @@ def test_element_checks_rigid_motion_of_euler_parameters():
         np.testing.assert_allclose(rotation_matrix(quat_mul(q, lam)), rotation_matrix(q) @ rotation_matrix(lam),
                                    atol=1e-14)
         np.testing.assert_allclose(rotation_matrix(q) @ rotation_matrix(q).T, np.eye(3), atol=1e-14)
+
+
+# ---------------------------------------------------------------------------------------------
+# The closed-form inverse of the beams (the explicit chain's positions, chain.hpp)
+# ---------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("type_", BEAMS)
+@pytest.mark.parametrize("end", [0, 1])
+def test_beam_end_from_the_other_end_and_its_deformations(type_, end):
+    # From a random configuration (beams bent by more than 90° too): the solved end reproduces e
+    # exactly, the other end is kept, and from a guess near the configuration (angles a turn
+    # away too) it is the configuration itself: the branch of the arcsines and the turn of the
+    # rotation are the guess's.
+    c = CASES[type_]
+    solved = slice(3, 6) if end == 1 else slice(0, 3)
+    kept = slice(0, 3) if end == 1 else slice(3, 6)
+    checked = 0
+    for rng, ref, k, x in c.samples("solve_end"):
+        assert k.has_closed_form
+        e = k.deformations(x)
+        alpha0 = ref.lgeomy[0] if ref.lgeomy else 0.0
+        alpha = math.atan2(x[4] - x[1], x[3] - x[0])
+        if min(abs(math.cos(alpha0 + x[2] - alpha)), abs(math.cos(alpha - alpha0 - x[5]))) < 0.2:
+            continue  # a bend near 90°: a guess 0.05 away may lie on the other branch
+        turn = 2 * math.pi * rng.integers(-2, 3)
+        guess, expected = x.copy(), x.copy()
+        guess[solved] += np.append(rng.normal(scale=0.01 * ref.l0, size=2), rng.normal(scale=0.01) + turn)
+        expected[solved.stop - 1] += turn
+        y = k.solve_end(end, e, guess, guess)
+        np.testing.assert_array_equal(y[kept], x[kept])
+        np.testing.assert_allclose(k.deformations(y), e, rtol=0, atol=1e-13 * ref.l0)
+        np.testing.assert_allclose(y, expected, rtol=0, atol=1e-12 * max(ref.l0, 1.0))
+        checked += 1
+    assert checked >= 5
+
+
+@pytest.mark.parametrize("type_", BEAMS)
+def test_beam_end_outside_the_range_of_its_deformations_is_declined(type_):
+    c = CASES[type_]
+    for _, ref, k, x in c.samples("solve_end range", n=3):
+        for e in ([-2 * ref.l0, 0.0, 0.0], [0.0, 1.5 * ref.l0, 0.0], [0.0, 0.0, -1.01 * ref.l0]):
+            assert k.solve_end(1, np.array(e), x, x) is None
+    assert not any(_testing.element_kernel(t).has_closed_form for t in ("PLTRUSS", "PLHINGE"))
+
+
+@pytest.mark.parametrize("type_", BEAMS)
+def test_beam_end_follows_its_known_end_with_the_guess_branches(type_):
+    # The known end turned and moved rigidly since the guess (as the blocks before it in a chain):
+    # the solved end turns and moves with it, bent as the guess on each branch.
+    c = CASES[type_]
+    for rng, ref, k, x in c.samples("solve_end rigid"):
+        e = k.deformations(x)
+        angle, shift = rng.uniform(-1.0, 1.0), rng.normal(size=2)
+        rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+        moved = x.copy()
+        moved[0:2] = rot @ x[0:2] + shift
+        moved[3:5] = rot @ x[3:5] + shift
+        moved[[2, 5]] += angle
+        start = moved.copy()
+        start[3:6] = x[3:6]  # the solved end still where the guess has it
+        y = k.solve_end(1, e, x, start)
+        np.testing.assert_allclose(y, moved, rtol=0, atol=1e-12 * max(ref.l0, 1.0) * (1 + np.abs(x).max()))

@@ -34,11 +34,12 @@ void bind_chain(py::module_& m) {
         out["e"] = d.e;
         out["ed"] = d.ed;
         out["blocks"] = chain->blocks();
+        out["closed_form_blocks"] = chain->closed_form_blocks();
         out["newton_iterations"] = d.newton_iterations;
         return out;
       },
       py::arg("simulation"), py::arg("t"), py::arg("q"), py::arg("qd"),
       "The right-hand side's state by the explicit chain at (t, q, q̇), starting from the simulation's "
-      "current positions (a dict of x, xd, xdd, qdd, e, ed, blocks, newton_iterations; None if the system "
+      "current positions (a dict of x, xd, xdd, qdd, e, ed, blocks, closed_form_blocks, newton_iterations; None if the system "
       "is not an open chain). The simulation's data is left at that state.");
 }

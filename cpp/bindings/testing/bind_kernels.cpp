@@ -51,6 +51,16 @@ void bind_kernels(py::module_& m) {
              h.k->rates(x.data(), v.data(), r.data());
              return r;
            })
+      .def("solve_end",  // x with one end solved from the other and e, or None (no closed form)
+           [](const KernelHandle& h, int end, const Eigen::VectorXd& e, const Eigen::VectorXd& guess,
+              Eigen::VectorXd x) -> py::object {
+             h.check(x, h.nc(), "x");
+             h.check(guess, h.nc(), "guess");
+             h.check(e, h.nd(), "e");
+             if (!h.k->solve_end(end, e.data(), guess.data(), x.data())) return py::none();
+             return py::cast(x);
+           })
+      .def_property_readonly("has_closed_form", [](const KernelHandle& h) { return h.k->has_closed_form(); })
       .def("velocity_level", [](const KernelHandle& h, int i) { return h.k->velocity_level(i); })
       .def("period", [](const KernelHandle& h, int i) { return h.k->period(i); })
       .def("convective",

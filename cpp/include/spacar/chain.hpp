@@ -6,7 +6,8 @@
 // a rigid or flexible tree. Each step is a Newton iteration of the element's few coordinates (one
 // or two iterations from the predicted positions), instead of a Newton iteration on all
 // calculable coordinates with a sparse factorization per iteration; the velocities follow in the
-// same order from the element's small linear system. The first Newton step is that of all
+// same order from the element's small linear system. Planar beams need no iteration: their
+// deformations invert in closed form (ElementKernel::solve_end). The first Newton step is that of all
 // coordinates together (the block-triangular Jacobian, solved block by block), so that the motion
 // of the coordinates a block starts from reaches its own before its iterations.
 //
@@ -18,6 +19,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -41,6 +43,9 @@ class ExplicitChain {
   void solve_velocities(const System& sys, Data& data);
 
   int blocks() const { return static_cast<int>(blocks_.size()); }
+  int closed_form_blocks() const {  // solved without iterations (Block::closed_end)
+    return static_cast<int>(std::count_if(blocks_.begin(), blocks_.end(), [](const Block& b) { return b.closed_end >= 0; }));
+  }
 
  private:
   struct Row {
@@ -59,15 +64,31 @@ class ExplicitChain {
       int j, slot, local, coord, target;
     };
     std::vector<Term> unknown_terms, known_terms;
+    // A single element whose deformations are the block's rows and whose unknowns are one end's
+    // coordinates: that end (0 or 1) if the element solves it in closed form
+    // (ElementKernel::solve_end), -1 otherwise. guess: its coordinates at the starting positions
+    // (taken before any block moves them); local_x, local_e: its coordinates and the rows' values.
+    int closed_end = -1;
+    std::vector<double> guess, local_x, local_e;
     Eigen::MatrixXd A;                    // ∂(rows)/∂(unknowns)
     Eigen::VectorXd r, dx;
   };
   void assemble(const Data& data, Block& b) const;
   // Σ over the known coordinates of B(row, l) v[coord], per row of the block, added to b.r.
   void add_known(const Data& data, Block& b, const Eigen::VectorXd& v, double sign) const;
+  // One Newton step of all calculable coordinates, block by block (see solve_positions).
+  void first_step(const System& sys, Data& data);
+  // Newton on one block's coordinates; the iterations taken.
+  int iterate(const System& sys, Data& data, Block& b, int max_iter, double tol) const;
+  // The block's coordinates in closed form (Block::closed_end); false if the element declines.
+  bool solve_closed(const System& sys, Data& data, Block& b) const;
+  static int closed_end(const System& sys, const Block& b);
+  // The block of `group`'s position rows on the unknowns U.
+  static Block make_block(const System& sys, const std::vector<int>& group, const std::vector<int>& U);
   static KinematicsError singular(const System& sys, const Data& data, const Block& b, const char* what);
 
   std::vector<Block> blocks_;
+  bool all_closed_ = false;  // every block in closed form: no first Newton step of all coordinates
   std::vector<int> rest_;  // elements without position rows: evaluated once at the end
   Eigen::VectorXd step_;   // the first Newton step of all coordinates (work space)
 };

@@ -55,6 +55,15 @@ class ElementKernel {
   // derivative of D along v, velocity-level rows from the element's slip-rate function.
   virtual void rates(const double* x, const double* v, double* edot) const = 0;
 
+  // The closed-form inverse of the deformations, where the element has one (the planar beams):
+  // the coordinates of one end (`end` 0: the first node pair's, 1: the second's) from those of the
+  // other end and the deformation values e, written over that end's coordinates in x (all the
+  // element's coordinates). `guess`: all its coordinates in a nearby state, whose branch of each
+  // angle (a beam bent by less or more than 90°) and turn of the rotation are kept. False where
+  // there is no closed form or e lies outside its range: the caller iterates.
+  virtual bool solve_end(int end, const double* e, const double* guess, double* x) const { return false; }
+  virtual bool has_closed_form() const { return false; }  // solve_end is implemented
+
   // Constitutive matrix from ESTIFF (or, in the same form, EDAMPP) values: σ = S e (+ D ė).
   // Zero for elements without stiffness data.
   virtual void constitutive(const std::vector<double>& values, double* S) const;
