@@ -267,10 +267,10 @@ void Simulation::move_to(double t, const double* q, const double* qd) {
 
 void Simulation::forces() { nodal_reactions(*sys_, *data_); }
 
-Linearization Simulation::linearize() {
+Linearization Simulation::linearize(bool precise) {
   forces();
   if (!linearizer_) linearizer_ = std::make_unique<Linearizer>(model_, dependent_);
-  return linearizer_->compute(*sys_, *data_);
+  return linearizer_->compute(*sys_, *data_, precise);
 }
 
 void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {

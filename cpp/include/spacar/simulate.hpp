@@ -158,7 +158,7 @@ class Simulation {
   // Reactions and complete stresses (FORCEMODE) at the state of the last evaluate().
   void forces();
   // Linearized equations at the state of the last evaluate() (computes the forces first).
-  Linearization linearize();
+  Linearization linearize(bool precise = true);  // precise: see Linearizer::compute
   // Complete state at (t, Y), Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
   void evaluate_state(double t, const Eigen::VectorXd& Y);
   // Right-hand side of the first-order system Y = (q, y, q̇).
