@@ -173,19 +173,27 @@ class Results:
         self._set_dofs(dof_labels)
 
     def _set_dofs(self, labels):
-        # Each DOF is a column of x (DYNX) or of e (DYNE): res.q gathers them in the DOF order.
         self.dof_labels = [str(lbl) for lbl in labels]
-        self._dof_x, self._dof_e = ([], []), ([], [])  # (positions in q, columns of x / e)
-        for j, lbl in enumerate(self.dof_labels):
-            attr, col = self.column(lbl)
-            target = self._dof_x if attr == "x" else self._dof_e
-            target[0].append(j)
-            target[1].append(col)
+        self._dof_columns = None  # found at the first use (a short run's results stay cheap)
+
+    def _dof_places(self) -> dict:
+        """{"x" or "e": (positions in q, columns of x or e)}: each DOF is a column of x (DYNX)
+        or of e (DYNE)."""
+        if self._dof_columns is None:
+            columns = {"x": ([], []), "e": ([], [])}
+            for j, lbl in enumerate(self.dof_labels):
+                attr, col = self.column(lbl)
+                columns[attr][0].append(j)
+                columns[attr][1].append(col)
+            self._dof_columns = columns
+        return self._dof_columns
 
     def _dof_values(self, x, e) -> np.ndarray:
+        places = self._dof_places()
+        (jx, cx), (je, ce) = places["x"], places["e"]
         out = np.empty((len(self.t), len(self.dof_labels)))
-        out[:, self._dof_x[0]] = x[:, self._dof_x[1]]
-        out[:, self._dof_e[0]] = e[:, self._dof_e[1]]
+        out[:, jx] = x[:, cx]
+        out[:, je] = e[:, ce]
         return out
 
     @property
@@ -230,6 +238,7 @@ class Results:
         self.__dict__.update(state)
         if "dof_labels" not in state:  # pickled before the results had their DOFs
             self._set_dofs(())
+        self.__dict__.setdefault("_dof_columns", None)
         self.geometry = geometry
 
     @property
@@ -707,6 +716,7 @@ def _load(cls, path: str) -> "Results":
     geometry = None if meta["geometry"] is None else Geometry.from_dict(meta["geometry"])
     res = cls(arrays, coord, defs, meta["stats"], geometry, lins, meta["settings_linear"],
               meta.get("dof_labels", ()))  # (files written before the DOFs were saved lack them)
+    res._dof_places()  # the DOF labels name coordinates and deformations of the file
     if energy is not None:
         res._energy = energy
     return res

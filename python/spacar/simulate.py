@@ -121,12 +121,15 @@ def _assembly_moves(positions: dict, system, x0) -> list:
         return []
     points = np.concatenate([p for p in positions.values()])
     size = float(np.ptp(points)) if points.size else 0.0
-    moved: dict = {}
-    for (n, i), value in zip(system.coord_label, x0):
-        if n in positions:
-            moved.setdefault(n, positions[n].copy())[i - 1] = value
+    labels = [(int(n), int(i)) for n, i in system.coord_label]
+    given = np.array([positions[n][i - 1] if n in positions else np.nan for n, i in labels])
+    far = np.abs(np.asarray(x0, dtype=float) - given) > 1e-3 * size / np.sqrt(3.0)  # a component moved far
     warnings = []
-    for n, x in moved.items():
+    for n in dict.fromkeys(labels[g][0] for g in np.flatnonzero(far)):  # in coordinate order
+        x = positions[n].copy()
+        for g, (m, i) in enumerate(labels):
+            if m == n:
+                x[i - 1] = x0[g]
         distance = float(np.linalg.norm(x - positions[n]))
         if distance > 1e-3 * size:
             warnings.append(f"the assembly moved node {n} by {distance:.4g} from its X position "
