@@ -20,7 +20,10 @@ from spacar.compare import models
 METHODS = ["dop853", "radau5", "auto"]
 RHO = [0.6, 0.8, 1.0]                 # exudyn generalized-α spectral radii ρ∞ (its default: 0.9)
 GA_RHO = [0.8, 1.0]                   # spacar's generalized-α: the spectral radii tried (best reported)
-GA_FIXED_EPS = 1e-7                   # its fixed-step runs: EPSINT = EPSIND, which only stop its Newton iterations
+GA_FIXED_EPS = [1e-7, 1e-5, 1e-3]     # its fixed-step runs: EPSINT = EPSIND, which only stop its Newton iterations
+# exudyn's Newton relative tolerance, swept as spacar's EPS of the fixed-step runs (None: its default
+# 1e-8, or the reference's where that stalls): each program at its best settings.
+EXUDYN_NEWTON_RTOL = [None, 1e-6, 1e-4]
 EI_ROD = 0.0012723                    # the manual's rod
 
 FULL = {
@@ -94,11 +97,11 @@ def _sweep(settings, run_one, target, budget):
     return out
 
 
-def _spacar_series(case, cfg, variant, method, ref, target, quick, eps_list, fixed=False, **options):
-    """A sweep of EPS (fixed=False) or, for generalized_alpha with fixed=True, of the fixed step h
-    at EPS = GA_FIXED_EPS; options: further arguments of simulate (rho_inf)."""
+def _spacar_series(case, cfg, variant, method, ref, target, quick, eps_list, fixed=None, **options):
+    """A sweep of EPS (fixed None) or, for generalized_alpha with fixed = an EPS, of the fixed step h
+    at EPS = fixed (a number); options: further arguments of simulate (rho_inf)."""
     def one(setting):
-        eps = GA_FIXED_EPS if fixed else setting
+        eps = fixed if fixed else setting
         run_options = dict(options, **({"fixed_step": setting} if fixed else {}))
         m = BUILD[case](variant, cfg["t_end"], eps)
         label = f"{method} {' '.join(f'{k}={v:g}' for k, v in run_options.items())} {'h' if fixed else 'eps'}={setting:g}"
@@ -188,23 +191,24 @@ def run_case(case, quick):
                           for m in METHODS}}
         row["spacar_ga"] = {f"ρ∞={rho:g}": _spacar_series(case, cfg, variant, "generalized_alpha", ref, target, quick,
                                                           cfg_all["eps"], rho_inf=rho) for rho in GA_RHO}
-        row["spacar_ga_fixed"] = {f"ρ∞={rho:g}": _spacar_series(case, cfg, variant, "generalized_alpha", ref, target,
-                                                                quick, cfg_all["steps"], fixed=True, rho_inf=rho)
-                                  for rho in GA_RHO}
+        row["spacar_ga_fixed"] = {f"ρ∞={rho:g}, EPS {eps:g}": _spacar_series(
+            case, cfg, variant, "generalized_alpha", ref, target, quick, cfg_all["steps"], fixed=eps, rho_inf=rho)
+            for rho in GA_RHO for eps in GA_FIXED_EPS}
         em = sx.build(BUILD[case](variant, cfg["t_end"], 1e-6),
                       **({"axial_stiffness": 1e4 * 175.0} if case == "cantilever" else {}))
         ex_ref, row["exudyn_reference_newton_rtol"] = _exudyn_reference(em, case, cfg, variant)
         if ex_ref is None:
-            row["model_difference"], row["exudyn"] = None, {f"GA ρ∞={rho:g}": [] for rho in RHO}
-            row["exudyn"]["trapezoidal"] = []
+            row["model_difference"], row["exudyn"], row["exudyn_trapezoidal"] = None, {}, {}
             out[variant] = row
             continue
         row["model_difference"] = float(np.abs(ex_ref - ref).max())
-        nrt = row["exudyn_reference_newton_rtol"]
-        row["exudyn"] = {f"GA ρ∞={rho:g}": _exudyn_series(em, case, cfg, variant, "generalized_alpha", rho, ex_ref,
-                                                          target, quick, cfg_all["steps"], nrt) for rho in RHO}
-        row["exudyn"]["trapezoidal"] = _exudyn_series(em, case, cfg, variant, "trapezoidal", None, ex_ref, target,
-                                                      quick, cfg_all["steps"], nrt)
+        rtols = [r or row["exudyn_reference_newton_rtol"] for r in EXUDYN_NEWTON_RTOL]
+        newton = lambda r: f", Newton {r:g}" if r else ""   # noqa: E731
+        row["exudyn"] = {f"GA ρ∞={rho:g}{newton(r)}": _exudyn_series(em, case, cfg, variant, "generalized_alpha", rho,
+                                                                     ex_ref, target, quick, cfg_all["steps"], r)
+                         for rho in RHO for r in rtols}
+        row["exudyn_trapezoidal"] = {f"trapezoidal{newton(r)}": _exudyn_series(
+            em, case, cfg, variant, "trapezoidal", None, ex_ref, target, quick, cfg_all["steps"], r) for r in rtols}
         out[variant] = row
     return out
 
@@ -259,8 +263,8 @@ def _table(res, case, cfg):
         sp = {m: steady(row["spacar"][m], target) for m in METHODS}
         sga_key, sga = _best_of(row.get("spacar_ga", {}), target)
         sgf_key, sgf = _best_of(row.get("spacar_ga_fixed", {}), target)
-        ga_key, ga = _best_of({k: v for k, v in row["exudyn"].items() if k != "trapezoidal"}, target)
-        tr = steady(row["exudyn"]["trapezoidal"], target)
+        ga_key, ga = _best_of(row["exudyn"], target)
+        tr_key, tr = _best_of(row["exudyn_trapezoidal"], target)
         best_sp = min((v["wall"] for v in [*(v for k, v in sp.items() if k != "dop853"), sga, sgf] if v is not None),
                       default=None)
         best_ex = min((v["wall"] for v in (ga, tr) if v is not None), default=None)
@@ -269,7 +273,7 @@ def _table(res, case, cfg):
         keyed = lambda r, k, fmt: "—" if r is None else f"{_cell(r, fmt)} ({k.replace('GA ', '')})"  # noqa: E731
         lines.append(f"| {variant} | {target:.1e} | {_cell(sp['dop853'], eps)} | {_cell(sp['radau5'], eps)} | {_cell(sp['auto'], eps)} | "
                      f"{keyed(sga, sga_key, eps)} | {keyed(sgf, sgf_key, step)} | "
-                     f"{keyed(ga, ga_key, step)} | {_cell(tr, step)} | {C.fmt_ratio(best_ex, best_sp)} | "
+                     f"{keyed(ga, ga_key, step)} | {keyed(tr, tr_key, step)} | {C.fmt_ratio(best_ex, best_sp)} | "
                      f"{C.fmt_ratio(sp['dop853'] and sp['dop853']['wall'], best_sp)} | "
                      f"{C.fmt_err(row['model_difference'])} | {' / '.join(_steps_at(row['spacar'][m], eps0) for m in METHODS)} |")
     return lines
@@ -299,14 +303,17 @@ def section_lines(res) -> list:
              "*steady* time to the target (the fastest run from which on every tighter run of the series reaches it) "
              "/ its steps / its setting; \"—\": the series did not reach the target within the limits. spacar's "
              f"generalized-α: ρ∞ = {', '.join(f'{r:g}' for r in GA_RHO)} (the best reported), with its error control "
-             f"(EPS as above) and with fixed steps h as exudyn's (EPS = {GA_FIXED_EPS:g} then only stops its Newton "
-             "iterations). Ratios against the fastest of radau5, auto and generalized-α. The last column, the steps at the loosest setting (reached "
+             f"(EPS as above) and with fixed steps h as exudyn's (EPS = {', '.join(f'{e:g}' for e in GA_FIXED_EPS)} "
+             "then only stops its Newton iterations; the best reported); exudyn's Newton relative tolerance "
+             f"{', '.join('its default' if r is None else f'{r:g}' for r in EXUDYN_NEWTON_RTOL)} (the best reported). "
+             "Ratios against the fastest of radau5, auto and generalized-α. The last column, the steps at the loosest setting (reached "
              "by every series), shows the growth with the stiffness itself: DOP853's steps are set by "
              "stability there.", ""]
     loose = [f"{case} {v}" for case in ("slidercrank", "cantilever") for v, row in res[case].items()
              if row.get("exudyn_reference_newton_rtol")]
     if loose:
-        lines += [f"exudyn with Newton tolerance 1e-6 relative (its default 1e-8 stalls at its reference step): "
+        lines += [f"exudyn's reference with Newton tolerance 1e-6 relative (its default 1e-8 stalls at its reference step; "
+                  f"then also in place of the default in the sweep): "
                   f"{', '.join(loose)}.", ""]
     for case, title in (("slidercrank", "Slider-crank, rod EI × k"), ("cantilever", "Steel cantilever, n PLBEAMs")):
         lines += [f"**{title}**: wall time / steps / setting", "", *_table(res, case, cfg), ""]
