@@ -206,15 +206,18 @@ bool ExplicitChain::solve_closed(const System& sys, Data& data, Block& b) const 
   return true;
 }
 
-void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter, double tol) {
+void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter, double tol,
+                                    const Eigen::VectorXd* reference) {
   set_targets(sys, data);
-  // The closed-form blocks keep the branches of their starting positions: taken before the
-  // blocks before them move their known end.
+  // The closed-form blocks keep the branches of a solved state, not of the starting positions
+  // extrapolated from it: an extrapolation over a long trial step of an implicit integrator may
+  // fold a beam, which Newton's method would not follow, and a closed form would.
+  const Eigen::VectorXd& ref = reference ? *reference : data.x;
   for (Block& b : blocks_) {
     if (b.closed_end < 0) continue;
     const std::vector<int>& coords = sys.elements[b.elements.front()].coords;
     b.guess.resize(coords.size());
-    for (size_t l = 0; l < coords.size(); ++l) b.guess[l] = data.x[coords[l]];
+    for (size_t l = 0; l < coords.size(); ++l) b.guess[l] = ref[coords[l]];
   }
   if (!all_closed_) first_step(sys, data);
   int most = 0;

@@ -158,17 +158,19 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
     positions.xd = positions.xdd = Eigen::VectorXd::Zero(sys.nx);
     predict_from(positions, t, q);
   }
-  // Right-hand sides of an open chain: positions and velocities element by element (chain.hpp);
-  // other evaluations also factorize the velocity block, which the forces and transfer use.
-  ExplicitChain* chain = in_rhs_ ? chain_.get() : nullptr;
+  // An open chain's positions element by element (chain.hpp), and in right-hand sides also its
+  // velocities; other evaluations factorize the velocity block, which the forces and transfer use.
+  ExplicitChain* chain = chain_.get();
   // Inside the integrator the positions must continue those of the step start (the anchor). An
   // explicit chain, whose elements' iterations start from their predicted positions one by one,
   // is held to that only from an exact anchor: an approximate one (generalized-α's last iterate)
   // differs by up to a Newton increment, which would reject good steps.
   const bool anchored = in_rhs_ && anchor_.valid;
   const bool check = anchored && !(chain && !anchor_.exact);
+  const Solved& solved = anchored ? anchor_ : base_;  // the chain's branches: of the step start
   auto positions = [&]() {
-    if (chain) chain->solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin);
+    if (chain)
+      chain->solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, solved.valid ? &solved.x : nullptr);
     else solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
   };
   std::string why;
@@ -189,7 +191,7 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
     positions();
     if (check && !continuous_with_step_start(why)) throw KinematicsError(why);
   }
-  if (chain) chain->solve_velocities(sys, *data_);
+  if (chain && in_rhs_) chain->solve_velocities(sys, *data_);
   else solve_velocities_direct(sys, *data_);
   solve_dynamics_direct(sys, *data_);
   remember(base_);

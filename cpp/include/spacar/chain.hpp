@@ -38,7 +38,11 @@ class ExplicitChain {
   // the calculable coordinates holding the starting guess), as solve_positions() leaves them:
   // e and B evaluated at the solution, data.residual and the iteration counters set. Throws
   // KinematicsError when an element's iteration does not converge in max_iter iterations.
-  void solve_positions(const System& sys, Data& data, int max_iter, double tol);
+  // `reference`: the positions of a nearby solved state (the step start) whose branches the
+  // closed-form blocks keep (a beam bent by less or more than 90°, the turn of a rotation);
+  // nullptr: the starting positions in data.
+  void solve_positions(const System& sys, Data& data, int max_iter, double tol,
+                       const Eigen::VectorXd* reference = nullptr);
   // ẋ of the calculable coordinates, ė and the convective terms, as solve_velocities_direct().
   void solve_velocities(const System& sys, Data& data);
 
@@ -66,8 +70,8 @@ class ExplicitChain {
     std::vector<Term> unknown_terms, known_terms;
     // A single element whose deformations are the block's rows and whose unknowns are one end's
     // coordinates: that end (0 or 1) if the element solves it in closed form
-    // (ElementKernel::solve_end), -1 otherwise. guess: its coordinates at the starting positions
-    // (taken before any block moves them); local_x, local_e: its coordinates and the rows' values.
+    // (ElementKernel::solve_end), -1 otherwise. guess: its coordinates in the reference state;
+    // local_x, local_e: its coordinates and the rows' values.
     int closed_end = -1;
     std::vector<double> guess, local_x, local_e;
     Eigen::MatrixXd A;                    // ∂(rows)/∂(unknowns)
