@@ -8,6 +8,7 @@
 
 #include <Eigen/Sparse>
 
+#include "spacar/chain.hpp"
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
@@ -16,7 +17,7 @@ namespace spacar {
 
 
 Linearizer::Linearizer(const Model& model, const std::map<int, int>& dependent)
-    : lin_(compile(model, dependent, true)), ld_(std::make_unique<Data>(*lin_)) {}
+    : lin_(compile(model, dependent, true)), ld_(std::make_unique<Data>(*lin_)), chain_(ExplicitChain::detect(*lin_)) {}
 
 void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd, bool transfer) {
   const System& L = *lin_;
@@ -29,7 +30,13 @@ void Linearizer::set_z(const Eigen::VectorXd& z, const Eigen::VectorXd& zd, bool
   for (int i = 0; i < L.n_input(); ++i) set_input(L, *ld_, i, inputs_(i, 0), inputs_(i, 1), inputs_(i, 2));
   set_dofs(L, *ld_, q.data(), qd.data());
   const double tol = std::min(L.settings.epskin, 1e-10);
-  solve_positions(L, *ld_, std::max(L.settings.maxiterat, 50), tol, false);
+  // The perturbed positions of an open chain element by element (chain.hpp; the branches of the
+  // nominal state, where ld_ starts); the nominal ones on the general path, for the transfer.
+  // The velocities always factorize the velocity block: the residual's projection solves with it.
+  if (chain_ && !transfer)
+    chain_->solve_positions(L, *ld_, std::max(L.settings.maxiterat, 50), tol);
+  else
+    solve_positions(L, *ld_, std::max(L.settings.maxiterat, 50), tol, false);
   if (transfer) solve_transfer(L, *ld_);
   solve_velocities_direct(L, *ld_);
 }

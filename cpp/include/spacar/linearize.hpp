@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "spacar/chain.hpp"
 #include "spacar/data.hpp"
 #include "spacar/model.hpp"
 #include "spacar/system.hpp"
@@ -62,6 +63,7 @@ class Linearizer {
   Eigen::MatrixXd inputs_;
   std::unique_ptr<Data> ld_;
   std::vector<int> order_;      // z index → DOF index of the linearization system
+  std::unique_ptr<ExplicitChain> chain_;  // the perturbed positions of an open chain; nullptr otherwise
 };
 
 }  // namespace spacar
