@@ -8,14 +8,9 @@
 namespace spacar {
 namespace {
 
-constexpr int kMaxNewton = 7;
-constexpr double kSafety = 0.9;
-constexpr double kMinError = 1e-10;
 // Newton stops when the predicted remaining error of the states is below this fraction of the
 // tolerance (the scaled norm in which the local error must stay below 1).
 constexpr double kNewtonTolerance = 0.02;
-const double kRound = std::numeric_limits<double>::epsilon();
-
 
 }  // namespace
 
@@ -295,7 +290,7 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
       result = Attempt::Rejected;
     }
     // The local error behaves as h³.
-    const double quot = std::clamp(std::cbrt(err) / kSafety, 0.2, 5.0);
+    const double quot = std::clamp(std::cbrt(err) / kStepSafety, 0.2, 5.0);
     if (result != Attempt::Accepted) {
       ++stats_.nreject;
       rejected = true;

@@ -200,7 +200,6 @@ constexpr Scheme kDopri5{6, 7, 1, 5.0, 0.2, 10.0, true, 3.25, kC5, kA5, kD5};
 
 const Scheme& scheme(Method m) { return m == Method::DOP853 ? kDop853 : kDopri5; }
 
-constexpr double kSafety = 0.9;
 
 // out = y + h * sum_j row[j] * k[j] over the first `count` stages (zero weights skipped: the
 // tableaux are sparse).
@@ -431,7 +430,7 @@ Integrator::Attempt Integrator::attempt_step(const Rhs& f, double t, double h, d
 // Step-size ratio the last error norm asks for, before the limits: the error scales as h^q.
 double Integrator::step_factor() const {
   const Scheme& sc = scheme(method_);
-  return err_ == 0.0 ? sc.fac_max : kSafety * std::pow(err_, -1.0 / sc.q);
+  return err_ == 0.0 ? sc.fac_max : kStepSafety * std::pow(err_, -1.0 / sc.q);
 }
 
 // Coefficients F of y(t + theta h) = y + theta (F0 + (1-theta) (F1 + theta (F2 + (1-theta) (F3

@@ -58,12 +58,6 @@ const Tableau& tableau() {
   return tb;
 }
 
-constexpr int kMaxNewton = 7;       // Hairer's NIT
-constexpr double kSafety = 0.9;
-constexpr double kMinError = 1e-10;
-const double kRound = std::numeric_limits<double>::epsilon();
-
-
 double scaled_rms(const Eigen::VectorXd& v, const Eigen::VectorXd& scale) {
   return std::sqrt((v.array() / scale.array()).square().sum() / static_cast<double>(v.size()));
 }
@@ -196,7 +190,6 @@ void reduced_matrix(const Eigen::MatrixXd& J, int m, Scalar sigma, Matrix& E, Ma
   E.rightCols(r - m) = -J.block(m, m, r, r - m).template cast<Scalar>();
   E.topRightCorner(r - m, r - m).diagonal().array() += sigma;
 }
-
 
 // LU factorization with partial pivoting in place (A = P L U, piv the row interchanges), and the
 // solve with it. The Newton matrices are small (the DOFs of a structure, tens): a plain
@@ -473,7 +466,7 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
     }
 
     // Hairer's step-size proposal: the error behaves as h^4; fewer Newton iterations, more trust.
-    const double fac = std::min(kSafety, kSafety * (1 + 2 * kMaxNewton) / (newton_its_ + 2 * kMaxNewton));
+    const double fac = std::min(kStepSafety, kStepSafety * (1 + 2 * kMaxNewton) / (newton_its_ + 2 * kMaxNewton));
     double quot = std::clamp(std::pow(err_, 0.25) / fac, 0.125, 5.0);
     if (result != Attempt::Accepted) {
       ++stats_.nreject;
@@ -492,7 +485,7 @@ double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd&
     ++accepted_here;
     if (accepted_here > 1) {
       // Predictive controller (Gustafsson): use the trend of the last two errors.
-      const double gus = std::clamp((h_acc / h_try) * std::pow(err_ * err_ / err_acc, 0.25) / kSafety, 0.125, 5.0);
+      const double gus = std::clamp((h_acc / h_try) * std::pow(err_ * err_ / err_acc, 0.25) / kStepSafety, 0.125, 5.0);
       quot = std::max(quot, gus);
     }
     h_acc = h_try;

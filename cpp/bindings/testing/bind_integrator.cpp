@@ -14,7 +14,7 @@ namespace py = pybind11;
 
 namespace {
 
-py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, double t_end,
+py::dict solve_explicit(const py::function& f, double t0, const Eigen::VectorXd& y0, double t_end,
                const std::vector<double>& touts, double rtol, double atol,
                const std::string& method, double hmax, bool detect_stiffness) {
   const int n = static_cast<int>(y0.size());
@@ -52,7 +52,7 @@ py::dict solve(const py::function& f, double t0, const Eigen::VectorXd& y0, doub
 }  // namespace
 
 void bind_integrator(py::module_& m) {
-  m.def("explicit_rk_solve", &solve, py::arg("f"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
+  m.def("explicit_rk_solve", &solve_explicit, py::arg("f"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
         py::arg("touts"), py::arg("rtol"), py::arg("atol"), py::arg("method") = "dop853",
         py::arg("hmax") = std::numeric_limits<double>::infinity(), py::arg("detect_stiffness") = false,
         "Test helper: integrate dy/dt = f(t, y) from t0 to t_end with the embedded Runge-Kutta "

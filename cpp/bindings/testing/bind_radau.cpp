@@ -47,7 +47,7 @@ double integrate_python(Integ& integrator, const py::function& f, const py::func
   return integrator.integrate(rhs, t0, t_end, y, touts, out);
 }
 
-py::dict solve(const py::function& f, const py::function& jac, double t0, const Eigen::VectorXd& y0,
+py::dict solve_radau5(const py::function& f, const py::function& jac, double t0, const Eigen::VectorXd& y0,
                double t_end, const std::vector<double>& touts, double rtol, double atol, double hmax,
                double first_step, double nonstiff_bound) {
   const int n = static_cast<int>(y0.size());
@@ -85,7 +85,7 @@ py::dict solve_generalized_alpha(const py::function& f, const py::function& jac,
 }  // namespace
 
 void bind_radau(py::module_& m) {
-  m.def("radau5_solve", &solve, py::arg("f"), py::arg("jac"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
+  m.def("radau5_solve", &solve_radau5, py::arg("f"), py::arg("jac"), py::arg("t0"), py::arg("y0"), py::arg("t_end"),
         py::arg("touts"), py::arg("rtol"), py::arg("atol"),
         py::arg("hmax") = std::numeric_limits<double>::infinity(), py::arg("first_step") = 0.0,
         py::arg("nonstiff_bound") = 0.0,

@@ -7,11 +7,19 @@
 
 #include <Eigen/Dense>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace spacar {
+
+// Constants of the step-size control and of the simplified Newton iterations that the
+// integrators share (Hairer's values in DOP853 and RADAU5).
+constexpr double kStepSafety = 0.9;          // safety factor of the step-size control
+constexpr int kMaxNewton = 7;                // RADAU5's NIT; generalized-α's too
+constexpr double kMinError = 1e-10;          // floor of a scaled error in the step-size formulas
+constexpr double kRound = std::numeric_limits<double>::epsilon();  // the unit round-off
 
 // Thrown by a right-hand side to ask the integrator to reject the current step and retry with half
 // the step (e.g. Newton iteration failed inside the rhs).
