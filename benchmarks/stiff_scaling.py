@@ -202,7 +202,7 @@ def run_case(case, quick):
             out[variant] = row
             continue
         row["model_difference"] = float(np.abs(ex_ref - ref).max())
-        rtols = [r or row["exudyn_reference_newton_rtol"] for r in EXUDYN_NEWTON_RTOL]
+        rtols = list(dict.fromkeys(r or row["exudyn_reference_newton_rtol"] for r in EXUDYN_NEWTON_RTOL))
         newton = lambda r: f", Newton {r:g}" if r else ""   # noqa: E731
         row["exudyn"] = {f"GA ρ∞={rho:g}{newton(r)}": _exudyn_series(em, case, cfg, variant, "generalized_alpha", rho,
                                                                      ex_ref, target, quick, cfg_all["steps"], r)

@@ -110,14 +110,15 @@ void bind_simulation(py::module_& m) {
       .def_readonly("newton_iterations", &Data::newton_iterations);
 
   py::class_<Simulation>(m, "Simulation")
-      .def(py::init([](Model& model, double time_limit) {
+      .def(py::init([](Model& model, double time_limit, double time_spent) {
              // The set-up (the model's preparation, compilation and work arrays) is bounded by
              // the analysis's time limit as the run is.
-             const DeadlineScope deadline(time_limit);
+             const DeadlineScope deadline(time_limit, time_spent);
              return std::make_unique<Simulation>(model);
            }),
-           py::arg("model"), py::arg("time_limit") = 0.0, py::keep_alive<1, 2>(),
-           "Prepare and compile `model` for its analyses; `time_limit`: seconds the set-up may take (0: no limit).")
+           py::arg("model"), py::arg("time_limit") = 0.0, py::arg("time_spent") = 0.0, py::keep_alive<1, 2>(),
+           "Prepare and compile `model` for its analyses within `time_limit` seconds (0: no limit) of which "
+           "`time_spent` are spent.")
       .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", &Simulation::assemble)

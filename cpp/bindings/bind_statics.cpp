@@ -60,6 +60,8 @@ void bind_statics(py::module_& m) {
           } catch (const StaticError&) {  // with the converged steps
             failure = std::current_exception();
           } catch (const TimeLimitError&) {
+            // With the converged steps once the rows exist; stopped in the set-up, without.
+            if (r.x.cols() == 0) throw;
             failure = std::current_exception();
           }
         }

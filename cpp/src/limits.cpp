@@ -1,5 +1,6 @@
 #include "spacar/limits.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -40,17 +41,21 @@ void check_thread_deadline(const char* where) {
   if (thread_deadline_passed()) throw_time_limit(where);
 }
 
-DeadlineScope::DeadlineScope(double limit, double spent) {
-  if (limit > 0.0 && std::isfinite(limit))
-    set_thread_deadline(std::chrono::steady_clock::now() +
-                            std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                std::chrono::duration<double>(limit - spent)),
-                        limit);
-  else
-    clear_thread_deadline();
+DeadlineScope::DeadlineScope(double limit, double spent)
+    : outer_active_(t_deadline.active), outer_limit_(t_deadline.seconds), outer_at_(t_deadline.at) {
+  constexpr double kNoLimit = 1e9;  // seconds (31 years): also keeps the clock arithmetic finite
+  if (!(limit > 0.0 && limit < kNoLimit)) return;
+  const auto at = std::chrono::steady_clock::now() +
+                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                      std::chrono::duration<double>(limit - std::max(spent, 0.0)));
+  if (!outer_active_ || at < outer_at_) set_thread_deadline(at, limit);
 }
 
-DeadlineScope::~DeadlineScope() { clear_thread_deadline(); }
+DeadlineScope::~DeadlineScope() {
+  t_deadline.active = outer_active_;
+  t_deadline.seconds = outer_limit_;
+  t_deadline.at = outer_at_;
+}
 
 std::size_t memory_limit() { return g_memory_limit.load(); }
 

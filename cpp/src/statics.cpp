@@ -171,6 +171,7 @@ class EquilibriumPath {
         a.why = "the forces or the stiffness are not finite";
         return a;
       }
+      check_thread_deadline("(in the static analysis)");  // the dense decompositions cannot be interrupted
       const Eigen::MatrixXd Ks = scale_.asDiagonal() * K_ * scale_.asDiagonal();
       const Eigen::PartialPivLU<Eigen::MatrixXd> lu(Ks);
       // A tiny pivot: the stiffness may be singular; full pivoting confirms it and finds the null
@@ -234,6 +235,7 @@ class EquilibriumPath {
   // Returns "" or the description of the direction of the most negative eigenvalue.
   std::string indefinite() const {
     if (nd_ == 0) return "";
+    check_thread_deadline("(in the static analysis)");
     const Eigen::MatrixXd Ks = scale_.asDiagonal() * K_ * scale_.asDiagonal();
     const double big = Ks.cwiseAbs().maxCoeff();
     double lowest = 0.0;
@@ -370,6 +372,7 @@ class ArcLength {
     Point p;
     Eigen::VectorXd Fs;
     path_.evaluate(qhat, 0.0, Fs, gs_);
+    check_thread_deadline("(in the static analysis)");
     const Eigen::MatrixXd Ks = path_.scaled_tangent();
     Eigen::FullPivLU<Eigen::MatrixXd> lu(Ks);
     lu.setThreshold(1e-13);

@@ -108,14 +108,15 @@ def check(model, time_limit=None) -> Check:
         return Check(summary(model), Diagnosis(0, 0, 0, [], [], f"  the model is empty{why}"))
     copy = model.copy()
     copy.prepare()
-    d = _core.Simulation(copy.core, time_limit=limit).diagnose(
-        time_limit=limit, time_spent=time.monotonic() - started if limit else 0.0)
+    spent = (lambda: time.monotonic() - started) if limit else (lambda: 0.0)
+    d = _core.Simulation(copy.core, time_limit=limit, time_spent=spent()).diagnose(time_limit=limit,
+                                                                                   time_spent=spent())
     diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
                           list(d["undetermined"]), d["text"])
     return Check(summary(model), diagnosis)
 
 
-def release_overconstraints(model) -> list:
+def release_overconstraints(model, time_limit=None) -> list:
     """Release (RLSE) the redundant rigid deformations that the constraint diagnosis names
     (``model.check().diagnosis.redundant``), as SPACAR Light's "autosolve" does: afterwards the
     constraints have full rank. Returns the released ``(element, deformation)`` pairs, empty
@@ -123,8 +124,9 @@ def release_overconstraints(model) -> list:
     ESTIFF, if given). Undetermined coordinates are not touched (the diagnosis still names
     them). Raises InputError, changing nothing, when a redundant deformation cannot be released
     (an input or degree-of-freedom deformation, or one of the automatic L2MIN1 elements of a
-    LAMBDA node: fix the model by hand there) or the constraint block is too large to diagnose."""
-    diagnosis = check(model).diagnosis
+    LAMBDA node: fix the model by hand there) or the constraint block is too large to diagnose.
+    ``time_limit``: as for :func:`check`."""
+    diagnosis = check(model, time_limit=time_limit).diagnosis
     if not diagnosis.detailed:
         raise InputError("the constraint block is too large for the diagnosis: no over-constraints released")
     elements = model.elements

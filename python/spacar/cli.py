@@ -194,7 +194,7 @@ def _check(args) -> int:
     for w in model.warnings:
         _comment(f"warning: {w}")
     if args.release:
-        released = model.release_overconstraints()
+        released = model.release_overconstraints(time_limit=args.time_limit)
         elements = model.elements
         _comment(f"released {len(released)} redundant constraint{'s' if len(released) != 1 else ''}"
                  + (":" if released else " (none is over-constrained)"))

@@ -460,12 +460,12 @@ class Model:
 
         return check(self, time_limit=time_limit)
 
-    def release_overconstraints(self) -> list:
+    def release_overconstraints(self, time_limit=None) -> list:
         """Release (RLSE) the redundant rigid deformations that :meth:`check` names; returns the
         released ``(element, deformation)`` pairs. See :func:`spacar.check.release_overconstraints`."""
         from .check import release_overconstraints
 
-        return release_overconstraints(self)
+        return release_overconstraints(self, time_limit=time_limit)
 
     def run_blocks(self, **kwargs):
         """Analyse the blocks of the input in order, as ``spacar run`` does: the current block

@@ -228,7 +228,8 @@ class Results:
     def __getstate__(self):
         # Pickles hold the Geometry (plain data, as before it was lazy), not the model's core
         # (nor the model that static results keep for spacar.compliance).
-        state = {k: v for k, v in self.__dict__.items() if k not in ("_geometry", "_geometry_source", "_static_model")}
+        state = {k: v for k, v in self.__dict__.items()
+                 if k not in ("_geometry", "_geometry_source", "_static_model", "_dof_columns")}
         state["geometry"] = self.geometry
         return state
 
@@ -238,7 +239,9 @@ class Results:
         self.__dict__.update(state)
         if "dof_labels" not in state:  # pickled before the results had their DOFs
             self._set_dofs(())
-        self.__dict__.setdefault("_dof_columns", None)
+        self._dof_columns = None  # (older pickles' _dof_x, _dof_e are dropped)
+        self.__dict__.pop("_dof_x", None)
+        self.__dict__.pop("_dof_e", None)
         self.geometry = geometry
 
     @property

@@ -124,12 +124,17 @@ def _assembly_moves(positions: dict, system, x0) -> list:
     labels = [(int(n), int(i)) for n, i in system.coord_label]
     given = np.array([positions[n][i - 1] if n in positions else np.nan for n, i in labels])
     far = np.abs(np.asarray(x0, dtype=float) - given) > 1e-3 * size / np.sqrt(3.0)  # a component moved far
+    components: dict = {}  # node → its (global index, component)
+    for g in np.flatnonzero(far):
+        components.setdefault(labels[g][0], [])
+    for g, (n, i) in enumerate(labels):
+        if n in components:
+            components[n].append((g, i))
     warnings = []
-    for n in dict.fromkeys(labels[g][0] for g in np.flatnonzero(far)):  # in coordinate order
+    for n, parts in components.items():  # in coordinate order
         x = positions[n].copy()
-        for g, (m, i) in enumerate(labels):
-            if m == n:
-                x[i - 1] = x0[g]
+        for g, i in parts:
+            x[i - 1] = x0[g]
         distance = float(np.linalg.norm(x - positions[n]))
         if distance > 1e-3 * size:
             warnings.append(f"the assembly moved node {n} by {distance:.4g} from its X position "

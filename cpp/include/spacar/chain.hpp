@@ -7,9 +7,10 @@
 // or two iterations from the predicted positions), instead of a Newton iteration on all
 // calculable coordinates with a sparse factorization per iteration; the velocities follow in the
 // same order from the element's small linear system. Planar beams need no iteration: their
-// deformations invert in closed form (ElementKernel::solve_end). The first Newton step is that of all
-// coordinates together (the block-triangular Jacobian, solved block by block), so that the motion
-// of the coordinates a block starts from reaches its own before its iterations.
+// deformations invert in closed form (ElementKernel::solve_end). Where some block iterates, the
+// first Newton step is that of all coordinates together (the block-triangular Jacobian, solved
+// block by block), so that the motion of the coordinates a block starts from reaches its own
+// before its iterations.
 //
 // Refused (detect() returns nullptr), for the general path: closed loops (an element whose known
 // values over-determine the coordinates it reaches), nonholonomic constraints (the velocity rows

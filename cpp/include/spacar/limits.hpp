@@ -35,14 +35,20 @@ bool thread_deadline_passed();
 // throw_time_limit(where) if the deadline has passed.
 void check_thread_deadline(const char* where);
 
-// The deadline of `limit` seconds (0: none) from `spent` seconds ago, for the lifetime of the
-// scope: a model's set-up and diagnosis, which no run's clock covers.
+// The deadline of `limit` seconds (0 or beyond 10⁹ s: none) from `spent` seconds ago, for the
+// lifetime of the scope (a run, a set-up, a diagnosis). Nested scopes (an analysis started from
+// a callback of another) keep the earlier deadline and restore the outer one when they end.
 class DeadlineScope {
  public:
   explicit DeadlineScope(double limit, double spent = 0.0);
   ~DeadlineScope();
   DeadlineScope(const DeadlineScope&) = delete;
   DeadlineScope& operator=(const DeadlineScope&) = delete;
+
+ private:
+  bool outer_active_;
+  double outer_limit_;
+  std::chrono::steady_clock::time_point outer_at_;
 };
 
 }  // namespace spacar

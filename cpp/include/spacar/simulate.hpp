@@ -268,8 +268,9 @@ class Simulation {
   std::unique_ptr<Linearizer> linearizer_;
   // The recursive right-hand side of planar and spatial rigid trees, set for a run (RunOptions::recursive).
   std::unique_ptr<RecursiveTree> tree_;
-  // The explicit positions of open chains in the right-hand sides (chain.hpp), set for a run
-  // (RunOptions::recursive) when the system is one and no tree_.
+  // The explicit positions of open chains (chain.hpp), set for a run (RunOptions::recursive) when
+  // the system is one and no tree_: in the right-hand sides (with their velocities), at the step
+  // starts and at the output times.
   std::unique_ptr<ExplicitChain> chain_;
   Eigen::VectorXd tree_qdd_;
   // The tree's state at (t, Y) into base_ (positions, rates, accelerations) and qdd; false if a

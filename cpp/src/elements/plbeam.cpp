@@ -74,32 +74,31 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   // The inverse of deform() for one end: l = l0 + e1 (less PLBEAMNL's bending elongation), the
   // chord angle α from the known end's tangent angle and its bending deformation
   // (e2 = l0 sin(φp − α), e3 = l0 sin(α − φq)), then the other end's position and tangent angle.
-  // The arcsines' branches (|φ − α| below or above π/2) and the rotation's turn are the guess's.
+  // Each bend δ (φp − α, α − φq) is taken on the arcsine's branch (below or above π/2) and the
+  // turn of the guess's δ; the solved rotation then follows the known one continuously, however
+  // far that has turned since the guess.
   bool has_closed_form() const override { return true; }
   bool solve_end(int end, const double* e, const double* guess, double* x) const override {
     const double l = l0_ + e[0] - (Nonlinear ? bending_elongation(e[1], e[2]) : 0.0);
     if (!(l > 0.0) || !(std::abs(e[1]) <= l0_) || !(std::abs(e[2]) <= l0_)) return false;
     const double guess_alpha = std::atan2(guess[4] - guess[1], guess[3] - guess[0]);
-    // The angle δ with l0 sin δ = value on the branch of the guess's δ.
     auto bend = [&](double value, double guess_delta) {
-      const double d = std::asin(value / l0_);
-      return std::cos(guess_delta) >= 0.0 ? d : M_PI - d;
+      const double d0 = std::asin(value / l0_);
+      const double d = std::cos(guess_delta) >= 0.0 ? d0 : M_PI - d0;
+      return d + 2.0 * M_PI * std::round((guess_delta - d) / (2.0 * M_PI));
     };
-    auto nearest_turn = [](double angle, double near) {
-      return angle + 2.0 * M_PI * std::round((near - angle) / (2.0 * M_PI));
-    };
-    const double delta_p = bend(e[1], guess[2] - (guess_alpha - alpha0_));  // φp − α
-    const double delta_q = bend(e[2], (guess_alpha - alpha0_) - guess[5]);  // α − φq
+    const double delta_p = bend(e[1], alpha0_ + guess[2] - guess_alpha);  // φp − α
+    const double delta_q = bend(e[2], guess_alpha - alpha0_ - guess[5]);  // α − φq
     if (end == 1) {
       const double alpha = alpha0_ + x[2] - delta_p;
       x[3] = x[0] + l * std::cos(alpha);
       x[4] = x[1] + l * std::sin(alpha);
-      x[5] = nearest_turn(alpha - delta_q - alpha0_, guess[5]);
+      x[5] = x[2] - delta_p - delta_q;
     } else {
       const double alpha = alpha0_ + x[5] + delta_q;
       x[0] = x[3] - l * std::cos(alpha);
       x[1] = x[4] - l * std::sin(alpha);
-      x[2] = nearest_turn(alpha + delta_p - alpha0_, guess[2]);
+      x[2] = x[5] + delta_q + delta_p;
     }
     return std::isfinite(x[0] + x[1] + x[2] + x[3] + x[4] + x[5]);
   }
