@@ -89,6 +89,12 @@ ExplicitChain::Block ExplicitChain::make_block(const System& sys, const std::vec
     }
   }
   b.closed_end = closed_end(sys, b);
+  if (b.closed_end >= 0) {
+    const size_t nc = sys.elements[group.front()].coords.size();
+    b.guess.resize(nc);
+    b.local_x.resize(nc);
+    b.local_e.resize(b.rows.size());
+  }
   const int n = static_cast<int>(U.size());
   b.A.setZero(n, n);
   b.r.setZero(n);
@@ -196,8 +202,6 @@ int ExplicitChain::closed_end(const System& sys, const Block& b) {
 bool ExplicitChain::solve_closed(const System& sys, Data& data, Block& b) const {
   const int i = b.elements.front();
   const SystemElement& se = sys.elements[i];
-  b.local_x.resize(se.coords.size());
-  b.local_e.resize(b.rows.size());
   for (size_t l = 0; l < se.coords.size(); ++l) b.local_x[l] = data.x[se.coords[l]];
   for (size_t j = 0; j < b.rows.size(); ++j) b.local_e[j] = data.target[b.rows[j].row];  // rows in local order
   if (!se.kernel->solve_end(b.closed_end, b.local_e.data(), b.guess.data(), b.local_x.data())) return false;
@@ -216,7 +220,6 @@ void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter,
   for (Block& b : blocks_) {
     if (b.closed_end < 0) continue;
     const std::vector<int>& coords = sys.elements[b.elements.front()].coords;
-    b.guess.resize(coords.size());
     for (size_t l = 0; l < coords.size(); ++l) b.guess[l] = ref[coords[l]];
   }
   if (!all_closed_) first_step(sys, data);

@@ -12,22 +12,8 @@ namespace spacar {
 
 namespace {
 std::atomic<std::size_t> g_memory_limit{std::size_t(4) << 30};
-
-struct ThreadDeadline {
-  bool active = false;
-  double seconds = 0.0;
-  std::chrono::steady_clock::time_point at;
-};
 thread_local ThreadDeadline t_deadline;
 }  // namespace
-
-void set_thread_deadline(std::chrono::steady_clock::time_point at, double limit) {
-  t_deadline.active = true;
-  t_deadline.seconds = limit;
-  t_deadline.at = at;
-}
-
-void clear_thread_deadline() { t_deadline.active = false; }
 
 bool thread_deadline_passed() { return t_deadline.active && std::chrono::steady_clock::now() > t_deadline.at; }
 
@@ -41,21 +27,16 @@ void check_thread_deadline(const char* where) {
   if (thread_deadline_passed()) throw_time_limit(where);
 }
 
-DeadlineScope::DeadlineScope(double limit, double spent)
-    : outer_active_(t_deadline.active), outer_limit_(t_deadline.seconds), outer_at_(t_deadline.at) {
+DeadlineScope::DeadlineScope(double limit, double spent) : outer_(t_deadline) {
   constexpr double kNoLimit = 1e9;  // seconds (31 years): also keeps the clock arithmetic finite
   if (!(limit > 0.0 && limit < kNoLimit)) return;
   const auto at = std::chrono::steady_clock::now() +
                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                       std::chrono::duration<double>(limit - std::max(spent, 0.0)));
-  if (!outer_active_ || at < outer_at_) set_thread_deadline(at, limit);
+  if (!outer_.active || at < outer_.at) t_deadline = ThreadDeadline{true, limit, at};
 }
 
-DeadlineScope::~DeadlineScope() {
-  t_deadline.active = outer_active_;
-  t_deadline.seconds = outer_limit_;
-  t_deadline.at = outer_at_;
-}
+DeadlineScope::~DeadlineScope() { t_deadline = outer_; }
 
 std::size_t memory_limit() { return g_memory_limit.load(); }
 

@@ -108,9 +108,8 @@ def check(model, time_limit=None) -> Check:
         return Check(summary(model), Diagnosis(0, 0, 0, [], [], f"  the model is empty{why}"))
     copy = model.copy()
     copy.prepare()
-    spent = (lambda: time.monotonic() - started) if limit else (lambda: 0.0)
-    d = _core.Simulation(copy.core, time_limit=limit, time_spent=spent()).diagnose(time_limit=limit,
-                                                                                   time_spent=spent())
+    sim = _core.Simulation(copy.core, time_limit=limit, time_spent=time.monotonic() - started)
+    d = sim.diagnose(time_limit=limit, time_spent=time.monotonic() - started)
     diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
                           list(d["undetermined"]), d["text"])
     return Check(summary(model), diagnosis)

@@ -306,7 +306,7 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
                          recursive=bool(recursive),  # numpy booleans too
                          sample_period=0.0 if controller is None else 1.0 / controller.rate,
                          on_sample=on_sample, energy=bool(energy), rho_inf=0.9 if rho_inf is None else float(rho_inf),
-                         fixed_step=step_size, time_spent=time.monotonic() - started if limit else 0.0)
+                         fixed_step=step_size, time_spent=time.monotonic() - started)
     except SpacarError as err:
         partial = getattr(err, "results", None)
         if isinstance(partial, dict):

@@ -47,14 +47,20 @@ double integrate_python(Integ& integrator, const py::function& f, const py::func
   return integrator.integrate(rhs, t0, t_end, y, touts, out);
 }
 
+// The settings both implicit integrators take from the test helpers.
+template <class Integ>
+void configure(Integ& integrator, int n, double rtol, double atol, double hmax, double first_step) {
+  integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol), Eigen::VectorXd::Constant(n, atol));
+  integrator.set_max_step(hmax);
+  integrator.set_initial_step(first_step);
+}
+
 py::dict solve_radau5(const py::function& f, const py::function& jac, double t0, const Eigen::VectorXd& y0,
                double t_end, const std::vector<double>& touts, double rtol, double atol, double hmax,
                double first_step, double nonstiff_bound) {
   const int n = static_cast<int>(y0.size());
   spacar::Radau5 integrator(n);
-  integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol), Eigen::VectorXd::Constant(n, atol));
-  integrator.set_max_step(hmax);
-  integrator.set_initial_step(first_step);
+  configure(integrator, n, rtol, atol, hmax, first_step);
   integrator.set_nonstiffness_detection(nonstiff_bound);
   Eigen::VectorXd y = y0;
   Eigen::MatrixXd ys;
@@ -72,9 +78,7 @@ py::dict solve_generalized_alpha(const py::function& f, const py::function& jac,
                                  int rate_offset, double rho_inf, double hmax, double first_step, double fixed_step) {
   const int n = static_cast<int>(y0.size());
   spacar::GeneralizedAlpha integrator(n, m, rate_offset < 0 ? n - m : rate_offset, rho_inf);
-  integrator.set_tolerances(Eigen::VectorXd::Constant(n, rtol), Eigen::VectorXd::Constant(n, atol));
-  integrator.set_max_step(hmax);
-  integrator.set_initial_step(first_step);
+  configure(integrator, n, rtol, atol, hmax, first_step);
   integrator.set_fixed_step(fixed_step);
   Eigen::VectorXd y = y0;
   Eigen::MatrixXd ys;

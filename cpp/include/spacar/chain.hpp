@@ -72,7 +72,7 @@ class ExplicitChain {
     // A single element whose deformations are the block's rows and whose unknowns are one end's
     // coordinates: that end (0 or 1) if the element solves it in closed form
     // (ElementKernel::solve_end), -1 otherwise. guess: its coordinates in the reference state;
-    // local_x, local_e: its coordinates and the rows' values.
+    // local_x, local_e: its coordinates and the rows' values (all three sized by make_block).
     int closed_end = -1;
     std::vector<double> guess, local_x, local_e;
     Eigen::MatrixXd A;                    // ∂(rows)/∂(unknowns)

@@ -22,13 +22,15 @@ void require_memory(double bytes, const std::string& what, const std::string& hi
 // "1.5 GB", "12 kB", ...
 std::string format_bytes(double bytes);
 
-// The wall-clock deadline of the analysis running on this thread (a run's time_limit), checked
-// also inside the long computations that no step of the integrator interrupts — the sparse
-// factorizations of large systems — so that a time limit bounds a run whatever its size.
-// Thread-local: the sweep runs analyses in threads side by side.
-// The deadline `at`; `limit`: the time limit in seconds that the message names.
-void set_thread_deadline(std::chrono::steady_clock::time_point at, double limit);
-void clear_thread_deadline();
+// The wall-clock deadline of the analysis running on this thread (a run's time_limit, set by a
+// DeadlineScope), checked also inside the long computations that no step of the integrator
+// interrupts — the sparse factorizations of large systems — so that a time limit bounds a run
+// whatever its size. Thread-local: the sweep runs analyses in threads side by side.
+struct ThreadDeadline {
+  bool active = false;
+  double seconds = 0.0;  // the time limit that the message names
+  std::chrono::steady_clock::time_point at;
+};
 bool thread_deadline_passed();
 // TimeLimitError "the time limit of <limit> s was exceeded <where>".
 [[noreturn]] void throw_time_limit(const std::string& where);
@@ -46,9 +48,7 @@ class DeadlineScope {
   DeadlineScope& operator=(const DeadlineScope&) = delete;
 
  private:
-  bool outer_active_;
-  double outer_limit_;
-  std::chrono::steady_clock::time_point outer_at_;
+  ThreadDeadline outer_;
 };
 
 }  // namespace spacar
