@@ -37,7 +37,7 @@ Data::Data(const System& sys) {
   body_M.assign(sys.bodies.size(), Eigen::Matrix4d::Zero());
   body_h.assign(sys.bodies.size(), Eigen::Vector4d::Zero());
   build_constraint_blocks(sys);
-  build_equations_of_motion(sys);
+  number_equations_of_motion(sys);
 }
 
 void Data::build_constraint_blocks(const System& sys) {
@@ -60,13 +60,18 @@ void Data::build_constraint_blocks(const System& sys) {
   if (AV.rows() == nc) luV.analyze(AV.matrix());
 }
 
-void Data::build_equations_of_motion(const System& sys) {
+void Data::number_equations_of_motion(const System& sys) {
   free_index.assign(sys.nx, -1);
   for (int g : sys.x_calc) free_index[g] = n_free++;
   for (int g : sys.x_dyn) free_index[g] = n_free++;
   c_row.assign(sys.ne, -1);
   for (int k : sys.defs_V)
     if (sys.def_class[k] != DefClass::Dynamic) c_row[k] = n_c_rows++;
+}
+
+void Data::ensure_equations_of_motion(const System& sys) {
+  if (equations_ready) return;
+  equations_ready = true;
   const int n = n_free + n_c_rows;
   KKT.reset(n, n);
   for (const SystemElement& se : sys.elements) {

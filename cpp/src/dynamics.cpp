@@ -171,6 +171,7 @@ void solve_dynamics(const System& sys, Data& data) {
 }
 
 void solve_dynamics_direct(const System& sys, Data& data) {
+  data.ensure_equations_of_motion(sys);
   const int nd = sys.n_dof();
   const int nf = data.n_free;
   compute_inertia_and_loads(sys, data);
@@ -243,22 +244,49 @@ void solve_dynamics_direct(const System& sys, Data& data) {
   }
 }
 
+namespace {
+// σ^V from A_Vᵀ σ^V = −[inertia_residual + Σ B_kᵀ σ_k]_c over the released and kinematic
+// deformations (formulation.md §6): every velocity row's stress in equilibrium with the motion.
+void equilibrium_stresses(const System& sys, Data& data, Eigen::VectorXd& sV) {
+  data.residual_load = data.inertia_residual;
+  add_element_loads(sys, data, [&](int k) {
+    return sys.def_class[k] == DefClass::Released || sys.def_class[k] == DefClass::Kinematic; }, data.residual_load);
+  const int nc = static_cast<int>(sys.x_calc.size());
+  for (int j = 0; j < nc; ++j) data.rhs_V[j] = -data.residual_load[sys.x_calc[j]];
+  data.luV.solve_transposed(data.rhs_V, sV);
+}
+}  // namespace
+
+bool solve_dynamics_known(const System& sys, Data& data, const Eigen::VectorXd& qdd) {
+  const int nd = sys.n_dof(), nc = static_cast<int>(sys.x_calc.size());
+  if (static_cast<int>(sys.defs_V.size()) != nc || qdd.size() != nd) return false;
+  compute_inertia_and_loads(sys, data);
+  constitutive_stresses(sys, data);
+  data.qdd = qdd;
+  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = qdd[j];
+  solve_accelerations_direct(sys, data);
+  inertia_force(sys, data);
+  if (nc > 0) {
+    equilibrium_stresses(sys, data, data.sol_V);
+    for (int r = 0; r < nc; ++r)
+      if (data.c_row[sys.defs_V[r]] >= 0) data.sigma[sys.defs_V[r]] = data.sol_V[r];
+  }
+  if (!data.xdd.allFinite() || !data.sigma.allFinite())
+    throw SingularMassError("the accelerations at t = " + std::to_string(data.t) + " are not finite");
+  return true;
+}
+
 void nodal_reactions(const System& sys, Data& data) {
   // r = M ẍ + h − f + Bᵀσ on fixed and input coordinates (6.2), σ complete.
   inertia_force(sys, data);
   // Consistency (formulation.md §6): σ of every velocity row from (6.1) with only the released
   // and kinematic stresses known, A_Vᵀ σ^V = −[g + B_Wᵀ σ^W]_c; its DOF rows equal the
   // constitutive stresses iff q̈ satisfies the equations of motion.
-  data.residual_load = data.inertia_residual;
-  add_element_loads(sys, data, [&](int k) {
-    return sys.def_class[k] == DefClass::Released || sys.def_class[k] == DefClass::Kinematic; }, data.residual_load);
   data.sigma_equilibrium.setZero();
   const int nc = static_cast<int>(sys.x_calc.size());
   if (nc > 0 && static_cast<int>(sys.defs_V.size()) == nc) {
-    Eigen::VectorXd rhs(nc), sV(nc);
-    for (int j = 0; j < nc; ++j) rhs[j] = -data.residual_load[sys.x_calc[j]];
-    data.luV.solve_transposed(rhs, sV);
-    for (int r = 0; r < nc; ++r) data.sigma_equilibrium[sys.defs_V[r]] = sV[r];
+    equilibrium_stresses(sys, data, data.sol_V);
+    for (int r = 0; r < nc; ++r) data.sigma_equilibrium[sys.defs_V[r]] = data.sol_V[r];
   }
   data.residual_load = data.inertia_residual;
   add_element_loads(sys, data, [](int) { return true; }, data.residual_load);

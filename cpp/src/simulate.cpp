@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <sstream>
 #include <type_traits>
 
@@ -35,13 +37,17 @@ std::unique_ptr<System> prepare_and_compile(Model& model) {
 }  // namespace
 
 Simulation::Simulation(Model& model)
-    : model_(model), sys_(prepare_and_compile(model)), data_(std::make_unique<Data>(*sys_)) {
+    : model_(model),
+      x_given_(model.frozen() ? 0 : 1),  // a marker until the positions are known
+      sys_(prepare_and_compile(model)),
+      data_(std::make_unique<Data>(*sys_)) {
   check_thread_deadline("(in the allocation of the work arrays)");
   predicted_ = Eigen::VectorXd::Zero(sys_->nx);
   for (const FreeRotation& fr : sys_->free_rotations) dependent_[fr.node] = fr.dependent;
   int g = 0;
   for (const auto& [id, n] : model_.nodes)
     for (double v : n.x) data_->x[g++] = v;
+  if (x_given_.size()) x_given_ = data_->x;
 }
 
 void Simulation::remember(Solved& s) const {
@@ -137,7 +143,8 @@ void Simulation::assemble() {
   have_transfer_ = false;
 }
 
-void Simulation::solve_state(double t, const double* q, const double* qd, bool transfer_predictor) {
+void Simulation::solve_state(double t, const double* q, const double* qd, bool transfer_predictor,
+                             const Eigen::VectorXd* known_qdd) {
   const System& sys = *sys_;
   set_inputs(sys, *data_, t);
   apply_time_loads(t);
@@ -193,7 +200,7 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
   }
   if (chain && in_rhs_) chain->solve_velocities(sys, *data_);
   else solve_velocities_direct(sys, *data_);
-  solve_dynamics_direct(sys, *data_);
+  if (!(known_qdd && solve_dynamics_known(sys, *data_, *known_qdd))) solve_dynamics_direct(sys, *data_);
   remember(base_);
   have_transfer_ = false;
 }
@@ -279,9 +286,10 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   // On the recursive path the last solved state may be a stage a whole (large) step away: start
   // Newton from the tree's exact positions at (q, q̇) instead.
-  if (tree_) tree_state(t, Y, tree_qdd_);
+  // Its q̈ is the general path's solution, which then needs no equations of motion.
+  const bool known = tree_ && tree_state(t, Y, tree_qdd_);
   for (int i = 0; i < ny; ++i) data_->e_integrated[sys_->y_defs[i]] = Y[nd + i];
-  solve_state(t, Y.data(), Y.data() + nd + ny, false);
+  solve_state(t, Y.data(), Y.data() + nd + ny, false, known ? &tree_qdd_ : nullptr);
 }
 
 bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& qdd) {
@@ -455,6 +463,45 @@ constexpr double kExplicitGain = 5.0;
 // stiff modes are excited (the manual's slider-crank) Radau's steps are no longer than DOP853's.
 constexpr double kStiffStepsAhead = 1000.0;
 
+std::string format_g(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+// Warnings for the position nodes that the first assembly moved far (more than 1e-3 of the
+// model's size, the spread of the X positions) from where X put them: the X positions do not
+// close a loop with the lengths given (LENGTHO), the targets of E or the inputs' start values.
+// An X position meant exactly then changed the mechanism; a rough one was closed as intended.
+void warn_of_assembly_moves(const System& sys, const Eigen::VectorXd& given, const Eigen::VectorXd& x,
+                            std::vector<std::string>& warnings) {
+  auto is_position = [&](int g) {
+    return sys.coord_node_kind[g] == NodeKind::XY || sys.coord_node_kind[g] == NodeKind::XYZ;
+  };
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int g = 0; g < sys.nx; ++g)
+    if (is_position(g)) {
+      lo = std::min(lo, given[g]);
+      hi = std::max(hi, given[g]);
+    }
+  const double far = 1e-3 * (hi - lo);
+  for (int g = 0, end; g < sys.nx; g = end) {  // node by node: its coordinates are consecutive
+    for (end = g + 1; end < sys.nx && sys.coord_label[end][0] == sys.coord_label[g][0];) ++end;
+    if (!is_position(g)) continue;
+    const double distance = (x.segment(g, end - g) - given.segment(g, end - g)).norm();
+    if (!(distance > far)) continue;
+    auto point = [&](const Eigen::VectorXd& v) {
+      std::string s = "(";
+      for (int i = g; i < end; ++i) s += (i > g ? ", " : "") + format_g(v[i], 6);
+      return s + ")";
+    };
+    warnings.push_back("the assembly moved node " + std::to_string(sys.coord_label[g][0]) + " by " +
+                       format_g(distance, 4) + " from its X position " + point(given) + " to " + point(x) +
+                       ": the X positions do not close the loop with the lengths (LENGTHO), E targets and "
+                       "input values given");
+  }
+}
+
 std::string num(double v) {
   std::ostringstream os;
   os.precision(12);
@@ -573,6 +620,10 @@ void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) cons
 
 void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out) {
   assemble();
+  if (x_given_.size()) {
+    warn_of_assembly_moves(*sys_, x_given_, data_->x, res.warnings);
+    x_given_.resize(0);
+  }
   // The recursive and explicit-chain paths know neither time-dependent loads nor the energy's
   // quadrature states.
   const bool plain = timed_.empty() && !options.energy && options.sample_period == 0.0;

@@ -112,39 +112,6 @@ def _time_loads(sim, system, forces, inputs):
     sim.set_time_loads(tables, motions, load_function)
 
 
-def _assembly_moves(positions: dict, system, x0) -> list:
-    """Warnings for the position nodes that the first assembly moved far (more than 1e-3 of the
-    model's size) from where X put them: the X positions do not close a loop with the lengths
-    given (LENGTHO), the targets of E or the inputs' start values. An X position that was meant
-    exactly then changed the mechanism; a rough one was closed as intended."""
-    if not positions:
-        return []
-    points = np.concatenate([p for p in positions.values()])
-    size = float(np.ptp(points)) if points.size else 0.0
-    labels = [(int(n), int(i)) for n, i in system.coord_label]
-    given = np.array([positions[n][i - 1] if n in positions else np.nan for n, i in labels])
-    far = np.abs(np.asarray(x0, dtype=float) - given) > 1e-3 * size / np.sqrt(3.0)  # a component moved far
-    components: dict = {}  # node → its (global index, component)
-    for g in np.flatnonzero(far):
-        components.setdefault(labels[g][0], [])
-    for g, (n, i) in enumerate(labels):
-        if n in components:
-            components[n].append((g, i))
-    warnings = []
-    for n, parts in components.items():  # in coordinate order
-        x = positions[n].copy()
-        for g, i in parts:
-            x[i - 1] = x0[g]
-        distance = float(np.linalg.norm(x - positions[n]))
-        if distance > 1e-3 * size:
-            warnings.append(f"the assembly moved node {n} by {distance:.4g} from its X position "
-                            f"({', '.join(f'{v:.6g}' for v in positions[n])}) to "
-                            f"({', '.join(f'{v:.6g}' for v in x)}): the X positions do not close the loop "
-                            f"with the lengths (LENGTHO), E targets and input values given")
-    return warnings
-
-
-
 def _dead_position_hint(err, res, system, model) -> str:
     """For a kinematic Newton failure after some output times: the inputs at the last position
     solved and where they were heading, with the usual cause — the mechanism passed a dead
@@ -261,9 +228,6 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         raise InputError(f"energy must be True or False, got {show(energy)}")
     if controller is not None and not isinstance(controller, Controller):
         raise InputError(f"controller must be a spacar.Controller or None, got {show(controller)}")
-    positions = ({} if model.core.frozen else   # the X positions, before the first assembly
-                 {n: np.array(node.x, dtype=float) for n, node in model.nodes.items()
-                  if node.kind.name in ("XY", "XYZ")})
     started = time.monotonic()   # the time limit covers the set-up too
     sim = _core.Simulation(model.core, time_limit=limit)  # prepares the model (the first END) and compiles it
     system = sim.system
@@ -328,5 +292,4 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
             bar.close()
     model._continue_step = arrays["last_step"]
     model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    model.warnings.extend(_assembly_moves(positions, sim.system, arrays["x"][0]))
     return _results(arrays, sim.system, model, method)

@@ -13,3 +13,28 @@ def assembled(model):
     sim = _core.Simulation(model.core)
     sim.assemble()
     return sim
+
+
+def start_rows_on_both_paths(model, seed=0):
+    """The output row at the start of a run on the recursive path and on the general path of
+    ``model`` (a tree), its DOFs set moving at random rates: the same state, whose recursive
+    output row is solved from the tree's q̈ and the general one from the equations of motion.
+    Returns (recursive results, general results)."""
+    import re
+
+    import numpy as np
+
+    import spacar
+
+    probe = spacar.simulate(model.copy(), method="dop853", progress=False)
+    rng = np.random.default_rng(seed)
+    for label in probe.dof_labels:
+        kind, a, b = re.match(r"([xe])\((\d+),(\d+)\)", label).groups()
+        setter = model.xd if kind == "x" else model.ed
+        setter(int(a), int(b), float(rng.uniform(-1.5, 1.5)))
+    model.forcemode(1)
+    model.timestep(1, 1e-3)
+    fast = spacar.simulate(model.copy(), method="dop853", progress=False)
+    general = spacar.simulate(model.copy(), method="dop853", recursive=False, progress=False)
+    assert fast.stats["recursive"] and not general.stats["recursive"]
+    return fast, general

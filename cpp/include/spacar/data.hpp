@@ -23,6 +23,10 @@ struct Data {
   // Allocate the dense matrices of the full path (transfer functions, reduced mass matrix).
   void ensure_dense(const System& sys);
   bool dense_ready = false;
+  // Build the sparse equations of motion (the system of solve_dynamics_direct, its pattern and
+  // ordering) on first use: the recursive path's runs never solve them.
+  void ensure_equations_of_motion(const System& sys);
+  bool equations_ready = false;
   // Bytes an analysis of `sys` allocates on the sparse path (vectors, element work arrays, the
   // constraint blocks and the equations of motion with room for the fill of their factors), and
   // in addition for the dense matrices of ensure_dense (transfer functions, mass matrices, the
@@ -32,7 +36,8 @@ struct Data {
 
  private:
   void build_constraint_blocks(const System& sys);
-  void build_equations_of_motion(const System& sys);
+  // The places of the free coordinates and constraint rows in the equations of motion.
+  void number_equations_of_motion(const System& sys);
 
  public:
   double t = 0.0;
@@ -68,7 +73,7 @@ struct Data {
   std::vector<int> free_index;  // coordinate → position among the free coordinates, −1
   std::vector<int> c_row;       // deformation → constraint row of C, −1
   int n_free = 0, n_c_rows = 0;
-  BlockMatrix KKT;
+  BlockMatrix KKT;              // built by ensure_equations_of_motion, at the first solve
   std::vector<int> KKT_mass, KKT_B, KKT_Bt;  // block ids per element (−1: none)
   std::vector<int> KKT_point, KKT_body;      // block ids of point masses and rigid bodies
   LinearSolver luK;

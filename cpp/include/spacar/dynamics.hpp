@@ -52,6 +52,16 @@ void solve_dynamics(const System& sys, Data& data);
 //   [M_ff B_Cfᵀ; B_Cf 0] [ẍ_f; σ^C] = [−g_f; ë^C − c^C],
 // which also yields the reaction stresses σ^C. Requires positions and solve_velocities_direct.
 void solve_dynamics_direct(const System& sys, Data& data);
+// The same state when the DOFs' accelerations q̈ are already known (the recursive path's, from
+// the articulated-body algorithm), without the equations of motion: ẍ and ë from the
+// second-order kinematics, and the stresses of the constraint rows from the equilibrium of the
+// calculable coordinates, A_Vᵀ σ^V = −[M ẍ + h − f + Σ B_kᵀ σ_k]_c with the released and
+// kinematic deformations' stresses known (as nodal_reactions); the DOF rows keep their
+// constitutive stresses. The solution of solve_dynamics_direct when q̈ solves the equations of
+// motion, at the cost of two solves with the velocity block instead of the factorization of
+// the whole system. Requires positions and solve_velocities_direct; false (nothing solved)
+// when the velocity block is not square.
+bool solve_dynamics_known(const System& sys, Data& data, const Eigen::VectorXd& qdd);
 // Nodal reactions (6.2) from the complete stresses (after solve_dynamics_direct).
 void nodal_reactions(const System& sys, Data& data);
 

@@ -146,7 +146,9 @@ class Simulation {
   void assemble();
   // State at (t, q, q̇) as the integrator needs it: positions, velocities, q̈, accelerations
   // and the complete stresses, without transfer functions (sparse, allocation-free).
-  void solve_state(double t, const double* q, const double* qd, bool transfer_predictor = false);
+  // known_qdd: q̈ already known there (the recursive path's): no equations of motion solved.
+  void solve_state(double t, const double* q, const double* qd, bool transfer_predictor = false,
+                   const Eigen::VectorXd* known_qdd = nullptr);
   // Complete state at (t, q, q̇): solve_state plus the transfer functions DF, DFe and the
   // reduced mass matrix M̄ (for users, tests and teaching).
   void evaluate(double t, const double* q, const double* qd);
@@ -255,6 +257,9 @@ class Simulation {
   void step_start(double t, const Eigen::VectorXd& Y);
   bool solved_dofs(const Solved& s, const Eigen::VectorXd& Y) const;  // s solved at Y's DOFs
   Model& model_;
+  // The X positions before the model's first assembly (empty once it is made, or when the model
+  // was prepared before this simulation): the first block warns of the nodes it moved far.
+  Eigen::VectorXd x_given_;
   std::map<int, int> dependent_;  // dependent Euler parameter of free rotations, by node
   std::unique_ptr<System> sys_;
   std::unique_ptr<Data> data_;  // replaced when the system is recompiled (repartition)
