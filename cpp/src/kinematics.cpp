@@ -95,6 +95,8 @@ void factorize(const System& sys, Data& data, const BlockMatrix& A, LinearSolver
 // Assemble and factorize the velocity block A_V at the current positions.
 void factorize_velocity_block(const System& sys, Data& data) {
   assemble_block(sys, data, data.AV, data.AV_block);
+  // Without nonholonomic rows A_V is A_P (same rows, same pattern): start from its pivots.
+  if (sys.defs_P == sys.defs_V) data.luV.adopt_pivots(data.luP);
   factorize(sys, data, data.AV, data.luV, "velocity");
   // Without nonholonomic rows the velocity block is the position block: a Jacobian for the
   // next position solve.

@@ -42,7 +42,7 @@ void SparseLU::analyze(const Eigen::SparseMatrix<double>& A) {
   stack_.assign(2 * n_, 0);
   mark_.assign(n_, 0);
   if (n_ == 0) return;
-  colamd_ = colamd_order(A);
+  first_ = true;
   replays_ = 0;
   amd_tried_ = false;
 }
@@ -253,12 +253,12 @@ bool SparseLU::compute(const Eigen::SparseMatrix<double>& A) {
     if (!amd_tried_ && ++replays_ >= kReplaysBeforeTrial) return try_amd(A);
     return true;
   }
-  if (!colamd_.empty()) {  // the first factorization
-    if (!factorize_pivoting(A, colamd_)) {  // singular in COLAMD's order: AMD's
+  if (first_) {  // the first factorization, in COLAMD's order (found only now: see adopt_pivots)
+    if (!factorize_pivoting(A, colamd_order(A))) {  // singular in COLAMD's order: AMD's
       if (!factorize_pivoting(A, amd_order(A))) return false;  // both again at the next factorization
       amd_tried_ = true;
     }
-    colamd_.clear();
+    first_ = false;
     return true;
   }
   return factorize_pivoting(A, q_);

@@ -22,7 +22,8 @@ namespace spacar {
 
 class SparseLU {
  public:
-  // Prepare for matrices of A's pattern: the column ordering starts as COLAMD's. Once its factors
+  // Prepare for matrices of A's pattern: the column ordering starts as COLAMD's (computed at the
+  // first factorization). Once its factors
   // have been replayed kReplaysBeforeTrial times, AMD's ordering of A + Aᵀ is tried once and kept
   // if its factors are sparser: a short run (a handful of factorizations) does not pay for the
   // trial, a long one gains from the sparser factors at every replay.
@@ -35,6 +36,13 @@ class SparseLU {
   void solve_transposed(const double* b, double* x) const;
 
   int size() const { return n_; }
+  // Take the pivot sequence (ordering, fill pattern, factors) of another factorization of a
+  // matrix of the same pattern, if this one has none yet: its first factorization is then a
+  // replay, not a search for pivots (the velocity block of a holonomic system is the position
+  // block, factorized first in the assembly).
+  void adopt_pivots(const SparseLU& other) {
+    if (first_ && other.have_pivots_ && other.n_ == n_) *this = other;
+  }
   int factor_nonzeros() const { return static_cast<int>(Li_.size() + Ui_.size()) + n_; }
   // Pivot choices made (not replays), one per ordering tried.
   int pivotings() const { return pivotings_; }
@@ -68,7 +76,7 @@ class SparseLU {
   bool have_pivots_ = false;  // a pivot sequence to replay
   bool valid_ = false;        // factors of the last factorized matrix, for solves
   int pivotings_ = 0;
-  std::vector<int> colamd_;        // COLAMD's ordering, until the first factorization
+  bool first_ = false;             // no factorization has succeeded since analyze
   int replays_ = 0;                // successful replays, until AMD's ordering is tried
   bool amd_tried_ = false;
   std::vector<int> q_;             // step k eliminates column q_[k] of A
