@@ -86,6 +86,35 @@ def test_a_poor_replayed_pivot_chooses_pivots_again():
     np.testing.assert_allclose(B.T @ lu.solve_transposed(b), b, rtol=0, atol=1e-14)
 
 
+def test_adopted_pivots_are_replayed_on_the_first_factorization():
+    """A second factorization of the same pattern (the velocity block after the position block)
+    takes the first one's pivots: its first factorization is a replay, with exact solves; where
+    the adopted pivots are poor for its values it chooses its own. A factorization that has
+    pivots of its own keeps them."""
+    rng = np.random.default_rng(11)
+    A = random_sparse(120, 0.04, rng)
+    first = _testing.SparseLU(A)
+    assert first.factorize(A)
+    second = _testing.SparseLU(A)
+    second.adopt_pivots(first)
+    assert second.pivotings == first.pivotings == 1
+    factorize_perturbed(second, A, rng, 3)
+    assert second.pivotings == 1  # replays only
+    # Poor for the adopted pivots: the 3 × 3 case of the test above.
+    D = sp.csc_matrix(np.array([[10.0, 1.0, 1.0], [1.0, 10.0, 1.0], [1.0, 1.0, 10.0]]))
+    Z = same_pattern(D, [0.0, 1.0, 2.0, 1.0, 0.0, 3.0, 2.0, 3.0, 0.0])
+    diagonal, zero = _testing.SparseLU(D), _testing.SparseLU(D)
+    assert diagonal.factorize(D)
+    zero.adopt_pivots(diagonal)
+    assert zero.factorize(Z) and zero.pivotings == 2
+    b = np.array([1.0, -2.0, 0.5])
+    np.testing.assert_allclose(Z @ zero.solve(b), b, rtol=0, atol=1e-14)
+    own = _testing.SparseLU(D)
+    assert own.factorize(Z)
+    own.adopt_pivots(diagonal)  # ignored: it has its own
+    assert own.factorize(Z) and own.pivotings == 1
+
+
 def test_saddle_point_matrix_with_zero_block():
     """The equations of motion with constraint rows: [[M, Bᵀ], [B, 0]], M positive definite
     and banded, B of full row rank; zero diagonal in the constraint block."""

@@ -52,6 +52,11 @@ void bind_sparse(py::module_& m) {
       .def("factorize", &TestLU::factorize, py::arg("A"))
       .def("solve", [](const TestLU& t, const Eigen::VectorXd& b) { return t.solve(b, false); })
       .def("solve_transposed", [](const TestLU& t, const Eigen::VectorXd& b) { return t.solve(b, true); })
+      .def("adopt_pivots", [](TestLU& t, const TestLU& other) {
+        if (!(other.pattern.rows() == t.pattern.rows() && other.pattern.nonZeros() == t.pattern.nonZeros()))
+          throw std::invalid_argument("SparseLU.adopt_pivots: the patterns differ");
+        t.lu.adopt_pivots(other.lu);
+      })
       .def_property_readonly("pivotings", [](const TestLU& t) { return t.lu.pivotings(); })
       .def_property_readonly("factor_nonzeros", [](const TestLU& t) { return t.lu.factor_nonzeros(); });
 }
