@@ -63,6 +63,16 @@ _ARRAYS = ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")
 _ELEMENT_TYPES = frozenset(t.name for t in _core.element_catalogue())
 
 
+def _int_pairs(labels) -> list:
+    """Labels (node or element, index) as pairs of Python ints. The core's and a results file's
+    are lists of int pairs already, taken as a whole (a short run's results stay cheap); others
+    (NumPy integers) are converted."""
+    pairs = list(map(tuple, labels))
+    if pairs and not (set(map(len, pairs)) == {2} and type(pairs[0][0]) is int and type(pairs[0][1]) is int):
+        pairs = [(int(a), int(b)) for a, b in pairs]
+    return pairs
+
+
 def require_results(res, what: str) -> None:
     """Refuse anything but Results in the drawing and plotting functions, with what to do."""
     from .model import Model
@@ -164,12 +174,12 @@ class Results:
         self.reaction = arrays["reaction"]
         self.linearizations = list(linearizations)  # one spacar.Linearization per output time
         self.settings_linear = settings_linear
-        self.coordinate_labels = [(int(n), int(c)) for n, c in coordinate_labels]
-        self.deformation_labels = [(int(n), int(k)) for n, k in deformation_labels]
+        self.coordinate_labels = _int_pairs(coordinate_labels)
+        self.deformation_labels = _int_pairs(deformation_labels)
         self.stats = dict(stats)
         self.geometry = geometry
-        self._coord = {lbl: i for i, lbl in enumerate(self.coordinate_labels)}
-        self._def = {lbl: i for i, lbl in enumerate(self.deformation_labels)}
+        self._coord = dict(zip(self.coordinate_labels, range(len(self.coordinate_labels))))
+        self._def = dict(zip(self.deformation_labels, range(len(self.deformation_labels))))
         self._set_dofs(dof_labels)
 
     def _set_dofs(self, labels):
