@@ -326,7 +326,7 @@ def section(r: dict, plots: dict | None = None) -> str:
                   f"in a run), {fits['spacar_evaluate']:.2f} (`evaluate`); "
                   f"Pinocchio ABA p = {fits['pinocchio_aba']:.2f}; exudyn tree p = {fits['exudyn_tree_rk44']:.2f}."]
     lines += ["", "'spacar in a run': the best block wall time (the C++ integration loop, with the assembly and the "
-              "output times, which the general path solves) of the EPSINT = 1e-6 run, repeated for at least 0.5 s like "
+              "output times) of the EPSINT = 1e-6 run, repeated for at least 0.5 s like "
               "the peers' calls, over its right-hand sides; on the default path, which for these chains (a planar tree "
               "of rigid bodies) is the recursive one" + (
                   "" if all(r["rhs"][n].get("spacar_recursive", True) for n in sizes) else " (NOT taken in every run)") +

@@ -181,7 +181,8 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     PLHINGEs, or rigid BEAMs joined by HINGEs, whose rotations are the degrees of freedom)
     integrate with the articulated-body algorithm in the hinge angles instead of the constraint
     formulation (the same equations, several times
-    cheaper per right-hand side; the output times are solved by the general path). ``False``
+    cheaper per right-hand side; at the output times the positions and velocities are solved
+    by the general path, the accelerations and stresses from the tree's q̈). ``False``
     always takes the general path. ``res.stats["recursive"]`` says which path ran.
 
     Time-dependent loads and inputs (docs/mechatronics.md): ``forces={node: f}`` adds to the
