@@ -414,11 +414,13 @@ def spatial_section(r: dict, quick: bool) -> list:
                       f"N = {n}: {C.fmt_time(r['rhs'][n]['spacar_fixed'])} + {C.fmt_time(r['rhs'][n]['spacar_loop'])} "
                       "per right-hand side" for n in sizes if r["rhs"][n].get("spacar_loop")) + ".",
                   "", f"Issue #21 target, time per right-hand side of the 20-link spatial chain inside a run no more "
-                  f"than `pinocchio.aba` per call: **{'met' if ratio <= 1 else 'NOT met'}** in the integration loop "
-                  f"({C.fmt_time(x['spacar_loop'])} against {C.fmt_time(x['pinocchio_aba'])}: {ratio:.2f}×); "
-                  f"averaged over the {r['t_end']:g} s run with its fixed costs {C.fmt_time(x['spacar_in_run'])} "
-                  f"({x['spacar_in_run'] / x['pinocchio_aba']:.2f}×), over the 10× longer run "
-                  f"{C.fmt_time(x['spacar_in_long_run'])} ({x['spacar_in_long_run'] / x['pinocchio_aba']:.2f}×)."]
+                  f"than `pinocchio.aba` per call: in the integration loop **{'met' if ratio <= 1 else 'NOT met'}** "
+                  f"({C.fmt_time(x['spacar_loop'])} against {C.fmt_time(x['pinocchio_aba'])}: {ratio:.2f}×); as the "
+                  f"average over the {r['t_end']:g} s run, its fixed costs included, "
+                  f"**{'met' if x['spacar_in_run'] <= x['pinocchio_aba'] else 'NOT met'}** "
+                  f"({C.fmt_time(x['spacar_in_run'])}, {x['spacar_in_run'] / x['pinocchio_aba']:.2f}×); over the 10× "
+                  f"longer run {C.fmt_time(x['spacar_in_long_run'])} ({x['spacar_in_long_run'] / x['pinocchio_aba']:.2f}×). "
+                  "The slope rests on two best-of timings and moves with the machine's load."]
     lines += ["", "Time to accuracy (error: largest joint-angle error at T against Pinocchio's ABA integrated by "
               "DOP853 at rtol 1e-13; time: the shortest run that reached it, best of repeats as above; MuJoCo: its "
               "RK4 at fixed steps from " + ", ".join(f"{h:g}" for h in MUJOCO_STEPS) + " s, a Python loop of "

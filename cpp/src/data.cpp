@@ -71,7 +71,7 @@ void Data::number_equations_of_motion(const System& sys) {
 
 void Data::ensure_equations_of_motion(const System& sys) {
   if (equations_ready) return;
-  equations_ready = true;
+  for (auto* ids : {&KKT_mass, &KKT_B, &KKT_Bt, &KKT_point, &KKT_body}) ids->clear();  // after a failed build
   const int n = n_free + n_c_rows;
   KKT.reset(n, n);
   for (const SystemElement& se : sys.elements) {
@@ -97,6 +97,7 @@ void Data::ensure_equations_of_motion(const System& sys) {
   KKT.finalize();
   luK.analyze(KKT.matrix());
   kkt_rhs = kkt_sol = Eigen::VectorXd::Zero(n);
+  equations_ready = true;
 }
 
 void Data::ensure_dense(const System& sys) {

@@ -96,11 +96,11 @@ void factorize(const System& sys, Data& data, const BlockMatrix& A, LinearSolver
 void factorize_velocity_block(const System& sys, Data& data) {
   assemble_block(sys, data, data.AV, data.AV_block);
   // Without nonholonomic rows A_V is A_P (same rows, same pattern): start from its pivots.
-  if (sys.defs_P == sys.defs_V) data.luV.adopt_pivots(data.luP);
+  if (sys.velocity_block_is_position_block) data.luV.adopt_pivots(data.luP, data.AV.matrix());
   factorize(sys, data, data.AV, data.luV, "velocity");
   // Without nonholonomic rows the velocity block is the position block: a Jacobian for the
   // next position solve.
-  data.jacobian_reusable = sys.defs_P == sys.defs_V;
+  data.jacobian_reusable = sys.velocity_block_is_position_block;
 }
 
 }  // namespace

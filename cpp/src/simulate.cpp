@@ -286,8 +286,10 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   // On the recursive path the last solved state may be a stage a whole (large) step away: start
   // Newton from the tree's exact positions at (q, q̇) instead.
-  // Its q̈ is the general path's solution, which then needs no equations of motion.
-  const bool known = tree_ && tree_state(t, Y, tree_qdd_);
+  // Its q̈ is the general path's solution, which then needs no equations of motion, where the
+  // tree knows all the loads (a run's tree; not with time-dependent or held loads set since
+  // recursive_state).
+  const bool known = tree_ && tree_state(t, Y, tree_qdd_) && timed_.empty() && held_.size() == 0;
   for (int i = 0; i < ny; ++i) data_->e_integrated[sys_->y_defs[i]] = Y[nd + i];
   solve_state(t, Y.data(), Y.data() + nd + ny, false, known ? &tree_qdd_ : nullptr);
 }
@@ -295,6 +297,9 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
 bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& qdd) {
   const int nd = sys_->n_dof();
   qdd.resize(nd);
+  // Outside a run (a tree kept from recursive_state) the last solved state may hold positions only.
+  for (Eigen::VectorXd* v : {&base_.x, &base_.xd, &base_.xdd})
+    if (v->size() != sys_->nx) v->setZero(sys_->nx);
   if (!tree_->solve(Y.data(), Y.data() + nd, base_.x, base_.xd, base_.xdd, qdd.data())) return false;
   base_.valid = true;  // the start of Newton's iterations at the next general evaluation
   base_.t = t;
@@ -484,6 +489,7 @@ void warn_of_assembly_moves(const System& sys, const Eigen::VectorXd& given, con
       lo = std::min(lo, given[g]);
       hi = std::max(hi, given[g]);
     }
+  if (!(hi >= lo)) return;  // no position nodes
   const double far = 1e-3 * (hi - lo);
   for (int g = 0, end; g < sys.nx; g = end) {  // node by node: its coordinates are consecutive
     for (end = g + 1; end < sys.nx && sys.coord_label[end][0] == sys.coord_label[g][0];) ++end;

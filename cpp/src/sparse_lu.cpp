@@ -236,6 +236,15 @@ bool SparseLU::replay(const Eigen::SparseMatrix<double>& A) {
   return true;
 }
 
+void SparseLU::adopt_pivots(const SparseLU& other, const Eigen::SparseMatrix<double>& A) {
+  if (!first_ || !other.have_pivots_ || other.n_ != n_ || A.rows() != n_ ||
+      static_cast<size_t>(A.nonZeros()) != other.Apos_.size())
+    return;
+  *this = other;
+  pivotings_ = 0;  // none chosen here
+  replays_ = 0;
+}
+
 bool SparseLU::factorize(const Eigen::SparseMatrix<double>& A) {
   valid_ = compute(A);
   return valid_;

@@ -155,6 +155,7 @@ void partition(System& sys) {
       sys.defs_V.push_back(k);
     }
   }
+  sys.velocity_block_is_position_block = sys.defs_P == sys.defs_V;
 
   // Columns of q̂ = (x^p, x^d, e^p, e^d).
   sys.qhat_col_x.assign(sys.nx, -1);

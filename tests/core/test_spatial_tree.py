@@ -198,8 +198,9 @@ def test_recursive_accelerations_equal_pinocchio_aba(name):
 
 @pytest.mark.parametrize("name", ["chain springs", "branched"])
 def test_runs_on_both_paths_agree(name):
-    """Output times and everything reported there (solved by the general path from the tree's
-    positions) agree with a run on the general path."""
+    """Output times and everything reported there (positions and velocities solved by the
+    general path from the tree's, accelerations and stresses from the tree's q̈) agree with a
+    run on the general path."""
     model = TREES[name]()
     model.forcemode(1)
     model.timestep(3, 0.3)

@@ -264,3 +264,24 @@ def test_a_massless_mesh_names_a_few_degrees_of_freedom_and_counts_the_rest():
     with pytest.raises(spacar.SingularMassError, match=r"deformation 3\] and 16 more move no mass") as info:
         spacar.simulate(m)
     assert len(info.value.args[0]) < 700
+
+
+def test_a_tree_taken_before_time_loads_leaves_their_state_to_the_equations_of_motion():
+    """recursive_state keeps its tree, which knows the constant loads only: with a time-dependent
+    load set afterwards, evaluate_state solves the equations of motion (the load's accelerations
+    included), as a simulation that never took the tree."""
+    model = TREES["chain"]()
+    with_tree, without = assembled(model.copy()), assembled(model.copy())
+    nd, nx = with_tree.system.n_dof, with_tree.system.nx
+    q, qd = np.array(with_tree.system.q0) + 0.1, np.full(nd, 0.3)
+    assert with_tree.recursive_state(q, qd) is not None
+    push = np.zeros(nx)
+    push[nx - 3] = 5.0  # the last node's x (coordinates x, y, then its BETA node)
+    for sim in (with_tree, without):
+        sim.set_time_loads([], [], lambda t: push)
+        sim.evaluate_state(0.0, np.concatenate([q, qd]))
+    np.testing.assert_allclose(with_tree.data.xdd, without.data.xdd, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(with_tree.data.sigma, without.data.sigma, rtol=0, atol=1e-9)
+    unloaded = assembled(model.copy())
+    unloaded.evaluate_state(0.0, np.concatenate([q, qd]))
+    assert np.abs(unloaded.data.xdd - without.data.xdd).max() > 1.0  # the load counts

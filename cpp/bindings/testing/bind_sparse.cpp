@@ -53,9 +53,12 @@ void bind_sparse(py::module_& m) {
       .def("solve", [](const TestLU& t, const Eigen::VectorXd& b) { return t.solve(b, false); })
       .def("solve_transposed", [](const TestLU& t, const Eigen::VectorXd& b) { return t.solve(b, true); })
       .def("adopt_pivots", [](TestLU& t, const TestLU& other) {
-        if (!(other.pattern.rows() == t.pattern.rows() && other.pattern.nonZeros() == t.pattern.nonZeros()))
-          throw std::invalid_argument("SparseLU.adopt_pivots: the patterns differ");
-        t.lu.adopt_pivots(other.lu);
+        const Sparse &a = t.pattern, &b = other.pattern;
+        const bool same = a.rows() == b.rows() && a.nonZeros() == b.nonZeros() &&
+                          std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1, b.outerIndexPtr()) &&
+                          std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr());
+        if (!same) throw std::invalid_argument("SparseLU.adopt_pivots: the patterns differ");
+        t.lu.adopt_pivots(other.lu, t.pattern);
       })
       .def_property_readonly("pivotings", [](const TestLU& t) { return t.lu.pivotings(); })
       .def_property_readonly("factor_nonzeros", [](const TestLU& t) { return t.lu.factor_nonzeros(); });

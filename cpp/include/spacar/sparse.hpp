@@ -55,8 +55,8 @@ class LinearSolver {
   void solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const;
   void solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
   int size() const { return n_; }
-  // See SparseLU::adopt_pivots: `other` factorized a matrix of this one's pattern.
-  void adopt_pivots(const LinearSolver& other) { lu_.adopt_pivots(other.lu_); }
+  // See SparseLU::adopt_pivots: `other` factorized a matrix of A's pattern.
+  void adopt_pivots(const LinearSolver& other, const Eigen::SparseMatrix<double>& A) { lu_.adopt_pivots(other.lu_, A); }
 
  private:
   int n_ = 0;

@@ -37,12 +37,11 @@ class SparseLU {
 
   int size() const { return n_; }
   // Take the pivot sequence (ordering, fill pattern, factors) of another factorization of a
-  // matrix of the same pattern, if this one has none yet: its first factorization is then a
-  // replay, not a search for pivots (the velocity block of a holonomic system is the position
-  // block, factorized first in the assembly).
-  void adopt_pivots(const SparseLU& other) {
-    if (first_ && other.have_pivots_ && other.n_ == n_) *this = other;
-  }
+  // matrix of A's pattern, if this one has not factorized yet: its first factorization of A is
+  // then a replay, not a search for pivots (the velocity block of a holonomic system is the
+  // position block, factorized first in the assembly). The caller guarantees the pattern; a
+  // different size or number of entries is refused here.
+  void adopt_pivots(const SparseLU& other, const Eigen::SparseMatrix<double>& A);
   int factor_nonzeros() const { return static_cast<int>(Li_.size() + Ui_.size()) + n_; }
   // Pivot choices made (not replays), one per ordering tried.
   int pivotings() const { return pivotings_; }
@@ -76,7 +75,7 @@ class SparseLU {
   bool have_pivots_ = false;  // a pivot sequence to replay
   bool valid_ = false;        // factors of the last factorized matrix, for solves
   int pivotings_ = 0;
-  bool first_ = false;             // no factorization has succeeded since analyze
+  bool first_ = false;             // no pivot sequence yet: the next factorization orders the columns
   int replays_ = 0;                // successful replays, until AMD's ordering is tried
   bool amd_tried_ = false;
   std::vector<int> q_;             // step k eliminates column q_[k] of A

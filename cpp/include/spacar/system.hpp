@@ -65,6 +65,8 @@ struct System {
   // below are the inverse maps).
   std::vector<int> defs_P;      // deformations with known values: position constraint rows
   std::vector<int> defs_V;      // deformations with known rates: velocity constraint rows
+  // defs_P == defs_V (no nonholonomic or kinematic rows): A_V is A_P, the same rows and pattern.
+  bool velocity_block_is_position_block = false;
   std::vector<int> auto_released;  // fixed rows with no calculable coordinate, checked instead
   std::vector<int> e_element;   // element (index into elements) of each deformation
   // Deformations defined up to a period (angles), unwrapped to continuous values: (index, period).
