@@ -37,7 +37,7 @@ import atheris
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/ (for `support`)
 with atheris.instrument_imports(include=["spacar"]):
     import spacar  # noqa: F401  (instrumented before anything else imports it)
-from support.fuzzing import CORPUS, Finding, run_reader_file, run_results_file  # noqa: E402
+from support.fuzzing import CORPUS, run_reader_file, run_results_file  # noqa: E402
 
 KINDS = ("reader", "results")
 CHILD = "SPACAR_COVERAGE_FUZZ"  # set in the libFuzzer process: the kind it fuzzes

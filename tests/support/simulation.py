@@ -2,6 +2,11 @@
 stages directly (evaluate, move_to, linearize) start from it."""
 from __future__ import annotations
 
+import re
+
+import numpy as np
+
+import spacar
 from spacar import _core
 
 
@@ -20,12 +25,6 @@ def assert_start_rows_agree(model, seed=0):
     ``model`` (a tree), its DOFs set moving at random rates: the same state, whose recursive
     output row is solved from the tree's q̈ and the general one from the equations of motion;
     everything reported there agrees to 1e-10."""
-    import re
-
-    import numpy as np
-
-    import spacar
-
     probe = spacar.simulate(model.copy(), method="dop853", progress=False)
     rng = np.random.default_rng(seed)
     for label in probe.dof_labels:
