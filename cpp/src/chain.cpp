@@ -286,22 +286,56 @@ int ExplicitChain::iterate(const System& sys, Data& data, Block& b, int max_iter
   }
 }
 
-void ExplicitChain::solve_velocities(const System& sys, Data& data) {
-  data.xd.setZero();
-  for (int g : sys.x_input) data.xd[g] = data.qhat_d[sys.qhat_col_x[g]];
-  for (int g : sys.x_dyn) data.xd[g] = data.qhat_d[sys.qhat_col_x[g]];
+void ExplicitChain::rates(const System& sys, Data& data, const Eigen::VectorXd& qhat_rate, bool convective,
+                          Eigen::VectorXd& y) {
+  y.setZero(sys.nx);
+  for (int g : sys.x_input) y[g] = qhat_rate[sys.qhat_col_x[g]];
+  for (int g : sys.x_dyn) y[g] = qhat_rate[sys.qhat_col_x[g]];
   for (Block& b : blocks_) {
-    // B_u ẋ_u = ė − B_k ẋ_k over the block's rows, ė the q̂ rate of the row (0 if fixed).
+    // B_u y_u = ė − s − B_k y_k over the block's rows, ė the q̂ rate of the row (0 if fixed),
+    // s the convective term for accelerations.
+    for (size_t j = 0; j < b.rows.size(); ++j) {
+      const int k = b.rows[j].def, col = sys.qhat_col_e[k];
+      b.r[static_cast<int>(j)] = (col >= 0 ? qhat_rate[col] : 0.0) - (convective ? data.conv[k] : 0.0);
+    }
+    add_known(data, b, y, -1.0);
+    assemble(data, b);
+    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, convective ? "acceleration" : "velocity");
+    for (size_t j = 0; j < b.coords.size(); ++j) y[b.coords[j]] = b.dx[static_cast<int>(j)];
+  }
+}
+
+void ExplicitChain::solve_velocities(const System& sys, Data& data) {
+  rates(sys, data, data.qhat_d, false, data.xd);
+  deformation_rates(sys, data);
+}
+
+void ExplicitChain::solve_accelerations(const System& sys, Data& data) {
+  rates(sys, data, data.qhat_dd, true, data.xdd);
+  deformation_accelerations(sys, data);
+}
+
+void ExplicitChain::transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out) {
+  // The velocities follow block by block, B_u ẋ_u = ė − B_k ẋ_k, so DFᵀ w is the adjoint sweep
+  // in reverse order: each block's multipliers μ from B_uᵀ μ = w_u (with what the later blocks
+  // passed on), μ to the q̂ columns of its rows, −B_kᵀ μ passed on to its known coordinates.
+  out.setZero(sys.n_qhat());
+  adjoint_ = w;
+  for (auto it = blocks_.rbegin(); it != blocks_.rend(); ++it) {
+    Block& b = *it;
+    for (size_t j = 0; j < b.coords.size(); ++j) b.r[static_cast<int>(j)] = adjoint_[b.coords[j]];
+    assemble(data, b);
+    b.A.transposeInPlace();
+    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "velocity");
+    for (const Block::Term& t : b.known_terms)
+      adjoint_[t.target] -= data.work[b.elements[t.slot]].B(t.local, t.coord) * b.dx[t.j];
     for (size_t j = 0; j < b.rows.size(); ++j) {
       const int col = sys.qhat_col_e[b.rows[j].def];
-      b.r[static_cast<int>(j)] = col >= 0 ? data.qhat_d[col] : 0.0;
+      if (col >= 0) out[col] += b.dx[static_cast<int>(j)];
     }
-    add_known(data, b, data.xd, -1.0);
-    assemble(data, b);
-    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "velocity");
-    for (size_t j = 0; j < b.coords.size(); ++j) data.xd[b.coords[j]] = b.dx[static_cast<int>(j)];
   }
-  deformation_rates(sys, data);
+  for (int g = 0; g < sys.nx; ++g)
+    if (sys.qhat_col_x[g] >= 0) out[sys.qhat_col_x[g]] += adjoint_[g];
 }
 
 }  // namespace spacar

@@ -33,6 +33,7 @@ Data::Data(const System& sys) {
   sol_V = Eigen::VectorXd::Zero(nc);
   h = f = inertia_residual = reaction = acc_known = residual_load = Eigen::VectorXd::Zero(nx);
   sigma_equilibrium = Eigen::VectorXd::Zero(ne);
+  qhat_load = Eigen::VectorXd::Zero(sys.n_qhat());
   rhs = qdd = Eigen::VectorXd::Zero(nd);
   body_M.assign(sys.bodies.size(), Eigen::Matrix4d::Zero());
   body_h.assign(sys.bodies.size(), Eigen::Vector4d::Zero());

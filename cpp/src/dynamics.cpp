@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "spacar/chain.hpp"
 #include "spacar/diagnosis.hpp"
 #include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
@@ -131,18 +132,20 @@ void add_element_loads(const System& sys, const Data& data, Take take, Eigen::Ve
 }
 }  // namespace
 
-void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R) {
-  solve_accelerations_direct(sys, data);
+void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R, ExplicitChain* chain) {
+  if (chain) chain->solve_accelerations(sys, data);
+  else solve_accelerations_direct(sys, data);
   compute_inertia_and_loads(sys, data);
   constitutive_stresses(sys, data);
   inertia_force(sys, data);
   // DFe = B DF element by element, so DF_qᵀ g + DFe_qᵀ σ = DF_qᵀ (g + Σ Bᵀ σ).
-  Eigen::VectorXd w = data.inertia_residual, all;
-  add_element_loads(sys, data, [](int) { return true; }, w);
-  transfer_transposed(sys, data, w, all);
+  data.residual_load = data.inertia_residual;
+  add_element_loads(sys, data, [](int) { return true; }, data.residual_load);
+  if (chain) chain->transfer_transposed(sys, data, data.residual_load, data.qhat_load);
+  else transfer_transposed(sys, data, data.residual_load, data.qhat_load);
   const int nd = sys.n_dof();
   R.resize(nd);
-  for (int j = 0; j < nd; ++j) R[j] = all[sys.dof_cols[j]];
+  for (int j = 0; j < nd; ++j) R[j] = data.qhat_load[sys.dof_cols[j]];
 }
 
 void solve_dynamics(const System& sys, Data& data) {

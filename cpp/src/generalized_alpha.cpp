@@ -69,6 +69,10 @@ double GeneralizedAlpha::last_step() const { return h_last_; }
 void GeneralizedAlpha::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
 void GeneralizedAlpha::set_step_start(StepStart start) { step_start_ = std::move(start); }
 void GeneralizedAlpha::set_jacobian(Jacobian jac) { jac_ = std::move(jac); }
+void GeneralizedAlpha::set_residual(Residual residual, Weight weight) {
+  residual_ = std::move(residual);
+  weight_ = std::move(weight);
+}
 const Radau5Stats& GeneralizedAlpha::stats() const { return stats_; }
 
 bool GeneralizedAlpha::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
@@ -82,13 +86,39 @@ bool GeneralizedAlpha::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Ei
   return false;
 }
 
+bool GeneralizedAlpha::newton_residual(const Rhs& f, double t) {
+  if (!residual_) {
+    if (!eval(f, t, y_new_, fy_)) return false;
+    res_ = fy_.tail(nz_) - d_new_;
+    return true;
+  }
+  ++stats_.nfev;
+  residual_(t, y_new_, d_new_, res_);
+  if (res_.size() != nz_)
+    throw std::invalid_argument("GeneralizedAlpha: the residual has " + std::to_string(res_.size()) + " values for " +
+                                std::to_string(nz_) + " states");
+  if (!res_.allFinite()) {
+    failure_ = "non-finite residual";
+    return false;
+  }
+  res_ = -res_;
+  return true;
+}
+
+void GeneralizedAlpha::apply_weight(Eigen::VectorXd& v) const {
+  if (!residual_) return;
+  const int r = r0_ - m_;
+  v.segment(r, m_) = W_ * v.segment(r, m_);
+}
+
 // N = I − γ′ h ∂f_Z/∂Z − β′ h² ∂f_Z/∂q: the derivative of the residual D⁺ − f_Z(q⁺, Z⁺) with
-// respect to D⁺.
+// respect to D⁺; in the residual form its rate rows times W_v.
 void GeneralizedAlpha::factorize(double h) {
   const double gh = gamma_d_ * h, bh2 = beta_d_ * h * h;
   N_ = -gh * J_.bottomRightCorner(nz_, nz_);
   N_.diagonal().array() += 1.0;
   N_.middleCols(r0_ - m_, m_) -= bh2 * J_.bottomLeftCorner(nz_, m_);
+  if (residual_) N_.middleRows(r0_ - m_, m_) = (W_ * N_.middleRows(r0_ - m_, m_)).eval();
   lu_.compute(N_);
   ++stats_.ndec;
 }
@@ -128,8 +158,7 @@ GeneralizedAlpha::Attempt GeneralizedAlpha::newton(const Rhs& f, double t, doubl
     ++stats_.nnewton;
     newton_its_ = it;
     state_at(h, y);
-    if (!eval(f, t + h, y_new_, fy_)) return Attempt::Failed;
-    res_ = fy_.tail(nz_) - d_new_;
+    if (!newton_residual(f, t + h)) return Attempt::Failed;
     dd_ = lu_.solve(res_);
     // The increment's effect on the states, in units of the tolerance.
     const double sq = (bh2 * dd_.segment(r, m_).array() / scale_.head(m_).array()).square().sum() +
@@ -182,6 +211,7 @@ double GeneralizedAlpha::error_norm(double h, const Eigen::VectorXd& y) {
     for (int j = 0; j < nz_; ++j)
       if (j < r || j >= r + m_) res_[j] = k * ((d_new_[j] - d_[j]) / h - (d_[j] - d_prev_[j]) / h_prev_);
   }
+  apply_weight(res_);  // the filter is N⁻¹ = (W_v N)⁻¹ W_v
   dd_ = lu_.solve(res_);
   double sum = 0.0;
   for (int j = 0; j < nz_; ++j) {
@@ -264,6 +294,12 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
         jac_(t, y, J_);
         if (J_.rows() != n_ || J_.cols() != n_) throw std::invalid_argument("GeneralizedAlpha: the Jacobian has the wrong size");
         if (!J_.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite Jacobian at " + describe_step(t, h_try));
+        if (residual_) {
+          weight_(W_);
+          if (W_.rows() != m_ || W_.cols() != m_ || !W_.allFinite())
+            throw IntegrationError("GeneralizedAlpha: the residual's weight is not a finite " + std::to_string(m_) +
+                                   " x " + std::to_string(m_) + " matrix at " + describe_step(t, h_try));
+        }
         need_jacobian = false;
         jacobian_fresh = true;
         h_factorized = 0.0;

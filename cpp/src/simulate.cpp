@@ -145,6 +145,13 @@ void Simulation::assemble() {
 
 void Simulation::solve_state(double t, const double* q, const double* qd, bool transfer_predictor,
                              const Eigen::VectorXd* known_qdd) {
+  solve_motion(t, q, qd, transfer_predictor);
+  if (!(known_qdd && solve_dynamics_known(*sys_, *data_, *known_qdd))) solve_dynamics_direct(*sys_, *data_);
+  remember(base_);
+  have_transfer_ = false;
+}
+
+void Simulation::solve_motion(double t, const double* q, const double* qd, bool transfer_predictor) {
   const System& sys = *sys_;
   set_inputs(sys, *data_, t);
   apply_time_loads(t);
@@ -200,9 +207,6 @@ void Simulation::solve_state(double t, const double* q, const double* qd, bool t
   }
   if (chain && in_rhs_) chain->solve_velocities(sys, *data_);
   else solve_velocities_direct(sys, *data_);
-  if (!(known_qdd && solve_dynamics_known(sys, *data_, *known_qdd))) solve_dynamics_direct(sys, *data_);
-  remember(base_);
-  have_transfer_ = false;
 }
 
 void Simulation::evaluate(double t, const double* q, const double* qd) {
@@ -306,6 +310,41 @@ bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd&
   return true;
 }
 
+template <class F>
+void Simulation::in_rhs(double t, F&& evaluate) {
+  struct InRhs {  // solve_motion() checks continuity with the step start only inside a right-hand side
+    bool& flag;
+    explicit InRhs(bool& f) : flag(f) { flag = true; }
+    ~InRhs() { flag = false; }
+  };
+  try {
+    const InRhs guard(in_rhs_);
+    evaluate();
+  } catch (const KinematicsError& err) {
+    kinematic_failure_ = err.what();
+    kinematic_failure_t_ = t;
+    throw StepRejected(err.what());
+  }
+}
+
+bool Simulation::residual_form() const {
+  return chain_ && !tree_ && sys_->y_defs.empty() && n_energy_ == 0;
+}
+
+void Simulation::residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& qdd, Eigen::VectorXd& R) {
+  const System& sys = *sys_;
+  const int nd = sys.n_dof();
+  check_time(t);
+  in_rhs(t, [&] {
+    solve_motion(t, Y.data(), Y.data() + nd, false);
+    data_->qdd = qdd;
+    for (int j = 0; j < nd; ++j) data_->qhat_dd[sys.dof_cols[j]] = qdd[j];
+    reduced_residual_direct(sys, *data_, R, chain_.get());
+  });
+  remember(base_);  // the next positions' predictor, and the anchor of the next step
+  have_transfer_ = false;
+}
+
 void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   check_time(t);
@@ -315,19 +354,7 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
     dY.head(nd) = Y.segment(nd + ny, nd);
     return;
   }
-  struct InRhs {  // evaluate() checks continuity with the step start only inside a right-hand side
-    bool& flag;
-    explicit InRhs(bool& f) : flag(f) { flag = true; }
-    ~InRhs() { flag = false; }
-  };
-  try {
-    const InRhs in_rhs(in_rhs_);
-    evaluate_state(t, Y);
-  } catch (const KinematicsError& err) {
-    kinematic_failure_ = err.what();
-    kinematic_failure_t_ = t;
-    throw StepRejected(err.what());
-  }
+  in_rhs(t, [&] { evaluate_state(t, Y); });
   dY.head(nd) = Y.segment(nd + ny, nd);
   for (int i = 0; i < ny; ++i) dY[nd + i] = data_->ed[sys_->y_defs[i]];
   dY.segment(nd + ny, nd) = data_->qdd;
@@ -735,6 +762,10 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
     if (nd == 0) throw InputError("method generalized_alpha: the model has no degrees of freedom to integrate");
     GeneralizedAlpha integ(static_cast<int>(Y.size()), nd, nd + ny, options.rho_inf);
     integ.set_jacobian(jacobian_of_state);
+    if (residual_form())
+      integ.set_residual([this](double tt, const Eigen::VectorXd& y, const Eigen::VectorXd& D,
+                                Eigen::VectorXd& R) { residual(tt, y, D, R); },
+                         [this](Eigen::MatrixXd& W) { W = jacobian_mass_; });
     integ.set_fixed_step(options.fixed_step);
     return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
   }

@@ -46,6 +46,12 @@ class ExplicitChain {
                        const Eigen::VectorXd* reference = nullptr);
   // ẋ of the calculable coordinates, ė and the convective terms, as solve_velocities_direct().
   void solve_velocities(const System& sys, Data& data);
+  // ẍ of the calculable coordinates and ë from q̂̈, as solve_accelerations_direct() (after
+  // solve_velocities: the convective terms).
+  void solve_accelerations(const System& sys, Data& data);
+  // out = DFᵀ w (n_qhat), as transfer_transposed() with the velocity block: the blocks'
+  // transposed solves in reverse order (B at the current positions).
+  void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out);
 
   int blocks() const { return static_cast<int>(blocks_.size()); }
   int closed_form_blocks() const {  // solved without iterations (Block::closed_end)
@@ -91,11 +97,15 @@ class ExplicitChain {
   // The block of `group`'s position rows on the unknowns U.
   static Block make_block(const System& sys, const std::vector<int>& group, const std::vector<int>& U);
   static KinematicsError singular(const System& sys, const Data& data, const Block& b, const char* what);
+  // Rates y of all coordinates from the q̂ rates (velocities; with the convective terms,
+  // accelerations), block by block as calculable_rates() does with the velocity block.
+  void rates(const System& sys, Data& data, const Eigen::VectorXd& qhat_rate, bool convective, Eigen::VectorXd& y);
 
   std::vector<Block> blocks_;
   bool all_closed_ = false;  // every block in closed form: no first Newton step of all coordinates
   std::vector<int> rest_;  // elements without position rows: evaluated once at the end
   Eigen::VectorXd step_;   // the first Newton step of all coordinates (work space)
+  Eigen::VectorXd adjoint_;  // w less the loads the later blocks passed on (transfer_transposed)
 };
 
 }  // namespace spacar

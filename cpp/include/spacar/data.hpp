@@ -98,6 +98,7 @@ struct Data {
   // coordinate (the reactions on fixed and input rows, ≈ 0 on the others) and σ of every
   // velocity row from (6.1), degree-of-freedom rows included (0 on the other rows).
   Eigen::VectorXd residual_load;      // (nx)
+  Eigen::VectorXd qhat_load;          // DFᵀ of a load (n_qhat)
   Eigen::VectorXd sigma_equilibrium;  // (ne)
 };
 

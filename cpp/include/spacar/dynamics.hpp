@@ -7,6 +7,8 @@
 
 namespace spacar {
 
+class ExplicitChain;
+
 // σ = S e + D ė for the deformations whose stresses are constitutive (released, dynamic,
 // kinematic); the others are reactions and are set to 0 here.
 void constitutive_stresses(const System& sys, Data& data);
@@ -23,8 +25,9 @@ void assemble_mass_matrix(const System& sys, Data& data);
 // R = DF_qᵀ [M ẍ + h − f] + DFe_qᵀ σ. Requires positions, DF and velocities.
 void reduced_residual(const System& sys, Data& data, Eigen::VectorXd& R);
 // The same residual without transfer functions (cost linear in the model size): accelerations
-// and DF_qᵀ from solves with the velocity block. Requires positions and solve_velocities_direct.
-void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R);
+// and DF_qᵀ from solves with the velocity block (requires positions and solve_velocities_direct)
+// or, given an open chain, block by block (requires positions and chain->solve_velocities).
+void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R, ExplicitChain* chain = nullptr);
 
 // The deformations whose stresses follow from their constitutive law (σ = S e + D ė).
 inline bool constitutive_class(DefClass c) {

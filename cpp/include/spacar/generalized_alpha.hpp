@@ -57,6 +57,15 @@ class GeneralizedAlpha {
   void set_stop_condition(StopCondition stop);
   void set_step_start(StepStart start);
   void set_jacobian(Jacobian jac);  // required before integrate()
+  // The residual form of the Newton iterations (optional): R = W(y) (D − f_Z(t, y)) for a trial
+  // D of Z, with W the identity except in the rates' rows, where it is a matrix W_v (m x m) of
+  // the positions (the reduced mass matrix M̄(q) of equations of motion M̄ q̈ = r(q, q̇)). Where
+  // the residual costs less than f_Z (no solve with M̄), the iterations use it with the Newton
+  // matrix W_v N, W_v taken at the Jacobian's state: the same increments to first order.
+  // `weight` gives W_v there, after each call of the Jacobian.
+  using Residual = std::function<void(double t, const Eigen::VectorXd& y, const Eigen::VectorXd& D, Eigen::VectorXd& R)>;
+  using Weight = std::function<void(Eigen::MatrixXd& W)>;
+  void set_residual(Residual residual, Weight weight);
   // Fixed steps of size h (the last one shortened to t_end) without error control, as structural
   // dynamics codes are used; the tolerances then only stop the Newton iterations. A step whose
   // Newton iterations fail is retried in halves. 0 (the default): error control.
@@ -73,6 +82,9 @@ class GeneralizedAlpha {
   enum class Attempt { Accepted, ErrorTooLarge, SlowNewton, Failed, Rejected };
 
   bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
+  // res_ = f_Z(t, y_new_) − d_new_, or its residual form −R (see set_residual).
+  bool newton_residual(const Rhs& f, double t);
+  void apply_weight(Eigen::VectorXd& v) const;  // v's rate part times W_ (residual form)
   void factorize(double h);
   void shift_acceleration(double h);                  // a_use_: A for a step of size h
   void state_at(double h, const Eigen::VectorXd& y);  // y_new_, a_new_ from d_new_
@@ -90,6 +102,8 @@ class GeneralizedAlpha {
   StopCondition stop_;
   StepStart step_start_;
   Jacobian jac_;
+  Residual residual_;
+  Weight weight_;
   Radau5Stats stats_;
   std::string failure_;
   double theta_ = 0.0, faccon_ = 1.0, slow_factor_ = 0.5;
@@ -98,7 +112,7 @@ class GeneralizedAlpha {
   double h_prev_ = 0.0;
 
   // Work space, allocated once. d_: D at the step start, a_: A there; d_new_, a_new_: at its end.
-  Eigen::MatrixXd J_, N_;
+  Eigen::MatrixXd J_, N_, W_;  // W_: W_v at the Jacobian's state (residual form)
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   Eigen::VectorXd d_, a_, a_use_, d_new_, a_new_, d_prev_, dd_, y_new_, fy_, res_, scale_, y_out_;
 };

@@ -165,6 +165,12 @@ class Simulation {
   void evaluate_state(double t, const Eigen::VectorXd& Y);
   // Right-hand side of the first-order system Y = (q, y, q̇).
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
+  // The residual of the reduced equations of motion R = M̄ (q̈ − q̈(Y)) at a trial q̈ of an open
+  // chain (ExplicitChain), without the equations of motion: the accelerations and DF_qᵀ
+  // follow block by block. Generalized-α's residual form (Y = (q, q̇): no integrated
+  // deformations, no energy states); the state is left without its constraints' stresses.
+  bool residual_form() const;
+  void residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& qdd, Eigen::VectorXd& R);
   // Its Jacobian ∂(q̇, ẏ, q̈)/∂(q, y, q̇) at (t, Y) from the linearized equations (simulate_jacobian.cpp).
   void jacobian(double t, const Eigen::VectorXd& Y, Eigen::MatrixXd& J);
   // The state at (q, q̇) by the recursive path: q̈ and the coordinates' positions, velocities and
@@ -248,6 +254,12 @@ class Simulation {
     Eigen::VectorXd x, xd, xdd, qhat, angle_ref;
   };
   void remember(Solved& s) const;
+  // solve_state up to the velocities: positions, velocities, no dynamics, not remembered.
+  void solve_motion(double t, const double* q, const double* qd, bool transfer_predictor);
+  // The kinematics of a right-hand side: a KinematicsError becomes StepRejected (the
+  // integrator retries a smaller step) and is remembered for the report.
+  template <class F>
+  void in_rhs(double t, F&& evaluate);
   // Start the positions from s: its solution advanced by a second-order Taylor step in time.
   void predict_from(const Solved& s, double t, const double* q);
   // The positions just solved against the prediction from the step start (anchor_): false if
@@ -277,6 +289,7 @@ class Simulation {
   // the system is one and no tree_: in the right-hand sides (with their velocities), at the step
   // starts and at the output times.
   std::unique_ptr<ExplicitChain> chain_;
+  Eigen::MatrixXd jacobian_mass_;  // M̄ at the state of the last jacobian()
   Eigen::VectorXd tree_qdd_;
   // The tree's state at (t, Y) into base_ (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.
