@@ -20,31 +20,58 @@ std::vector<int> unknown_coords(const System& sys, const std::vector<char>& know
   return u;
 }
 
-// x = A⁻¹ r by Gaussian elimination with partial pivoting, in place (A and r are overwritten):
-// the blocks have a few unknowns (3 for a planar beam, 7 for a spatial one), where a general
-// LU's blocking and dispatch cost more than the arithmetic. False if A is singular.
-bool small_solve(Eigen::MatrixXd& A, Eigen::VectorXd& r, Eigen::VectorXd& x) {
+// LU factors of A with partial pivoting, in place (the row swaps in piv): the blocks have a few
+// unknowns (3 for a planar beam, 7 for a spatial one), where a general LU's blocking and dispatch
+// cost more than the arithmetic. False if A is singular.
+bool small_factor(Eigen::MatrixXd& A, std::vector<int>& piv) {
   const int n = static_cast<int>(A.rows());
+  piv.resize(n);
   for (int c = 0; c < n; ++c) {
     int p = c;
     for (int i = c + 1; i < n; ++i)
       if (std::abs(A(i, c)) > std::abs(A(p, c))) p = i;
     if (!(A(p, c) != 0.0)) return false;
-    if (p != c) {
-      A.row(p).swap(A.row(c));
-      std::swap(r[p], r[c]);
-    }
+    piv[c] = p;
+    if (p != c) A.row(p).swap(A.row(c));
     for (int i = c + 1; i < n; ++i) {
-      const double f = A(i, c) / A(c, c);
+      const double f = A(i, c) /= A(c, c);
       for (int j = c + 1; j < n; ++j) A(i, j) -= f * A(c, j);
-      r[i] -= f * r[c];
     }
   }
+  return true;
+}
+
+// x = A⁻¹ r from the factors (P A = L U).
+void solve_factored(const Eigen::MatrixXd& LU, const std::vector<int>& piv, const Eigen::VectorXd& r, Eigen::VectorXd& x) {
+  const int n = static_cast<int>(LU.rows());
+  x = r;
+  for (int c = 0; c < n; ++c) std::swap(x[c], x[piv[c]]);
+  for (int c = 0; c < n; ++c)
+    for (int i = c + 1; i < n; ++i) x[i] -= LU(i, c) * x[c];
   for (int c = n - 1; c >= 0; --c) {
-    double v = r[c];
-    for (int j = c + 1; j < n; ++j) v -= A(c, j) * x[j];
-    x[c] = v / A(c, c);
+    for (int j = c + 1; j < n; ++j) x[c] -= LU(c, j) * x[j];
+    x[c] /= LU(c, c);
   }
+}
+
+// x = A⁻ᵀ r from the factors: Uᵀ Lᵀ (P x) = r.
+void solve_factored_transposed(const Eigen::MatrixXd& LU, const std::vector<int>& piv, const Eigen::VectorXd& r,
+                            Eigen::VectorXd& x) {
+  const int n = static_cast<int>(LU.rows());
+  x = r;
+  for (int c = 0; c < n; ++c) {
+    for (int j = 0; j < c; ++j) x[c] -= LU(j, c) * x[j];
+    x[c] /= LU(c, c);
+  }
+  for (int c = n - 1; c >= 0; --c)
+    for (int i = c + 1; i < n; ++i) x[c] -= LU(i, c) * x[i];
+  for (int c = n - 1; c >= 0; --c) std::swap(x[c], x[piv[c]]);
+}
+
+// x = A⁻¹ r, A overwritten by its factors; false if A is singular.
+bool small_solve(Eigen::MatrixXd& A, std::vector<int>& piv, const Eigen::VectorXd& r, Eigen::VectorXd& x) {
+  if (!small_factor(A, piv)) return false;
+  solve_factored(A, piv, r, x);
   return x.allFinite();
 }
 
@@ -213,6 +240,7 @@ bool ExplicitChain::solve_closed(const System& sys, Data& data, Block& b) const 
 void ExplicitChain::solve_positions(const System& sys, Data& data, int max_iter, double tol,
                                     const Eigen::VectorXd* reference) {
   set_targets(sys, data);
+  rates_factorized_ = false;  // the positions move, and first_step and iterate use the blocks' A
   // The closed-form blocks keep the branches of a solved state, not of the starting positions
   // extrapolated from it: an extrapolation over a long trial step of an implicit integrator may
   // fold a beam, which Newton's method would not follow, and a closed form would.
@@ -250,7 +278,7 @@ void ExplicitChain::first_step(const System& sys, Data& data) {
     for (size_t j = 0; j < b.rows.size(); ++j) b.r[static_cast<int>(j)] = data.e[b.rows[j].def] - data.target[b.rows[j].row];
     add_known(data, b, step_, 1.0);
     assemble(data, b);
-    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "position");
+    if (!small_solve(b.A, b.piv, b.r, b.dx)) throw singular(sys, data, b, "position");
     for (size_t j = 0; j < b.coords.size(); ++j) step_[b.coords[j]] = -b.dx[static_cast<int>(j)];
   }
   if (!step_.allFinite()) throw singular(sys, data, blocks_.front(), "position");
@@ -281,13 +309,14 @@ int ExplicitChain::iterate(const System& sys, Data& data, Block& b, int max_iter
       throw KinematicsError(os.str());
     }
     assemble(data, b);
-    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "position");
+    if (!small_solve(b.A, b.piv, b.r, b.dx)) throw singular(sys, data, b, "position");
     for (size_t j = 0; j < b.coords.size(); ++j) data.x[b.coords[j]] -= b.dx[static_cast<int>(j)];
   }
 }
 
 void ExplicitChain::rates(const System& sys, Data& data, const Eigen::VectorXd& qhat_rate, bool convective,
                           Eigen::VectorXd& y) {
+  if (!rates_factorized_) factorize_rates(sys, data);
   y.setZero(sys.nx);
   for (int g : sys.x_input) y[g] = qhat_rate[sys.qhat_col_x[g]];
   for (int g : sys.x_dyn) y[g] = qhat_rate[sys.qhat_col_x[g]];
@@ -299,13 +328,21 @@ void ExplicitChain::rates(const System& sys, Data& data, const Eigen::VectorXd& 
       b.r[static_cast<int>(j)] = (col >= 0 ? qhat_rate[col] : 0.0) - (convective ? data.conv[k] : 0.0);
     }
     add_known(data, b, y, -1.0);
-    assemble(data, b);
-    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, convective ? "acceleration" : "velocity");
+    solve_factored(b.A, b.piv, b.r, b.dx);
     for (size_t j = 0; j < b.coords.size(); ++j) y[b.coords[j]] = b.dx[static_cast<int>(j)];
   }
 }
 
+void ExplicitChain::factorize_rates(const System& sys, const Data& data) {
+  for (Block& b : blocks_) {
+    assemble(data, b);
+    if (!small_factor(b.A, b.piv)) throw singular(sys, data, b, "velocity");
+  }
+  rates_factorized_ = true;
+}
+
 void ExplicitChain::solve_velocities(const System& sys, Data& data) {
+  factorize_rates(sys, data);  // B at the positions just solved
   rates(sys, data, data.qhat_d, false, data.xd);
   deformation_rates(sys, data);
 }
@@ -319,14 +356,13 @@ void ExplicitChain::transfer_transposed(const System& sys, Data& data, const Eig
   // The velocities follow block by block, B_u ẋ_u = ė − B_k ẋ_k, so DFᵀ w is the adjoint sweep
   // in reverse order: each block's multipliers μ from B_uᵀ μ = w_u (with what the later blocks
   // passed on), μ to the q̂ columns of its rows, −B_kᵀ μ passed on to its known coordinates.
+  if (!rates_factorized_) factorize_rates(sys, data);
   out.setZero(sys.n_qhat());
   adjoint_ = w;
   for (auto it = blocks_.rbegin(); it != blocks_.rend(); ++it) {
     Block& b = *it;
     for (size_t j = 0; j < b.coords.size(); ++j) b.r[static_cast<int>(j)] = adjoint_[b.coords[j]];
-    assemble(data, b);
-    b.A.transposeInPlace();
-    if (!small_solve(b.A, b.r, b.dx)) throw singular(sys, data, b, "velocity");
+    solve_factored_transposed(b.A, b.piv, b.r, b.dx);
     for (const Block::Term& t : b.known_terms)
       adjoint_[t.target] -= data.work[b.elements[t.slot]].B(t.local, t.coord) * b.dx[t.j];
     for (size_t j = 0; j < b.rows.size(); ++j) {

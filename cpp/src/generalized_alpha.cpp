@@ -11,6 +11,10 @@ namespace {
 // Newton stops when the predicted remaining error of the states is below this fraction of the
 // tolerance (the scaled norm in which the local error must stay below 1).
 constexpr double kNewtonTolerance = 0.02;
+// The residual form is left when Newton contracts by less than this per iteration: W_v has moved
+// from M̄ by about as much (a relative change of the mass matrix), which costs iterations where
+// the form with the exact M̄ still converges in two.
+constexpr double kResidualDrift = 1e-3;
 
 }  // namespace
 
@@ -87,12 +91,13 @@ bool GeneralizedAlpha::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Ei
 }
 
 bool GeneralizedAlpha::newton_residual(const Rhs& f, double t) {
-  if (!residual_) {
+  if (!in_residual_form_) {
     if (!eval(f, t, y_new_, fy_)) return false;
     res_ = fy_.tail(nz_) - d_new_;
     return true;
   }
   ++stats_.nfev;
+  ++stats_.nresidual;
   residual_(t, y_new_, d_new_, res_);
   if (res_.size() != nz_)
     throw std::invalid_argument("GeneralizedAlpha: the residual has " + std::to_string(res_.size()) + " values for " +
@@ -106,7 +111,7 @@ bool GeneralizedAlpha::newton_residual(const Rhs& f, double t) {
 }
 
 void GeneralizedAlpha::apply_weight(Eigen::VectorXd& v) const {
-  if (!residual_) return;
+  if (!in_residual_form_) return;
   const int r = r0_ - m_;
   v.segment(r, m_) = W_ * v.segment(r, m_);
 }
@@ -118,8 +123,9 @@ void GeneralizedAlpha::factorize(double h) {
   N_ = -gh * J_.bottomRightCorner(nz_, nz_);
   N_.diagonal().array() += 1.0;
   N_.middleCols(r0_ - m_, m_) -= bh2 * J_.bottomLeftCorner(nz_, m_);
-  if (residual_) N_.middleRows(r0_ - m_, m_) = (W_ * N_.middleRows(r0_ - m_, m_)).eval();
+  if (in_residual_form_) N_.middleRows(r0_ - m_, m_) = (W_ * N_.middleRows(r0_ - m_, m_)).eval();
   lu_.compute(N_);
+  factorized_residual_form_ = in_residual_form_;
   ++stats_.ndec;
 }
 
@@ -303,8 +309,9 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
         need_jacobian = false;
         jacobian_fresh = true;
         h_factorized = 0.0;
+        in_residual_form_ = static_cast<bool>(residual_);  // W_v is fresh
       }
-      if (h_try != h_factorized) {
+      if (h_try != h_factorized || in_residual_form_ != factorized_residual_form_) {
         factorize(h_try);
         h_factorized = h_try;
       }
@@ -330,6 +337,13 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
     if (result != Attempt::Accepted) {
       ++stats_.nreject;
       rejected = true;
+      if (in_residual_form_ && (result == Attempt::SlowNewton || result == Attempt::Failed) &&
+          failure_ != "non-finite residual") {
+        // W_v has drifted from M̄ (the mechanism has moved since the Jacobian): the same step
+        // again in the form with the exact M̄.
+        in_residual_form_ = false;
+        continue;
+      }
       if (result == Attempt::ErrorTooLarge) h = h_try / quot;
       else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
       else h = 0.5 * h_try;
@@ -352,7 +366,11 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
     y = y_new_;
     t = t_new;
     rejected = jacobian_fresh = false;
-    need_jacobian = theta_ > 0.1;  // a Jacobian is a linearization: keep it while Newton contracts
+    // A Jacobian is a linearization: keep it while Newton contracts. In the residual form, slow
+    // contraction is first taken for the drift of W_v (cheap to leave behind: the form with the
+    // exact M̄, until the next Jacobian).
+    if (in_residual_form_ && theta_ > kResidualDrift) in_residual_form_ = false;
+    else need_jacobian = theta_ > 0.1;
     if (!need_jacobian && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;  // keep the factorization
     h = last ? std::max(h_new, std::min(h, hmax_)) : h_new;
     if (stop_ && t < t_end && stop_(t, y)) break;

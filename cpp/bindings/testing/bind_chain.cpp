@@ -42,4 +42,33 @@ void bind_chain(py::module_& m) {
       "The right-hand side's state by the explicit chain at (t, q, q̇), starting from the simulation's "
       "current positions (a dict of x, xd, xdd, qdd, e, ed, blocks, closed_form_blocks, newton_iterations; None if the system "
       "is not an open chain). The simulation's data is left at that state.");
+  m.def(
+      "chain_residual",
+      [](spacar::Simulation& sim, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+         const Eigen::VectorXd& qdd) -> py::object {
+        const spacar::System& sys = sim.system();
+        const int nd = sys.n_dof();
+        if (q.size() != nd || qd.size() != nd || qdd.size() != nd)
+          throw spacar::InputError("chain_residual(): q, qd and qdd must have one value per degree of freedom");
+        std::unique_ptr<spacar::ExplicitChain> chain = spacar::ExplicitChain::detect(sys);
+        if (!chain) return py::none();
+        spacar::Data& d = sim.data();
+        spacar::set_inputs(sys, d, t);
+        spacar::set_dofs(sys, d, q.data(), qd.data());
+        chain->solve_positions(sys, d, sys.settings.maxiterat, sys.settings.epskin);
+        chain->solve_velocities(sys, d);
+        d.qdd = qdd;
+        for (int j = 0; j < nd; ++j) d.qhat_dd[sys.dof_cols[j]] = qdd[j];
+        Eigen::VectorXd R;
+        spacar::reduced_residual_direct(sys, d, R, chain.get());
+        py::dict out;
+        out["residual"] = R;
+        out["xdd"] = d.xdd;
+        out["edd"] = d.edd;
+        return out;
+      },
+      py::arg("simulation"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
+      "The residual of the reduced equations of motion at a trial q̈ by the explicit chain "
+      "(generalized-α's residual form), from the simulation's current positions: a dict of residual "
+      "(R = M̄ (q̈ − q̈(q, q̇))), xdd and edd at that q̈; None if the system is not an open chain.");
 }

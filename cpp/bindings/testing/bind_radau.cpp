@@ -24,6 +24,7 @@ py::dict outputs(const std::vector<double>& touts, const Eigen::MatrixXd& ys, co
   result["njev"] = s.njev;
   result["ndec"] = s.ndec;
   result["nnewton"] = s.nnewton;
+  result["nresidual"] = s.nresidual;
   result["nsteps"] = s.nsteps;
   result["naccept"] = s.naccept;
   result["nreject"] = s.nreject;
@@ -75,11 +76,18 @@ py::dict solve_radau5(const py::function& f, const py::function& jac, double t0,
 
 py::dict solve_generalized_alpha(const py::function& f, const py::function& jac, double t0, const Eigen::VectorXd& y0,
                                  double t_end, const std::vector<double>& touts, double rtol, double atol, int m,
-                                 int rate_offset, double rho_inf, double hmax, double first_step, double fixed_step) {
+                                 int rate_offset, double rho_inf, double hmax, double first_step, double fixed_step,
+                                 const py::object& residual, const py::object& weight) {
   const int n = static_cast<int>(y0.size());
   spacar::GeneralizedAlpha integrator(n, m, rate_offset < 0 ? n - m : rate_offset, rho_inf);
   configure(integrator, n, rtol, atol, hmax, first_step);
   integrator.set_fixed_step(fixed_step);
+  if (!residual.is_none())
+    integrator.set_residual(
+        [residual](double t, const Eigen::VectorXd& y, const Eigen::VectorXd& D, Eigen::VectorXd& R) {
+          R = residual(t, y, D).cast<Eigen::VectorXd>();
+        },
+        [weight](Eigen::MatrixXd& W) { W = weight().cast<Eigen::MatrixXd>(); });
   Eigen::VectorXd y = y0;
   Eigen::MatrixXd ys;
   integrate_python(integrator, f, jac, t0, y, t_end, touts, ys);
@@ -101,8 +109,10 @@ void bind_radau(py::module_& m) {
         py::arg("y0"), py::arg("t_end"), py::arg("touts"), py::arg("rtol"), py::arg("atol"), py::arg("m"),
         py::arg("rate_offset") = -1, py::arg("rho_inf") = 0.9,
         py::arg("hmax") = std::numeric_limits<double>::infinity(), py::arg("first_step") = 0.0,
-        py::arg("fixed_step") = 0.0,
+        py::arg("fixed_step") = 0.0, py::arg("residual") = py::none(), py::arg("weight") = py::none(),
         "Test helper: integrate dy/dt = f(t, y) whose first m components are positions with rates at "
         "rate_offset (default: the last m) by generalized-alpha with spectral radius rho_inf (fixed_step > 0: "
-        "fixed steps, no error control); returns the dense output at touts and the counters as radau5_solve.");
+        "fixed steps, no error control); returns the dense output at touts and the counters as radau5_solve. "
+        "residual(t, y, D) -> R and weight() -> W_v: the residual form (GeneralizedAlpha::set_residual); "
+        "weight is called after each call of jac.");
 }

@@ -81,7 +81,8 @@ class ExplicitChain {
     // local_x, local_e: its coordinates and the rows' values (all three sized by make_block).
     int closed_end = -1;
     std::vector<double> guess, local_x, local_e;
-    Eigen::MatrixXd A;                    // ∂(rows)/∂(unknowns)
+    Eigen::MatrixXd A;                    // ∂(rows)/∂(unknowns), or its LU factors
+    std::vector<int> piv;                 // the factors' row swaps
     Eigen::VectorXd r, dx;
   };
   void assemble(const Data& data, Block& b) const;
@@ -100,11 +101,14 @@ class ExplicitChain {
   // Rates y of all coordinates from the q̂ rates (velocities; with the convective terms,
   // accelerations), block by block as calculable_rates() does with the velocity block.
   void rates(const System& sys, Data& data, const Eigen::VectorXd& qhat_rate, bool convective, Eigen::VectorXd& y);
+  // The blocks' A = B_u at the current positions, factorized for the rates and the adjoint sweep.
+  void factorize_rates(const System& sys, const Data& data);
 
   std::vector<Block> blocks_;
   bool all_closed_ = false;  // every block in closed form: no first Newton step of all coordinates
   std::vector<int> rest_;  // elements without position rows: evaluated once at the end
   Eigen::VectorXd step_;   // the first Newton step of all coordinates (work space)
+  bool rates_factorized_ = false;  // the blocks' A hold the factors of B_u at the current positions
   Eigen::VectorXd adjoint_;  // w less the loads the later blocks passed on (transfer_transposed)
 };
 

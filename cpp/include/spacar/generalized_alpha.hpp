@@ -104,6 +104,9 @@ class GeneralizedAlpha {
   Jacobian jac_;
   Residual residual_;
   Weight weight_;
+  // The residual form is used from each Jacobian on until Newton contracts slowly (W_v has
+  // drifted); lu_ holds the Newton matrix of factorized_residual_form_.
+  bool in_residual_form_ = false, factorized_residual_form_ = false;
   Radau5Stats stats_;
   std::string failure_;
   double theta_ = 0.0, faccon_ = 1.0, slow_factor_ = 0.5;

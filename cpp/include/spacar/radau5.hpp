@@ -27,6 +27,7 @@ struct Radau5Stats {
   long njev = 0;      // Jacobian evaluations
   long ndec = 0;      // factorizations of the Newton matrix (one real and one complex each)
   long nnewton = 0;   // simplified Newton iterations (three rhs and two solves each)
+  long nresidual = 0; // of nfev, residuals of the residual form (GeneralizedAlpha::set_residual)
 };
 
 class Radau5 {
