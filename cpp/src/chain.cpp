@@ -329,11 +329,13 @@ void ExplicitChain::rates(const System& sys, Data& data, const Eigen::VectorXd& 
     }
     add_known(data, b, y, -1.0);
     solve_factored(b.A, b.piv, b.r, b.dx);
+    if (!b.dx.allFinite()) throw singular(sys, data, b, convective ? "acceleration" : "velocity");
     for (size_t j = 0; j < b.coords.size(); ++j) y[b.coords[j]] = b.dx[static_cast<int>(j)];
   }
 }
 
 void ExplicitChain::factorize_rates(const System& sys, const Data& data) {
+  rates_factorized_ = false;  // until every block is
   for (Block& b : blocks_) {
     assemble(data, b);
     if (!small_factor(b.A, b.piv)) throw singular(sys, data, b, "velocity");
@@ -363,6 +365,7 @@ void ExplicitChain::transfer_transposed(const System& sys, Data& data, const Eig
     Block& b = *it;
     for (size_t j = 0; j < b.coords.size(); ++j) b.r[static_cast<int>(j)] = adjoint_[b.coords[j]];
     solve_factored_transposed(b.A, b.piv, b.r, b.dx);
+    if (!b.dx.allFinite()) throw singular(sys, data, b, "velocity");
     for (const Block::Term& t : b.known_terms)
       adjoint_[t.target] -= data.work[b.elements[t.slot]].B(t.local, t.coord) * b.dx[t.j];
     for (size_t j = 0; j < b.rows.size(); ++j) {

@@ -11,9 +11,9 @@ namespace {
 // Newton stops when the predicted remaining error of the states is below this fraction of the
 // tolerance (the scaled norm in which the local error must stay below 1).
 constexpr double kNewtonTolerance = 0.02;
-// The residual form is left when Newton contracts by less than this per iteration: W_v has moved
-// from M̄ by about as much (a relative change of the mass matrix), which costs iterations where
-// the form with the exact M̄ still converges in two.
+// The residual form is left when Newton's contraction factor exceeds this: W_v may have moved from
+// M̄ by about as much (a relative change of the mass matrix), which costs iterations where the
+// form with the exact M̄ still converges in two.
 constexpr double kResidualDrift = 1e-3;
 
 }  // namespace
@@ -40,6 +40,7 @@ GeneralizedAlpha::GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf
   lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(nz_);
   for (Eigen::VectorXd* v : {&d_, &a_, &a_use_, &d_new_, &a_new_, &d_prev_, &dd_, &res_}) v->setZero(nz_);
   for (Eigen::VectorXd* v : {&y_new_, &fy_, &scale_, &y_out_}) v->setZero(n);
+  wv_.setZero(m);
   failure_.reserve(256);
 }
 
@@ -110,10 +111,11 @@ bool GeneralizedAlpha::newton_residual(const Rhs& f, double t) {
   return true;
 }
 
-void GeneralizedAlpha::apply_weight(Eigen::VectorXd& v) const {
+void GeneralizedAlpha::apply_weight(Eigen::VectorXd& v) {
   if (!in_residual_form_) return;
   const int r = r0_ - m_;
-  v.segment(r, m_) = W_ * v.segment(r, m_);
+  wv_.noalias() = W_ * v.segment(r, m_);
+  v.segment(r, m_) = wv_;
 }
 
 // N = I − γ′ h ∂f_Z/∂Z − β′ h² ∂f_Z/∂q: the derivative of the residual D⁺ − f_Z(q⁺, Z⁺) with
@@ -279,6 +281,7 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
   }
   h = std::min({h, hmax_, t_end - t0});
   bool rejected = false, need_jacobian = true, jacobian_fresh = false;
+  bool retry = false;  // the same step again in the other form of the iterations: not a new attempt
   double h_factorized = 0.0;
   faccon_ = 1.0;
   double t = t0;
@@ -290,8 +293,11 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
                              failure_ + ")");
     const bool last = t + std::min(1.01 * h, hmax_) >= t_end;
     const double h_try = last ? t_end - t : h;
-    ++stats_.nsteps;
-    if (step_start_) step_start_(t, y);
+    if (!retry) {
+      ++stats_.nsteps;
+      if (step_start_) step_start_(t, y);
+    }
+    retry = false;
     Attempt result = Attempt::Failed;
     double err = 0.0;
     try {
@@ -335,15 +341,16 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
     // The local error behaves as h³.
     const double quot = std::clamp(std::cbrt(err) / kStepSafety, 0.2, 5.0);
     if (result != Attempt::Accepted) {
-      ++stats_.nreject;
-      rejected = true;
       if (in_residual_form_ && (result == Attempt::SlowNewton || result == Attempt::Failed) &&
           failure_ != "non-finite residual") {
-        // W_v has drifted from M̄ (the mechanism has moved since the Jacobian): the same step
-        // again in the form with the exact M̄.
+        // W_v may have drifted from M̄ (the mechanism has moved since the Jacobian): the same
+        // step again in the form with the exact M̄, from the same anchor.
         in_residual_form_ = false;
+        retry = true;
         continue;
       }
+      ++stats_.nreject;
+      rejected = true;
       if (result == Attempt::ErrorTooLarge) h = h_try / quot;
       else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
       else h = 0.5 * h_try;
@@ -366,11 +373,11 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
     y = y_new_;
     t = t_new;
     rejected = jacobian_fresh = false;
-    // A Jacobian is a linearization: keep it while Newton contracts. In the residual form, slow
-    // contraction is first taken for the drift of W_v (cheap to leave behind: the form with the
-    // exact M̄, until the next Jacobian).
+    // A Jacobian is a linearization: keep it while Newton contracts. In the residual form a
+    // contraction factor above kResidualDrift may be the drift of W_v alone: the form with the
+    // exact M̄ from here until the next Jacobian.
     if (in_residual_form_ && theta_ > kResidualDrift) in_residual_form_ = false;
-    else need_jacobian = theta_ > 0.1;
+    need_jacobian = theta_ > 0.1;
     if (!need_jacobian && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;  // keep the factorization
     h = last ? std::max(h_new, std::min(h, hmax_)) : h_new;
     if (stop_ && t < t_end && stop_(t, y)) break;

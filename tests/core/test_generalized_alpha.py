@@ -109,7 +109,7 @@ def test_residual_form_gives_the_same_motion(a):
                                                residual=residual, weight=weight)
         error = np.abs(plain["y"][0] - exact).max()
         assert np.abs(res["y"][0] - plain["y"][0]).max() < 0.05 * error, (a, tol)
-        assert res["nsteps"] == plain["nsteps"] and res["nresidual"] > 0
+        assert res["nsteps"] == plain["nsteps"] and res["nreject"] == plain["nreject"] and res["nresidual"] > 0
         if a == 10.0:
             assert res["nresidual"] < 20 and res["nfev"] <= plain["nfev"] + 5, res
 

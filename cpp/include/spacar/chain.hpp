@@ -46,11 +46,12 @@ class ExplicitChain {
                        const Eigen::VectorXd* reference = nullptr);
   // ẋ of the calculable coordinates, ė and the convective terms, as solve_velocities_direct().
   void solve_velocities(const System& sys, Data& data);
-  // ẍ of the calculable coordinates and ë from q̂̈, as solve_accelerations_direct() (after
-  // solve_velocities: the convective terms).
+  // ẍ of the calculable coordinates and ë from q̂̈, as solve_accelerations_direct(). Both this
+  // and transfer_transposed() require solve_velocities() at the current positions (the
+  // convective terms, and the blocks factorized there).
   void solve_accelerations(const System& sys, Data& data);
   // out = DFᵀ w (n_qhat), as transfer_transposed() with the velocity block: the blocks'
-  // transposed solves in reverse order (B at the current positions).
+  // transposed solves in reverse order.
   void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out);
 
   int blocks() const { return static_cast<int>(blocks_.size()); }

@@ -84,7 +84,7 @@ class GeneralizedAlpha {
   bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
   // res_ = f_Z(t, y_new_) − d_new_, or its residual form −R (see set_residual).
   bool newton_residual(const Rhs& f, double t);
-  void apply_weight(Eigen::VectorXd& v) const;  // v's rate part times W_ (residual form)
+  void apply_weight(Eigen::VectorXd& v);  // v's rate part times W_ (residual form)
   void factorize(double h);
   void shift_acceleration(double h);                  // a_use_: A for a step of size h
   void state_at(double h, const Eigen::VectorXd& y);  // y_new_, a_new_ from d_new_
@@ -117,7 +117,7 @@ class GeneralizedAlpha {
   // Work space, allocated once. d_: D at the step start, a_: A there; d_new_, a_new_: at its end.
   Eigen::MatrixXd J_, N_, W_;  // W_: W_v at the Jacobian's state (residual form)
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
-  Eigen::VectorXd d_, a_, a_use_, d_new_, a_new_, d_prev_, dd_, y_new_, fy_, res_, scale_, y_out_;
+  Eigen::VectorXd d_, a_, a_use_, d_new_, a_new_, d_prev_, dd_, y_new_, fy_, res_, scale_, y_out_, wv_;
 };
 
 }  // namespace spacar
