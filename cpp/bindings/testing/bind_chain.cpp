@@ -11,20 +11,35 @@
 
 namespace py = pybind11;
 
+namespace {
+
+// The chain's positions and velocities at (t, q, q̇), from the simulation's current positions;
+// nullptr (nothing done) if the system is not an open chain.
+std::unique_ptr<spacar::ExplicitChain> chain_motion(const char* what, spacar::Simulation& sim, double t,
+                                                    const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  const spacar::System& sys = sim.system();
+  if (q.size() != sys.n_dof() || qd.size() != sys.n_dof())
+    throw spacar::InputError(std::string(what) + "(): q and qd must have one value per degree of freedom");
+  std::unique_ptr<spacar::ExplicitChain> chain = spacar::ExplicitChain::detect(sys);
+  if (!chain) return chain;
+  spacar::Data& d = sim.data();
+  spacar::set_inputs(sys, d, t);
+  spacar::set_dofs(sys, d, q.data(), qd.data());
+  chain->solve_positions(sys, d, sys.settings.maxiterat, sys.settings.epskin);
+  chain->solve_velocities(sys, d);
+  return chain;
+}
+
+}  // namespace
+
 void bind_chain(py::module_& m) {
   m.def(
       "chain_state",
       [](spacar::Simulation& sim, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) -> py::object {
         const spacar::System& sys = sim.system();
-        if (q.size() != sys.n_dof() || qd.size() != sys.n_dof())
-          throw spacar::InputError("chain_state(): q and qd must have one value per degree of freedom");
-        std::unique_ptr<spacar::ExplicitChain> chain = spacar::ExplicitChain::detect(sys);
+        std::unique_ptr<spacar::ExplicitChain> chain = chain_motion("chain_state", sim, t, q, qd);
         if (!chain) return py::none();
         spacar::Data& d = sim.data();
-        spacar::set_inputs(sys, d, t);
-        spacar::set_dofs(sys, d, q.data(), qd.data());
-        chain->solve_positions(sys, d, sys.settings.maxiterat, sys.settings.epskin);
-        chain->solve_velocities(sys, d);
         spacar::solve_dynamics_direct(sys, d);
         py::dict out;
         out["x"] = d.x;
@@ -48,15 +63,10 @@ void bind_chain(py::module_& m) {
          const Eigen::VectorXd& qdd) -> py::object {
         const spacar::System& sys = sim.system();
         const int nd = sys.n_dof();
-        if (q.size() != nd || qd.size() != nd || qdd.size() != nd)
-          throw spacar::InputError("chain_residual(): q, qd and qdd must have one value per degree of freedom");
-        std::unique_ptr<spacar::ExplicitChain> chain = spacar::ExplicitChain::detect(sys);
+        if (qdd.size() != nd) throw spacar::InputError("chain_residual(): qdd must have one value per degree of freedom");
+        std::unique_ptr<spacar::ExplicitChain> chain = chain_motion("chain_residual", sim, t, q, qd);
         if (!chain) return py::none();
         spacar::Data& d = sim.data();
-        spacar::set_inputs(sys, d, t);
-        spacar::set_dofs(sys, d, q.data(), qd.data());
-        chain->solve_positions(sys, d, sys.settings.maxiterat, sys.settings.epskin);
-        chain->solve_velocities(sys, d);
         d.qdd = qdd;
         for (int j = 0; j < nd; ++j) d.qhat_dd[sys.dof_cols[j]] = qdd[j];
         Eigen::VectorXd R;
