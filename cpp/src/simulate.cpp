@@ -505,8 +505,12 @@ std::string format_g(double v, int digits) {
 // model's size, the spread of the X positions) from where X put them: the X positions do not
 // close a loop with the lengths given (LENGTHO), the targets of E or the inputs' start values.
 // An X position meant exactly then changed the mechanism; a rough one was closed as intended.
+// The first kMovedNodesNamed nodes are named one by one, the others summed up in one line (a
+// turned ground moves every node: a warning per node would bury the others, and cost a run's
+// fixed time in formatting).
 void warn_of_assembly_moves(const System& sys, const Eigen::VectorXd& given, const Eigen::VectorXd& x,
                             std::vector<std::string>& warnings) {
+  constexpr int kMovedNodesNamed = 3;
   auto is_position = [&](int g) {
     return sys.coord_node_kind[g] == NodeKind::XY || sys.coord_node_kind[g] == NodeKind::XYZ;
   };
@@ -518,11 +522,20 @@ void warn_of_assembly_moves(const System& sys, const Eigen::VectorXd& given, con
     }
   if (!(hi >= lo)) return;  // no position nodes
   const double far = 1e-3 * (hi - lo);
+  int moved = 0, farthest = -1;
+  double largest = 0.0;
   for (int g = 0, end; g < sys.nx; g = end) {  // node by node: its coordinates are consecutive
     for (end = g + 1; end < sys.nx && sys.coord_label[end][0] == sys.coord_label[g][0];) ++end;
     if (!is_position(g)) continue;
     const double distance = (x.segment(g, end - g) - given.segment(g, end - g)).norm();
     if (!(distance > far)) continue;
+    if (++moved > kMovedNodesNamed) {
+      if (distance > largest) {
+        largest = distance;
+        farthest = sys.coord_label[g][0];
+      }
+      continue;
+    }
     auto point = [&](const Eigen::VectorXd& v) {
       std::string s = "(";
       for (int i = g; i < end; ++i) s += (i > g ? ", " : "") + format_g(v[i], 6);
@@ -533,6 +546,10 @@ void warn_of_assembly_moves(const System& sys, const Eigen::VectorXd& given, con
                        ": the X positions do not close the loop with the lengths (LENGTHO), E targets and "
                        "input values given");
   }
+  if (moved > kMovedNodesNamed)
+    warnings.push_back("the assembly moved " + std::to_string(moved - kMovedNodesNamed) +
+                       " more nodes from their X positions, the farthest node " + std::to_string(farthest) +
+                       " by " + format_g(largest, 4));
 }
 
 std::string num(double v) {

@@ -276,6 +276,18 @@ def test_a_loop_that_the_x_positions_do_not_close_warns_with_the_node_and_the_di
     assert len(turned.warnings) == 2
 
 
+def test_a_turned_ground_that_moves_every_node_warns_of_three_and_sums_up_the_rest():
+    from spacar.compare import models
+    model = models.spatial_chain(6, seed=3, n_out=1, t_end=0.01)  # the ground turned 0.4 rad: all 6 nodes move
+    given = {i: np.array(model.nodes[i].x) for i in range(2, 8)}
+    res = spacar.simulate(model)
+    assert [w.split(" by ")[0] for w in model.warnings[:3]] == [f"the assembly moved node {i}" for i in (2, 3, 4)]
+    moved = {i: np.linalg.norm(res.node(i).x[0] - given[i]) for i in (5, 6, 7)}
+    far = max(moved, key=moved.get)
+    assert model.warnings[3:] == [
+        f"the assembly moved 3 more nodes from their X positions, the farthest node {far} by {moved[far]:.4g}"]
+
+
 def test_a_crank_driven_past_a_dead_position_says_so_and_names_the_input_reached():
     """The four-bar of fourbar_coupler.dat with a crank of 3 (B = (0, 3)) and C = (2, 4): the
     coupler (√5) is the shortest link, so the crank cannot turn fully; coupler and rocker fall in
