@@ -56,10 +56,86 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
     e[4] = -l0_ * dot3(el, yp);
     e[5] = l0_ * dot3(el, yq);
     e[0] = l - l0_;
-    if constexpr (Nonlinear)
-      e[0] += (2.0 * e[2] * e[2] + e[2] * e[3] + 2.0 * e[3] * e[3] + 2.0 * e[4] * e[4] + e[4] * e[5] +
-               2.0 * e[5] * e[5]) /
-              (30.0 * l0_);
+    if constexpr (Nonlinear) e[0] += correction(e);
+  }
+
+  // Written out, with the values of deform(): the dual-number versions of the base cost several
+  // times more, in every Newton iteration and output of a spatial model. The generic element
+  // checks test these against finite differences like any other kernel's derivatives.
+  void first_derivatives(const double* x, double* e, double* B) const override {
+    const Axes a = axes(x);
+    Eigen::Map<Eigen::Matrix<double, 6, 14>> Bm(B);
+    Bm.setZero();
+    e[0] = a.l - l0_;
+    Bm.block<1, 3>(0, 0) = -a.el.transpose();
+    Bm.block<1, 3>(0, 7) = a.el.transpose();
+    e[1] = 0.5 * l0_ * (a.zp.dot(a.yq) - a.yp.dot(a.zq));
+    Bm.block<1, 4>(1, 3) = 0.5 * l0_ * (a.yq.transpose() * a.Jzp - a.zq.transpose() * a.Jyp);
+    Bm.block<1, 4>(1, 10) = 0.5 * l0_ * (a.zp.transpose() * a.Jyq - a.yp.transpose() * a.Jzq);
+    // Bending: e_i = k e_l·w with w a section axis of the node whose λ starts at column lam.
+    auto bending = [&](int i, double k, const Eigen::Vector3d& w, const Mat34& Jw, int lam) {
+      e[i] = k * a.el.dot(w);
+      const Eigen::RowVector3d g = k * w.transpose() * a.P;
+      Bm.block<1, 3>(i, 0) = -g;
+      Bm.block<1, 3>(i, 7) = g;
+      Bm.block<1, 4>(i, lam) = k * a.el.transpose() * Jw;
+    };
+    bending(2, l0_, a.zp, a.Jzp, 3);
+    bending(3, -l0_, a.zq, a.Jzq, 10);
+    bending(4, -l0_, a.yp, a.Jyp, 3);
+    bending(5, l0_, a.yq, a.Jyq, 10);
+    if constexpr (Nonlinear) {
+      e[0] += correction(e);
+      Bm.row(0) += ((4.0 * e[2] + e[3]) * Bm.row(2) + (e[2] + 4.0 * e[3]) * Bm.row(3) +
+                    (4.0 * e[4] + e[5]) * Bm.row(4) + (e[4] + 4.0 * e[5]) * Bm.row(5)) /
+                   (30.0 * l0_);
+    }
+  }
+
+  void rates(const double* x, const double* v, double* edot) const override {
+    double e[6];
+    Eigen::Matrix<double, 6, 14> B;
+    first_derivatives(x, e, B.data());
+    Eigen::Map<Eigen::Matrix<double, 6, 1>>(edot).noalias() = B * Eigen::Map<const Eigen::Matrix<double, 14, 1>>(v);
+  }
+
+  // c = d²e/dt² at ẍ = 0: e_l and the section axes w = R(λ)c0 by their rates, with
+  // ẅ = 2 R(λ̇)c0 (R(λ)c0 is quadratic in λ) and, of the chord, l̈ = (|ḋ|² − l̇²)/l and
+  // ë_l = −(2 ė_l l̇ + e_l l̈)/l.
+  void convective(const double* x, const double* v, double* c) const override {
+    const Axes a = axes(x);
+    const Eigen::Vector3d dd(v[7] - v[0], v[8] - v[1], v[9] - v[2]);
+    const double ld = a.el.dot(dd);
+    const Eigen::Vector3d eld = (dd - ld * a.el) / a.l;
+    const double ldd = (dd.squaredNorm() - ld * ld) / a.l;
+    const Eigen::Vector3d eldd = -(2.0 * ld * eld + ldd * a.el) / a.l;
+    const Eigen::Map<const Eigen::Vector4d> lpd(v + 3), lqd(v + 10);
+    const Eigen::Vector3d ypd = a.Jyp * lpd, zpd = a.Jzp * lpd, yqd = a.Jyq * lqd, zqd = a.Jzq * lqd;
+    const Eigen::Vector3d ypdd = 2.0 * rotated(v + 3, C0_.col(1)), zpdd = 2.0 * rotated(v + 3, C0_.col(2));
+    const Eigen::Vector3d yqdd = 2.0 * rotated(v + 10, C0_.col(1)), zqdd = 2.0 * rotated(v + 10, C0_.col(2));
+    // (a·b)¨ with ä, b̈ the convective parts.
+    auto product = [](const Eigen::Vector3d& u, const Eigen::Vector3d& ud, const Eigen::Vector3d& udd,
+                      const Eigen::Vector3d& w, const Eigen::Vector3d& wd, const Eigen::Vector3d& wdd) {
+      return udd.dot(w) + 2.0 * ud.dot(wd) + u.dot(wdd);
+    };
+    c[0] = ldd;
+    c[1] = 0.5 * l0_ * (product(a.zp, zpd, zpdd, a.yq, yqd, yqdd) - product(a.yp, ypd, ypdd, a.zq, zqd, zqdd));
+    c[2] = l0_ * product(a.el, eld, eldd, a.zp, zpd, zpdd);
+    c[3] = -l0_ * product(a.el, eld, eldd, a.zq, zqd, zqdd);
+    c[4] = -l0_ * product(a.el, eld, eldd, a.yp, ypd, ypdd);
+    c[5] = l0_ * product(a.el, eld, eldd, a.yq, yqd, yqdd);
+    if constexpr (Nonlinear) {
+      // f = 2a² + ab + 2b² per bending pair: f̈ = (4a + b) ä + (a + 4b) b̈ + 4ȧ² + 2ȧḃ + 4ḃ².
+      const double e[6] = {0.0, 0.0, l0_ * a.el.dot(a.zp), -l0_ * a.el.dot(a.zq), -l0_ * a.el.dot(a.yp),
+                           l0_ * a.el.dot(a.yq)};
+      const double ed[6] = {0.0, 0.0, l0_ * (eld.dot(a.zp) + a.el.dot(zpd)), -l0_ * (eld.dot(a.zq) + a.el.dot(zqd)),
+                            -l0_ * (eld.dot(a.yp) + a.el.dot(ypd)), l0_ * (eld.dot(a.yq) + a.el.dot(yqd))};
+      double f = 0.0;
+      for (int i : {2, 4})
+        f += (4.0 * e[i] + e[i + 1]) * c[i] + (e[i] + 4.0 * e[i + 1]) * c[i + 1] + 4.0 * ed[i] * ed[i] +
+             2.0 * ed[i] * ed[i + 1] + 4.0 * ed[i + 1] * ed[i + 1];
+      c[0] += f / (30.0 * l0_);
+    }
   }
 
   // Mass points x_p, l0 R(λp)e_x0, x_q, l0 R(λq)e_x0.
@@ -74,6 +150,19 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
     }
   }
   const MassPoints<4, 3>& mass_model() const { return mass_; }
+
+  // The mass points' Jacobian and convective accelerations, written out (see point_derivatives).
+  void point_jacobian(const double* x, const double* v, Eigen::Matrix<double, 12, 14>& Jg,
+                      Eigen::Matrix<double, 12, 1>& gamma) const {
+    Jg.setZero();
+    gamma.setZero();
+    Jg.block<3, 3>(0, 0).setIdentity();
+    Jg.block<3, 4>(3, 3) = l0_ * rotate_jacobian(x + 3, C0_.col(0));
+    Jg.block<3, 3>(6, 7).setIdentity();
+    Jg.block<3, 4>(9, 10) = l0_ * rotate_jacobian(x + 10, C0_.col(0));
+    gamma.segment<3>(3) = 2.0 * l0_ * rotated(v + 3, C0_.col(0));
+    gamma.segment<3>(9) = 2.0 * l0_ * rotated(v + 10, C0_.col(0));
+  }
 
   bool has_mass() const override { return Base::has_mass() || rotary_; }
 
@@ -117,6 +206,40 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
   }
 
  private:
+  using Mat34 = Eigen::Matrix<double, 3, 4>;
+  // The chord and the section axes of both ends, with their Jacobians.
+  struct Axes {
+    Eigen::Vector3d el;  // chord direction
+    double l;            // chord length
+    Eigen::Matrix3d P;   // ∂e_l/∂(x_q − x_p) = (1 − e_l e_lᵀ)/l
+    Eigen::Vector3d yp, zp, yq, zq;
+    Mat34 Jyp, Jzp, Jyq, Jzq;
+  };
+  Axes axes(const double* x) const {
+    Axes a;
+    const Eigen::Vector3d d(x[7] - x[0], x[8] - x[1], x[9] - x[2]);
+    a.l = d.norm();
+    a.el = d / a.l;
+    a.P = (Eigen::Matrix3d::Identity() - a.el * a.el.transpose()) / a.l;
+    a.yp = rotated(x + 3, C0_.col(1));
+    a.zp = rotated(x + 3, C0_.col(2));
+    a.yq = rotated(x + 10, C0_.col(1));
+    a.zq = rotated(x + 10, C0_.col(2));
+    a.Jyp = rotate_jacobian(x + 3, C0_.col(1));
+    a.Jzp = rotate_jacobian(x + 3, C0_.col(2));
+    a.Jyq = rotate_jacobian(x + 10, C0_.col(1));
+    a.Jzq = rotate_jacobian(x + 10, C0_.col(2));
+    return a;
+  }
+
+  // BEAMNL's bending correction of the elongation.
+  template <class S>
+  S correction(const S* e) const {
+    return (2.0 * e[2] * e[2] + e[2] * e[3] + 2.0 * e[3] * e[3] + 2.0 * e[4] * e[4] + e[4] * e[5] +
+            2.0 * e[5] * e[5]) /
+           (30.0 * l0_);
+  }
+
   void add_rotary_inertia(const double* x, const double* v, double* M, double* h) const {
     if (!rotary_) return;
     const int lam[2] = {3, 10};

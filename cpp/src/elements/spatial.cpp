@@ -46,6 +46,19 @@ Eigen::Matrix3d hinge_frame(const Eigen::Vector3d& axis_in, const std::string& w
   return frame_from_axis(axis, Eigen::Vector3d::Unit(k), what);
 }
 
+// R(λ)c = (λ0² − λ̄·λ̄) c + 2 λ̄ (λ̄·c) + 2 λ0 λ̄ × c: ∂/∂λ0 = 2 λ0 c + 2 λ̄ × c,
+// ∂/∂λ̄ = 2 ((λ̄·c) 1 + λ̄ cᵀ − c λ̄ᵀ − λ0 c̃).
+Eigen::Matrix<double, 3, 4> rotate_jacobian(const double* l, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d lb(l[1], l[2], l[3]);
+  Eigen::Matrix<double, 3, 4> J;
+  J.col(0) = 2.0 * (l[0] * c + lb.cross(c));
+  Eigen::Matrix3d c_skew;
+  c_skew << 0.0, -c.z(), c.y(), c.z(), 0.0, -c.x(), -c.y(), c.x(), 0.0;
+  J.rightCols<3>() = 2.0 * (lb.dot(c) * Eigen::Matrix3d::Identity() + lb * c.transpose() - c * lb.transpose() -
+                            l[0] * c_skew);
+  return J;
+}
+
 Eigen::Matrix<double, 3, 4> euler_G(const double* l) {
   Eigen::Matrix<double, 3, 4> G;
   G << -l[1], l[0], l[3], -l[2],  //

@@ -10,7 +10,12 @@
 //   template <class S> S potential(const S* x, const double* g) const;
 // AutoDiffElement derives the exact first derivatives B = ∂e/∂x, the convective terms, the
 // stress-weighted Hessians Σσ_i Γ_i, the mass matrix and convective inertia forces (Lagrange's
-// equations) from these by forward-mode dual numbers (see autodiff.hpp).
+// equations) from these by forward-mode dual numbers (see autodiff.hpp). Where an element is
+// evaluated often and its derivatives are simple (BEAM, HINGE), it may override
+// first_derivatives, rates and convective with written-out versions, and give its mass points'
+// Jacobian and convective accelerations written out as
+//   void point_jacobian(const double* x, const double* v, Eigen::Matrix<double, NG·DIM, NC>& Jg,
+//                       Eigen::Matrix<double, NG·DIM, 1>& gamma) const;
 #pragma once
 
 #include <Eigen/Dense>
@@ -127,6 +132,10 @@ template <class T, class = void>
 struct velocity_rows : std::integral_constant<unsigned, 0> {};
 template <class T>
 struct velocity_rows<T, std::void_t<decltype(T::kVelocityRows)>> : std::integral_constant<unsigned, T::kVelocityRows> {};
+template <class T, class = void>
+struct has_point_jacobian : std::false_type {};
+template <class T>
+struct has_point_jacobian<T, std::void_t<decltype(&T::point_jacobian)>> : std::true_type {};
 template <class T, class = void>
 struct has_kinetic : std::false_type {};
 template <class T>
@@ -404,6 +413,10 @@ class AutoDiffElement : public ElementKernel {
   // Jacobian of the mass points and their convective acceleration vᵀ∇²g v.
   template <class MJ, class MG>
   void point_derivatives(const double* x, const double* v, MJ& Jg, MG& gamma) const {
+    if constexpr (detail::has_point_jacobian<Derived>::value) {  // written out by the element
+      self().point_jacobian(x, v, Jg, gamma);
+      return;
+    }
     {
       using J = Jet<double, NC>;
       J xj[NC], gj[NG * DIM];

@@ -32,6 +32,15 @@ Vec3<S> rotate(const S* l, const Eigen::Vector3d& c) {
           s * c[2] + 2.0 * l[3] * lc + 2.0 * l[0] * cz};
 }
 
+// R(λ) c as an Eigen vector, and its Jacobian ∂(R(λ)c)/∂λ (3×4) — exact for the quadratic form.
+// Along a motion (λ̈ = 0) the second rate of R(λ)c is 2 R(λ̇)c, the form at λ̇: the written-out
+// convective terms of the spatial elements use that.
+inline Eigen::Vector3d rotated(const double* l, const Eigen::Vector3d& c) {
+  const Vec3<double> r = rotate(l, c);
+  return {r[0], r[1], r[2]};
+}
+Eigen::Matrix<double, 3, 4> rotate_jacobian(const double* l, const Eigen::Vector3d& c);
+
 // Orthonormal frame [e_x e_y e_z] with e_x along `axis` and e_y from `y_hint` (its e_x component
 // removed). Throws InputError (message names `what`) if the axis has zero length or the hint is
 // parallel to the axis (remainder below 1e-5 of its length).
