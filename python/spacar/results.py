@@ -84,13 +84,15 @@ def require_results(res, what: str) -> None:
         raise InputError(f"spacar.{what} needs spacar.Results (of spacar.simulate or spacar.static), got {show(res)}")
 
 
-def dof_labels(system, core) -> list:
+def dof_labels(system, core, coords=None, defs=None) -> list:
     """Labels of the degrees of freedom of a compiled system (``_core.Simulation(...).system``) in
     its DOF order, the order of q in the core: the DYNX coordinates ascending (``"x(5,1)"``),
-    then the DYNE deformations ascending, with their element type (``"e(3,1) HINGE"``)."""
-    # Each attribute of the compiled system is a fresh copy of the whole list: taken once
-    # (inside the loops, a chain of 4000 beams took minutes).
-    coords, defs = system.coord_label, system.def_label
+    then the DYNE deformations ascending, with their element type (``"e(3,1) HINGE"``).
+    ``coords``, ``defs``: the system's coordinate and deformation labels, if already taken."""
+    # Each attribute of the compiled system is a fresh copy of the whole list (20 µs for a
+    # 20-link spatial chain): taken once (inside the loops, a chain of 4000 beams took minutes).
+    coords = system.coord_label if coords is None else coords
+    defs = system.def_label if defs is None else defs
     out = [f"x({n},{c})" for n, c in (coords[g] for g in system.x_dyn)]
     for k in system.e_dyn:
         e, i = defs[k]

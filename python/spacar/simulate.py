@@ -34,9 +34,10 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     # The implicit method's work, where it ran: Jacobians (linearizations), LU factorizations.
     if method in ("radau5", "generalized_alpha") or arrays["switches"]:
         stats.update(jacobians=arrays["jacobians"], decompositions=arrays["decompositions"])
-    lins = [Linearization(d, system.coord_label, system.def_label) for d in arrays["linearizations"]]
-    res = Results(arrays, system.coord_label, system.def_label, stats, None, lins, model.settings.linear,
-                  dof_labels(system, model.core))
+    coords, defs = system.coord_label, system.def_label  # each a fresh copy of the list: taken once
+    lins = [Linearization(d, coords, defs) for d in arrays["linearizations"]]
+    res = Results(arrays, coords, defs, stats, None, lins, model.settings.linear,
+                  dof_labels(system, model.core, coords, defs))
     res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
     if "energy" in arrays:
         res._energy = Energy(res.t, arrays["energy"])
