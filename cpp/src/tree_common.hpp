@@ -41,20 +41,33 @@ struct BeamBodies {
 BeamBodies group_beams(const std::vector<std::pair<int, std::vector<int>>>& beams,
                        const std::map<int, NodeInfo>& nodes, NodeKind orientation);
 
+// Tᵀ M T of element_inertia, with its matrices' storage bounded to Max rows (on the stack) or
+// not (Max = Eigen::Dynamic, on the heap).
+template <int N, int Max, class Row>
+Eigen::Matrix<double, N, N> projected_mass(const SystemElement& se, const Eigen::VectorXd& x, Row row) {
+  const int n = static_cast<int>(se.coords.size());
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, Max, 1> xl(n), vl(n), h(n);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, Max, Max> M(n, n);
+  Eigen::Matrix<double, Eigen::Dynamic, N, 0, Max, N> T(n, N);
+  vl.setZero();
+  for (int a = 0; a < n; ++a) xl[a] = x[se.coords[a]];
+  se.kernel->mass(xl.data(), vl.data(), M.data(), h.data());
+  for (int a = 0; a < n; ++a) T.row(a) = row(se.coords[a]);
+  return T.transpose() * M * T;
+}
+
 // The element's mass matrix at the positions x, projected on the rigid motions of a body:
 // Tᵀ M T, with T's row a the rate of the element's coordinate a for the body's velocity (rows
 // from `row`, a function of the global coordinate index). Zero without element mass.
 template <int N, class Row>
 Eigen::Matrix<double, N, N> element_inertia(const SystemElement& se, const Eigen::VectorXd& x, Row row) {
   if (!se.has_mass) return Eigen::Matrix<double, N, N>::Zero();
-  const int n = static_cast<int>(se.coords.size());
-  Eigen::VectorXd xl(n), vl = Eigen::VectorXd::Zero(n), h(n);
-  Eigen::MatrixXd M(n, n);
-  Eigen::Matrix<double, Eigen::Dynamic, N> T(n, N);
-  for (int a = 0; a < n; ++a) xl[a] = x[se.coords[a]];
-  se.kernel->mass(xl.data(), vl.data(), M.data(), h.data());
-  for (int a = 0; a < n; ++a) T.row(a) = row(se.coords[a]);
-  return T.transpose() * M * T;
+  // Up to 16 coordinates (a BEAM has 14) on the stack, the small products evaluated
+  // coefficient-wise: on the heap, recognizing a 20-link tree called the general matrix product
+  // and malloc 40 times each.
+  constexpr int kOnStack = 16;
+  if (se.coords.size() <= kOnStack) return projected_mass<N, kOnStack>(se, x, row);
+  return projected_mass<N, Eigen::Dynamic>(se, x, row);
 }
 
 }  // namespace tree_detail
