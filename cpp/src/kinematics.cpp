@@ -158,7 +158,7 @@ void check_constraint_counts(const System& sys, Data& data) {
   }
 }
 
-void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly) {
+void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly, bool exact_start) {
   const int nc = static_cast<int>(sys.x_calc.size());
   set_targets(sys, data);
   evaluate_elements(sys, data);
@@ -191,6 +191,10 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
       break;
     }
     if (converged && (!chord || rmax <= 1e-3 * tol)) break;  // polished
+    if (exact_start && it == 0 && rmax <= tol) {  // exact up to round-off, not a prediction
+      converged = true;
+      break;
+    }
     converged = converged || rmax <= tol;
     if (it == limit && !converged) break;
     note(rmax);

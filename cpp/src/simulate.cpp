@@ -143,15 +143,15 @@ void Simulation::assemble() {
   have_transfer_ = false;
 }
 
-void Simulation::solve_state(double t, const double* q, const double* qd, bool transfer_predictor,
+void Simulation::solve_state(double t, const double* q, const double* qd, Start start,
                              const Eigen::VectorXd* known_qdd) {
-  solve_motion(t, q, qd, transfer_predictor);
+  solve_motion(t, q, qd, start);
   if (!(known_qdd && solve_dynamics_known(*sys_, *data_, *known_qdd))) solve_dynamics_direct(*sys_, *data_);
   remember(base_);
   have_transfer_ = false;
 }
 
-void Simulation::solve_motion(double t, const double* q, const double* qd, bool transfer_predictor) {
+void Simulation::solve_motion(double t, const double* q, const double* qd, Start start) {
   const System& sys = *sys_;
   set_inputs(sys, *data_, t);
   apply_time_loads(t);
@@ -160,7 +160,7 @@ void Simulation::solve_motion(double t, const double* q, const double* qd, bool 
   // independent coordinates (states given by the user, when DF of the last state is known), or
   // the last solved state advanced by a second-order Taylor step in time (integration stages).
   predicted_.setZero();
-  if (transfer_predictor && have_transfer_) {
+  if (start == Start::Transfer && have_transfer_) {
     predict_from(base_, base_.t, q);
     predicted_.noalias() = data_->DF * (data_->qhat - qhat_transfer_);
     for (int c : sys.x_calc) data_->x[c] += predicted_[c];
@@ -185,7 +185,7 @@ void Simulation::solve_motion(double t, const double* q, const double* qd, bool 
   auto positions = [&]() {
     if (chain)
       chain->solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, solved.valid ? &solved.x : nullptr);
-    else solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false);
+    else solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false, start == Start::Exact);
   };
   std::string why;
   bool ok = false;
@@ -210,7 +210,7 @@ void Simulation::solve_motion(double t, const double* q, const double* qd, bool 
 }
 
 void Simulation::evaluate(double t, const double* q, const double* qd) {
-  solve_state(t, q, qd, true);
+  solve_state(t, q, qd, Start::Transfer);
   // Transfer functions and the reduced mass matrix, for users, tests and teaching.
   const System& sys = *sys_;
   solve_transfer(sys, *data_);
@@ -295,7 +295,8 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   // recursive_state).
   const bool known = tree_ && tree_state(t, Y, tree_qdd_) && timed_.empty() && held_.size() == 0;
   for (int i = 0; i < ny; ++i) data_->e_integrated[sys_->y_defs[i]] = Y[nd + i];
-  solve_state(t, Y.data(), Y.data() + nd + ny, false, known ? &tree_qdd_ : nullptr);
+  if (known) solve_state(t, Y.data(), Y.data() + nd + ny, Start::Exact, &tree_qdd_);
+  else solve_state(t, Y.data(), Y.data() + nd + ny);
 }
 
 bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& qdd) {
@@ -336,7 +337,7 @@ void Simulation::residual(double t, const Eigen::VectorXd& Y, const Eigen::Vecto
   const int nd = sys.n_dof();
   check_time(t);
   in_rhs(t, [&] {
-    solve_motion(t, Y.data(), Y.data() + nd, false);
+    solve_motion(t, Y.data(), Y.data() + nd, Start::Taylor);
     data_->qdd = qdd;
     for (int j = 0; j < nd; ++j) data_->qhat_dd[sys.dof_cols[j]] = qdd[j];
     reduced_residual_direct(sys, *data_, R, chain_.get());

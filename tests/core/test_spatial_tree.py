@@ -157,6 +157,23 @@ def test_recursive_state_equals_the_constraint_formulation(name):
                                        err_msg=key)
 
 
+def test_an_output_time_takes_the_trees_positions_without_newton_iterations():
+    """At an output time of the recursive path the tree's positions already satisfy the
+    constraints: Newton checks them and does not iterate (no polish, no factorization), and they
+    equal the general path's solution at the same state."""
+    sim = assembled(models.spatial_chain(6, seed=6, epskin=1e-13))
+    q0 = np.array(sim.system.q0)
+    rng = np.random.default_rng(4)
+    q, qd = q0 + rng.uniform(-1.0, 1.0, q0.size), rng.uniform(-2.0, 2.0, q0.size)
+    sim.move_to(0.0, q, qd)
+    general = np.array(sim.data.x)
+    assert sim.data.newton_iterations > 0
+    assert sim.recursive_state(q, qd) is not None
+    sim.evaluate_state(0.0, np.concatenate([q, qd]))
+    assert sim.data.newton_iterations == 0
+    np.testing.assert_allclose(sim.data.x, general, rtol=0, atol=1e-12 * np.abs(general).max())
+
+
 PINOCCHIO_TREES = {
     "chain 8": lambda: models.spatial_chain(8, seed=8, epskin=1e-13),
     "chain springs": lambda: models.spatial_chain(5, seed=2, stiffness=1.5, epskin=1e-13),

@@ -32,8 +32,11 @@ void check_auto_released(const System& sys, const Data& data, double tol);
 
 // Newton iteration on x^c until max|D^P(x) − target| ≤ tol, then one polish iteration; leaves e
 // and B evaluated at the solution. assembly: allow max(max_iter, 50) iterations with
-// backtracking (initial assembly of a roughly given geometry). Throws KinematicsError.
-void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly);
+// backtracking (initial assembly of a roughly given geometry). exact_start: data.x already
+// solves the constraints up to round-off (the recursive path's positions, not a prediction): no
+// iteration at all when the residual is within tol. Throws KinematicsError.
+void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly,
+                     bool exact_start = false);
 
 // DF (∂x/∂q̂) and DFe (∂e/∂q̂) at the current positions; factorizes the velocity block.
 void solve_transfer(const System& sys, Data& data);

@@ -146,8 +146,15 @@ class Simulation {
   void assemble();
   // State at (t, q, q̇) as the integrator needs it: positions, velocities, q̈, accelerations
   // and the complete stresses, without transfer functions (sparse, allocation-free).
+  // Where Newton's iterations on the positions start (the predictor).
+  enum class Start {
+    Taylor,    // the last solved state advanced by a second-order Taylor step in time
+    Transfer,  // the last solution moved by its transfer function DF (when known, else Taylor)
+    Exact      // the last solved state, which holds the exact positions at (t, q): the recursive
+               // path's; no polish iteration
+  };
   // known_qdd: q̈ already known there (the recursive path's): no equations of motion solved.
-  void solve_state(double t, const double* q, const double* qd, bool transfer_predictor = false,
+  void solve_state(double t, const double* q, const double* qd, Start start = Start::Taylor,
                    const Eigen::VectorXd* known_qdd = nullptr);
   // Complete state at (t, q, q̇): solve_state plus the transfer functions DF, DFe and the
   // reduced mass matrix M̄ (for users, tests and teaching).
@@ -255,7 +262,7 @@ class Simulation {
   };
   void remember(Solved& s) const;
   // solve_state up to the velocities: positions, velocities, no dynamics, not remembered.
-  void solve_motion(double t, const double* q, const double* qd, bool transfer_predictor);
+  void solve_motion(double t, const double* q, const double* qd, Start start);
   // The kinematics of a right-hand side: a KinematicsError becomes StepRejected (the
   // integrator retries a smaller step) and is remembered for the report.
   template <class F>
