@@ -204,8 +204,10 @@ void bind_simulation(py::module_& m) {
           "run",
           [](Simulation& s, py::object on_output, double initial_step, const std::string& method,
              double time_limit, bool recursive, double sample_period, py::object on_sample, bool energy,
-             double rho_inf, double fixed_step, double time_spent) {
+             double rho_inf, double fixed_step, double time_spent, int predictor_order, bool chord) {
             RunOptions opt;
+            opt.predictor_order = predictor_order;
+            opt.chord = chord;
             opt.energy = energy;
             opt.sample_period = sample_period;
             if (!on_sample.is_none()) {
@@ -258,8 +260,11 @@ void bind_simulation(py::module_& m) {
           py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
           py::arg("time_limit") = 0.0, py::arg("recursive") = true, py::arg("sample_period") = 0.0,
           py::arg("on_sample") = py::none(), py::arg("energy") = false, py::arg("rho_inf") = 0.9, py::arg("fixed_step") = 0.0,
-          py::arg("time_spent") = 0.0,
-          "Run the block (`time_spent`: seconds of the analysis spent before it, counted against `time_limit`); on failure the exception has the results up to the failure as `results`.");
+          py::arg("time_spent") = 0.0, py::arg("predictor_order") = 2, py::arg("chord") = true,
+          "Run the block (`time_spent`: seconds of the analysis spent before it, counted against `time_limit`); on "
+          "failure the exception has the results up to the failure as `results`. `predictor_order` (2, 1, 0) and "
+          "`chord` change the start and the matrix of Newton's iterations on the positions, for measurements "
+          "(benchmarks/newton.py).");
 }
 
 }  // namespace spacar::bindings

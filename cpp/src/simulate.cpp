@@ -68,7 +68,8 @@ void Simulation::predict_from(const Solved& s, double t, const double* q) {
   for (int g : sys.x_input) data_->x[g] = data_->qhat[sys.qhat_col_x[g]];
   for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_->x[sys.x_dyn[j]] = q[j];
   const double dt = t - s.t;
-  for (int c : sys.x_calc) data_->x[c] += dt * (s.xd[c] + 0.5 * dt * s.xdd[c]);
+  const double first = predictor_order_ >= 1 ? dt : 0.0, second = predictor_order_ >= 2 ? 0.5 * dt * dt : 0.0;
+  for (int c : sys.x_calc) data_->x[c] += first * s.xd[c] + second * s.xdd[c];
 }
 
 // The nonlinear part of the motion since the step start must not exceed the predicted motion
@@ -187,6 +188,7 @@ void Simulation::solve_motion(double t, const double* q, const double* qd, Start
       chain->solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, solved.valid ? &solved.x : nullptr);
     else solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false, start == Start::Exact);
   };
+  if (!chord_) data_->jacobian_reusable = false;
   std::string why;
   bool ok = false;
   try {
@@ -576,6 +578,8 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   const BlockPlan plan = plan_block(options, res.warnings);
   n_energy_ = options.energy ? 2 : 0;
   held_.resize(0);
+  predictor_order_ = options.predictor_order;
+  chord_ = options.chord;
   // One deadline (limits.hpp), checked at every right-hand side and output time and inside the
   // sparse factorizations; the time the set-up took counts against it.
   const DeadlineScope deadline(options.time_limit, options.time_spent);
@@ -587,6 +591,8 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     tree_.reset();
     chain_.reset();
     held_.resize(0);
+    predictor_order_ = RunOptions().predictor_order;
+    chord_ = RunOptions().chord;
   };
   try {
     integrate_block(res, options, plan, k_out);
@@ -604,6 +610,8 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
   if (!(options.time_limit >= 0.0)) throw InputError("the time limit must not be negative");
   if (!(options.time_spent >= 0.0)) throw InputError("the time spent before the run must not be negative");
   if (options.max_steps < 1) throw InputError("the step limit must be positive");
+  if (options.predictor_order < 0 || options.predictor_order > 2)
+    throw InputError("the predictor's order must be 0, 1 or 2, not " + std::to_string(options.predictor_order));
   if (!(options.sample_period >= 0.0) || !std::isfinite(options.sample_period))
     throw InputError("the controller's sample period must be a positive number of seconds");
   // The system may be recompiled during the run (repartition): keep copies, not references.

@@ -57,6 +57,13 @@ struct RunOptions {
   // Energy balance (BlockResults::energy): the dissipated power and the external power integrated
   // as two extra states of the integrator, at the cost of O(n) per right-hand side.
   bool energy = false;
+  // The start of Newton's iterations on the positions of the general path, for measurements
+  // (benchmarks/newton.py): the last solved state advanced by a Taylor step in time of this order
+  // (2: its velocities and accelerations; 1: velocities; 0: its positions as they are), and the
+  // chord (large systems iterate with the last velocity block while it contracts; false: a
+  // fresh factorization in every iteration).
+  int predictor_order = 2;
+  bool chord = true;
 };
 
 // Loads and input motions that vary in time, beyond FORCE's constants and the inputs' constant
@@ -144,8 +151,6 @@ class Simulation {
   // Assemble at the block start: inputs at t0, DOFs at their initial values, Newton on the
   // calculable coordinates (with the relaxed limits of an initial assembly).
   void assemble();
-  // State at (t, q, q̇) as the integrator needs it: positions, velocities, q̈, accelerations
-  // and the complete stresses, without transfer functions (sparse, allocation-free).
   // Where Newton's iterations on the positions start (the predictor).
   enum class Start {
     Taylor,    // the last solved state advanced by a second-order Taylor step in time
@@ -153,6 +158,8 @@ class Simulation {
     Exact      // the last solved state, which holds the exact positions at (t, q): the recursive
                // path's; no polish iteration
   };
+  // State at (t, q, q̇) as the integrator needs it: positions, velocities, q̈, accelerations
+  // and the complete stresses, without transfer functions (sparse, allocation-free).
   // known_qdd: q̈ already known there (the recursive path's): no equations of motion solved.
   void solve_state(double t, const double* q, const double* qd, Start start = Start::Taylor,
                    const Eigen::VectorXd* known_qdd = nullptr);
@@ -286,6 +293,8 @@ class Simulation {
   // leaves the branch of the step start, again from the step start (anchor_).
   Solved base_, anchor_;
   bool in_rhs_ = false;          // evaluating a right-hand side of the integrator
+  int predictor_order_ = RunOptions().predictor_order;  // of the run (measurements)
+  bool chord_ = RunOptions().chord;
   Eigen::VectorXd qhat_transfer_;  // q̂ at which data holds DF (set by evaluate)
   Eigen::VectorXd predicted_;    // change of the positions predicted by the transfer function
   bool have_transfer_ = false;
