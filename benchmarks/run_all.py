@@ -1,6 +1,7 @@
 """Run every benchmark and write its section of docs/performance.md (and the plots under
 docs/img/): the manual's slider-crank (spacar alone, benchmarks/slidercrank.py), then spacar
-side by side with the peers — rigid chains (chains.py), the four-bar (fourbar.py), the flexible
+side by side with the peers — rigid chains (chains.py), the four-bar (fourbar.py), Newton's
+iterations of the general path with its predictor and chord (newton.py, spacar alone), the flexible
 cantilever (cantilever.py), the manual's slider-crank against exudyn (slidercrank_exudyn.py) and
 the steel cantilever's time to tip accuracy with the stiff integrator (stiff.py) and the
 static solve of a large-deflection cantilever against exudyn's SolveStatic (statics.py).
@@ -24,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import cantilever  # noqa: E402
 import chains  # noqa: E402
 import fourbar  # noqa: E402
+import newton  # noqa: E402
 import slidercrank  # noqa: E402
 import slidercrank_exudyn  # noqa: E402
 import statics  # noqa: E402
@@ -33,6 +35,7 @@ CASES = {
     "slidercrank": slidercrank,
     "chains": chains,
     "fourbar": fourbar,
+    "newton": newton,
     "cantilever": cantilever,
     "slidercrank_exudyn": slidercrank_exudyn,
     "stiff": stiff,

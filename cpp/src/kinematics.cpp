@@ -174,13 +174,16 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
   // Large systems reuse the factorization of the velocity block of the last solved state, the
   // same matrix at nearby positions: the iteration converges linearly but saves factorizations;
   // the iterates then go to 1e-3 EPSKIN (a polish of the same effect as the quadratic step) and
-  // a fresh factorization is made as soon as the contraction is poor. Small systems use full
-  // Newton with one polish step after convergence: near a singular configuration it fails with
-  // the residual that names the constraints. (With the replayed sparse LU both cost the same
-  // on benchmarks/chains.py from 10 to 100 links, within the noise of the measurement.)
+  // a fresh factorization is made as soon as the contraction is poor or slow. Small systems use
+  // full Newton with one polish step after convergence: near a singular configuration it fails
+  // with the residual that names the constraints. (benchmarks/newton.py: the chord saves 0–10 %
+  // of the time of a run against a fresh factorization in every iteration.)
   constexpr int kChordMinimum = 31;  // calculable coordinates
+  constexpr double kRoundOff = 1e-14;  // residuals of unit-size coordinates below it are noise
   const bool chord = !assembly && data.jacobian_reusable && nc >= kChordMinimum;
   LinearSolver* J = chord ? &data.luV : nullptr;
+  // The chord's polish goes to 1e-3 EPSKIN, but not below round-off.
+  const double polished = std::max(1e-3 * tol, kRoundOff * std::max(1.0, sys.length_scale));
   bool converged = false;
   double previous = std::numeric_limits<double>::infinity();
   for (int it = 0; it <= limit && nc > 0; ++it) {
@@ -190,7 +193,7 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
       note(rmax);
       break;
     }
-    if (converged && (!chord || rmax <= 1e-3 * tol)) break;  // polished
+    if (converged && (!chord || rmax <= polished)) break;
     if (exact_start && it == 0 && rmax <= tol) {  // exact up to round-off, not a prediction
       converged = true;
       break;
@@ -198,7 +201,10 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
     converged = converged || rmax <= tol;
     if (it == limit && !converged) break;
     note(rmax);
-    if (!chord || rmax > 0.25 * previous) {
+    // A fresh factorization when the chord contracts poorly, or so slowly that it would take
+    // more than three more iterations to its target.
+    const double rate = rmax / previous, target = converged ? polished : tol;
+    if (!chord || rate > 0.25 || rmax * rate * rate * rate > target) {
       assemble_block(sys, data, data.AP, data.AP_block);
       factorize(sys, data, data.AP, data.luP, "position");
       J = &data.luP;
