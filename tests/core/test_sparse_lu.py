@@ -282,3 +282,46 @@ def test_amd_trial_keeps_exact_factors_either_way(seed):
     colamd_fill = lu.factor_nonzeros
     factorize_perturbed(lu, A, rng, 40, tol=1e-13)
     assert lu.factor_nonzeros <= colamd_fill
+
+
+def test_block_matrix_assembles_what_dense_accumulation_gives():
+    """The fixed-pattern assembly (BlockMatrix, sparse.hpp) of blocks that overlap, leave rows and
+    columns out (−1) and repeat a global row or column within a block: its pattern holds exactly
+    the entries the blocks reach, sorted and compressed, and add, add_transposed and add_value
+    sum into the same matrix as a dense accumulation."""
+    rng = np.random.default_rng(7)
+    rows, cols = 23, 17
+    B = _testing.BlockMatrix(rows, cols)
+    blocks = []
+    for _ in range(30):
+        r = [int(v) for v in rng.integers(-1, rows, rng.integers(1, 7))]
+        c = [int(v) for v in rng.integers(-1, cols, rng.integers(1, 7))]
+        blocks.append((B.add_block(r, c), r, c))
+    B.finalize()
+    for _ in range(2):  # a second assembly into the same pattern starts from zero
+        B.set_zero()
+        dense, reached = np.zeros((rows, cols)), np.zeros((rows, cols), bool)
+        for k, (bid, r, c) in enumerate(blocks):
+            local = rng.normal(size=(len(r), len(c)))
+            transposed = k % 3 == 1
+            if transposed:
+                B.add_transposed(bid, local.T.copy())
+            else:
+                B.add(bid, local)
+            for a, i in enumerate(r):
+                for b, j in enumerate(c):
+                    if i >= 0 and j >= 0:
+                        dense[i, j] += local[a, b]
+                        reached[i, j] = True
+            if k % 3 == 2:  # one more entry, by its local place
+                a, b = int(rng.integers(len(r))), int(rng.integers(len(c)))
+                B.add_value(bid, a, b, 0.5)
+                if r[a] >= 0 and c[b] >= 0:
+                    dense[r[a], c[b]] += 0.5
+        A = B.matrix
+        assert A.has_sorted_indices
+        coo = A.tocoo()
+        stored = np.zeros((rows, cols), bool)
+        stored[coo.row, coo.col] = True
+        assert A.nnz == reached.sum() and np.array_equal(stored, reached)
+        np.testing.assert_allclose(A.toarray(), dense, rtol=0, atol=1e-14)

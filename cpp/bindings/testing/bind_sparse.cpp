@@ -1,12 +1,15 @@
 // Test-only binding of the sparse LU (sparse_lu.hpp): factorize scipy.sparse matrices of one
 // pattern, solve, and count the factorizations that chose pivots, so that the tests can check
-// the replayed elimination against dense solves.
+// the replayed elimination against dense solves; and of the fixed-pattern assembly (BlockMatrix,
+// sparse.hpp), checked against dense accumulation.
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <algorithm>
 #include <stdexcept>
 
+#include "spacar/sparse.hpp"
 #include "spacar/sparse_lu.hpp"
 
 namespace py = pybind11;
@@ -47,6 +50,20 @@ struct TestLU {
 }  // namespace
 
 void bind_sparse(py::module_& m) {
+  py::class_<spacar::BlockMatrix>(m, "BlockMatrix")
+      .def(py::init([](int rows, int cols) {
+             auto b = std::make_unique<spacar::BlockMatrix>();
+             b->reset(rows, cols);
+             return b;
+           }),
+           py::arg("rows"), py::arg("cols"))
+      .def("add_block", &spacar::BlockMatrix::add_block, py::arg("rows"), py::arg("cols"))
+      .def("finalize", &spacar::BlockMatrix::finalize)
+      .def("set_zero", &spacar::BlockMatrix::set_zero)
+      .def("add", &spacar::BlockMatrix::add, py::arg("id"), py::arg("local"))
+      .def("add_transposed", &spacar::BlockMatrix::add_transposed, py::arg("id"), py::arg("local"))
+      .def("add_value", &spacar::BlockMatrix::add_value, py::arg("id"), py::arg("a"), py::arg("b"), py::arg("v"))
+      .def_property_readonly("matrix", [](const spacar::BlockMatrix& b) { return Sparse(b.matrix()); });
   py::class_<TestLU>(m, "SparseLU")
       .def(py::init<const Sparse&>(), py::arg("A"))
       .def("factorize", &TestLU::factorize, py::arg("A"))
