@@ -42,12 +42,6 @@ Eigen::Vector4d euler_E_transpose_times(const Eigen::Vector4d& l, const Eigen::V
   return out;
 }
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
-
 // R(λ) = E(λ) G(λ)ᵀ, body → global.
 Eigen::Matrix3d euler_R(const Eigen::Vector4d& l) { return euler_E(l) * euler_G(l.data()).transpose(); }
 

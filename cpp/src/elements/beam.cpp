@@ -92,13 +92,6 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
     }
   }
 
-  void rates(const double* x, const double* v, double* edot) const override {
-    double e[6];
-    Eigen::Matrix<double, 6, 14> B;
-    first_derivatives(x, e, B.data());
-    Eigen::Map<Eigen::Matrix<double, 6, 1>>(edot).noalias() = B * Eigen::Map<const Eigen::Matrix<double, 14, 1>>(v);
-  }
-
   // c = d²e/dt² at ẍ = 0: e_l and the section axes w = R(λ)c0 by their rates, with
   // ẅ = 2 R(λ̇)c0 (R(λ)c0 is quadratic in λ) and, of the chord, l̈ = (|ḋ|² − l̇²)/l and
   // ë_l = −(2 ė_l l̇ + e_l l̈)/l.
@@ -113,23 +106,25 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
     const Eigen::Vector3d ypd = a.Jyp * lpd, zpd = a.Jzp * lpd, yqd = a.Jyq * lqd, zqd = a.Jzq * lqd;
     const Eigen::Vector3d ypdd = 2.0 * rotated(v + 3, C0_.col(1)), zpdd = 2.0 * rotated(v + 3, C0_.col(2));
     const Eigen::Vector3d yqdd = 2.0 * rotated(v + 10, C0_.col(1)), zqdd = 2.0 * rotated(v + 10, C0_.col(2));
-    // (a·b)¨ with ä, b̈ the convective parts.
-    auto product = [](const Eigen::Vector3d& u, const Eigen::Vector3d& ud, const Eigen::Vector3d& udd,
-                      const Eigen::Vector3d& w, const Eigen::Vector3d& wd, const Eigen::Vector3d& wdd) {
-      return udd.dot(w) + 2.0 * ud.dot(wd) + u.dot(wdd);
-    };
     c[0] = ldd;
-    c[1] = 0.5 * l0_ * (product(a.zp, zpd, zpdd, a.yq, yqd, yqdd) - product(a.yp, ypd, ypdd, a.zq, zqd, zqdd));
-    c[2] = l0_ * product(a.el, eld, eldd, a.zp, zpd, zpdd);
-    c[3] = -l0_ * product(a.el, eld, eldd, a.zq, zqd, zqdd);
-    c[4] = -l0_ * product(a.el, eld, eldd, a.yp, ypd, ypdd);
-    c[5] = l0_ * product(a.el, eld, eldd, a.yq, yqd, yqdd);
+    c[1] = 0.5 * l0_ * (dot_rates(a.zp, zpd, zpdd, a.yq, yqd, yqdd).second -
+                        dot_rates(a.yp, ypd, ypdd, a.zq, zqd, zqdd).second);
+    // Bending: e_i = k_i e_l·w_i.
+    const double k[6] = {0.0, 0.0, l0_, -l0_, -l0_, l0_};
+    const DotRates bend[6] = {{},
+                              {},
+                              dot_rates(a.el, eld, eldd, a.zp, zpd, zpdd),
+                              dot_rates(a.el, eld, eldd, a.zq, zqd, zqdd),
+                              dot_rates(a.el, eld, eldd, a.yp, ypd, ypdd),
+                              dot_rates(a.el, eld, eldd, a.yq, yqd, yqdd)};
+    double e[6] = {}, ed[6] = {};
+    for (int i = 2; i < 6; ++i) {
+      e[i] = k[i] * bend[i].value;
+      ed[i] = k[i] * bend[i].rate;
+      c[i] = k[i] * bend[i].second;
+    }
     if constexpr (Nonlinear) {
       // f = 2a² + ab + 2b² per bending pair: f̈ = (4a + b) ä + (a + 4b) b̈ + 4ȧ² + 2ȧḃ + 4ḃ².
-      const double e[6] = {0.0, 0.0, l0_ * a.el.dot(a.zp), -l0_ * a.el.dot(a.zq), -l0_ * a.el.dot(a.yp),
-                           l0_ * a.el.dot(a.yq)};
-      const double ed[6] = {0.0, 0.0, l0_ * (eld.dot(a.zp) + a.el.dot(zpd)), -l0_ * (eld.dot(a.zq) + a.el.dot(zqd)),
-                            -l0_ * (eld.dot(a.yp) + a.el.dot(ypd)), l0_ * (eld.dot(a.yq) + a.el.dot(yqd))};
       double f = 0.0;
       for (int i : {2, 4})
         f += (4.0 * e[i] + e[i + 1]) * c[i] + (e[i] + 4.0 * e[i + 1]) * c[i + 1] + 4.0 * ed[i] * ed[i] +

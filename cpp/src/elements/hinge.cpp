@@ -48,13 +48,6 @@ class Hinge : public AutoDiffElement<Hinge, 8, 3> {
     Bm.block<1, 4>(2, 4) = -a.x1.transpose() * a.Jy2;
   }
 
-  void rates(const double* x, const double* v, double* edot) const override {
-    double e[3];
-    Eigen::Matrix<double, 3, 8> B;
-    first_derivatives(x, e, B.data());
-    Eigen::Map<Eigen::Vector3d>(edot).noalias() = B * Eigen::Map<const Eigen::Matrix<double, 8, 1>>(v);
-  }
-
   // c = d²e/dt² at ẍ = 0, with ẅ = 2 R(λ̇)c0 for an axis w = R(λ)c0 (see BEAM), and
   // θ̈ = (D N̈ − N D̈)/r² − 2 θ̇ (N Ṅ + D Ḋ)/r², θ̇ = (D Ṅ − N Ḋ)/r².
   void convective(const double* x, const double* v, double* c) const override {
@@ -65,21 +58,14 @@ class Hinge : public AutoDiffElement<Hinge, 8, 3> {
     const Eigen::Vector3d x1dd = 2.0 * rotated(v, C0_.col(0)), y1dd = 2.0 * rotated(v, C0_.col(1)),
                           z1dd = 2.0 * rotated(v, C0_.col(2)), y2dd = 2.0 * rotated(v + 4, C0_.col(1)),
                           z2dd = 2.0 * rotated(v + 4, C0_.col(2));
-    struct Product {
-      double value, rate, second;
-    };
-    auto product = [](const Eigen::Vector3d& u, const Eigen::Vector3d& ud, const Eigen::Vector3d& udd,
-                      const Eigen::Vector3d& w, const Eigen::Vector3d& wd, const Eigen::Vector3d& wdd) {
-      return Product{u.dot(w), ud.dot(w) + u.dot(wd), udd.dot(w) + 2.0 * ud.dot(wd) + u.dot(wdd)};
-    };
-    const Product zy = product(a.z1, z1d, z1dd, a.y2, y2d, y2dd), yz = product(a.y1, y1d, y1dd, a.z2, z2d, z2dd);
-    const Product yy = product(a.y1, y1d, y1dd, a.y2, y2d, y2dd), zz = product(a.z1, z1d, z1dd, a.z2, z2d, z2dd);
+    const DotRates zy = dot_rates(a.z1, z1d, z1dd, a.y2, y2d, y2dd), yz = dot_rates(a.y1, y1d, y1dd, a.z2, z2d, z2dd);
+    const DotRates yy = dot_rates(a.y1, y1d, y1dd, a.y2, y2d, y2dd), zz = dot_rates(a.z1, z1d, z1dd, a.z2, z2d, z2dd);
     const double N = 0.5 * (zy.value - yz.value), Nd = 0.5 * (zy.rate - yz.rate), Ndd = 0.5 * (zy.second - yz.second);
     const double D = 0.5 * (yy.value + zz.value), Dd = 0.5 * (yy.rate + zz.rate), Ddd = 0.5 * (yy.second + zz.second);
     const double r2 = N * N + D * D, thd = (D * Nd - N * Dd) / r2;
     c[0] = (D * Ndd - N * Ddd) / r2 - 2.0 * thd * (N * Nd + D * Dd) / r2;
-    c[1] = product(a.x1, x1d, x1dd, a.z2, z2d, z2dd).second;
-    c[2] = -product(a.x1, x1d, x1dd, a.y2, y2d, y2dd).second;
+    c[1] = dot_rates(a.x1, x1d, x1dd, a.z2, z2d, z2dd).second;
+    c[2] = -dot_rates(a.x1, x1d, x1dd, a.y2, y2d, y2dd).second;
   }
 
   double period(int i) const override { return i == 0 ? 2.0 * M_PI : 0.0; }

@@ -52,11 +52,15 @@ Eigen::Matrix<double, 3, 4> rotate_jacobian(const double* l, const Eigen::Vector
   const Eigen::Vector3d lb(l[1], l[2], l[3]);
   Eigen::Matrix<double, 3, 4> J;
   J.col(0) = 2.0 * (l[0] * c + lb.cross(c));
-  Eigen::Matrix3d c_skew;
-  c_skew << 0.0, -c.z(), c.y(), c.z(), 0.0, -c.x(), -c.y(), c.x(), 0.0;
   J.rightCols<3>() = 2.0 * (lb.dot(c) * Eigen::Matrix3d::Identity() + lb * c.transpose() - c * lb.transpose() -
-                            l[0] * c_skew);
+                            l[0] * skew(c));
   return J;
+}
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return S;
 }
 
 Eigen::Matrix<double, 3, 4> euler_G(const double* l) {

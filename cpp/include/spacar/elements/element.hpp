@@ -12,8 +12,9 @@
 // stress-weighted Hessians Σσ_i Γ_i, the mass matrix and convective inertia forces (Lagrange's
 // equations) from these by forward-mode dual numbers (see autodiff.hpp). Where an element is
 // evaluated often and its derivatives are simple (BEAM, HINGE), it may override
-// first_derivatives, rates and convective with written-out versions, and give its mass points'
-// Jacobian and convective accelerations written out as
+// first_derivatives and convective with written-out versions (the rates, one directional
+// derivative, stay dual: cheaper than B v), and give its mass points' Jacobian and convective
+// accelerations written out as
 //   void point_jacobian(const double* x, const double* v, Eigen::Matrix<double, NG·DIM, NC>& Jg,
 //                       Eigen::Matrix<double, NG·DIM, 1>& gamma) const;
 #pragma once

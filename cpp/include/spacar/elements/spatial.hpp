@@ -41,6 +41,18 @@ inline Eigen::Vector3d rotated(const double* l, const Eigen::Vector3d& c) {
 }
 Eigen::Matrix<double, 3, 4> rotate_jacobian(const double* l, const Eigen::Vector3d& c);
 
+// The cross-product matrix: skew(v) w = v × w.
+Eigen::Matrix3d skew(const Eigen::Vector3d& v);
+
+// u·w with its first and second rates, from those of u and w (the written-out convective terms).
+struct DotRates {
+  double value, rate, second;
+};
+inline DotRates dot_rates(const Eigen::Vector3d& u, const Eigen::Vector3d& ud, const Eigen::Vector3d& udd,
+                          const Eigen::Vector3d& w, const Eigen::Vector3d& wd, const Eigen::Vector3d& wdd) {
+  return {u.dot(w), ud.dot(w) + u.dot(wd), udd.dot(w) + 2.0 * ud.dot(wd) + u.dot(wdd)};
+}
+
 // Orthonormal frame [e_x e_y e_z] with e_x along `axis` and e_y from `y_hint` (its e_x component
 // removed). Throws InputError (message names `what`) if the axis has zero length or the hint is
 // parallel to the axis (remainder below 1e-5 of its length).
