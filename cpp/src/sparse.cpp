@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace spacar {
 
@@ -14,15 +15,6 @@ int BlockMatrix::add_block(const std::vector<int>& rows, const std::vector<int>&
   blocks_.push_back({rows, cols, {}, {}, {}});
   return static_cast<int>(blocks_.size()) - 1;
 }
-
-namespace {
-
-// Offsets of a counting sort: start[k] = Σ_{k' < k} count[k'] (count in start[k + 1] on entry).
-void counts_to_offsets(std::vector<int>& start) {
-  for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
-}
-
-}  // namespace
 
 // The pattern and every block entry's value position in O(entries), column by column, from a
 // counting sort of the blocks' rows and of the blocks themselves by column (triplets sorted by
@@ -50,8 +42,9 @@ void BlockMatrix::finalize() {
         ++ref_start[c + 1];
       }
   }
-  counts_to_offsets(row_start);
-  counts_to_offsets(ref_start);
+  // Counts (in [c + 1]) to offsets.
+  std::partial_sum(row_start.begin(), row_start.end(), row_start.begin());
+  std::partial_sum(ref_start.begin(), ref_start.end(), ref_start.begin());
   std::vector<int> rows_in(row_start.back());
   std::vector<Ref> refs(ref_start.back());
   std::vector<int> row_fill(row_start.begin(), row_start.end() - 1), ref_fill(ref_start.begin(), ref_start.end() - 1);
