@@ -283,6 +283,32 @@ bool SparseLU::try_amd(const Eigen::SparseMatrix<double>& A) {
   return true;
 }
 
+namespace {
+// +1 for an even permutation, −1 for an odd one (by its cycles).
+int parity(const std::vector<int>& perm) {
+  std::vector<char> seen(perm.size(), 0);
+  int sign = 1;
+  for (size_t i = 0; i < perm.size(); ++i) {
+    if (seen[i]) continue;
+    size_t length = 0;
+    for (size_t j = i; !seen[j]; j = static_cast<size_t>(perm[j])) {
+      seen[j] = 1;
+      ++length;
+    }
+    if (length % 2 == 0) sign = -sign;
+  }
+  return sign;
+}
+}  // namespace
+
+int SparseLU::sign_determinant() const {
+  if (!valid_) return 0;
+  int sign = parity(q_) * parity(pinv_);
+  for (double u : Uinv_)
+    if (u < 0.0) sign = -sign;
+  return sign;
+}
+
 // Without valid factors (none yet, or the last factorization failed part way) the solution is
 // NaN: the factors and permutations are incomplete then.
 bool SparseLU::refuse_solve(double* x) const {

@@ -55,6 +55,7 @@ class LinearSolver {
   void solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const;
   void solve_transposed(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
   int size() const { return n_; }
+  int sign_determinant() const { return lu_.sign_determinant(); }
   // See SparseLU::adopt_pivots: `other` factorized a matrix of A's pattern.
   void adopt_pivots(const LinearSolver& other, const Eigen::SparseMatrix<double>& A) { lu_.adopt_pivots(other.lu_, A); }
 

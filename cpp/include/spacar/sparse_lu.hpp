@@ -43,6 +43,9 @@ class SparseLU {
   // different size or number of entries is refused here.
   void adopt_pivots(const SparseLU& other, const Eigen::SparseMatrix<double>& A);
   int factor_nonzeros() const { return static_cast<int>(Li_.size() + Ui_.size()) + n_; }
+  // The sign of det A from the last successful factorization: the parities of the two
+  // permutations times the signs of U's diagonal.
+  int sign_determinant() const;
   // Pivot choices made (not replays), one per ordering tried.
   int pivotings() const { return pivotings_; }
 
