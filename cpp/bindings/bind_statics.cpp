@@ -1,6 +1,6 @@
 // Binding of the static analysis (statics.hpp): spacar._core.solve_static (a failure raises
 // StaticError, bind_errors.cpp, carrying the converged load steps as `results`) and
-// static_tangent (for spacar.compliance).
+// static_compliance (for spacar.compliance).
 #include <optional>
 
 #include <pybind11/eigen.h>
@@ -75,22 +75,18 @@ void bind_statics(py::module_& m) {
       "points); StaticError (with `results`, the converged steps) if no equilibrium is found.");
 
   m.def(
-      "static_tangent",
-      [](Model& model, double load_factor, std::optional<Eigen::VectorXd> x, std::optional<Eigen::VectorXd> e) {
-        const StaticTangent t = static_tangent(model, load_factor, x ? &*x : nullptr, e ? &*e : nullptr);
-        py::dict d;
-        d["K"] = t.K;
-        d["R"] = t.R;
-        d["DF"] = t.DF;
-        d["x"] = t.x;
-        d["coord_label"] = t.coord_label;
-        d["dof_names"] = t.dof_names;
-        return d;
+      "static_compliance",
+      [](Model& model, const std::vector<int>& nodes, double load_factor, std::optional<Eigen::VectorXd> x,
+         std::optional<Eigen::VectorXd> e) {
+        py::gil_scoped_release release;
+        return static_compliance(model, nodes, load_factor, x ? &*x : nullptr, e ? &*e : nullptr);
       },
-      py::arg("model"), py::arg("load_factor") = 1.0, py::arg("x") = py::none(), py::arg("e") = py::none(),
+      py::arg("model"), py::arg("nodes"), py::arg("load_factor") = 1.0, py::arg("x") = py::none(),
+      py::arg("e") = py::none(),
       "At the model's current state, or at the degrees of freedom of (x, e) (a row of static results): the "
-      "reduced forces R and tangent stiffness K0 + G0 of the static solve under load_factor times the block's "
-      "loads, DF of the degrees of freedom, x and the labels.");
+      "compliance at the nodes (their coordinates; a LAMBDA node's rotation vector in global axes) under the "
+      "tangent stiffness K0 + G0 of the static solve at load_factor times the block's loads (sparse); StaticError "
+      "naming the direction if the stiffness is singular.");
 }
 
 }  // namespace spacar::bindings

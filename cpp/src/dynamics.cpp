@@ -318,43 +318,6 @@ Eigen::MatrixXd congruence(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A) {
   return T.transpose() * AT;
 }
 
-Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::VectorXd& sigma) {
-  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(sys.nx, sys.nx);
-  for (size_t i = 0; i < sys.elements.size(); ++i) {
-    const SystemElement& se = sys.elements[i];
-    const ElementWork& w = data.work[i];
-    const int n = static_cast<int>(se.coords.size());
-    Eigen::VectorXd s = sigma.segment(se.def_offset, se.nd);
-    if (s.any()) {
-      Eigen::MatrixXd G(n, n);
-      se.kernel->stress_hessian(w.x.data(), s.data(), G.data());
-      for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b) K(se.coords[a], se.coords[b]) += G(a, b);
-    }
-    // Position-dependent gravity loads of the element mass (beam tangent terms).
-    if (se.has_mass && sys.gravity.squaredNorm() > 0.0) {
-      Eigen::VectorXd xp = w.x, fp(n), fm(n);
-      for (int b = 0; b < n; ++b) {
-        const double h = 1e-6 * std::max(1.0, std::abs(w.x[b]));
-        xp[b] = w.x[b] + h;
-        se.kernel->gravity(xp.data(), sys.gravity.data(), fp.data());
-        xp[b] = w.x[b] - h;
-        se.kernel->gravity(xp.data(), sys.gravity.data(), fm.data());
-        xp[b] = w.x[b];
-        for (int a = 0; a < n; ++a) K(se.coords[a], se.coords[b]) -= (fp[a] - fm[a]) / (2.0 * h);
-      }
-    }
-  }
-  // Body-fixed torques: f_λ = 2 G(λ)ᵀ T' is linear in λ.
-  for (const auto& [coord, T] : sys.torquel)
-    for (int b = 0; b < 4; ++b) {
-      double unit[4] = {0, 0, 0, 0};
-      unit[b] = 1.0;
-      K.block<4, 1>(coord, coord + b) -= 2.0 * euler_G(unit).transpose() * T;
-    }
-  return K;
-}
-
 double kinetic_energy(const System& sys, const Data& data) {
   Eigen::VectorXd Mv;
   inertia_times(sys, data, data.xd, Mv);

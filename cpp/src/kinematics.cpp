@@ -388,6 +388,11 @@ void solve_accelerations_direct(const System& sys, Data& data) {
   deformation_accelerations(sys, data);
 }
 
+void transfer_times(const System& sys, Data& data, const Eigen::VectorXd& v, Eigen::VectorXd& dx) {
+  dx.resize(sys.nx);
+  calculable_rates(sys, data, v, false, dx);
+}
+
 void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out) {
   // DF = [unit rows of the coordinates in q̂; A_V⁻¹ rhs_DF on the calculable ones], so
   // DFᵀ w = (unit part)ᵀ w + rhs_DFᵀ μ with A_Vᵀ μ = w^c: one transposed solve.

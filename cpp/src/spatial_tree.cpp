@@ -18,13 +18,6 @@ using tree_detail::element_nodes;
 using tree_detail::kGround;
 using tree_detail::NodeInfo;
 
-// E(λ) of ω = 2 E(λ) λ̇ (formulation.md §0).
-Eigen::Matrix<double, 3, 4> euler_E(const Eigen::Vector4d& l) {
-  Eigen::Matrix<double, 3, 4> E;
-  E << -l[1], l[0], -l[3], l[2], -l[2], l[3], l[0], -l[1], -l[3], -l[2], l[1], l[0];
-  return E;
-}
-
 // The Euler parameters of the composed rotation R(p ⊗ r) = R(p) R(r).
 Eigen::Vector4d compose(const Eigen::Vector4d& p, const Eigen::Vector4d& r) {
   const Eigen::Vector3d pv = p.tail<3>(), rv = r.tail<3>();

@@ -9,6 +9,8 @@
 #include "spacar/dynamics.hpp"
 #include "spacar/kinematics.hpp"
 #include "spacar/limits.hpp"
+#include "spacar/elements/spatial.hpp"
+#include "spacar/nodal.hpp"
 
 namespace spacar {
 
@@ -43,18 +45,17 @@ std::string dof_name(const System& sys, int j) {
 }
 
 double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K,
-                     Eigen::VectorXd* dR_dlambda, const Eigen::VectorXd* input_rate) {
+                     Eigen::VectorXd* full_load) {
   const int nd = sys.n_dof();
-  // At rest: no rates, no accelerations, hence no inertia or convective forces.
+  // At rest: no rates, no accelerations, hence no inertia or convective forces. The velocity
+  // block is factorized here, for the transposed solve below.
   data.qhat_d.setZero();
   data.qhat_dd.setZero();
-  solve_transfer(sys, data);
-  solve_velocities(sys, data);
+  solve_velocities_direct(sys, data);
   data.xdd.setZero();
   data.edd.setZero();
   compute_inertia_and_loads(sys, data);
-  Eigen::VectorXd full_load;
-  if (dR_dlambda) full_load = data.f;
+  if (full_load) *full_load = data.f;
   data.f *= lambda;
   constitutive_stresses(sys, data);
   // The unbalanced load w = −λf + Σ Bᵀσ on every coordinate; R = DF_qᵀ w.
@@ -66,59 +67,90 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
     scale = std::max(scale, std::max(std::abs(w[g]), std::abs(data.f[g])) * size);
   }
   w -= data.f;
-  for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
-  R.noalias() = data.DFq.transpose() * w;
-  if (dR_dlambda) dR_dlambda->noalias() = -data.DFq.transpose() * full_load;
-  // Reaction stresses of the velocity rows from the equilibrium of the calculable coordinates,
-  // A_Vᵀ y = −w_c (formulation.md §6); on DOF deformation rows y → 0 at equilibrium. With them
-  // Σ σ_k H_k is exactly the derivative of DF_q (the second-order transfer) contracted with w.
-  const int nc = static_cast<int>(sys.x_calc.size());
-  if (nc > 0) {
-    Eigen::VectorXd rhs(nc), y(nc);
-    for (int j = 0; j < nc; ++j) rhs[j] = -w[sys.x_calc[j]];
-    data.luV.solve_transposed(rhs, y);
-    for (int r = 0; r < nc; ++r) data.sigma[sys.defs_V[r]] += y[r];
-  }
+  // R = DF_qᵀ w without DF: one transposed solve with the velocity block, A_Vᵀ μ = w_c, which
+  // leaves μ in data.sol_V. The reaction stresses of the velocity rows are y = −μ, from the
+  // equilibrium of the calculable coordinates (formulation.md §6); on DOF deformation rows
+  // y → 0 at equilibrium. With them Σ σ_k H_k is exactly the derivative of DF_q (the
+  // second-order transfer) contracted with w.
+  Eigen::VectorXd out;
+  transfer_transposed(sys, data, w, out);
+  R.resize(nd);
+  for (int j = 0; j < nd; ++j) R[j] = out[sys.dof_cols[j]];
+  if (!sys.x_calc.empty())
+    for (size_t r = 0; r < sys.defs_V.size(); ++r) data.sigma[sys.defs_V[r]] -= data.sol_V[r];
   data.reaction = -data.f;
   add_stress_loads(sys, data, data.reaction);
   for (int g = 0; g < sys.nx; ++g) {
     const CoordClass c = sys.coord_class[g];
     if (c != CoordClass::Fixed && c != CoordClass::Input) data.reaction[g] = 0.0;
   }
-  if (!K) return scale;
-  // Tangent stiffness K0 + G0: G0 with the complete stresses and the stiffness of the
-  // position-dependent loads (beam gravity, TORQUEL), which scale with λ.
-  Eigen::MatrixXd Kx = geometric_stiffness(sys, data, data.sigma);
-  if (lambda != 1.0 && (sys.gravity.squaredNorm() > 0.0 || !sys.torquel.empty()))
-    Kx -= (1.0 - lambda) * geometric_stiffness(sys, data, Eigen::VectorXd::Zero(sys.ne));
-  Eigen::MatrixXd DFeq(sys.ne, nd);
-  for (int j = 0; j < nd; ++j) DFeq.col(j) = data.DFe.col(sys.dof_cols[j]);
-  const Eigen::MatrixXd S = global_constitutive(sys, false);
-  *K = congruence(data.DFq, Kx) + congruence(DFeq, S);   // G0 + K0
-  if (dR_dlambda && input_rate && input_rate->size() > 0) {
-    // The same tangent in the direction of the inputs' motion: the inputs are further columns
-    // of q̂, and Σ σ_k H_k with the complete stresses differentiates DF_q along them too.
-    Eigen::VectorXd dx = Eigen::VectorXd::Zero(sys.nx), de = Eigen::VectorXd::Zero(sys.ne);
-    for (int i = 0; i < sys.n_input(); ++i) {
-      dx.noalias() += (*input_rate)[i] * data.DF.col(sys.input_cols[i]);
-      de.noalias() += (*input_rate)[i] * data.DFe.col(sys.input_cols[i]);
-    }
-    dR_dlambda->noalias() += data.DFq.transpose() * (Kx * dx) + DFeq.transpose() * (S * de);
+  if (K) {
+    // The reduced tangent K0 + G0 = DF_qᵀ H DF_q, H the nodal tangent (structural plus
+    // geometric with the complete stresses, the loads' stiffness scaled by λ): dense, for tests
+    // and small models only.
+    solve_transfer(sys, data);
+    for (int j = 0; j < nd; ++j) data.DFq.col(j) = data.DF.col(sys.dof_cols[j]);
+    NodalCoefficients c;
+    c.load_factor = lambda;
+    const Eigen::SparseMatrix<double> H = nodal_matrix(sys, data, data.sigma, c);
+    const Eigen::MatrixXd HD = H * data.DFq;
+    *K = data.DFq.transpose() * HD;
   }
   return scale;
 }
 
 namespace {
 
+// The change of the DOFs for a change dx of the coordinates: their own entries, B_k dx.
+Eigen::VectorXd dof_change(const System& sys, const Data& data, const Eigen::VectorXd& dx) {
+  const int nxd = static_cast<int>(sys.x_dyn.size());
+  Eigen::VectorXd dq(sys.n_dof());
+  for (int j = 0; j < nxd; ++j) dq[j] = dx[sys.x_dyn[j]];
+  for (size_t j = 0; j < sys.e_dyn.size(); ++j) {
+    const int k = sys.e_dyn[j], i = sys.e_element[k];
+    const SystemElement& se = sys.elements[i];
+    double v = 0.0;
+    for (size_t c = 0; c < se.coords.size(); ++c) v += data.work[i].B(k - se.def_offset, c) * dx[se.coords[c]];
+    dq[nxd + j] = v;
+  }
+  return dq;
+}
+
+// The characteristic size of each DOF: the mean element length for lengths, 1 for angles.
+Eigen::VectorXd dof_scale(const System& sys) {
+  Eigen::VectorXd scale(sys.n_dof());
+  int j = 0;
+  for (int g : sys.x_dyn) scale[j++] = sys.coord_is_length[g] ? sys.length_scale : 1.0;
+  for (int k : sys.e_dyn) scale[j++] = sys.def_is_length[k] ? sys.length_scale : 1.0;
+  return scale;
+}
+
+// The DOFs that make up the directions V (columns) of q: components ≥ 10% of the largest,
+// the largest first, at most four named.
+std::string dof_directions(const System& sys, const Eigen::MatrixXd& V) {
+  std::vector<std::pair<double, int>> part;
+  for (int j = 0; j < V.rows(); ++j) {
+    double w = 0.0;
+    for (int c = 0; c < V.cols(); ++c) w = std::max(w, std::abs(V(j, c)) / V.col(c).cwiseAbs().maxCoeff());
+    if (w >= 0.1) part.push_back({-w, j});
+  }
+  std::sort(part.begin(), part.end());
+  std::ostringstream os;
+  os << "the direction of";
+  for (size_t i = 0; i < part.size() && i < 4; ++i) os << (i ? ", " : " ") << dof_name(sys, part[i].second);
+  if (part.size() > 4) os << " and " << part.size() - 4 << " more";
+  return os.str();
+}
+
 // Newton's iterations for one load factor from the current state, and the state to go back to.
+// The tangent stiffness K = K0 + G0 of the degrees of freedom is never formed: its solves go
+// through the sparse saddle-point system of the nodal coordinates (nodal.hpp), a load in q
+// represented on the coordinates and the solution read back in q.
 class EquilibriumPath {
  public:
   EquilibriumPath(const System& sys, Data& data, const StaticOptions& opt, StaticResults& res)
-      : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()) {
-    scale_.resize(nd_);
-    int j = 0;
-    for (int g : sys.x_dyn) scale_[j++] = sys.coord_is_length[g] ? sys.length_scale : 1.0;
-    for (int k : sys.e_dyn) scale_[j++] = sys.def_is_length[k] ? sys.length_scale : 1.0;
+      : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()), layout_(sys), tangent_(sys, layout_),
+        scale_(dof_scale(sys)) {
     // Inputs at the block start (λ = 0) and end (λ = 1), ordered as input_cols.
     const double tp = sys.settings.timestep_tp;
     p0_ = sys.p0;
@@ -138,10 +170,7 @@ class EquilibriumPath {
   // for an unloaded stress-free start, the equilibrium of the block before otherwise. The path
   // solves R(q, λ) − (1 − λ) R0 = 0: it begins exactly at the current state, and from one block
   // to the next the loads change gradually instead of being released and applied again.
-  void start() {
-    static_forces(sys_, data_, 0.0, R0_, nullptr);
-    have_DF_ = true;
-  }
+  void start() { static_forces(sys_, data_, 0.0, R0_); }
 
   // Equilibrium at load factor λ, starting from the current state. The sign of det K must stay
   // that of the start: a change during the iterations means that the step crosses a limit or
@@ -152,39 +181,26 @@ class EquilibriumPath {
   Attempt solve(double lambda, bool last_chance) {
     Attempt a;
     Eigen::VectorXd qhat = with_inputs(data_.qhat, lambda);
-    Eigen::VectorXd R;
+    Eigen::VectorXd R, dq, dx;
     double last_correction = std::numeric_limits<double>::infinity();
     int start_sign = 0;
     bool crossed = false;
     for (int it = 0;; ++it) {
       check_thread_deadline("(in the static analysis)");
       try {
-        place(qhat);
+        place(qhat, it > 0 ? &dx : nullptr);
       } catch (const KinematicsError& err) {
         a.why = std::string("the kinematics has no solution there (") + err.what() + ")";
         return a;
       }
-      const double force = static_forces(sys_, data_, lambda, R, &K_);
-      R -= (1.0 - lambda) * R0_;
+      const double force = evaluate_here(lambda, R);
       const Eigen::VectorXd Rs = scale_.cwiseProduct(R);
-      if (!Rs.allFinite() || !K_.allFinite()) {
+      if (!Rs.allFinite() || !factorized_) {
         a.why = "the forces or the stiffness are not finite";
         return a;
       }
-      check_thread_deadline("(in the static analysis)");  // the dense decompositions cannot be interrupted
-      const Eigen::MatrixXd Ks = scale_.asDiagonal() * K_ * scale_.asDiagonal();
-      const Eigen::PartialPivLU<Eigen::MatrixXd> lu(Ks);
-      // A tiny pivot: the stiffness may be singular; full pivoting confirms it and finds the null
-      // directions.
-      Eigen::MatrixXd null_space;
-      const Eigen::VectorXd pivots = lu.matrixLU().diagonal().cwiseAbs();
-      if (nd_ > 0 && !(pivots.minCoeff() > 1e-13 * pivots.maxCoeff())) {
-        Eigen::FullPivLU<Eigen::MatrixXd> full(Ks);
-        full.setThreshold(1e-13);
-        if (!full.isInvertible()) null_space = full.kernel();
-      }
-      const bool singular = null_space.cols() > 0;
-      const int sign = singular || nd_ == 0 ? 0 : determinant_sign(lu);
+      const bool singular = tangent_.singular();
+      const int sign = singular || nd_ == 0 ? 0 : tangent_.sign_determinant();
       if (it == 0) start_sign = sign;
       else if (sign != start_sign) crossed = true;
       if (crossed && !last_chance) {
@@ -192,17 +208,18 @@ class EquilibriumPath {
                 "bifurcation point)";
         return a;
       }
-      double res_max = 0.0;
-      Eigen::VectorXd dy;
+      double res_max = 0.0, correction = 0.0;
       if (nd_ > 0) {
         res_max = Rs.cwiseAbs().maxCoeff(&a.worst);
         a.worst_residual = R[a.worst];
-        if (!singular) dy = lu.solve(-Rs);
+        if (!singular) {
+          solve_dofs(-R, dq, dx);
+          correction = dq.cwiseQuotient(scale_).cwiseAbs().maxCoeff();
+        }
       }
       // Converged: the residual is small against the forces it balances; or it would move the
       // DOFs by less than round-off (nothing is loaded: a mechanism moved by its inputs); or the
       // corrections have reached round-off with a residual near it.
-      const double correction = dy.size() ? dy.cwiseAbs().maxCoeff() : 0.0;
       if (res_max <= opt_.tolerance * force || (!singular && correction <= 1e-13) ||
           (last_correction <= 1e-12 && res_max <= 1e-6 * force)) {
         if (crossed && sign == start_sign) {
@@ -217,134 +234,156 @@ class EquilibriumPath {
         return a;
       }
       if (singular) {
-        a.why = "the tangent stiffness is singular: no stiffness in " + directions(null_space);
+        a.why = "the tangent stiffness is singular: no stiffness in " + singular_directions();
         a.singular_at_start = it == 0;
         return a;
       }
       ++a.iterations;
       ++res_.newton_iterations;
       last_correction = correction;
-      for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += scale_[j] * dy[j];
+      for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += dq[j];
     }
   }
 
-  // The scaled tangent stiffness of the last evaluation has an eigenvalue with a negative real
-  // part: the equilibrium is unstable (for a symmetric stiffness, i.e. conservative loads: not
-  // positive definite). Follower loads (TORQUEL) make it unsymmetric; its symmetric part may then
-  // be indefinite at a stable equilibrium, so the eigenvalues of the matrix itself decide.
-  // Returns "" or the description of the direction of the most negative eigenvalue.
-  std::string indefinite() const {
-    if (nd_ == 0) return "";
+  // The tangent stiffness of the last evaluation has a negative eigenvalue: the equilibrium is
+  // unstable. For a symmetric stiffness (conservative loads) its inertia, counted by the
+  // symmetric factorization, decides. Follower loads (TORQUEL) make it unsymmetric and only
+  // the sign of its determinant is known: a negative determinant means a real negative
+  // eigenvalue (a divergence instability); a pair of complex eigenvalues with negative real
+  // parts (flutter) is not detected. Returns "" or the description of the direction of the
+  // eigenvalue nearest zero (inverse iteration).
+  std::string indefinite() {
+    if (nd_ == 0 || !factorized_) return "";
     check_thread_deadline("(in the static analysis)");
-    const Eigen::MatrixXd Ks = scale_.asDiagonal() * K_ * scale_.asDiagonal();
-    const double big = Ks.cwiseAbs().maxCoeff();
-    double lowest = 0.0;
-    Eigen::VectorXd direction;
-    if ((Ks - Ks.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * big) {
-      const Eigen::MatrixXd sym = 0.5 * (Ks + Ks.transpose());
-      // Eigenvalues only at every step; the vector once an equilibrium is unstable.
-      lowest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(sym, Eigen::EigenvaluesOnly).eigenvalues()[0];
-      if (!(lowest < -1e-9 * big)) return "";
-      direction = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(sym).eigenvectors().col(0);
-    } else {
-      Eigen::EigenSolver<Eigen::MatrixXd> eig(Ks);
-      Eigen::Index k = 0;
-      lowest = eig.eigenvalues().real().minCoeff(&k);
-      direction = eig.eigenvectors().col(k).cwiseAbs();
-    }
-    if (!(lowest < -1e-9 * big)) return "";
-    return directions(direction) + " (eigenvalue " + num(lowest / big) + " of the largest entry)";
+    const int negative = tangent_.negative_eigenvalues();
+    if (negative == 0 || (negative < 0 && tangent_.sign_determinant() >= 0)) return "";
+    double value = 0.0;
+    const Eigen::VectorXd dx = tangent_.lowest_direction(8, value);
+    std::string how = negative > 0 ? std::to_string(negative) + " negative eigenvalue" + (negative > 1 ? "s" : "")
+                                   : std::string("a negative determinant");
+    return directions(dofs_scaled(dx)) + " (" + how + ")";
   }
 
-  // For the arc-length method: the state with the DOFs (and inputs) at q̂, at load factor λ:
-  // the scaled residual of the path Fs = S (R − (1 − λ) R0), its derivative in λ at fixed q,
-  // gs = S (−DF_qᵀ f + R0), and the tangent (scaled_tangent()). Returns the force scale.
-  double evaluate(const Eigen::VectorXd& qhat, double lambda, Eigen::VectorXd& Fs, Eigen::VectorXd& gs) {
-    place(with_inputs(qhat, lambda));
-    Eigen::VectorXd R, g;
-    const Eigen::VectorXd rate = p1_ - p0_;
-    const double force = static_forces(sys_, data_, lambda, R, &K_, &g, &rate);
+  // For the arc-length method: the state with the DOFs (and inputs) at q̂, at load factor λ
+  // (positions predicted by dx from the current ones, if given): the scaled residual of the path
+  // Fs = S (R − (1 − λ) R0), its derivative in λ at fixed q, gs = S (−DF_qᵀ f + R0 + the
+  // tangent's response to the inputs' motion), and the tangent factorized. Returns the force
+  // scale.
+  double evaluate(const Eigen::VectorXd& qhat, double lambda, const Eigen::VectorXd* dx, Eigen::VectorXd& Fs,
+                  Eigen::VectorXd& gs) {
+    place(with_inputs(qhat, lambda), dx);
+    Eigen::VectorXd R, full_load;
+    const double force = evaluate_here(lambda, R, &full_load);
+    // ∂R/∂λ: the loads, R0, and where the inputs move with λ, the tangent along their motion
+    // (the inputs are further columns of q̂; Σ σ_k H_k with the complete stresses
+    // differentiates DF_q along them too): DF_qᵀ (−f + H δx_p), δx_p = DF_p (p1 − p0).
+    Eigen::VectorXd g = -full_load;
+    if (sys_.n_input() > 0 && p1_ != p0_) {
+      Eigen::VectorXd rate = Eigen::VectorXd::Zero(sys_.n_qhat()), dx_p;
+      for (int i = 0; i < sys_.n_input(); ++i) rate[sys_.input_cols[i]] = p1_[i] - p0_[i];
+      transfer_times(sys_, data_, rate, dx_p);
+      NodalCoefficients c;
+      c.load_factor = lambda;
+      g += nodal_matrix(sys_, data_, data_.sigma, c) * dx_p;
+    }
+    Eigen::VectorXd out;
+    transfer_transposed(sys_, data_, g, out);
     R -= (1.0 - lambda) * R0_;
-    g += R0_;
     Fs = scale_.cwiseProduct(R);
-    gs = scale_.cwiseProduct(g);
+    gs.resize(nd_);
+    for (int j = 0; j < nd_; ++j) gs[j] = scale_[j] * (out[sys_.dof_cols[j]] + R0_[j]);
     return force;
   }
-  Eigen::MatrixXd scaled_tangent() const { return scale_.asDiagonal() * K_ * scale_.asDiagonal(); }
+  bool factorized() const { return factorized_; }
+  bool singular() const { return tangent_.singular(); }
   const Eigen::VectorXd& scale() const { return scale_; }
-  std::string dof_directions(const Eigen::VectorXd& v) const { return directions(v); }
+  // dy = Ks⁻¹ rs for the scaled tangent Ks = S K S of the last evaluation, and dx, the change of
+  // the coordinates for the change S dy of the DOFs.
+  void solve_scaled(const Eigen::VectorXd& rs, Eigen::VectorXd& dy, Eigen::VectorXd& dx) {
+    solve_dofs(rs.cwiseQuotient(scale_), dy, dx);
+    dy = dy.cwiseQuotient(scale_);
+  }
+  // "the direction of ..." of the singular tangent of the last evaluation.
+  std::string singular_directions() {
+    const Eigen::VectorXd dx = tangent_.null_direction();
+    if (dx.size() == 0) return "a direction not located (an unsymmetric tangent)";
+    return directions(dofs_scaled(dx));
+  }
 
   struct Snapshot {
     Eigen::VectorXd x, qhat, angle_ref;
-    Eigen::MatrixXd DF;
-    bool have_DF = false;
   };
-  Snapshot save() const { return {data_.x, data_.qhat, data_.angle_ref, data_.DF, have_DF_}; }
+  Snapshot save() const { return {data_.x, data_.qhat, data_.angle_ref}; }
   void restore(const Snapshot& s) {
     data_.x = s.x;
     data_.qhat = s.qhat;
     data_.angle_ref = s.angle_ref;
-    data_.DF = s.DF;
-    have_DF_ = s.have_DF;
   }
 
  private:
+  // The state at the current positions for load factor λ: R − (1 − λ) R0 and the tangent
+  // factorized.
+  double evaluate_here(double lambda, Eigen::VectorXd& R, Eigen::VectorXd* full_load = nullptr) {
+    const double force = static_forces(sys_, data_, lambda, R, nullptr, full_load);
+    R -= (1.0 - lambda) * R0_;
+    NodalCoefficients c;
+    c.load_factor = lambda;
+    check_thread_deadline("(in the static analysis)");
+    factorized_ = tangent_.factorize(sys_, data_, data_.sigma, c);
+    return force;
+  }
+
+  // dq = K⁻¹ v and dx = DF_q dq for a vector v of generalized forces of the DOFs: v as a load on
+  // the coordinates (Zᵀ of it is v: unit loads on DOF coordinates, B_kᵀ v_k on the coordinates
+  // of a DOF deformation k), then δx from the saddle-point system and dq from δx.
+  void solve_dofs(const Eigen::VectorXd& v, Eigen::VectorXd& dq, Eigen::VectorXd& dx) {
+    const int nxd = static_cast<int>(sys_.x_dyn.size());
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(sys_.nx);
+    for (int j = 0; j < nxd; ++j) r[sys_.x_dyn[j]] += v[j];
+    for (size_t j = 0; j < sys_.e_dyn.size(); ++j) {
+      const int k = sys_.e_dyn[j], i = sys_.e_element[k];
+      const SystemElement& se = sys_.elements[i];
+      for (size_t c = 0; c < se.coords.size(); ++c) r[se.coords[c]] += data_.work[i].B(k - se.def_offset, c) * v[nxd + j];
+    }
+    tangent_.solve(r, dx);
+    dq = dof_change(sys_, data_, dx);
+  }
+
+  Eigen::VectorXd dofs_scaled(const Eigen::VectorXd& dx) const { return dof_change(sys_, data_, dx).cwiseQuotient(scale_); }
+
   // q̂ with the inputs at their values for load factor λ (moved linearly from p0 to p1).
   Eigen::VectorXd with_inputs(Eigen::VectorXd qhat, double lambda) const {
     for (int i = 0; i < sys_.n_input(); ++i) qhat[sys_.input_cols[i]] = p0_[i] + lambda * (p1_[i] - p0_[i]);
     return qhat;
   }
 
-  // Positions for q̂: the calculable coordinates predicted along DF from the last state, then
-  // solved by Newton on the constraints.
-  void place(const Eigen::VectorXd& qhat) {
-    if (have_DF_) data_.x.noalias() += data_.DF * (qhat - data_.qhat);
+  // Positions for q̂: the coordinates moved by the predicted change dx (the first-order change
+  // for the step of the DOFs, if known), then the constraints solved by Newton.
+  void place(const Eigen::VectorXd& qhat, const Eigen::VectorXd* dx) {
+    if (dx) data_.x += *dx;
     data_.qhat = qhat;
     for (int g : sys_.x_input) data_.x[g] = qhat[sys_.qhat_col_x[g]];
     for (int g : sys_.x_dyn) data_.x[g] = qhat[sys_.qhat_col_x[g]];
-    have_DF_ = false;  // until static_forces has evaluated it here
     // Full Newton on the positions: the steps between static iterates are large, and the chord
     // iteration with the last velocity block (meant for small time steps) would crawl.
     data_.jacobian_reusable = false;
     solve_positions(sys_, data_, std::max(sys_.settings.maxiterat, 50), std::min(sys_.settings.epskin, 1e-10), false);
     res_.kinematic_iterations += data_.newton_iterations;
-    have_DF_ = true;   // static_forces follows at once
   }
 
-  // The DOFs that make up the directions V (columns) of q: components ≥ 10% of the largest,
-  // the largest first, at most four named.
-  std::string directions(const Eigen::MatrixXd& V) const {
-    std::vector<std::pair<double, int>> part;
-    for (int j = 0; j < nd_; ++j) {
-      double w = 0.0;
-      for (int c = 0; c < V.cols(); ++c) w = std::max(w, std::abs(V(j, c)) / V.col(c).cwiseAbs().maxCoeff());
-      if (w >= 0.1) part.push_back({-w, j});
-    }
-    std::sort(part.begin(), part.end());
-    std::ostringstream os;
-    os << "the direction of";
-    for (size_t i = 0; i < part.size() && i < 4; ++i) os << (i ? ", " : " ") << dof_name(sys_, part[i].second);
-    if (part.size() > 4) os << " and " << part.size() - 4 << " more";
-    return os.str();
-  }
-
-  static int determinant_sign(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu) {
-    int sign = static_cast<int>(lu.permutationP().determinant());
-    for (int i = 0; i < lu.matrixLU().rows(); ++i)
-      if (lu.matrixLU()(i, i) < 0.0) sign = -sign;
-    return sign;
-  }
+  std::string directions(const Eigen::MatrixXd& V) const { return dof_directions(sys_, V); }
 
   const System& sys_;
   Data& data_;
   const StaticOptions& opt_;
   StaticResults& res_;
   const int nd_;
+  NodalLayout layout_;
+  SaddlePoint tangent_;
+  bool factorized_ = false;
   Eigen::VectorXd scale_;        // characteristic size of each DOF: lengths vs angles
   Eigen::VectorXd p0_, p1_;
   Eigen::VectorXd R0_;           // generalized forces at the start (see start())
-  Eigen::MatrixXd K_;
-  bool have_DF_ = false;
 };
 
 // Riks' normal-plane arc-length method on y = (q_s, μ), q_s the DOFs divided by their scale
@@ -354,7 +393,8 @@ class EquilibriumPath {
 // regular at limit points, where K alone is singular. The tangent at a new point solves the
 // same bordered system with the previous tangent, τ_oldᵀ τ > 0: the path goes on in the
 // direction it came from, λ falling after a limit point. The step length follows the Newton
-// iterations; a failed step is halved.
+// iterations; a failed step is halved. The bordered systems are solved by block elimination
+// with two solves of the tangent (EquilibriumPath::solve_scaled).
 class ArcLength {
  public:
   ArcLength(const System& sys, EquilibriumPath& path, const StaticOptions& opt, StaticResults& res)
@@ -363,7 +403,8 @@ class ArcLength {
   struct Point {
     EquilibriumPath::Snapshot state;
     double lambda = 0.0;
-    Eigen::VectorXd tau;  // unit tangent in y
+    Eigen::VectorXd tau;   // unit tangent in y
+    Eigen::VectorXd x_tau; // the change of the coordinates per unit step along it
   };
 
   // The starting point (the current state at λ = 0), its tangent, c and the first step length
@@ -371,20 +412,22 @@ class ArcLength {
   Point start(const Eigen::VectorXd& qhat) {
     Point p;
     Eigen::VectorXd Fs;
-    path_.evaluate(qhat, 0.0, Fs, gs_);
+    path_.evaluate(qhat, 0.0, nullptr, Fs, gs_);
     check_thread_deadline("(in the static analysis)");
-    const Eigen::MatrixXd Ks = path_.scaled_tangent();
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(Ks);
-    lu.setThreshold(1e-13);
-    if (nd_ > 0 && !lu.isInvertible())
+    if (nd_ > 0 && (!path_.factorized() || path_.singular()))
       throw StaticError("arc-length continuation needs a regular tangent stiffness at the start; it is singular in " +
-                        path_.dof_directions(lu.kernel().col(0)));
-    c_ = nd_ > 0 ? lu.solve(-gs_).norm() : 0.0;
+                        path_.singular_directions());
+    c_ = 1.0;
+    if (nd_ > 0) {
+      Eigen::VectorXd dy, dx;
+      path_.solve_scaled(-gs_, dy, dx);
+      c_ = dy.norm();
+    }
     if (!(c_ > 0.0) || !std::isfinite(c_)) c_ = 1.0;  // nothing loaded: λ alone
     Eigen::VectorXd e = Eigen::VectorXd::Zero(nd_ + 1);
     e[nd_] = 1.0;
     p.state = path_.save();
-    p.tau = tangent(e);
+    tangent(e, p);
     first_length_ = c_ / opt_.steps / p.tau[nd_];
     return p;
   }
@@ -405,11 +448,11 @@ class ArcLength {
     const Eigen::VectorXd& scale = path_.scale();
     for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += scale[j] * ds * a.tau[j];
     double lambda = a.lambda + ds * a.tau[nd_] / c_;
-    Step s = correct(qhat, lambda, a.tau);
+    Step s = correct(qhat, lambda, a.tau, ds * a.x_tau);
     if (!s.converged) return s;
     b.state = path_.save();
     b.lambda = lambda;
-    b.tau = tangent(a.tau);
+    tangent(a.tau, b);
     if (!b.tau.allFinite()) {
       s.converged = false;
       s.why = "the tangent of the path is not defined there";
@@ -450,22 +493,22 @@ class ArcLength {
   }
 
  private:
-  // Newton on [F(q, λ); nᵀ (y − y0)] = 0 from y0 = (q̂, λ).
-  Step correct(Eigen::VectorXd qhat, double& lambda, const Eigen::VectorXd& n) {
+  // Newton on [F(q, λ); nᵀ (y − y0)] = 0 from y0 = (q̂, λ), the coordinates predicted by dx.
+  Step correct(Eigen::VectorXd qhat, double& lambda, const Eigen::VectorXd& n, Eigen::VectorXd dx) {
     Step s;
     const Eigen::VectorXd& scale = path_.scale();
-    Eigen::VectorXd Fs;
+    Eigen::VectorXd Fs, dy;
     double last_correction = std::numeric_limits<double>::infinity();
     for (int it = 0;; ++it) {
       check_thread_deadline("(in the static analysis)");
       double force = 0.0;
       try {
-        force = path_.evaluate(qhat, lambda, Fs, gs_);
+        force = path_.evaluate(qhat, lambda, &dx, Fs, gs_);
       } catch (const KinematicsError& err) {
         s.why = std::string("the kinematics has no solution there (") + err.what() + ")";
         return s;
       }
-      if (!Fs.allFinite() || !gs_.allFinite()) {
+      if (!Fs.allFinite() || !gs_.allFinite() || !path_.factorized()) {
         s.why = "the forces or the stiffness are not finite";
         return s;
       }
@@ -474,10 +517,7 @@ class ArcLength {
         res_max = Fs.cwiseAbs().maxCoeff(&s.worst);
         s.worst_residual = Fs[s.worst] / scale[s.worst];
       }
-      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nd_ + 1);
-      rhs.head(nd_) = -Fs;
-      const Eigen::VectorXd dy = bordered(n).partialPivLu().solve(rhs);
-      if (!dy.allFinite()) {
+      if (!bordered(n, -Fs, 0.0, dy, dx)) {
         s.why = "the bordered tangent is singular";
         return s;
       }
@@ -500,21 +540,41 @@ class ArcLength {
     }
   }
 
-  // [K_s, g_s / c; nᵀ] at the last evaluation.
-  Eigen::MatrixXd bordered(const Eigen::VectorXd& n) const {
-    Eigen::MatrixXd J(nd_ + 1, nd_ + 1);
-    J.topLeftCorner(nd_, nd_) = path_.scaled_tangent();
-    J.topRightCorner(nd_, 1) = gs_ / c_;
-    J.row(nd_) = n.transpose();
-    return J;
+  // [y_q; y_λ] solving [K_s, g_s / c; n_qᵀ, n_λ] y = [r; ρ] at the last evaluation, and dx, the
+  // change of the coordinates for y: with a = K_s⁻¹ r and b = K_s⁻¹ g_s / c, y_q = a − y_λ b and
+  // y_λ = (ρ − n_qᵀ a) / (n_λ − n_qᵀ b). False if it is singular.
+  bool bordered(const Eigen::VectorXd& n, const Eigen::VectorXd& r, double rho, Eigen::VectorXd& y,
+                Eigen::VectorXd& dx) {
+    y.resize(nd_ + 1);
+    if (nd_ == 0) {
+      if (n[0] == 0.0) return false;
+      y[0] = rho / n[0];
+      dx = Eigen::VectorXd::Zero(sys_.nx);
+      return true;
+    }
+    if (path_.singular()) return false;
+    Eigen::VectorXd a, b, dx_a, dx_b;
+    path_.solve_scaled(gs_ / c_, b, dx_b);
+    if (r.any()) path_.solve_scaled(r, a, dx_a);
+    else a = Eigen::VectorXd::Zero(nd_), dx_a = Eigen::VectorXd::Zero(sys_.nx);
+    const double denominator = n[nd_] - n.head(nd_).dot(b);
+    y[nd_] = (rho - n.head(nd_).dot(a)) / denominator;
+    y.head(nd_) = a - y[nd_] * b;
+    dx = dx_a - y[nd_] * dx_b;
+    return y.allFinite() && dx.allFinite();
   }
 
-  // The unit tangent at the last evaluation, oriented by nᵀ τ > 0.
-  Eigen::VectorXd tangent(const Eigen::VectorXd& n) const {
-    Eigen::VectorXd e = Eigen::VectorXd::Zero(nd_ + 1);
-    e[nd_] = 1.0;
-    const Eigen::VectorXd t = bordered(n).partialPivLu().solve(e);
-    return t / t.norm();
+  // The unit tangent at the last evaluation, oriented by nᵀ τ > 0, into p (with x_tau).
+  void tangent(const Eigen::VectorXd& n, Point& p) {
+    Eigen::VectorXd t, dx;
+    if (!bordered(n, Eigen::VectorXd::Zero(nd_), 1.0, t, dx)) {
+      p.tau = Eigen::VectorXd::Constant(nd_ + 1, std::numeric_limits<double>::quiet_NaN());
+      p.x_tau = Eigen::VectorXd::Zero(sys_.nx);
+      return;
+    }
+    const double norm = t.norm();
+    p.tau = t / norm;
+    p.x_tau = dx / norm;
   }
 
   const System& sys_;
@@ -683,7 +743,7 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
       path.restore(a.state);
       EquilibriumPath::Attempt last;
       try {
-        path.evaluate(qhat, 1.0, Fs, gs);
+        path.evaluate(qhat, 1.0, nullptr, Fs, gs);
         last = path.solve(1.0, true);
       } catch (const KinematicsError& err) {
         last.converged = false;
@@ -710,7 +770,7 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
     if (turned) {  // back to b from the limit point's search
       path.restore(b.state);
       Eigen::VectorXd Fs, gs;
-      path.evaluate(b.state.qhat, b.lambda, Fs, gs);
+      path.evaluate(b.state.qhat, b.lambda, nullptr, Fs, gs);
     }
     ++done;
     rows.store(b.lambda, iterations);
@@ -772,14 +832,49 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
   sim.store_state();
 }
 
-StaticTangent static_tangent(Model& model, double load_factor, const Eigen::VectorXd* x, const Eigen::VectorXd* e) {
+namespace {
+
+// The rows T (m x nx) of the displacements of the nodes: a position node's coordinates, a BETA
+// node's angle, a LAMBDA node's small rotation vector in global axes, δθ = 2 E(λ) δλ.
+Eigen::MatrixXd displacement_rows(const System& sys, const Data& data, const std::vector<int>& nodes) {
+  std::vector<Eigen::RowVectorXd> rows;
+  for (int n : nodes) {
+    std::vector<int> coords;
+    for (int g = 0; g < sys.nx; ++g)
+      if (sys.coord_label[g][0] == n) coords.push_back(g);
+    if (coords.empty()) throw InputError("node " + std::to_string(n) + " has no coordinates used by an element");
+    if (sys.coord_node_kind[coords[0]] == NodeKind::Lambda) {
+      const Eigen::Vector4d l = Eigen::Vector4d(data.x.segment<4>(coords[0])).normalized();
+      const Eigen::Matrix<double, 3, 4> E = 2.0 * euler_E(l);
+      for (int i = 0; i < 3; ++i) {
+        Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(sys.nx);
+        row.segment<4>(coords[0]) = E.row(i);
+        rows.push_back(row);
+      }
+      continue;
+    }
+    for (int g : coords) {
+      Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(sys.nx);
+      row[g] = 1.0;
+      rows.push_back(row);
+    }
+  }
+  Eigen::MatrixXd T(rows.size(), sys.nx);
+  for (size_t i = 0; i < rows.size(); ++i) T.row(i) = rows[i];
+  return T;
+}
+
+}  // namespace
+
+Eigen::MatrixXd static_compliance(Model& model, const std::vector<int>& nodes, double load_factor,
+                                  const Eigen::VectorXd* x, const Eigen::VectorXd* e) {
   Simulation sim(model);
   sim.assemble();
   const System& sys = sim.system();
   Data& data = sim.data();
   if (x || e) {
     if (!x || !e || x->size() != sys.nx || e->size() != sys.ne)
-      throw InputError("static_tangent: x and e must both be given, with " + std::to_string(sys.nx) + " and " +
+      throw InputError("static_compliance: x and e must both be given, with " + std::to_string(sys.nx) + " and " +
                        std::to_string(sys.ne) + " values");
     // The row is a solved state: its positions, and the independent coordinates from them; the
     // kinematics then only refreshes the deformations and their derivatives there.
@@ -791,13 +886,27 @@ StaticTangent static_tangent(Model& model, double load_factor, const Eigen::Vect
     data.jacobian_reusable = false;
     solve_positions(sys, data, std::max(sys.settings.maxiterat, 50), std::min(sys.settings.epskin, 1e-10), false);
   }
-  StaticTangent t;
-  static_forces(sys, data, load_factor, t.R, &t.K);
-  t.DF = Eigen::MatrixXd(data.DFq);
-  t.x = data.x;
-  t.coord_label = sys.coord_label;
-  for (int j = 0; j < sys.n_dof(); ++j) t.dof_names.push_back(dof_name(sys, j));
-  return t;
+  Eigen::VectorXd R;
+  static_forces(sys, data, load_factor, R);
+  const NodalLayout layout(sys);
+  SaddlePoint tangent(sys, layout);
+  NodalCoefficients c;
+  c.load_factor = load_factor;
+  if (!tangent.factorize(sys, data, data.sigma, c))
+    throw StaticError("the tangent stiffness is not finite at this state");
+  if (tangent.singular() && sys.n_dof() > 0) {
+    const Eigen::VectorXd dx = tangent.null_direction();
+    const std::string where = dx.size() ? dof_directions(sys, dof_change(sys, data, dx).cwiseQuotient(dof_scale(sys))) : "a direction not located";
+    throw StaticError("the tangent stiffness is singular: no stiffness in " + where + "; the compliance is unbounded");
+  }
+  const Eigen::MatrixXd T = displacement_rows(sys, data, nodes);
+  Eigen::MatrixXd TD(T.rows(), T.rows());
+  Eigen::VectorXd dx;
+  for (int j = 0; j < T.rows(); ++j) {
+    tangent.solve(T.row(j).transpose(), dx);
+    TD.col(j) = T * dx;
+  }
+  return TD;
 }
 
 }  // namespace spacar

@@ -12,6 +12,8 @@ current state under the block's full loads) seen through the transfer function o
 so C_ij is the displacement i of the node per unit load j on it (a small load added to the
 block's loads). For a LAMBDA node the rows of T are the small rotation vector in global axes,
 δθ = 2 E(λ) δλ (docs/formulation.md §2): the rotations are compliant to moments in global axes.
+K is never formed: each column of C is one solve of the sparse saddle-point system of the nodal
+coordinates (docs/formulation.md §8), so the cost grows linearly with the size of the model.
 """
 from __future__ import annotations
 
@@ -19,26 +21,19 @@ import numpy as np
 
 from . import _core
 from ._util import show
-from .errors import InputError, StaticError
-from .geometry import euler_e
+from .errors import InputError
 
-# The coordinates of a node kind that describe its displacement.
+# The node kinds whose displacements the compliance gives (a LAMBDA node: its rotation vector).
 _SIZE = {"XY": 2, "BETA": 1, "XYZ": 3}
 
 
-def _rows(tangent: dict, nodes: dict, n, what: str) -> np.ndarray:
-    """The rows of T for node n: DF of its coordinates (a LAMBDA node: 2 E(λ) DF_λ)."""
+def _node(nodes: dict, n, what: str) -> int:
+    """Node n, checked to be a node of the model with a displacement."""
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or int(n) not in nodes:
         raise InputError(f"{what} {show(n)} is not a node of the model")
-    kind = nodes[int(n)].kind.name
-    rows = [i for i, (node, _) in enumerate(tangent["coord_label"]) if node == int(n)]
-    DF = np.asarray(tangent["DF"])[rows]
-    if kind == "LAMBDA":
-        lam = np.asarray(tangent["x"])[rows]
-        return 2.0 * euler_e(lam / np.linalg.norm(lam)) @ DF
-    if kind not in _SIZE:
+    if nodes[int(n)].kind.name not in (*_SIZE, "LAMBDA"):
         raise InputError(f"{what} {int(n)} has no coordinates used by an element")
-    return DF
+    return int(n)
 
 
 def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.ndarray:
@@ -73,35 +68,21 @@ def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.n
                              "pickle): call compliance(model, node, results=res)")
     if not isinstance(model, Model):
         raise InputError(f"compliance needs a spacar.Model (at its equilibrium) or spacar.static's results, got {show(model)}")
-    if results is None:
-        tangent = _core.static_tangent(model.core)
-    else:
-        if getattr(results, "stats", {}).get("analysis") != "static":
-            raise InputError("results must come from spacar.static (the rows are equilibria at load factors)")
-        k = range(len(results.t))[k]
-        tangent = _core.static_tangent(model.core, float(results.t[k]), np.asarray(results.x[k], dtype=float),
-                                       np.asarray(results.e[k], dtype=float))
     nodes = model.nodes
-    T = _rows(tangent, nodes, node, "node")
+    chosen = [_node(nodes, node, "node")]
     if rotation is not None:
         is_number = isinstance(rotation, (int, np.integer)) and not isinstance(rotation, bool)
         if not is_number or int(rotation) not in nodes or nodes[int(rotation)].kind.name not in ("BETA", "LAMBDA"):
             raise InputError(f"rotation {show(rotation)} must be a BETA or LAMBDA node of the model")
-        T = np.vstack([T, _rows(tangent, nodes, rotation, "rotation node")])
-    K = np.asarray(tangent["K"])
-    if K.size == 0:
-        return np.zeros((T.shape[0], T.shape[0]))
-    # Singular? Judged on the stiffness scaled to a unit diagonal, so that lengths and angles,
-    # stiff and soft parts compare (a zero diagonal is left as it is: a direction without stiffness).
-    diag = np.abs(np.diag(K))
-    d = 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0))
-    _, s, vt = np.linalg.svd(d[:, None] * K * d[None, :])
-    if not s[-1] > 1e-13 * s[0]:
-        weights = np.abs(d * vt[-1])
-        names = [tangent["dof_names"][j] for j in np.argsort(-weights) if weights[j] >= 0.1 * weights.max()]
-        raise StaticError(f"the tangent stiffness is singular: no stiffness in the direction of "
-                          f"{', '.join(names[:4])}{' and more' if len(names) > 4 else ''}; the compliance is unbounded")
-    return T @ np.linalg.solve(K, T.T)
+        chosen.append(int(rotation))
+    if results is None:
+        return np.asarray(_core.static_compliance(model.core, chosen))
+    if getattr(results, "stats", {}).get("analysis") != "static":
+        raise InputError("results must come from spacar.static (the rows are equilibria at load factors)")
+    k = range(len(results.t))[k]
+    return np.asarray(_core.static_compliance(model.core, chosen, float(results.t[k]),
+                                              np.asarray(results.x[k], dtype=float),
+                                              np.asarray(results.e[k], dtype=float)))
 
 
 def support_stiffness(model, node, components=None) -> np.ndarray:

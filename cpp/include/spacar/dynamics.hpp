@@ -42,10 +42,6 @@ Eigen::MatrixXd global_constitutive(const System& sys, bool damping);
 // A taken as a sparse factor, which halves the cost of the dense products.
 Eigen::MatrixXd congruence(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A);
 
-// Σ σ_k H_k − ∂f/∂x (nx x nx) at the current positions for the stress vector sigma: the
-// geometric stiffness of the stresses and the stiffness of position-dependent loads.
-Eigen::MatrixXd geometric_stiffness(const System& sys, Data& data, const Eigen::VectorXd& sigma);
-
 // Solve M̄ q̈ = rhs (3.1) and complete ẍ, ë. Requires positions, DF and velocities.
 // Throws SingularMassError naming the degrees of freedom without inertia.
 void solve_dynamics(const System& sys, Data& data);

@@ -61,8 +61,12 @@ void deformation_accelerations(const System& sys, Data& data);
 void solve_accelerations_direct(const System& sys, Data& data);
 
 // out = DFᵀ w (one entry per column of q̂) without forming DF: one solve with the transposed
-// velocity block (after solve_velocities_direct). Uses the rhs_V/sol_V work vectors.
+// velocity block (after solve_velocities_direct). Uses the rhs_V/sol_V work vectors and leaves
+// in sol_V the multipliers μ of A_Vᵀ μ = w^c (one per velocity row).
 void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out);
+// dx = DF v (nx) for rates v of q̂ without forming DF: one solve with the velocity block (after
+// solve_velocities_direct).
+void transfer_times(const System& sys, Data& data, const Eigen::VectorXd& v, Eigen::VectorXd& dx);
 
 // Assemble the constraint block A (AP or AV, `block`: its element block ids) at the current
 // element derivatives.

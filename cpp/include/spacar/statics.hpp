@@ -8,7 +8,9 @@
 // second term being zero from an unloaded, stress-free start (and the previous block's loads in
 // generalized form when a block continues from an equilibrium).
 // Full Newton with the exact tangent stiffness ∂R/∂q = K0 + G0 of the linearization (structural
-// plus geometric, formulation.md §7.2; C0 = N0 = 0 at rest), λ from 0 to 1 in equal load steps,
+// plus geometric, formulation.md §7.2; C0 = N0 = 0 at rest), solved through the sparse
+// saddle-point system of the nodal coordinates (nodal.hpp, formulation.md §8): no dense matrix
+// of the model's size is formed. λ from 0 to 1 in equal load steps,
 // a step halved when Newton fails there. No mass is needed. With arc_length the path is followed
 // in (q, λ) instead (Riks' normal-plane arc-length method): past limit points, λ rising and
 // falling, until λ = 1.
@@ -57,16 +59,16 @@ struct StaticResults {
 };
 
 // The static state at load factor λ with the positions solved: the reduced generalized forces
-// R (n_dof) and, if K is not null, the tangent stiffness ∂R/∂q (n_dof x n_dof). Leaves in data
-// the transfer functions, the rates at zero, data.f = λ f, the complete stresses σ (reaction
-// stresses of the velocity rows from the equilibrium of the calculable coordinates) and the
-// reactions on the fixed and input coordinates. If dR_dlambda is not null (needs K), ∂R/∂λ at
-// fixed DOFs: −DF_qᵀ f, plus, when the inputs move with λ at the rates `input_rate` (n_input,
-// ordered as input_cols), the tangent's response to that motion, ∂R/∂p · input_rate. Returns
-// the scale of R: the largest applied or elastic load on a coordinate (loads on lengths times
-// the mean element length).
-double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K,
-                     Eigen::VectorXd* dR_dlambda = nullptr, const Eigen::VectorXd* input_rate = nullptr);
+// R = DF_qᵀ (−λ f + Σ Bᵀσ) (n_dof), from one transposed solve with the velocity block (no
+// transfer functions). Leaves in data the rates at zero, data.f = λ f, the complete stresses σ
+// (reaction stresses of the velocity rows from the equilibrium of the calculable coordinates)
+// and the reactions on the fixed and input coordinates; full_load, if given: f at λ = 1. If K
+// is not null, also the tangent stiffness ∂R/∂q = K0 + G0 (n_dof x n_dof), dense (the transfer
+// functions formed): for tests and small models; the static path itself solves with the
+// sparse tangent of the nodal coordinates (nodal.hpp). Returns the scale of R: the largest
+// applied or elastic load on a coordinate (loads on lengths times the mean element length).
+double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K = nullptr,
+                     Eigen::VectorXd* full_load = nullptr);
 
 // "DYNX node 3 component 2" / "DYNE element 2 (PLBEAM) deformation 3" of degree of freedom j.
 std::string dof_name(const System& sys, int j);
@@ -76,19 +78,15 @@ std::string dof_name(const System& sys, int j);
 // with `res` holding the rows converged before it; the model is then not changed.
 void solve_static(Model& model, StaticResults& res, const StaticOptions& options = {});
 
-// The tangent of the static solve (spacar.compliance): R and K = K0 + G0 under λ times the
-// block's loads, DF of the degrees of freedom (∂x/∂q), x and the names of the DOFs.
-struct StaticTangent {
-  Eigen::VectorXd R, x;
-  Eigen::MatrixXd K, DF;
-  std::vector<std::array<int, 2>> coord_label;
-  std::vector<std::string> dof_names;
-};
-
-// At the model's current state or, given both x and e (a row of static results), at that row:
-// the model is assembled as a simulation does and put there. InputError if only one of x, e is
-// given or their sizes are wrong.
-StaticTangent static_tangent(Model& model, double load_factor, const Eigen::VectorXd* x = nullptr,
-                             const Eigen::VectorXd* e = nullptr);
+// The static compliance C = T DF_q K⁻¹ DF_qᵀ Tᵀ at the nodes (spacar.compliance), T the rows of
+// their displacements (m x nx: a position node's coordinates, a BETA node's angle, a LAMBDA
+// node's small rotation vector in global axes, δθ = 2 E(λ) δλ), K = K0 + G0 the tangent
+// stiffness of the static solve at load_factor times the block's loads: one solve of the sparse
+// saddle-point system per row of T (no dense matrix of the model's size). At the model's
+// current state or, given both x and e (a row of static results), at that row: the model is
+// assembled as a simulation does and put there. InputError if only one of x, e is given or a
+// size is wrong; StaticError naming the direction if K is singular.
+Eigen::MatrixXd static_compliance(Model& model, const std::vector<int>& nodes, double load_factor = 1.0,
+                                  const Eigen::VectorXd* x = nullptr, const Eigen::VectorXd* e = nullptr);
 
 }  // namespace spacar

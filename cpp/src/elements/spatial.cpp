@@ -71,6 +71,12 @@ Eigen::Matrix<double, 3, 4> euler_G(const double* l) {
   return G;
 }
 
+Eigen::Matrix<double, 3, 4> euler_E(const Eigen::Vector4d& l) {
+  Eigen::Matrix<double, 3, 4> E;
+  E << -l[1], l[0], -l[3], l[2], -l[2], l[3], l[0], -l[1], -l[3], -l[2], l[1], l[0];
+  return E;
+}
+
 void add_rotational_inertia(int n, const double* x, const double* v, const int* lam, int nblocks,
                             const Eigen::Matrix3d* A, double* M, double* h) {
   Eigen::Map<Eigen::MatrixXd> Mm(M, n, n);
