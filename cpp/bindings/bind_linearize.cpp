@@ -18,6 +18,22 @@ py::dict linearization_to_dict(const Linearization& l) {
   return d;
 }
 
+py::dict nodal_linearization_to_dict(NodalLinearization&& n) {
+  py::dict d;
+  d["t"] = n.t;
+  d["z_label"] = n.z_label;
+  d["n_line"] = n.n_line;
+  d["M"] = std::move(n.M);
+  d["D"] = std::move(n.D);
+  d["K"] = std::move(n.K);
+  d["G"] = std::move(n.G);
+  d["A"] = std::move(n.A);
+  d["E"] = std::move(n.E);
+  d["free"] = n.free;
+  d["r0"] = std::move(n.r0);
+  return d;
+}
+
 // The names of the arrays, in the order of for_each_array (spacar.linearize.MATRICES).
 py::tuple linearization_arrays() {
   py::list names;

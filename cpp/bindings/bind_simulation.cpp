@@ -125,6 +125,48 @@ void bind_simulation(py::module_& m) {
       .def("forces", &Simulation::forces)
       .def("reduced_accelerations", &Simulation::reduced_accelerations)
       .def("linearize", [](Simulation& s) { return linearization_to_dict(s.linearize()); })
+      .def("linearize_nodal",
+           [](Simulation& s) -> py::object {
+             NodalLinearization n;
+             if (!s.linearize_nodal(n)) return py::none();
+             return nodal_linearization_to_dict(std::move(n));
+           },
+           "The linearized equations at rest in the nodal coordinates (sparse M, D, K, G, the constraint rows "
+           "A, the map E: δz = E δx) at the assembled state, or None if it is not at rest in static equilibrium.")
+      .def("nodal_factorize",
+           [](Simulation& s, double stiffness, double geometric, double mass, double damping) {
+             NodalCoefficients c;
+             c.stiffness = stiffness, c.geometric = geometric, c.mass = mass, c.damping = damping;
+             Linearizer& lin = s.linearizer();
+             py::dict d;
+             d["ok"] = lin.nodal_factorize(c);
+             const SaddlePoint& sp = lin.nodal_system();
+             d["singular"] = sp.singular();
+             d["sign"] = sp.sign_determinant();
+             d["negative"] = sp.negative_eigenvalues();
+             d["symmetric"] = sp.symmetric();
+             return d;
+           },
+           py::arg("stiffness") = 1.0, py::arg("geometric") = 1.0, py::arg("mass") = 0.0, py::arg("damping") = 0.0,
+           "Factorize H = stiffness·K + geometric·G + mass·M + damping·D of linearize_nodal's state in the "
+           "saddle-point system; its reduced matrix's singularity, determinant sign and negative eigenvalues.")
+      .def("nodal_solve",
+           [](Simulation& s, const Eigen::VectorXd& b) {
+             Linearizer& lin = s.linearizer();
+             const int nf = lin.nodal_system().layout().n_free;
+             if (b.size() != nf)
+               throw InputError("nodal_solve: b needs " + std::to_string(nf) + " values, got " + std::to_string(b.size()));
+             Eigen::VectorXd x(nf);
+             lin.nodal_solve(b.data(), x.data());
+             return x;
+           },
+           py::arg("b"),
+           "x_f = Z (Zᵀ H Z)⁻¹ Zᵀ b_f over the free coordinates with the last nodal_factorize.")
+      .def("nodal_energies",
+           [](Simulation& s, const Eigen::VectorXd& v) { return s.linearizer().nodal_energies(v); },
+           py::arg("v"),
+           "(vᵀKv, vᵀGv, vᵀMv, vᵀDv) of linearize_nodal's state for v over the free coordinates, element by "
+           "element (the Rayleigh quotients of the sparse eigen-analyses).")
       .def("diagnose",
            [](Simulation& s, double time_limit, double time_spent) {
              const DeadlineScope deadline(time_limit, time_spent);

@@ -25,6 +25,7 @@ void bind_statics(py::module_& m);
 [[noreturn]] void raise_with_results(const std::exception_ptr& p, py::object results);
 
 py::dict linearization_to_dict(const Linearization& l);
+py::dict nodal_linearization_to_dict(NodalLinearization&& n);
 py::tuple linearization_arrays();
 
 }  // namespace spacar::bindings

@@ -12,6 +12,8 @@
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
+#include "spacar/nodal.hpp"
+#include "spacar/statics.hpp"
 
 namespace spacar {
 
@@ -51,7 +53,8 @@ void Linearizer::residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R) {
   for (int i = 0; i < nz; ++i) R[i] = RL[order_[i]];
 }
 
-Linearization Linearizer::compute(const System& sys, const Data& data, bool precise) {
+Linearizer::ZState Linearizer::z_state(const System& sys, const Data& data, std::vector<std::array<int, 3>>& labels,
+                                       int& n_line) {
   const System& L = *lin_;
   const int nz = L.n_dof();
   const int nxd_L = static_cast<int>(L.x_dyn.size());
@@ -59,18 +62,18 @@ Linearization Linearizer::compute(const System& sys, const Data& data, bool prec
   std::vector<int> dof_of_coord(L.nx, -1), dof_of_def(L.ne, -1);
   for (int i = 0; i < nxd_L; ++i) dof_of_coord[L.x_dyn[i]] = i;
   for (size_t i = 0; i < L.e_dyn.size(); ++i) dof_of_def[L.e_dyn[i]] = nxd_L + static_cast<int>(i);
-  Linearization lin;
-  lin.t = data.t;
   order_.clear();
-  Eigen::VectorXd z(nz), zd(nz), zdd(nz);
-  Eigen::VectorXd scale(nz);  // characteristic size of each z: finite-difference steps
+  labels.clear();
+  ZState zs;
+  zs.z.resize(nz), zs.zd.resize(nz), zs.zdd.resize(nz), zs.scale.resize(nz);  // scale: finite-difference steps
   auto add = [&](int dof, std::array<int, 3> label, double v, double vd, double vdd, bool length) {
-    scale[order_.size()] = length ? L.length_scale : 1.0;
-    z[order_.size()] = v;
-    zd[order_.size()] = vd;
-    zdd[order_.size()] = vdd;
+    const size_t i = order_.size();
+    zs.scale[i] = length ? L.length_scale : 1.0;
+    zs.z[i] = v;
+    zs.zd[i] = vd;
+    zs.zdd[i] = vdd;
     order_.push_back(dof);
-    lin.z_label.push_back(label);
+    labels.push_back(label);
   };
   for (int g : sys.x_dyn) {
     const int col = sys.qhat_col_x[g];
@@ -84,8 +87,98 @@ Linearization Linearizer::compute(const System& sys, const Data& data, bool prec
   }
   for (int k : sys.e_line)
     add(dof_of_def[k], {1, sys.def_label[k][0], sys.def_label[k][1]}, sys.e_target[k], 0.0, 0.0, sys.def_is_length[k]);
-  lin.n_line = static_cast<int>(sys.e_line.size());
+  n_line = static_cast<int>(sys.e_line.size());
   if (static_cast<int>(order_.size()) != nz) throw Error("linearize: the coordinates of the two systems differ");
+  return zs;
+}
+
+void Linearizer::set_nominal(const System& sys, const Data& data, const ZState& zs, bool transfer) {
+  // The inputs and the time-dependent loads of the analysis at its state (tables, load
+  // functions, a controller's held loads: formulation.md's constant block motion otherwise).
+  if (lin_->n_input() != sys.n_input()) throw Error("linearize: the inputs of the two systems differ");
+  inputs_.resize(sys.n_input(), 3);
+  for (int i = 0; i < sys.n_input(); ++i) {
+    const int col = sys.input_cols[i];
+    inputs_.row(i) << data.qhat[col], data.qhat_d[col], data.qhat_dd[col];
+  }
+  ld_->time_load = data.time_load;
+  ld_->t = data.t;
+  ld_->x = data.x;
+  ld_->angle_ref = data.angle_ref;
+  ld_->e_integrated = data.e_integrated;
+  set_z(zs.z, zs.zd, transfer);
+}
+
+bool Linearizer::compute_nodal(const System& sys, const Data& data, NodalLinearization& out) {
+  const System& L = *lin_;
+  saddle_.reset();
+  if (!sys.e_kinematic.empty()) return false;
+  out = NodalLinearization();
+  out.t = data.t;
+  const ZState zs = z_state(sys, data, out.z_label, out.n_line);
+  if (zs.zd.any()) return false;
+  for (int col : sys.input_cols)
+    if (data.qhat_d[col] != 0.0 || data.qhat_dd[col] != 0.0) return false;
+  set_nominal(sys, data, zs, false);
+  // In static equilibrium (then q̈ = 0 and N0 = 0): the reduced residual at rest, the complete
+  // stresses with it.
+  Eigen::VectorXd R;
+  const double force = static_forces(L, *ld_, 1.0, R);
+  const int nz = L.n_dof(), nq = nz - out.n_line;
+  for (int i = 0; i < nq; ++i)
+    if (!(std::abs(R[order_[i]]) * zs.scale[i] <= 1e-8 * force)) return false;
+  out.r0.resize(nz);
+  for (int i = 0; i < nz; ++i) out.r0[i] = -R[order_[i]];
+  nodal_sigma_ = ld_->sigma;
+  out.M = nodal_part(L, *ld_, nodal_sigma_, kMass);
+  out.D = nodal_part(L, *ld_, nodal_sigma_, kDamping);
+  out.K = nodal_part(L, *ld_, nodal_sigma_, kStiffness);
+  out.G = nodal_part(L, *ld_, nodal_sigma_, kGeometric);
+  layout_ = std::make_unique<NodalLayout>(L);
+  out.A = nodal_constraints(L, *ld_, *layout_);
+  out.free = layout_->free;
+  // E in the order of z: row i is the row of L's DOF order_[i].
+  Eigen::SparseMatrix<double> P(nz, nz);
+  std::vector<Eigen::Triplet<double>> unit;
+  for (int i = 0; i < nz; ++i) unit.emplace_back(i, order_[i], 1.0);
+  P.setFromTriplets(unit.begin(), unit.end());
+  out.E = P * nodal_dof_map(L, *ld_);
+  saddle_ = std::make_unique<SaddlePoint>(L, *layout_);
+  return true;
+}
+
+bool Linearizer::nodal_factorize(const NodalCoefficients& c) {
+  if (!saddle_) throw Error("linearize: no nodal linearization to factorize (compute_nodal first)");
+  return saddle_->factorize(*lin_, *ld_, nodal_sigma_, c);
+}
+
+const SaddlePoint& Linearizer::nodal_system() const {
+  if (!saddle_) throw Error("linearize: no nodal linearization (compute_nodal first)");
+  return *saddle_;
+}
+
+void Linearizer::nodal_solve(const double* b, double* x) {
+  if (!saddle_) throw Error("linearize: no nodal linearization to solve with (compute_nodal first)");
+  saddle_->solve_free(b, x);
+}
+
+Eigen::Vector4d Linearizer::nodal_energies(const Eigen::VectorXd& v_free) {
+  if (!saddle_) throw Error("linearize: no nodal linearization (compute_nodal first)");
+  if (v_free.size() != layout_->n_free)
+    throw InputError("nodal_energies: v needs " + std::to_string(layout_->n_free) + " values, got " +
+                     std::to_string(v_free.size()));
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(lin_->nx);
+  for (int f = 0; f < layout_->n_free; ++f) v[layout_->free[f]] = v_free[f];
+  return spacar::nodal_energies(*lin_, *ld_, nodal_sigma_, v);
+}
+
+Linearization Linearizer::compute(const System& sys, const Data& data, bool precise) {
+  const System& L = *lin_;
+  const int nz = L.n_dof();
+  Linearization lin;
+  lin.t = data.t;
+  const ZState zs = z_state(sys, data, lin.z_label, lin.n_line);
+  const Eigen::VectorXd &z = zs.z, &zd = zs.zd, &zdd = zs.zdd, &scale = zs.scale;
 
   // Kinematic coordinates of nonholonomic constraints: y^k, integrated in the motion.
   Eigen::VectorXd y(sys.e_kinematic.size()), yscale(sys.e_kinematic.size());
@@ -97,20 +190,8 @@ Linearization Linearizer::compute(const System& sys, const Data& data, bool prec
   }
   const int nk = static_cast<int>(y.size());
 
-  // Nominal state, with the inputs and the time-dependent loads of the analysis at it (tables,
-  // load functions, a controller's held loads: formulation.md's constant block motion otherwise).
-  if (L.n_input() != sys.n_input()) throw Error("linearize: the inputs of the two systems differ");
-  inputs_.resize(sys.n_input(), 3);
-  for (int i = 0; i < sys.n_input(); ++i) {
-    const int col = sys.input_cols[i];
-    inputs_.row(i) << data.qhat[col], data.qhat_d[col], data.qhat_dd[col];
-  }
-  ld_->time_load = data.time_load;
-  ld_->t = data.t;
-  ld_->x = data.x;
-  ld_->angle_ref = data.angle_ref;
-  ld_->e_integrated = data.e_integrated;
-  set_z(z, zd, true);
+  // Nominal state.
+  set_nominal(sys, data, zs, true);
   const Eigen::VectorXd x_nominal = ld_->x, angles_nominal = ld_->angle_ref;
   residual(zdd, lin.r0);
   lin.r0 = -lin.r0;
@@ -124,7 +205,7 @@ Linearization Linearizer::compute(const System& sys, const Data& data, bool prec
   lin.M0 = congruence(lin.DFz, ld_->M);
   lin.K0 = congruence(lin.DFez, global_constitutive(L, false));
   lin.D0 = congruence(lin.DFez, global_constitutive(L, true));
-  lin.G0 = congruence(lin.DFz, geometric_stiffness(L, *ld_, data.sigma));
+  lin.G0 = lin.DFz.transpose() * (nodal_part(L, *ld_, data.sigma, kGeometric) * lin.DFz);
   lin.AK0.resize(nk, nz);
   for (int j = 0; j < nk; ++j) lin.AK0.row(j) = lin.DFez.row(sys.e_kinematic[j]);
 

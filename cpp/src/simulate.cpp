@@ -282,11 +282,17 @@ void Simulation::move_to(double t, const double* q, const double* qd) {
 
 void Simulation::forces() { nodal_reactions(*sys_, *data_); }
 
+Linearizer& Simulation::linearizer() {
+  if (!linearizer_) linearizer_ = std::make_unique<Linearizer>(model_, dependent_);
+  return *linearizer_;
+}
+
 Linearization Simulation::linearize(bool precise) {
   forces();
-  if (!linearizer_) linearizer_ = std::make_unique<Linearizer>(model_, dependent_);
-  return linearizer_->compute(*sys_, *data_, precise);
+  return linearizer().compute(*sys_, *data_, precise);
 }
+
+bool Simulation::linearize_nodal(NodalLinearization& out) { return linearizer().compute_nodal(*sys_, *data_, out); }
 
 void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _core
 from ._util import show
-from .errors import InputError
+from .errors import InputError, SpacarError
 from .model import Model
 
 
@@ -35,6 +35,11 @@ class Linearization:
     ("e", element, deformation) of each kinematic coordinate y^k; the arrays named in
     :data:`MATRICES`; ``DF`` (∂x/∂z) and ``DFe`` (∂e/∂z) give the nodal coordinates and
     deformations per unit z (mode shapes)."""
+
+    # Models with more degrees of freedom than this solve eigenfrequencies(k=...) and
+    # buckling_factors(k=...) on the sparse nodal matrices (when they are available) rather than
+    # the dense reduced ones.
+    SPARSE_ABOVE = 200
 
     def __init__(self, d: dict, coordinate_labels, deformation_labels):
         """From the dictionary of the core (``Simulation.linearize()``, the on_output state)."""
@@ -70,6 +75,65 @@ class Linearization:
         self.coordinate_labels = [tuple(int(v) for v in c) for c in coordinate_labels]
         self.deformation_labels = [tuple(int(v) for v in c) for c in deformation_labels]
 
+    @classmethod
+    def _from_nodal(cls, d: dict, sim, state, coordinate_labels, deformation_labels):
+        """A linearization at rest in static equilibrium from ``Simulation.linearize_nodal()``:
+        the sparse nodal matrices now, the dense reduced ones (M0, ..., DF) on first use, from
+        the simulation kept for it."""
+        self = cls.__new__(cls)
+        self.t = float(d["t"])
+        self.z_labels = [("x" if k == 0 else "e", int(a), int(b)) for k, a, b in d["z_label"]]
+        self.n_line = int(d["n_line"])
+        self.y_labels = []
+        self.r0 = np.asarray(d["r0"])
+        self.coordinate_labels = [tuple(int(v) for v in c) for c in coordinate_labels]
+        self.deformation_labels = [tuple(int(v) for v in c) for c in deformation_labels]
+        self.nodal = NodalMatrices(d, self.coordinate_labels)
+        self._sim, self._state = sim, state
+        return self
+
+    def __getattr__(self, name):
+        # The dense reduced matrices of a nodal linearization, computed when first asked for.
+        if name in MATRICES and "_sim" in self.__dict__ and not self.__dict__.get("_dense", False):
+            self._densify()
+            return getattr(self, name)
+        raise AttributeError(f"{type(self).__name__!s} has no attribute {name!r}")
+
+    def _densify(self):
+        """The dense reduced matrices (formulation.md §7) at the nodal linearization's state."""
+        sim = self._sim
+        t, q, qd = self._state
+        sim.move_to(t, q, qd)
+        d = sim.linearize()
+        nz = len(self.z_labels)
+        for name in MATRICES:
+            if name != "r0":
+                setattr(self, name, np.asarray(d[name]))
+        self.Kk = self.Kk.reshape(nz, 0)
+        self.AK0 = self.AK0.reshape(0, nz)
+        self.BK0 = self.BK0.reshape(0, nz)
+        self._dense = True
+
+    def __getstate__(self):
+        # A pickle holds the arrays, not the simulation: the dense matrices are computed first.
+        if "_sim" in self.__dict__ and not self.__dict__.get("_dense", False):
+            self._densify()
+        return {k: v for k, v in self.__dict__.items() if k not in ("_sim", "_state")}
+
+    def _sparse(self, k, method) -> bool:
+        """Whether an eigen-analysis of k values takes the sparse nodal path."""
+        if method not in ("auto", "dense", "sparse"):
+            raise InputError(f"method must be 'auto', 'dense' or 'sparse', got {show(method)}")
+        nodal = "_sim" in self.__dict__
+        if method == "sparse":
+            if not nodal:
+                raise InputError("the sparse eigen-analysis needs a linearization at rest in static equilibrium "
+                                 "from spacar.linearize(model) (this one is not)")
+            if k is None:
+                raise InputError("the sparse eigen-analysis computes the lowest k values: give k")
+            return True
+        return method == "auto" and nodal and k is not None and len(self.z_labels) > self.SPARSE_ABOVE
+
     @property
     def stiffness(self) -> np.ndarray:
         """K0 + N0 + G0."""
@@ -83,27 +147,68 @@ class Linearization:
     def _undamped(self):
         import scipy.linalg  # lazily: `import spacar` stays light
 
-        w2, v = scipy.linalg.eig(self.stiffness, self.M0)
-        w2 = np.real_if_close(w2, tol=1e6)
+        K, M = self.stiffness, self.M0
+        symmetric = (K.size == 0 or (np.abs(K - K.T).max() <= 1e-12 * np.abs(K).max()
+                                     and np.abs(M - M.T).max() <= 1e-12 * np.abs(M).max()))
+        try:
+            if not symmetric:
+                raise np.linalg.LinAlgError
+            # Symmetric with K positive definite (a stable structure): the inverse pencil
+            # M v = (1/ω²) K v, whose largest eigenvalues, the lowest modes, come with full
+            # relative precision (the condition of K of a fine mesh costs them digits in K v = ω² M v).
+            nu, v = scipy.linalg.eigh(0.5 * (M + M.T), 0.5 * (K + K.T))
+            with np.errstate(divide="ignore"):
+                w2 = np.where(nu > 0, 1.0 / np.where(nu > 0, nu, 1.0), np.inf)
+        except (np.linalg.LinAlgError, ValueError):
+            try:  # symmetric, M0 positive definite
+                if not symmetric:
+                    raise np.linalg.LinAlgError
+                w2, v = scipy.linalg.eigh(0.5 * (K + K.T), 0.5 * (M + M.T))
+            except (np.linalg.LinAlgError, ValueError):
+                w2, v = scipy.linalg.eig(K, M)
+                w2 = np.real_if_close(w2, tol=1e6)
         order = np.argsort(np.abs(w2))
         return np.real(w2[order]), v[:, order]
 
-    def eigenfrequencies(self) -> np.ndarray:
+    def _modes(self, k, method):
+        """(ω², shapes in z, shapes in x) of the k lowest |ω²| (all if k is None)."""
+        if self._sparse(k, method):
+            w2, vx = self.nodal.modes(self._sim, _count(k, len(self.z_labels)))
+            return w2, self.nodal.E @ vx, vx
+        w2, v = self._undamped()
+        if k is not None:
+            k = _count(k, len(self.z_labels))
+            w2, v = w2[:k], v[:, :k]
+        v = np.real(v)
+        return w2, v, None
+
+    def eigenfrequencies(self, k=None, *, method: str = "auto") -> np.ndarray:
         """Undamped eigenfrequencies in Hz, sorted, from (K0 + N0 + G0) v = ω² M0 v. An unstable
-        mode (ω² < 0) is returned as a negative number −√|ω²|/2π."""
-        w2, _ = self._undamped()
+        mode (ω² < 0) is returned as a negative number −√|ω²|/2π.
+
+        ``k``: only the k lowest (by |ω²|; None: all). ``method``: "dense" solves the reduced
+        matrices (all modes, small models); "sparse" the nodal matrices of a linearization at
+        rest in static equilibrium (formulation.md §8) for the k lowest, in shift-invert mode
+        (ARPACK), with a cost that grows linearly with the mesh; "auto" (default) takes the
+        sparse path when k is given, the linearization has it, and the model has more than
+        ``Linearization.SPARSE_ABOVE`` degrees of freedom."""
+        w2 = self._modes(k, method)[0]
         return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi)
 
-    def mode_shapes(self):
+    def mode_shapes(self, k=None, *, method: str = "auto"):
         """(frequencies in Hz, shapes in z (nz x nmodes), shapes in the nodal coordinates
         (nx x nmodes)). Each shape in z is normalised to unit largest component (sign
         arbitrary); the nodal shapes are DF times the same vectors, so both describe the same
-        motion (their largest component is generally not 1)."""
-        w2, v = self._undamped()
-        v = np.real(v)
+        motion (their largest component is generally not 1). ``k``, ``method``: as
+        :meth:`eigenfrequencies`."""
+        w2, v, vx = self._modes(k, method)
         if v.size:
-            v = v / np.abs(v).max(axis=0)
-        return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi), v, self.DF @ v
+            scale = np.abs(v).max(axis=0)
+            v = v / scale
+            vx = self.DF @ v if vx is None else vx / scale
+        elif vx is None:
+            vx = self.DF @ v
+        return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi), v, vx
 
     def state_matrix(self) -> np.ndarray:
         """A of d/dt [δz; δy^k; δż] = A [δz; δy^k; δż] (formulation.md §7.3); without
@@ -122,22 +227,31 @@ class Linearization:
         lam = np.linalg.eigvals(self.state_matrix())
         return lam[np.lexsort((lam.real, np.abs(lam.imag)))]
 
-    def buckling_factors(self) -> np.ndarray:
+    def buckling_factors(self, k=None, *, method: str = "auto") -> np.ndarray:
         """Load multipliers μ of (K0 + μ G0) v = 0 for a static state, sorted by |μ|; only the
-        finite ones."""
+        finite ones. ``k``, ``method``: as :meth:`eigenfrequencies` (the sparse path gives the k
+        smallest |μ| and needs no mass)."""
+        if self._sparse(k, method):
+            return self.nodal.buckling(self._sim, _count(k, len(self.z_labels)))[0]
         import scipy.linalg
 
         mu = scipy.linalg.eigvals(-self.K0, self.G0)
         mu = mu[np.isfinite(mu)]
         mu = np.real_if_close(mu, tol=1e6)
-        return np.real(mu[np.argsort(np.abs(mu))]) if np.isrealobj(mu) else mu[np.argsort(np.abs(mu))]
+        mu = np.real(mu[np.argsort(np.abs(mu))]) if np.isrealobj(mu) else mu[np.argsort(np.abs(mu))]
+        return mu if k is None else mu[:_count(k, len(self.z_labels))]
 
-    def buckling_modes(self):
+    def buckling_modes(self, k=None, *, method: str = "auto"):
         """(μ, shapes in z (nz x n), shapes in the nodal coordinates (nx x n)) of
         (K0 + μ G0) v = 0: the real, finite buckling factors sorted by |μ| (as
         :meth:`buckling_factors`, complex ones left out) with their mode shapes, each normalised
         to unit largest component in z (sign arbitrary); the nodal shapes are DF v, drawable with
-        ``spacar.draw(res, mode=shapes_x[:, i])``."""
+        ``spacar.draw(res, mode=shapes_x[:, i])``. ``k``, ``method``: as :meth:`eigenfrequencies`."""
+        if self._sparse(k, method):
+            mu, vx = self.nodal.buckling(self._sim, _count(k, len(self.z_labels)))
+            v = self.nodal.E @ vx
+            scale = np.abs(v).max(axis=0) if v.size else 1.0
+            return mu, v / scale, vx / scale
         import scipy.linalg
 
         mu, v = scipy.linalg.eig(-self.K0, self.G0)
@@ -145,6 +259,9 @@ class Linearization:
         mu, v = np.real(mu[keep]), np.real(v[:, keep])
         order = np.argsort(np.abs(mu))
         mu, v = mu[order], v[:, order]
+        if k is not None:
+            k = _count(k, len(self.z_labels))
+            mu, v = mu[:k], v[:, :k]
         if v.size:
             v = v / np.abs(v).max(axis=0)
         return mu, v, self.DF @ v
@@ -165,7 +282,105 @@ class Linearization:
         return A, B, C, np.zeros((C.shape[0], n))
 
     def __repr__(self):
-        return f"<spacar.Linearization at t = {self.t:g}: {len(self.z_labels)} coordinates ({self.n_line} LINE)>"
+        kind = ", sparse nodal matrices" if "_sim" in self.__dict__ else ""
+        return f"<spacar.Linearization at t = {self.t:g}: {len(self.z_labels)} coordinates ({self.n_line} LINE){kind}>"
+
+
+def _count(k, nz: int) -> int:
+    """k, checked: an integer from 1 to nz."""
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= nz:
+        raise InputError(f"k must be an integer from 1 to the number of coordinates ({nz}), got {show(k)}")
+    return int(k)
+
+
+class NodalMatrices:
+    """The linearized equations at rest in the nodal coordinates (formulation.md §8), sparse
+    (scipy.sparse, over all nx coordinates, those of fixed and input coordinates zero): ``M``
+    mass, ``D`` damping (EDAMPP), ``K`` structural stiffness (ESTIFF), ``G`` geometric stiffness
+    (the complete stresses and the loads' stiffness); ``A`` the constraint rows (rigid, input and
+    LINE-free deformations of the velocity rows that are not degrees of freedom, ∂e/∂x);
+    ``E`` the map δz = E δx to the coordinates z of the linearization; ``free`` the indices of
+    the free coordinates; ``coordinate_labels`` (node, component) of every coordinate. The reduced
+    matrices are Zᵀ M Z etc. with Z = DF (the motions δx = Z δz with A δx = 0); Z is never formed.
+    """
+
+    def __init__(self, d: dict, coordinate_labels):
+        import scipy.sparse
+
+        for name in ("M", "D", "K", "G", "A", "E"):
+            setattr(self, name, scipy.sparse.csr_matrix(d[name]))
+        self.free = np.asarray(d["free"], dtype=int)
+        self.coordinate_labels = list(coordinate_labels)
+
+    def _scatter(self, vf):
+        vx = np.zeros((self.M.shape[0],) + vf.shape[1:])
+        vx[self.free] = vf
+        return vx
+
+    def modes(self, sim, k: int):
+        """(ω², shapes in x (nx x k)) of the k lowest |ω²| of (K + G) v = ω² M v on A v = 0, by
+        ARPACK in shift-invert mode about 0 (just below 0 if K + G is singular there: rigid-body
+        motions), each solve one of the saddle-point system."""
+        import scipy.sparse.linalg as sla
+
+        f = self.free
+        M = self.M[f][:, f].tocsc()
+        sigma = 0.0
+        info = sim.nodal_factorize(1.0, 1.0, 0.0, 0.0)
+        if info["ok"] and info["singular"]:
+            # Rigid-body motions: shift below zero by a small fraction of the stiffness's size.
+            sigma = -1e-6 * abs(self.K[f][:, f].diagonal()).max() / max(abs(M.diagonal()).max(), 1e-300)
+            info = sim.nodal_factorize(1.0, 1.0, -sigma, 0.0)
+        if not info["ok"] or info["singular"]:
+            raise SpacarError("the stiffness matrix K0 + G0 - σ M0 of the eigen-analysis is singular or not finite")
+        op = sla.LinearOperator(M.shape, matvec=lambda b: sim.nodal_solve(np.asarray(b, dtype=float).ravel()),
+                                dtype=float)
+        v0 = sim.nodal_solve(np.ones(M.shape[0]))
+        k = min(k, _arpack_max(M.shape[0]))
+        if info["symmetric"]:
+            w2, vf = sla.eigsh(M, k=k, M=M, sigma=sigma, OPinv=op, which="LM", v0=v0)
+        else:
+            w2, vf = sla.eigs(M, k=k, M=M, sigma=sigma, OPinv=op, which="LM", v0=v0)
+            vf = np.real(vf)
+        w2 = np.real(w2)
+        if info["symmetric"]:
+            # The Rayleigh quotients, from the elements' energies (nodal_energies): the shift-invert
+            # solves carry the rounding of the assembled matrices of a fine mesh (ε times their
+            # condition), the quotients of the vectors they give do not.
+            energies = np.array([sim.nodal_energies(vf[:, j]) for j in range(vf.shape[1])]).reshape(-1, 4)
+            w2 = (energies[:, 0] + energies[:, 1]) / energies[:, 2]
+        order = np.argsort(np.abs(w2))
+        return w2[order], self._scatter(vf[:, order])
+
+    def buckling(self, sim, k: int):
+        """(μ, shapes in x) of the k smallest |μ| of (K + μ G) v = 0 on A v = 0: the largest
+        eigenvalues 1/μ of K⁻¹(−G) (ARPACK), each K⁻¹ a solve of the saddle-point system."""
+        import scipy.sparse.linalg as sla
+
+        f = self.free
+        G = self.G[f][:, f].tocsc()
+        info = sim.nodal_factorize(1.0, 0.0, 0.0, 0.0)
+        if not info["ok"] or info["singular"]:
+            raise SpacarError("the structural stiffness K0 is singular (a degree of freedom without stiffness): "
+                              "the sparse buckling analysis needs a regular K0; use method='dense'")
+        op = sla.LinearOperator(G.shape, matvec=lambda b: sim.nodal_solve(-(G @ np.asarray(b, dtype=float).ravel())),
+                                dtype=float)
+        k = min(k, _arpack_max(G.shape[0]))
+        nu, vf = sla.eigs(op, k=k, which="LM", v0=sim.nodal_solve(np.ones(G.shape[0])))
+        keep = np.abs(nu) > 0
+        real = np.abs(np.imag(nu)) <= 1e-6 * np.abs(nu)
+        nu, vf = np.real(nu[keep & real]), np.real(vf[:, keep & real])
+        mu = 1.0 / nu
+        if info["symmetric"]:  # Rayleigh quotients from the elements' energies, as in modes()
+            energies = np.array([sim.nodal_energies(vf[:, j]) for j in range(vf.shape[1])]).reshape(-1, 4)
+            mu = -energies[:, 0] / energies[:, 1]
+        order = np.argsort(np.abs(mu))
+        return mu[order], self._scatter(vf[:, order])
+
+
+def _arpack_max(n: int) -> int:
+    """The most eigenvalues ARPACK computes of an n x n problem."""
+    return max(n - 2, 1)
 
 
 def linearize(model, state=None) -> Linearization:
@@ -199,5 +414,11 @@ def linearized_simulation(model, state=None):
         if not (np.isfinite(t) and np.isfinite(q).all() and np.isfinite(qd).all()):
             raise InputError("state (t, q, qd) must hold finite numbers only (no NaN or infinity)")
     t, q, qd = float(t), np.array(q, dtype=float), np.array(qd, dtype=float)
+    if state is None:
+        # At rest in static equilibrium: the sparse nodal matrices, the dense ones on first use.
+        nodal = sim.linearize_nodal()
+        if nodal is not None:
+            return (Linearization._from_nodal(nodal, sim, (t, q, qd), system.coord_label, system.def_label), sim,
+                    (t, q, qd))
     sim.move_to(t, q, qd)
     return Linearization(sim.linearize(), system.coord_label, system.def_label), sim, (t, q, qd)

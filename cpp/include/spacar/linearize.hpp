@@ -17,6 +17,7 @@
 #include "spacar/chain.hpp"
 #include "spacar/data.hpp"
 #include "spacar/model.hpp"
+#include "spacar/nodal.hpp"
 #include "spacar/system.hpp"
 
 namespace spacar {
@@ -41,6 +42,23 @@ struct Linearization {
   }
 };
 
+// The linearized equations at rest in the nodal coordinates (formulation.md §8): for a state
+// without rates, inputs at rest and in static equilibrium, where C0 = N0 = 0, the matrices of
+// Linearization are M0 = Zᵀ M Z, D0 = Zᵀ D Z, K0 = Zᵀ K Z and G0 = Zᵀ G Z with Z = DF_z, the
+// transfer function of z; here M, D, K, G are the sparse nodal matrices (over all coordinates,
+// nx x nx), A the constraint rows and E the map δz = E δx. The eigen-analyses of large models
+// solve with them and never form Z (spacar.Linearization.eigenfrequencies(k=...)).
+struct NodalLinearization {
+  double t = 0.0;
+  std::vector<std::array<int, 3>> z_label;  // as Linearization's
+  int n_line = 0;
+  Eigen::SparseMatrix<double> M, D, K, G;   // nx x nx
+  Eigen::SparseMatrix<double> A;            // constraint rows x nx
+  Eigen::SparseMatrix<double> E;            // nz x nx
+  std::vector<int> free;                    // the free coordinates (the columns the solves use)
+  Eigen::VectorXd r0;                       // the residual at the state (drives LINE parameters)
+};
+
 class Linearizer {
  public:
   // Compiles the model with its LINE parameters as coordinates. `dependent`: the dependent
@@ -51,8 +69,30 @@ class Linearizer {
   // precise = false: the finite-difference parts (C0, N0, Kk, BK0) to about 1e-8 relative
   // instead of 1e-11, at a third of the cost (an implicit integrator's Jacobian).
   Linearization compute(const System& sys, const Data& data, bool precise = true);
+  // The nodal linearization at the analysed state (sys/data solved positions, rates and the
+  // inputs' motion; no stresses needed): false, and nothing computed, unless the state is at
+  // rest (no rates, inputs at rest, no kinematic coordinates) and in static equilibrium (the
+  // reduced static residual below 1e-8 of the loads it balances).
+  bool compute_nodal(const System& sys, const Data& data, NodalLinearization& out);
+  // After compute_nodal: H = the coefficients' combination of K, G, M, D at that state in the
+  // saddle-point system (nodal.hpp), factorized; then solves over the free coordinates,
+  // x_f = Z (Zᵀ H Z)⁻¹ Zᵀ b_f. False if the values are not finite.
+  bool nodal_factorize(const NodalCoefficients& c);
+  const SaddlePoint& nodal_system() const;
+  void nodal_solve(const double* b, double* x);
+  // vᵀ K v, vᵀ G v, vᵀ M v, vᵀ D v at compute_nodal's state for v over the free coordinates
+  // (nodal_energies: the Rayleigh quotients of the eigen-analyses).
+  Eigen::Vector4d nodal_energies(const Eigen::VectorXd& v_free);
 
  private:
+  // The coordinates z of the analysed system (its DOFs, then the LINE parameters) with their
+  // values, rates, accelerations and sizes, and their labels into `labels`; fills order_.
+  struct ZState {
+    Eigen::VectorXd z, zd, zdd, scale;
+  };
+  ZState z_state(const System& sys, const Data& data, std::vector<std::array<int, 3>>& labels, int& n_line);
+  // The nominal state in ld_: the analysed one's inputs, time loads, positions; z, ż.
+  void set_nominal(const System& sys, const Data& data, const ZState& zs, bool transfer);
   void residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R);
   // Kinematics at z, ż; the dense transfer functions only if asked (the nominal state: the
   // perturbed states of the finite differences need the residual only).
@@ -64,6 +104,10 @@ class Linearizer {
   std::unique_ptr<Data> ld_;
   std::vector<int> order_;      // z index → DOF index of the linearization system
   std::unique_ptr<ExplicitChain> chain_;  // the perturbed positions of an open chain; nullptr otherwise
+  // The nodal linearization's numbering, saddle-point system and stresses (compute_nodal).
+  std::unique_ptr<NodalLayout> layout_;
+  std::unique_ptr<SaddlePoint> saddle_;
+  Eigen::VectorXd nodal_sigma_;
 };
 
 }  // namespace spacar

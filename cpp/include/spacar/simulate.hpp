@@ -175,6 +175,11 @@ class Simulation {
   void forces();
   // Linearized equations at the state of the last evaluate() (computes the forces first).
   Linearization linearize(bool precise = true);  // precise: see Linearizer::compute
+  // The linearized equations at rest in the nodal coordinates at the state of the last
+  // assemble() or evaluate() (Linearizer::compute_nodal); false if that state is not at rest in
+  // static equilibrium. Then the saddle-point solves of the eigen-analyses (linearizer()).
+  bool linearize_nodal(NodalLinearization& out);
+  Linearizer& linearizer();
   // Complete state at (t, Y), Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
   void evaluate_state(double t, const Eigen::VectorXd& Y);
   // Right-hand side of the first-order system Y = (q, y, q̇).
