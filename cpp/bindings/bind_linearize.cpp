@@ -29,6 +29,9 @@ py::dict nodal_linearization_to_dict(NodalLinearization&& n) {
   d["G"] = std::move(n.G);
   d["A"] = std::move(n.A);
   d["E"] = std::move(n.E);
+  d["B"] = std::move(n.B);
+  d["S"] = std::move(n.S);
+  d["Dc"] = std::move(n.Dc);
   d["free"] = n.free;
   d["r0"] = std::move(n.r0);
   return d;

@@ -124,7 +124,14 @@ void bind_simulation(py::module_& m) {
       .def("assemble", &Simulation::assemble)
       .def("forces", &Simulation::forces)
       .def("reduced_accelerations", &Simulation::reduced_accelerations)
-      .def("linearize", [](Simulation& s) { return linearization_to_dict(s.linearize()); })
+      .def("linearize",
+           [](Simulation& s, bool differences) {
+             return linearization_to_dict(
+                 s.linearize(differences ? Linearizer::Differences::Precise : Linearizer::Differences::None));
+           },
+           py::arg("differences") = true,
+           "The linearized equations at the state of the last evaluate(); differences=False at a state "
+           "linearize_nodal accepted (at rest in static equilibrium: C0 = N0 = 0, no finite differences).")
       .def("linearize_nodal",
            [](Simulation& s) -> py::object {
              NodalLinearization n;

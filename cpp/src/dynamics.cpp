@@ -300,24 +300,6 @@ void nodal_reactions(const System& sys, Data& data) {
   }
 }
 
-Eigen::MatrixXd global_constitutive(const System& sys, bool damping) {
-  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(sys.ne, sys.ne);
-  for (const SystemElement& se : sys.elements) {
-    const Eigen::MatrixXd& Se = damping ? se.D : se.S;
-    for (int a = 0; a < se.nd; ++a) {
-      if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
-      S.block(se.def_offset + a, se.def_offset, 1, se.nd) = Se.row(a);
-    }
-  }
-  return S;
-}
-
-Eigen::MatrixXd congruence(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A) {
-  const Eigen::SparseMatrix<double> As = A.sparseView();
-  const Eigen::MatrixXd AT = As * T;
-  return T.transpose() * AT;
-}
-
 double kinetic_energy(const System& sys, const Data& data) {
   Eigen::VectorXd Mv;
   inertia_times(sys, data, data.xd, Mv);

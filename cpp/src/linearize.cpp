@@ -111,7 +111,7 @@ void Linearizer::set_nominal(const System& sys, const Data& data, const ZState& 
 
 bool Linearizer::compute_nodal(const System& sys, const Data& data, NodalLinearization& out) {
   const System& L = *lin_;
-  saddle_.reset();
+  reduced_.reset();
   if (!sys.e_kinematic.empty()) return false;
   out = NodalLinearization();
   out.t = data.t;
@@ -134,45 +134,53 @@ bool Linearizer::compute_nodal(const System& sys, const Data& data, NodalLineari
   out.D = nodal_part(L, *ld_, nodal_sigma_, kDamping);
   out.K = nodal_part(L, *ld_, nodal_sigma_, kStiffness);
   out.G = nodal_part(L, *ld_, nodal_sigma_, kGeometric);
-  layout_ = std::make_unique<NodalLayout>(L);
-  out.A = nodal_constraints(L, *ld_, *layout_);
-  out.free = layout_->free;
+  reduced_ = std::make_unique<ReducedSystem>(L, *ld_);
+  out.A = nodal_constraints(L, *ld_, reduced_->layout());
+  out.free = reduced_->layout().free;
   // E in the order of z: row i is the row of L's DOF order_[i].
   Eigen::SparseMatrix<double> P(nz, nz);
   std::vector<Eigen::Triplet<double>> unit;
   for (int i = 0; i < nz; ++i) unit.emplace_back(i, order_[i], 1.0);
   P.setFromTriplets(unit.begin(), unit.end());
   out.E = P * nodal_dof_map(L, *ld_);
-  saddle_ = std::make_unique<SaddlePoint>(L, *layout_);
+  out.B = nodal_deformation_jacobian(L, *ld_);
+  out.S = nodal_constitutive(L, false);
+  out.Dc = nodal_constitutive(L, true);
   return true;
 }
 
 bool Linearizer::nodal_factorize(const NodalCoefficients& c) {
-  if (!saddle_) throw Error("linearize: no nodal linearization to factorize (compute_nodal first)");
-  return saddle_->factorize(*lin_, *ld_, nodal_sigma_, c);
+  if (!reduced_) throw Error("linearize: no nodal linearization to factorize (compute_nodal first)");
+  return reduced_->factorize(nodal_sigma_, c);
 }
 
 const SaddlePoint& Linearizer::nodal_system() const {
-  if (!saddle_) throw Error("linearize: no nodal linearization (compute_nodal first)");
-  return *saddle_;
+  if (!reduced_) throw Error("linearize: no nodal linearization (compute_nodal first)");
+  return reduced_->saddle();
 }
 
 void Linearizer::nodal_solve(const double* b, double* x) {
-  if (!saddle_) throw Error("linearize: no nodal linearization to solve with (compute_nodal first)");
-  saddle_->solve_free(b, x);
+  if (!reduced_) throw Error("linearize: no nodal linearization to solve with (compute_nodal first)");
+  const NodalLayout& layout = reduced_->layout();
+  Eigen::VectorXd bx = Eigen::VectorXd::Zero(lin_->nx), q, dx;
+  for (int f = 0; f < layout.n_free; ++f) bx[layout.free[f]] = b[f];
+  reduced_->solve(reduced_->reduce(bx), q, dx);
+  for (int f = 0; f < layout.n_free; ++f) x[f] = dx[layout.free[f]];
 }
 
 Eigen::Vector4d Linearizer::nodal_energies(const Eigen::VectorXd& v_free) {
-  if (!saddle_) throw Error("linearize: no nodal linearization (compute_nodal first)");
-  if (v_free.size() != layout_->n_free)
-    throw InputError("nodal_energies: v needs " + std::to_string(layout_->n_free) + " values, got " +
+  if (!reduced_) throw Error("linearize: no nodal linearization (compute_nodal first)");
+  const NodalLayout& layout = reduced_->layout();
+  if (v_free.size() != layout.n_free)
+    throw InputError("nodal_energies: v needs " + std::to_string(layout.n_free) + " values, got " +
                      std::to_string(v_free.size()));
   Eigen::VectorXd v = Eigen::VectorXd::Zero(lin_->nx);
-  for (int f = 0; f < layout_->n_free; ++f) v[layout_->free[f]] = v_free[f];
+  for (int f = 0; f < layout.n_free; ++f) v[layout.free[f]] = v_free[f];
   return spacar::nodal_energies(*lin_, *ld_, nodal_sigma_, v);
 }
 
-Linearization Linearizer::compute(const System& sys, const Data& data, bool precise) {
+Linearization Linearizer::compute(const System& sys, const Data& data, Differences differences) {
+  const bool precise = differences == Differences::Precise;
   const System& L = *lin_;
   const int nz = L.n_dof();
   Linearization lin;
@@ -201,13 +209,34 @@ Linearization Linearizer::compute(const System& sys, const Data& data, bool prec
     lin.DFz.col(i) = ld_->DF.col(L.dof_cols[order_[i]]);
     lin.DFez.col(i) = ld_->DFe.col(L.dof_cols[order_[i]]);
   }
-  assemble_mass_matrix(L, *ld_);
-  lin.M0 = congruence(lin.DFz, ld_->M);
-  lin.K0 = congruence(lin.DFez, global_constitutive(L, false));
-  lin.D0 = congruence(lin.DFez, global_constitutive(L, true));
+  // Zᵀ M Z and Zᵀ G Z of the nodal matrices (nodal.hpp), the mass at the nominal velocities;
+  // K0 and D0 from the deformations, DFeᵀ S DFe: the same matrices, without the cancellation of
+  // the nodal stiffness's large entries along a fine mesh (the static compliance of a
+  // 100-beam cantilever stays at 1e-12 instead of 1e-9).
+  compute_inertia_and_loads(L, *ld_);
+  lin.M0 = lin.DFz.transpose() * (nodal_part(L, *ld_, data.sigma, kMass) * lin.DFz);
   lin.G0 = lin.DFz.transpose() * (nodal_part(L, *ld_, data.sigma, kGeometric) * lin.DFz);
+  lin.K0 = lin.DFez.transpose() * (nodal_constitutive(L, false) * lin.DFez);
+  lin.D0 = lin.DFez.transpose() * (nodal_constitutive(L, true) * lin.DFez);
   lin.AK0.resize(nk, nz);
   for (int j = 0; j < nk; ++j) lin.AK0.row(j) = lin.DFez.row(sys.e_kinematic[j]);
+
+  auto refuse = [&](const char* name) {
+    std::ostringstream os;
+    os << "the linearized equations at t = " << data.t << " are not finite (" << name
+       << " has infinite or NaN entries): the model's values exceed double precision";
+    throw Error(os.str());
+  };
+  if (differences == Differences::None) {  // at rest in static equilibrium (compute_nodal)
+    if (nk > 0) throw Error("linearize: a state with kinematic coordinates needs the differences");
+    lin.C0 = lin.N0 = Eigen::MatrixXd::Zero(nz, nz);
+    lin.Kk.resize(nz, 0);
+    lin.BK0.resize(0, nz);
+    lin.for_each_array([&](const char* name, const auto& m) {
+      if (!m.allFinite()) refuse(name);
+    });
+    return lin;
+  }
 
   // Residual R and kinematic rates ẏ^k at perturbed positions (kinematics re-solved) or rates.
   auto response = [&](const Eigen::VectorXd& zz, const Eigen::VectorXd& zzd, const Eigen::VectorXd& yy) {
@@ -258,12 +287,6 @@ Linearization Linearizer::compute(const System& sys, const Data& data, bool prec
   lin.BK0 << dz.bottomRows(nk), dy.bottomRows(nk);
   // Values beyond double precision (e.g. GRAVITY 1e308) give infinities and NaNs here: refuse them
   // rather than hand non-finite matrices to the eigen-analyses.
-  auto refuse = [&](const char* name) {
-    std::ostringstream os;
-    os << "the linearized equations at t = " << data.t << " are not finite (" << name
-       << " has infinite or NaN entries): the model's values exceed double precision";
-    throw Error(os.str());
-  };
   lin.for_each_array([&](const char* name, const auto& m) {
     if (!m.allFinite()) refuse(name);  // throws: the first non-finite array is named
   });

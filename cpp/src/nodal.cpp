@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "spacar/dynamics.hpp"
+#include "spacar/kinematics.hpp"
 #include "spacar/elements/spatial.hpp"
 
 namespace spacar {
@@ -33,18 +34,19 @@ NodalLayout::NodalLayout(const System& sys) {
 
 namespace {
 
-// Bᵀ C B over the constitutive deformations of the element (C: its S or D), their rows and
-// columns: a coupling to a rigid or prescribed deformation does not move on the constrained
-// space (its B row vanishes there), and without it the matrix keeps the symmetry of C.
+// Bᵀ C B over the element's constitutive deformations (C: its S or D; σ_a = Σ_b C_ab e_b for
+// each constitutive a), the columns b of deformations that `layout` constrains left out when a
+// layout is given: they do not move on the constrained space (their B rows vanish there), and
+// without them the matrix keeps the symmetry of C.
 void add_constitutive(const System& sys, const SystemElement& se, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
-                      double coefficient, Eigen::MatrixXd& out) {
+                      double coefficient, const NodalLayout* layout, Eigen::MatrixXd& out) {
   if (coefficient == 0.0 || !se.has_constitutive) return;
   Eigen::MatrixXd CB = Eigen::MatrixXd::Zero(se.nd, B.cols());
   bool any = false;
   for (int a = 0; a < se.nd; ++a) {
     if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
     for (int b = 0; b < se.nd; ++b)
-      if (C(a, b) != 0.0 && constitutive_class(sys.def_class[se.def_offset + b])) CB.row(a) += C(a, b) * B.row(b);
+      if (C(a, b) != 0.0 && !(layout && layout->row_of[se.def_offset + b] >= 0)) CB.row(a) += C(a, b) * B.row(b);
     any = true;
   }
   if (any) out.noalias() += coefficient * B.transpose() * CB;
@@ -69,15 +71,14 @@ void add_gravity_stiffness(const System& sys, const SystemElement& se, const Ele
   out -= 0.5 * coefficient * (J + J.transpose());
 }
 
-// The element's part of H (local, n x n).
-void element_matrix(const System& sys, const Data& data, size_t i, const Eigen::VectorXd& sigma,
-                    const NodalCoefficients& c, Eigen::MatrixXd& out) {
+// The element's part of H without the constitutive terms (the geometric stiffness, the loads'
+// stiffness, the mass; local, n x n).
+void element_rest(const System& sys, const Data& data, size_t i, const Eigen::VectorXd& sigma,
+                  const NodalCoefficients& c, Eigen::MatrixXd& out) {
   const SystemElement& se = sys.elements[i];
   const ElementWork& w = data.work[i];
   const int n = static_cast<int>(se.coords.size());
   out.setZero(n, n);
-  add_constitutive(sys, se, w.B, se.S, c.stiffness, out);
-  add_constitutive(sys, se, w.B, se.D, c.damping, out);
   if (c.geometric != 0.0) {
     const Eigen::VectorXd s = sigma.segment(se.def_offset, se.nd);
     if (s.any()) {
@@ -89,6 +90,31 @@ void element_matrix(const System& sys, const Data& data, size_t i, const Eigen::
       add_gravity_stiffness(sys, se, w, c.geometric * c.load_factor, out);
   }
   if (c.mass != 0.0 && se.has_mass) out += c.mass * w.M;
+}
+
+// The element's part of H (local, n x n); `layout`: see add_constitutive.
+void element_matrix(const System& sys, const Data& data, size_t i, const Eigen::VectorXd& sigma,
+                    const NodalCoefficients& c, const NodalLayout* layout, Eigen::MatrixXd& out) {
+  element_rest(sys, data, i, sigma, c, out);
+  const SystemElement& se = sys.elements[i];
+  add_constitutive(sys, se, data.work[i].B, se.S, c.stiffness, layout, out);
+  add_constitutive(sys, se, data.work[i].B, se.D, c.damping, layout, out);
+}
+
+// Whether the element's Bᵀ C B of add_constitutive is symmetric for its S and D: C symmetric
+// among the constitutive deformations, and no coupling of a constitutive deformation to a free
+// one that is not constitutive (a LINE parameter of the linearization).
+bool symmetric_constitutive(const System& sys, const SystemElement& se, const NodalLayout& layout) {
+  if (!se.has_constitutive) return true;
+  for (const Eigen::MatrixXd* C : {&se.S, &se.D})
+    for (int a = 0; a < se.nd; ++a) {
+      if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
+      for (int b = 0; b < se.nd; ++b) {
+        if ((*C)(a, b) == 0.0 || layout.row_of[se.def_offset + b] >= 0) continue;
+        if (!constitutive_class(sys.def_class[se.def_offset + b]) || (*C)(a, b) != (*C)(b, a)) return false;
+      }
+    }
+  return true;
 }
 
 // −∂f/∂λ of a body-fixed torque T: f_λ = 2 G(λ)ᵀ T is linear in λ (4 x 4, unsymmetric).
@@ -118,7 +144,7 @@ Eigen::SparseMatrix<double> nodal_matrix(const System& sys, Data& data, const Ei
   std::vector<Eigen::Triplet<double>> entries;
   Eigen::MatrixXd local;
   for (size_t i = 0; i < sys.elements.size(); ++i) {
-    element_matrix(sys, data, i, sigma, c, local);
+    element_matrix(sys, data, i, sigma, c, nullptr, local);
     const std::vector<int>& g = sys.elements[i].coords;
     for (int b = 0; b < local.cols(); ++b)
       for (int a = 0; a < local.rows(); ++a)
@@ -158,11 +184,8 @@ Eigen::Vector4d nodal_energies(const System& sys, Data& data, const Eigen::Vecto
       de.noalias() = w.B * ve;
       for (int a = 0; a < se.nd; ++a) {
         if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
-        for (int b = 0; b < se.nd; ++b) {
-          if (!constitutive_class(sys.def_class[se.def_offset + b])) continue;
-          out[0] += de[a] * se.S(a, b) * de[b];
-          out[3] += de[a] * se.D(a, b) * de[b];
-        }
+        out[0] += de[a] * se.S.row(a).dot(de);
+        out[3] += de[a] * se.D.row(a).dot(de);
       }
     }
     const Eigen::VectorXd s = sigma.segment(se.def_offset, se.nd);
@@ -208,6 +231,36 @@ Eigen::SparseMatrix<double> nodal_constraints(const System& sys, const Data& dat
   return A;
 }
 
+Eigen::SparseMatrix<double> nodal_deformation_jacobian(const System& sys, const Data& data) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const Eigen::MatrixXd& B = data.work[i].B;
+    for (int a = 0; a < se.nd; ++a)
+      for (size_t j = 0; j < se.coords.size(); ++j)
+        if (B(a, j) != 0.0) entries.emplace_back(se.def_offset + a, se.coords[j], B(a, j));
+  }
+  Eigen::SparseMatrix<double> B(sys.ne, sys.nx);
+  B.setFromTriplets(entries.begin(), entries.end());
+  return B;
+}
+
+Eigen::SparseMatrix<double> nodal_constitutive(const System& sys, bool damping) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (const SystemElement& se : sys.elements) {
+    if (!se.has_constitutive) continue;
+    const Eigen::MatrixXd& C = damping ? se.D : se.S;
+    for (int a = 0; a < se.nd; ++a) {
+      if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
+      for (int b = 0; b < se.nd; ++b)
+        if (C(a, b) != 0.0) entries.emplace_back(se.def_offset + a, se.def_offset + b, C(a, b));
+    }
+  }
+  Eigen::SparseMatrix<double> S(sys.ne, sys.ne);
+  S.setFromTriplets(entries.begin(), entries.end());
+  return S;
+}
+
 Eigen::SparseMatrix<double> nodal_dof_map(const System& sys, const Data& data) {
   std::vector<Eigen::Triplet<double>> entries;
   const int nxd = static_cast<int>(sys.x_dyn.size());
@@ -231,8 +284,7 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
   // not integrable) or an unsymmetric constitutive matrix make H unsymmetric.
   symmetric_ = sys.torquel.empty();
   for (int k = 0; k < sys.ne; ++k) symmetric_ = symmetric_ && !sys.def_velocity_level[k];
-  for (const SystemElement& se : sys.elements)
-    symmetric_ = symmetric_ && (!se.has_constitutive || (se.S == se.S.transpose() && se.D == se.D.transpose()));
+  for (const SystemElement& se : sys.elements) symmetric_ = symmetric_ && symmetric_constitutive(sys, se, layout);
   kkt_.reset(n_, n_);
   for (const SystemElement& se : sys.elements) {
     std::vector<int> fi(se.coords.size()), cr(se.nd);
@@ -294,9 +346,13 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
   kkt_.set_zero();
   // H, scaled to energies: H_s(a, b) = H(a, b) s_a s_b.
   auto scale_of = [&](int g) { return layout_.free_of[g] >= 0 ? s[layout_.free_of[g]] : 1.0; };
+  rest_.resize(sys.elements.size());
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
-    element_matrix(sys, data, i, sigma, c, local_);
+    spacar::element_rest(sys, data, i, sigma, c, rest_[i]);
+    local_ = rest_[i];
+    add_constitutive(sys, se, data.work[i].B, se.S, c.stiffness, &layout_, local_);
+    add_constitutive(sys, se, data.work[i].B, se.D, c.damping, &layout_, local_);
     const int n = static_cast<int>(se.coords.size());
     for (int b = 0; b < n; ++b)
       for (int a = 0; a < n; ++a) local_(a, b) *= scale_of(se.coords[a]) * scale_of(se.coords[b]);
@@ -369,17 +425,6 @@ bool SaddlePoint::factorize(const System& sys, Data& data, const Eigen::VectorXd
   return true;
 }
 
-void SaddlePoint::residual_extended(const Eigen::VectorXd& b, const Eigen::VectorXd& x, Eigen::VectorXd& r) {
-  const Eigen::SparseMatrix<double>& A = kkt_.matrix();
-  wide_.assign(n_, 0.0L);
-  for (int c = 0; c < n_; ++c) {
-    const long double xc = x[c];
-    for (Eigen::SparseMatrix<double>::InnerIterator it(A, c); it; ++it) wide_[it.row()] += it.value() * xc;
-  }
-  r.resize(n_);
-  for (int i = 0; i < n_; ++i) r[i] = static_cast<double>(static_cast<long double>(b[i]) - wide_[i]);
-}
-
 void SaddlePoint::solve_scaled(Eigen::VectorXd& rhs) {
   auto once = [&](const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     if (symmetric_) {
@@ -390,23 +435,13 @@ void SaddlePoint::solve_scaled(Eigen::VectorXd& rhs) {
     }
   };
   once(rhs, sol_);
-  // Iterative refinement with the residuals in extended precision (long double: 64 bits of
-  // mantissa on x86): the saddle-point system of a fine mesh is ill-conditioned (a cantilever of
-  // n beams: the ratio of its elements' stiffness to its own grows as n²), where the reduced
-  // K0 + G0 of deformation DOFs is not; residuals in double would leave the solution with the
-  // relative error of ε times that condition (2e-9 at n = 100). Until the correction stops
-  // shrinking, at most kRefinements steps.
+  // One step of iterative refinement: the factorization chose its pivots for no accuracy (the
+  // error left is that of the assembled matrix itself, which ReducedSystem refines away).
+  res_ = rhs;
+  res_.noalias() -= kkt_.matrix() * sol_;
   Eigen::VectorXd correction;
-  double last = std::numeric_limits<double>::infinity();
-  for (int step = 0; step < kRefinements; ++step) {
-    residual_extended(rhs, sol_, res_);
-    once(res_, correction);
-    const double size = correction.cwiseAbs().maxCoeff();
-    if (!(size < last)) break;
-    sol_ += correction;
-    last = size;
-    if (size <= 1e-15 * sol_.cwiseAbs().maxCoeff()) break;
-  }
+  once(res_, correction);
+  sol_ += correction;
   rhs = sol_;
 }
 
@@ -453,6 +488,119 @@ Eigen::VectorXd SaddlePoint::lowest_direction(int iterations, double& value) {
   Eigen::VectorXd dx = Eigen::VectorXd::Zero(static_cast<int>(layout_.free_of.size()));
   for (int f = 0; f < nf; ++f) dx[layout_.free[f]] = u[f] * layout_.scale[f];
   return dx;
+}
+
+ReducedSystem::ReducedSystem(const System& sys, Data& data)
+    : sys_(sys), data_(data), layout_(sys), saddle_(sys, layout_) {
+  dof_of_def_.assign(sys.ne, -1);
+  const int nxd = static_cast<int>(sys.x_dyn.size());
+  for (size_t j = 0; j < sys.e_dyn.size(); ++j) dof_of_def_[sys.e_dyn[j]] = nxd + static_cast<int>(j);
+}
+
+bool ReducedSystem::factorize(const Eigen::VectorXd& sigma, const NodalCoefficients& c) {
+  c_ = c;
+  return saddle_.factorize(sys_, data_, sigma, c);
+}
+
+Eigen::VectorXd ReducedSystem::load(const Eigen::VectorXd& v) const {
+  // Unit loads on DOF coordinates, B_kᵀ v_k on the coordinates of a DOF deformation k.
+  const int nxd = static_cast<int>(sys_.x_dyn.size());
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(sys_.nx);
+  for (int j = 0; j < nxd; ++j) b[sys_.x_dyn[j]] += v[j];
+  for (size_t j = 0; j < sys_.e_dyn.size(); ++j) {
+    const int k = sys_.e_dyn[j], i = sys_.e_element[k];
+    const SystemElement& se = sys_.elements[i];
+    for (size_t c = 0; c < se.coords.size(); ++c) b[se.coords[c]] += data_.work[i].B(k - se.def_offset, c) * v[nxd + j];
+  }
+  return b;
+}
+
+Eigen::VectorXd ReducedSystem::dofs(const Eigen::VectorXd& dx) const {
+  const int nxd = static_cast<int>(sys_.x_dyn.size());
+  Eigen::VectorXd q(sys_.n_dof());
+  for (int j = 0; j < nxd; ++j) q[j] = dx[sys_.x_dyn[j]];
+  for (size_t j = 0; j < sys_.e_dyn.size(); ++j) {
+    const int k = sys_.e_dyn[j], i = sys_.e_element[k];
+    const SystemElement& se = sys_.elements[i];
+    double v = 0.0;
+    for (size_t c = 0; c < se.coords.size(); ++c) v += data_.work[i].B(k - se.def_offset, c) * dx[se.coords[c]];
+    q[nxd + j] = v;
+  }
+  return q;
+}
+
+Eigen::VectorXd ReducedSystem::reduce(const Eigen::VectorXd& b) {
+  Eigen::VectorXd out;
+  transfer_transposed(sys_, data_, b, out);
+  Eigen::VectorXd v(sys_.n_dof());
+  for (int j = 0; j < sys_.n_dof(); ++j) v[j] = out[sys_.dof_cols[j]];
+  return v;
+}
+
+Eigen::VectorXd ReducedSystem::motion(const Eigen::VectorXd& q) {
+  Eigen::VectorXd rate = Eigen::VectorXd::Zero(sys_.n_qhat()), dx;
+  for (int j = 0; j < sys_.n_dof(); ++j) rate[sys_.dof_cols[j]] = q[j];
+  transfer_times(sys_, data_, rate, dx);
+  return dx;
+}
+
+Eigen::VectorXd ReducedSystem::product(const Eigen::VectorXd& q, Eigen::VectorXd* dx_out) {
+  const Eigen::VectorXd dx = motion(q);
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(sys_.n_dof());
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(sys_.nx), xe, de;
+  for (size_t i = 0; i < sys_.elements.size(); ++i) {
+    const SystemElement& se = sys_.elements[i];
+    const Eigen::MatrixXd& B = data_.work[i].B;
+    const int n = static_cast<int>(se.coords.size());
+    xe.resize(n);
+    for (int j = 0; j < n; ++j) xe[j] = dx[se.coords[j]];
+    // The rest of H (geometric, loads', mass) element by element; its terms do not cancel.
+    const Eigen::VectorXd fe = saddle_.element_rest(i) * xe;
+    for (int j = 0; j < n; ++j) f[se.coords[j]] += fe[j];
+    if (!se.has_constitutive || (c_.stiffness == 0.0 && c_.damping == 0.0)) continue;
+    // The deformations' increments, those of DOF deformations exactly; their stresses, of a
+    // DOF deformation straight into y (Zᵀ B_kᵀ is the unit row of its DOF), of the others
+    // through the coordinates.
+    de.noalias() = B * xe;
+    for (int a = 0; a < se.nd; ++a)
+      if (dof_of_def_[se.def_offset + a] >= 0) de[a] = q[dof_of_def_[se.def_offset + a]];
+    for (int a = 0; a < se.nd; ++a) {
+      const int k = se.def_offset + a;
+      if (!constitutive_class(sys_.def_class[k])) continue;
+      const double stress = c_.stiffness * se.S.row(a).dot(de) + c_.damping * se.D.row(a).dot(de);
+      if (dof_of_def_[k] >= 0) y[dof_of_def_[k]] += stress;
+      else
+        for (int j = 0; j < n; ++j) f[se.coords[j]] += B(a, j) * stress;
+    }
+  }
+  if (c_.mass != 0.0) {
+    for (int g = 0; g < sys_.nx; ++g) f[g] += c_.mass * sys_.point_mass[g] * dx[g];
+    for (size_t b = 0; b < sys_.bodies.size(); ++b)
+      f.segment<4>(sys_.bodies[b].coord) += c_.mass * data_.body_M[b] * dx.segment<4>(sys_.bodies[b].coord);
+  }
+  if (c_.geometric != 0.0 && c_.load_factor != 0.0)
+    for (const auto& [coord, T] : sys_.torquel)
+      f.segment<4>(coord) += c_.geometric * c_.load_factor * torque_stiffness(T) * dx.segment<4>(coord);
+  y += reduce(f);
+  if (dx_out) *dx_out = dx;
+  return y;
+}
+
+void ReducedSystem::solve(const Eigen::VectorXd& r, Eigen::VectorXd& q, Eigen::VectorXd& dx, int refinements) {
+  saddle_.solve(load(r), dx);
+  q = dofs(dx);
+  if (refinements <= 0) return;
+  Eigen::VectorXd step;
+  const double size = r.cwiseAbs().maxCoeff();
+  for (int it = 0; it < refinements && size > 0.0; ++it) {
+    const Eigen::VectorXd residual = r - product(q);
+    if (!(residual.cwiseAbs().maxCoeff() > 1e-15 * size)) break;
+    saddle_.solve(load(residual), step);
+    const Eigen::VectorXd dq = dofs(step);
+    q += dq;
+    if (!(dq.cwiseAbs().maxCoeff() > 1e-15 * q.cwiseAbs().maxCoeff())) break;
+  }
+  dx = motion(q);
 }
 
 }  // namespace spacar

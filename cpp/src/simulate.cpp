@@ -287,9 +287,9 @@ Linearizer& Simulation::linearizer() {
   return *linearizer_;
 }
 
-Linearization Simulation::linearize(bool precise) {
+Linearization Simulation::linearize(Linearizer::Differences differences) {
   forces();
-  return linearizer().compute(*sys_, *data_, precise);
+  return linearizer().compute(*sys_, *data_, differences);
 }
 
 bool Simulation::linearize_nodal(NodalLinearization& out) { return linearizer().compute_nodal(*sys_, *data_, out); }

@@ -18,7 +18,7 @@ void Simulation::jacobian(double t, const Eigen::VectorXd& Y, Eigen::MatrixXd& J
   Linearization lin;
   try {
     evaluate_state(t, Y);
-    lin = linearize(false);  // a Newton matrix: 1e-8 is plenty
+    lin = linearize(Linearizer::Differences::Fast);  // a Newton matrix: 1e-8 is plenty
   } catch (const KinematicsError& err) {
     throw StepRejected(err.what());
   }

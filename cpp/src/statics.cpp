@@ -101,21 +101,6 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
 
 namespace {
 
-// The change of the DOFs for a change dx of the coordinates: their own entries, B_k dx.
-Eigen::VectorXd dof_change(const System& sys, const Data& data, const Eigen::VectorXd& dx) {
-  const int nxd = static_cast<int>(sys.x_dyn.size());
-  Eigen::VectorXd dq(sys.n_dof());
-  for (int j = 0; j < nxd; ++j) dq[j] = dx[sys.x_dyn[j]];
-  for (size_t j = 0; j < sys.e_dyn.size(); ++j) {
-    const int k = sys.e_dyn[j], i = sys.e_element[k];
-    const SystemElement& se = sys.elements[i];
-    double v = 0.0;
-    for (size_t c = 0; c < se.coords.size(); ++c) v += data.work[i].B(k - se.def_offset, c) * dx[se.coords[c]];
-    dq[nxd + j] = v;
-  }
-  return dq;
-}
-
 // The characteristic size of each DOF: the mean element length for lengths, 1 for angles.
 Eigen::VectorXd dof_scale(const System& sys) {
   Eigen::VectorXd scale(sys.n_dof());
@@ -149,7 +134,7 @@ std::string dof_directions(const System& sys, const Eigen::MatrixXd& V) {
 class EquilibriumPath {
  public:
   EquilibriumPath(const System& sys, Data& data, const StaticOptions& opt, StaticResults& res)
-      : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()), layout_(sys), tangent_(sys, layout_),
+      : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()), reduced_(sys, data), tangent_(reduced_.saddle()),
         scale_(dof_scale(sys)) {
     // Inputs at the block start (λ = 0) and end (λ = 1), ordered as input_cols.
     const double tp = sys.settings.timestep_tp;
@@ -329,27 +314,15 @@ class EquilibriumPath {
     NodalCoefficients c;
     c.load_factor = lambda;
     check_thread_deadline("(in the static analysis)");
-    factorized_ = tangent_.factorize(sys_, data_, data_.sigma, c);
+    factorized_ = reduced_.factorize(data_.sigma, c);
     return force;
   }
 
-  // dq = K⁻¹ v and dx = DF_q dq for a vector v of generalized forces of the DOFs: v as a load on
-  // the coordinates (Zᵀ of it is v: unit loads on DOF coordinates, B_kᵀ v_k on the coordinates
-  // of a DOF deformation k), then δx from the saddle-point system and dq from δx.
-  void solve_dofs(const Eigen::VectorXd& v, Eigen::VectorXd& dq, Eigen::VectorXd& dx) {
-    const int nxd = static_cast<int>(sys_.x_dyn.size());
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(sys_.nx);
-    for (int j = 0; j < nxd; ++j) r[sys_.x_dyn[j]] += v[j];
-    for (size_t j = 0; j < sys_.e_dyn.size(); ++j) {
-      const int k = sys_.e_dyn[j], i = sys_.e_element[k];
-      const SystemElement& se = sys_.elements[i];
-      for (size_t c = 0; c < se.coords.size(); ++c) r[se.coords[c]] += data_.work[i].B(k - se.def_offset, c) * v[nxd + j];
-    }
-    tangent_.solve(r, dx);
-    dq = dof_change(sys_, data_, dx);
-  }
+  // dq = K⁻¹ v and dx = DF_q dq for a vector v of generalized forces of the DOFs (ReducedSystem),
+  // unrefined: Newton's residuals are exact, its steps need not be.
+  void solve_dofs(const Eigen::VectorXd& v, Eigen::VectorXd& dq, Eigen::VectorXd& dx) { reduced_.solve(v, dq, dx, 0); }
 
-  Eigen::VectorXd dofs_scaled(const Eigen::VectorXd& dx) const { return dof_change(sys_, data_, dx).cwiseQuotient(scale_); }
+  Eigen::VectorXd dofs_scaled(const Eigen::VectorXd& dx) const { return reduced_.dofs(dx).cwiseQuotient(scale_); }
 
   // q̂ with the inputs at their values for load factor λ (moved linearly from p0 to p1).
   Eigen::VectorXd with_inputs(Eigen::VectorXd qhat, double lambda) const {
@@ -378,8 +351,8 @@ class EquilibriumPath {
   const StaticOptions& opt_;
   StaticResults& res_;
   const int nd_;
-  NodalLayout layout_;
-  SaddlePoint tangent_;
+  ReducedSystem reduced_;
+  SaddlePoint& tangent_;   // reduced_'s saddle-point system
   bool factorized_ = false;
   Eigen::VectorXd scale_;        // characteristic size of each DOF: lengths vs angles
   Eigen::VectorXd p0_, p1_;
@@ -888,22 +861,21 @@ Eigen::MatrixXd static_compliance(Model& model, const std::vector<int>& nodes, d
   }
   Eigen::VectorXd R;
   static_forces(sys, data, load_factor, R);
-  const NodalLayout layout(sys);
-  SaddlePoint tangent(sys, layout);
+  ReducedSystem reduced(sys, data);
   NodalCoefficients c;
   c.load_factor = load_factor;
-  if (!tangent.factorize(sys, data, data.sigma, c))
-    throw StaticError("the tangent stiffness is not finite at this state");
-  if (tangent.singular() && sys.n_dof() > 0) {
-    const Eigen::VectorXd dx = tangent.null_direction();
-    const std::string where = dx.size() ? dof_directions(sys, dof_change(sys, data, dx).cwiseQuotient(dof_scale(sys))) : "a direction not located";
+  if (!reduced.factorize(data.sigma, c)) throw StaticError("the tangent stiffness is not finite at this state");
+  if (reduced.saddle().singular() && sys.n_dof() > 0) {
+    const Eigen::VectorXd dx = reduced.saddle().null_direction();
+    const std::string where = dx.size() ? dof_directions(sys, reduced.dofs(dx).cwiseQuotient(dof_scale(sys)))
+                                        : "a direction not located";
     throw StaticError("the tangent stiffness is singular: no stiffness in " + where + "; the compliance is unbounded");
   }
   const Eigen::MatrixXd T = displacement_rows(sys, data, nodes);
   Eigen::MatrixXd TD(T.rows(), T.rows());
-  Eigen::VectorXd dx;
+  Eigen::VectorXd q, dx;
   for (int j = 0; j < T.rows(); ++j) {
-    tangent.solve(T.row(j).transpose(), dx);
+    reduced.solve(reduced.reduce(T.row(j).transpose()), q, dx);
     TD.col(j) = T * dx;
   }
   return TD;

@@ -18,7 +18,7 @@ import numpy as np
 from . import _core
 from ._util import show
 from .errors import InputError
-from .linearize import Linearization, linearized_simulation
+from .linearize import Linearization, linearized_simulation, second_order_eigenvalues
 from .model import Model, Signal
 
 INPUT_KEYWORDS = ("INPUTF", "INPUTS")
@@ -48,8 +48,14 @@ class StateSpace:
 
     def poles(self) -> np.ndarray:
         """Eigenvalues of A in rad/s (complex), sorted by |Im| and then Re: the eigenvalues of
-        :meth:`spacar.Linearization.eigenvalues`."""
-        lam = np.linalg.eigvals(self.A)
+        :meth:`spacar.Linearization.eigenvalues`. While A is that of the second-order equations
+        (no kinematic coordinates), from those in their undamped modes
+        (:func:`spacar.linearize.second_order_eigenvalues`: the slow poles of a fine mesh keep
+        their digits)."""
+        second_order = self._second_order()
+        lam = None if second_order is None else second_order_eigenvalues(*second_order[:3])
+        if lam is None:
+            lam = np.linalg.eigvals(self.A)
         return lam[np.lexsort((lam.real, np.abs(lam.imag)))]
 
     def frequency_response(self, freqs, unit: str = "Hz") -> np.ndarray:

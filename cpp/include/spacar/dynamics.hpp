@@ -34,14 +34,6 @@ inline bool constitutive_class(DefClass c) {
   return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
 }
 
-// Block-diagonal constitutive matrix (ne x ne; stiffness S, or damping D) over the
-// deformations whose stresses are constitutive, as in constitutive_stresses().
-Eigen::MatrixXd global_constitutive(const System& sys, bool damping);
-
-// Tᵀ A T for a block-sparse A (element by element: mass, constitutive, geometric matrices):
-// A taken as a sparse factor, which halves the cost of the dense products.
-Eigen::MatrixXd congruence(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A);
-
 // Solve M̄ q̈ = rhs (3.1) and complete ẍ, ë. Requires positions, DF and velocities.
 // Throws SingularMassError naming the degrees of freedom without inertia.
 void solve_dynamics(const System& sys, Data& data);

@@ -55,6 +55,8 @@ struct NodalLinearization {
   Eigen::SparseMatrix<double> M, D, K, G;   // nx x nx
   Eigen::SparseMatrix<double> A;            // constraint rows x nx
   Eigen::SparseMatrix<double> E;            // nz x nx
+  Eigen::SparseMatrix<double> B;            // ∂e/∂x, ne x nx
+  Eigen::SparseMatrix<double> S, Dc;        // constitutive stiffness and damping, ne x ne
   std::vector<int> free;                    // the free coordinates (the columns the solves use)
   Eigen::VectorXd r0;                       // the residual at the state (drives LINE parameters)
 };
@@ -64,11 +66,14 @@ class Linearizer {
   // Compiles the model with its LINE parameters as coordinates. `dependent`: the dependent
   // Euler parameters of free rotations (as in the analysed system).
   explicit Linearizer(const Model& model, const std::map<int, int>& dependent = {});
+  // How the finite-difference parts (C0, N0, Kk, BK0) are computed: to about 1e-11 relative;
+  // to about 1e-8, at a third of the cost (an implicit integrator's Jacobian); or not at all, at
+  // a state that compute_nodal accepted (at rest in static equilibrium: C0 = N0 = 0, no
+  // kinematic coordinates).
+  enum class Differences { Precise, Fast, None };
   // Linearize about the state of an analysis: sys/data hold a complete evaluation at time
   // data.t, with the complete stresses (the multipliers of the equations of motion).
-  // precise = false: the finite-difference parts (C0, N0, Kk, BK0) to about 1e-8 relative
-  // instead of 1e-11, at a third of the cost (an implicit integrator's Jacobian).
-  Linearization compute(const System& sys, const Data& data, bool precise = true);
+  Linearization compute(const System& sys, const Data& data, Differences differences = Differences::Precise);
   // The nodal linearization at the analysed state (sys/data solved positions, rates and the
   // inputs' motion; no stresses needed): false, and nothing computed, unless the state is at
   // rest (no rates, inputs at rest, no kinematic coordinates) and in static equilibrium (the
@@ -76,7 +81,7 @@ class Linearizer {
   bool compute_nodal(const System& sys, const Data& data, NodalLinearization& out);
   // After compute_nodal: H = the coefficients' combination of K, G, M, D at that state in the
   // saddle-point system (nodal.hpp), factorized; then solves over the free coordinates,
-  // x_f = Z (Zᵀ H Z)⁻¹ Zᵀ b_f. False if the values are not finite.
+  // x_f = Z (Zᵀ H Z)⁻¹ Zᵀ b_f (ReducedSystem: refined in z). False if the values are not finite.
   bool nodal_factorize(const NodalCoefficients& c);
   const SaddlePoint& nodal_system() const;
   void nodal_solve(const double* b, double* x);
@@ -104,9 +109,8 @@ class Linearizer {
   std::unique_ptr<Data> ld_;
   std::vector<int> order_;      // z index → DOF index of the linearization system
   std::unique_ptr<ExplicitChain> chain_;  // the perturbed positions of an open chain; nullptr otherwise
-  // The nodal linearization's numbering, saddle-point system and stresses (compute_nodal).
-  std::unique_ptr<NodalLayout> layout_;
-  std::unique_ptr<SaddlePoint> saddle_;
+  // The nodal linearization's reduced system and stresses (compute_nodal).
+  std::unique_ptr<ReducedSystem> reduced_;
   Eigen::VectorXd nodal_sigma_;
 };
 

@@ -174,7 +174,7 @@ class Simulation {
   // Reactions and complete stresses (FORCEMODE) at the state of the last evaluate().
   void forces();
   // Linearized equations at the state of the last evaluate() (computes the forces first).
-  Linearization linearize(bool precise = true);  // precise: see Linearizer::compute
+  Linearization linearize(Linearizer::Differences differences = Linearizer::Differences::Precise);
   // The linearized equations at rest in the nodal coordinates at the state of the last
   // assemble() or evaluate() (Linearizer::compute_nodal); false if that state is not at rest in
   // static equilibrium. Then the saddle-point solves of the eigen-analyses (linearizer()).
