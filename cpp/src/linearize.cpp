@@ -121,20 +121,33 @@ bool Linearizer::compute_nodal(const System& sys, const Data& data, NodalLineari
     if (data.qhat_d[col] != 0.0 || data.qhat_dd[col] != 0.0) return false;
   set_nominal(sys, data, zs, false);
   // In static equilibrium (then q̈ = 0 and N0 = 0): the reduced residual at rest, the complete
-  // stresses with it.
+  // stresses with it, small against the loads it balances, or Newton's correction from the state
+  // (K0 + G0)⁻¹ R below 1e-8 of the DOFs' sizes (an unloaded structure, whose residual is
+  // rounding).
   Eigen::VectorXd R;
   const double force = static_forces(L, *ld_, 1.0, R);
   const int nz = L.n_dof(), nq = nz - out.n_line;
-  for (int i = 0; i < nq; ++i)
-    if (!(std::abs(R[order_[i]]) * zs.scale[i] <= 1e-8 * force)) return false;
+  nodal_sigma_ = ld_->sigma;
+  reduced_ = std::make_unique<ReducedSystem>(L, *ld_);
+  bool equilibrium = true;
+  for (int i = 0; i < nq; ++i) equilibrium = equilibrium && std::abs(R[order_[i]]) * zs.scale[i] <= 1e-8 * force;
+  if (!equilibrium) {
+    Eigen::VectorXd Rq = R, dq, dx;
+    for (int i = nq; i < nz; ++i) Rq[order_[i]] = 0.0;  // the LINE parameters are held
+    equilibrium = reduced_->factorize(nodal_sigma_, NodalCoefficients()) && !reduced_->saddle().singular();
+    if (equilibrium) reduced_->solve(Rq, dq, dx, 0);
+    for (int i = 0; i < nq && equilibrium; ++i) equilibrium = std::abs(dq[order_[i]]) <= 1e-8 * zs.scale[i];
+  }
+  if (!equilibrium) {
+    reduced_.reset();
+    return false;
+  }
   out.r0.resize(nz);
   for (int i = 0; i < nz; ++i) out.r0[i] = -R[order_[i]];
-  nodal_sigma_ = ld_->sigma;
   out.M = nodal_part(L, *ld_, nodal_sigma_, kMass);
   out.D = nodal_part(L, *ld_, nodal_sigma_, kDamping);
   out.K = nodal_part(L, *ld_, nodal_sigma_, kStiffness);
   out.G = nodal_part(L, *ld_, nodal_sigma_, kGeometric);
-  reduced_ = std::make_unique<ReducedSystem>(L, *ld_);
   out.A = nodal_constraints(L, *ld_, reduced_->layout());
   out.free = reduced_->layout().free;
   // E in the order of z: row i is the row of L's DOF order_[i].

@@ -18,7 +18,7 @@ import numpy as np
 from . import _core
 from ._util import show
 from .errors import InputError
-from .linearize import Linearization, linearized_simulation, second_order_eigenvalues
+from .linearize import Linearization, _count, linearized_simulation, second_order_eigenvalues
 from .model import Model, Signal
 
 INPUT_KEYWORDS = ("INPUTF", "INPUTS")
@@ -150,7 +150,7 @@ class StateSpace:
                 f"{len(self.input_labels)} inputs, {len(self.output_labels)} outputs>")
 
 
-def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
+def state_space(source, at=None, inputs=None, outputs=None, *, modes=None) -> StateSpace:
     """The state-space model of ``source`` linearized about a state.
 
     ``source``: a :class:`spacar.Model`; a :class:`spacar.Linearization`; or a
@@ -165,7 +165,15 @@ def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
     Rate outputs at a moving state include the convective term ∂(DF ż)/∂z, stress outputs need
     ∂σ/∂z and ∂σ/∂ż, and the outputs of a nonholonomic model their derivatives over its kinematic
     coordinates y^k: these come from central differences on the Model, for models without LINE
-    parameters; otherwise they are refused."""
+    parameters; otherwise they are refused.
+
+    ``modes``: the number k of the lowest undamped modes to keep (None: all degrees of freedom).
+    The model is then built on the sparse nodal matrices of a state at rest in static equilibrium
+    (:func:`spacar.linearize`, formulation.md §8), with no dense matrix of the model's size: the
+    states are the modal coordinates and their rates (Φᵀ M Φ = I), A = [[0, I], [−Ω², −Φᵀ D Φ]],
+    and the static response of the truncated modes, C (K⁻¹ − Φ Ω⁻² Φᵀ) F, is kept as the direct
+    feedthrough D, so that the static gain stays exact (the residual flexibility of the modal
+    truncation). For models of thousands of degrees of freedom; damping from EDAMPP."""
     if hasattr(source, "linearizations") and hasattr(source, "time_index"):  # a spacar.Results
         if not source.linearizations:
             raise InputError("state_space: these results have no linearizations (run with LINE or LINEAR 1), "
@@ -186,6 +194,8 @@ def state_space(source, at=None, inputs=None, outputs=None) -> StateSpace:
         raise InputError(f"state_space: a spacar.Model, Linearization or Results, got {show(source)}")
     inputs = _checked(inputs, INPUT_KEYWORDS, "inputs")
     outputs = _checked(outputs, OUTPUT_KEYWORDS, "outputs")
+    if modes is not None:
+        return _build_modal(lin, inputs, outputs, modes)
     return _build(lin, inputs, outputs, velocities)
 
 
@@ -276,6 +286,94 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin,
                       None if k else (lin.M0, lin.damping, lin.stiffness, Q))
+
+
+def _build_modal(lin: Linearization, inputs, outputs, modes) -> StateSpace:
+    """The state space in the lowest undamped modes from the nodal matrices (state_space's
+    ``modes``)."""
+    nodal = getattr(lin, "nodal", None)
+    if nodal is None:
+        raise InputError("state_space: modes= needs a state at rest in static equilibrium (e.g. after "
+                         "spacar.static, or an unloaded model at rest), where the sparse nodal matrices apply; "
+                         "this one is not (the dense model, without modes=, is)")
+    if lin.n_line:
+        raise InputError("state_space: modes= is for models without LINE parameters")
+    sim = lin._sim
+    k = _count(modes, len(lin.z_labels))
+    w2, vx = nodal.modes(sim, k)
+    mass = np.einsum("ij,ij->j", vx, nodal.M @ vx)
+    if not np.all(mass > 0):
+        raise InputError("state_space: a mode moves no mass (a degree of freedom without inertia)")
+    phi = vx / np.sqrt(mass)                                   # Φᵀ M Φ = I
+    nx = nodal.M.shape[0]
+    free = np.zeros(nx, dtype=bool)
+    free[nodal.free] = True
+    defs = {label: i for i, label in enumerate(lin.deformation_labels)}
+    coords = {label: i for i, label in enumerate(lin.coordinate_labels)}
+    classes = sim.system.def_class
+    constitutive = (_core.DefClass.released, _core.DefClass.dynamic)
+
+    def index(sig):
+        on_node = sig.keyword in ("INPUTF", "OUTX", "OUTXP")
+        table = coords if on_node else defs
+        key = (sig.number, sig.index)
+        if key not in table:
+            what = "node {} has no coordinate {}" if on_node else "element {} has no deformation {}"
+            raise InputError(f"{_where(sig)}: {what.format(*key)}")
+        return table[key]
+
+    # Loads on the coordinates of the inputs (nx x m): a force, or −B_kᵀ for a stress.
+    F = np.zeros((nx, len(inputs)))
+    for j, sig in enumerate(inputs):
+        i = index(sig)
+        if sig.keyword == "INPUTF":
+            if not free[i]:
+                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
+                                 "input coordinate)")
+            F[i, j] = 1.0
+        else:
+            if classes[i] not in constitutive:
+                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a deformation "
+                                 "that is not DYNE or released)")
+            F[:, j] = -nodal.B[i].toarray().ravel()
+    # Outputs over the coordinates: positions (and the stresses' elastic part) and rates.
+    Cx, Cv = np.zeros((len(outputs), nx)), np.zeros((len(outputs), nx))
+    for r, sig in enumerate(outputs):
+        i = index(sig)
+        if sig.keyword == "OUTX":
+            Cx[r, i] = 1.0
+        elif sig.keyword == "OUTXP":
+            Cv[r, i] = 1.0
+        elif sig.keyword == "OUTE":
+            Cx[r] = nodal.B[i].toarray().ravel()
+        elif sig.keyword == "OUTEP":
+            Cv[r] = nodal.B[i].toarray().ravel()
+        else:
+            if classes[i] not in constitutive:
+                raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
+                                 "constitutive, σ = S e + D ė); this one is a reaction stress")
+            Cx[r] = (nodal.S[i] @ nodal.B).toarray().ravel()
+            Cv[r] = (nodal.Dc[i] @ nodal.B).toarray().ravel()
+    Q = phi.T @ F
+    damping = phi.T @ (nodal.D @ phi)
+    A = np.block([[np.zeros((k, k)), np.eye(k)], [-np.diag(w2), -damping]])
+    B = np.vstack([np.zeros((k, len(inputs))), Q])
+    C = np.hstack([Cx @ phi, Cv @ phi])
+    # The static response of the modes left out, as a feedthrough: C (K⁻¹ − Φ Ω⁻² Φᵀ) F.
+    D = np.zeros((len(outputs), len(inputs)))
+    if len(inputs) and np.any(Cx):
+        info = sim.nodal_factorize(1.0, 1.0, 0.0, 0.0)
+        if not info["ok"] or info["singular"]:
+            raise InputError("state_space: the stiffness K0 + G0 is singular (a free rigid-body motion): the "
+                             "static correction of the truncated modes needs a supported model")
+        static = np.zeros((nx, len(inputs)))
+        for j in range(len(inputs)):
+            static[nodal.free, j] = sim.nodal_solve(F[nodal.free, j])
+        D = Cx @ (static - phi @ (Q / w2[:, None]))
+    states = [f"mode({i + 1})" for i in range(k)] + [f"moded({i + 1})" for i in range(k)]
+    return StateSpace(A, B, C, D, states, [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
+                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin,
+                      (np.eye(k), damping, np.diag(w2), Q))
 
 
 def _sensitivities(lin, outputs, velocities) -> dict:
