@@ -174,11 +174,16 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
   };
   // Elements that determine their unknowns alone are taken first: small blocks, and a beam after
   // the hinge that turns its end is solved in closed form.
-  for (bool progress = true; progress && !pending.empty();) {
+  // Taken elements are marked (is_pending) and dropped from the list only when they are more than
+  // half of it, and the scan starts after the taken ones at its front: linear in the number of
+  // elements for a chain in any order (erasing each taken element at once made it quadratic).
+  size_t first = 0, taken = 0;
+  for (bool progress = true; progress && first < pending.size();) {
     progress = false;
     for (int pass = 0; pass < 2 && !progress; ++pass)
-      for (size_t p = 0; p < pending.size() && !progress; ++p) {
+      for (size_t p = first; p < pending.size() && !progress; ++p) {
         const int i = pending[p];
+        if (!is_pending[i]) continue;
         const std::vector<int> U = unknown_coords(sys, known, i);
         if (U.empty()) return nullptr;  // rows on known coordinates only: a loop closes here
         const std::vector<int> group = group_of(i, U, pass == 0);
@@ -186,13 +191,18 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
         chain->blocks_.push_back(make_block(sys, group, U));
         for (int g : U) known[g] = 1;
         for (int j : group) is_pending[j] = 0;
-        pending.erase(std::remove_if(pending.begin(), pending.end(),
-                                     [&](int j) { return std::find(group.begin(), group.end(), j) != group.end(); }),
-                      pending.end());
+        taken += group.size();
         progress = true;
       }
+    while (first < pending.size() && !is_pending[pending[first]]) ++first, --taken;
+    if (2 * taken > pending.size() - first) {
+      pending.erase(std::remove_if(pending.begin() + first, pending.end(), [&](int j) { return !is_pending[j]; }),
+                    pending.end());
+      pending.erase(pending.begin(), pending.begin() + first);
+      first = taken = 0;
+    }
   }
-  if (!pending.empty()) return nullptr;
+  if (first < pending.size()) return nullptr;
   chain->all_closed_ = std::all_of(chain->blocks_.begin(), chain->blocks_.end(),
                                    [](const Block& b) { return b.closed_end >= 0; });
   for (int g : sys.x_calc)
@@ -371,6 +381,7 @@ void ExplicitChain::transfer_transposed(const System& sys, Data& data, const Eig
     for (size_t j = 0; j < b.rows.size(); ++j) {
       const int col = sys.qhat_col_e[b.rows[j].def];
       if (col >= 0) out[col] += b.dx[static_cast<int>(j)];
+      data.sol_V[sys.row_V[b.rows[j].def]] = b.dx[static_cast<int>(j)];
     }
   }
   for (int g = 0; g < sys.nx; ++g)

@@ -367,6 +367,17 @@ void solve_velocities_direct(const System& sys, Data& data) {
   deformation_rates(sys, data);
 }
 
+void rest_velocities(const System& sys, Data& data, bool factorize) {
+  if (factorize && !sys.x_calc.empty()) factorize_velocity_block(sys, data);
+  data.xd.setZero();
+  data.ed.setZero();
+  data.conv.setZero();
+  for (ElementWork& w : data.work) {
+    w.v.setZero();
+    w.c.setZero();
+  }
+}
+
 void deformation_rates(const System& sys, Data& data) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];

@@ -41,15 +41,12 @@ namespace {
 void add_constitutive(const System& sys, const SystemElement& se, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
                       double coefficient, const NodalLayout* layout, Eigen::MatrixXd& out) {
   if (coefficient == 0.0 || !se.has_constitutive) return;
-  Eigen::MatrixXd CB = Eigen::MatrixXd::Zero(se.nd, B.cols());
-  bool any = false;
   for (int a = 0; a < se.nd; ++a) {
     if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
     for (int b = 0; b < se.nd; ++b)
-      if (C(a, b) != 0.0 && !(layout && layout->row_of[se.def_offset + b] >= 0)) CB.row(a) += C(a, b) * B.row(b);
-    any = true;
+      if (C(a, b) != 0.0 && !(layout && layout->row_of[se.def_offset + b] >= 0))
+        out.noalias() += (coefficient * C(a, b)) * B.row(a).transpose() * B.row(b);
   }
-  if (any) out.noalias() += coefficient * B.transpose() * CB;
 }
 
 // −∂f/∂x of the gravity load of the element's mass (central differences, symmetrized: the load
@@ -80,11 +77,10 @@ void element_rest(const System& sys, const Data& data, size_t i, const Eigen::Ve
   const int n = static_cast<int>(se.coords.size());
   out.setZero(n, n);
   if (c.geometric != 0.0) {
-    const Eigen::VectorXd s = sigma.segment(se.def_offset, se.nd);
-    if (s.any()) {
-      Eigen::MatrixXd G(n, n);
-      se.kernel->stress_hessian(w.x.data(), s.data(), G.data());
-      out += c.geometric * G;
+    const double* s = sigma.data() + se.def_offset;
+    if (std::any_of(s, s + se.nd, [](double v) { return v != 0.0; })) {
+      se.kernel->stress_hessian(w.x.data(), s, out.data());
+      out *= c.geometric;
     }
     if (se.has_mass && sys.gravity.squaredNorm() > 0.0 && c.load_factor != 0.0)
       add_gravity_stiffness(sys, se, w, c.geometric * c.load_factor, out);
@@ -380,7 +376,8 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
     const SystemElement& se = sys.elements[i];
     const Eigen::MatrixXd& B = data.work[i].B;
     const int n = static_cast<int>(se.coords.size());
-    Eigen::MatrixXd As = Eigen::MatrixXd::Zero(se.nd, n);
+    Eigen::MatrixXd& As = rows_;
+    As.setZero(se.nd, n);
     local_.setZero(n, n);
     for (int a = 0; a < se.nd; ++a) {
       const int r = layout_.row_of[se.def_offset + a];

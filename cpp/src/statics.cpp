@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "spacar/chain.hpp"
 #include "spacar/dynamics.hpp"
 #include "spacar/kinematics.hpp"
 #include "spacar/limits.hpp"
@@ -45,13 +46,13 @@ std::string dof_name(const System& sys, int j) {
 }
 
 double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K,
-                     Eigen::VectorXd* full_load) {
+                     Eigen::VectorXd* full_load, ExplicitChain* chain) {
   const int nd = sys.n_dof();
   // At rest: no rates, no accelerations, hence no inertia or convective forces. The velocity
-  // block is factorized here, for the transposed solve below.
+  // block (or the chain's blocks) is factorized here, for the transposed solve below.
   data.qhat_d.setZero();
   data.qhat_dd.setZero();
-  solve_velocities_direct(sys, data);
+  rest_velocities(sys, data, !chain);  // a chain factorizes its blocks in its transposed solve
   data.xdd.setZero();
   data.edd.setZero();
   compute_inertia_and_loads(sys, data);
@@ -73,7 +74,8 @@ double static_forces(const System& sys, Data& data, double lambda, Eigen::Vector
   // y → 0 at equilibrium. With them Σ σ_k H_k is exactly the derivative of DF_q (the
   // second-order transfer) contracted with w.
   Eigen::VectorXd out;
-  transfer_transposed(sys, data, w, out);
+  if (chain) chain->transfer_transposed(sys, data, w, out);
+  else transfer_transposed(sys, data, w, out);
   R.resize(nd);
   for (int j = 0; j < nd; ++j) R[j] = out[sys.dof_cols[j]];
   if (!sys.x_calc.empty())
@@ -135,7 +137,7 @@ class EquilibriumPath {
  public:
   EquilibriumPath(const System& sys, Data& data, const StaticOptions& opt, StaticResults& res)
       : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()), reduced_(sys, data), tangent_(reduced_.saddle()),
-        scale_(dof_scale(sys)) {
+        chain_(ExplicitChain::detect(sys)), scale_(dof_scale(sys)) {
     // Inputs at the block start (λ = 0) and end (λ = 1), ordered as input_cols.
     const double tp = sys.settings.timestep_tp;
     p0_ = sys.p0;
@@ -155,7 +157,7 @@ class EquilibriumPath {
   // for an unloaded stress-free start, the equilibrium of the block before otherwise. The path
   // solves R(q, λ) − (1 − λ) R0 = 0: it begins exactly at the current state, and from one block
   // to the next the loads change gradually instead of being released and applied again.
-  void start() { static_forces(sys_, data_, 0.0, R0_); }
+  void start() { static_forces(sys_, data_, 0.0, R0_, nullptr, nullptr, chain_.get()); }
 
   // Equilibrium at load factor λ, starting from the current state. The sign of det K must stay
   // that of the start: a change during the iterations means that the step crosses a limit or
@@ -266,13 +268,15 @@ class EquilibriumPath {
     if (sys_.n_input() > 0 && p1_ != p0_) {
       Eigen::VectorXd rate = Eigen::VectorXd::Zero(sys_.n_qhat()), dx_p;
       for (int i = 0; i < sys_.n_input(); ++i) rate[sys_.input_cols[i]] = p1_[i] - p0_[i];
-      transfer_times(sys_, data_, rate, dx_p);
+      if (chain_) chain_->transfer_times(sys_, data_, rate, dx_p);
+      else transfer_times(sys_, data_, rate, dx_p);
       NodalCoefficients c;
       c.load_factor = lambda;
       g += nodal_matrix(sys_, data_, data_.sigma, c) * dx_p;
     }
     Eigen::VectorXd out;
-    transfer_transposed(sys_, data_, g, out);
+    if (chain_) chain_->transfer_transposed(sys_, data_, g, out);
+    else transfer_transposed(sys_, data_, g, out);
     R -= (1.0 - lambda) * R0_;
     Fs = scale_.cwiseProduct(R);
     gs.resize(nd_);
@@ -309,7 +313,7 @@ class EquilibriumPath {
   // The state at the current positions for load factor λ: R − (1 − λ) R0 and the tangent
   // factorized.
   double evaluate_here(double lambda, Eigen::VectorXd& R, Eigen::VectorXd* full_load = nullptr) {
-    const double force = static_forces(sys_, data_, lambda, R, nullptr, full_load);
+    const double force = static_forces(sys_, data_, lambda, R, nullptr, full_load, chain_.get());
     R -= (1.0 - lambda) * R0_;
     NodalCoefficients c;
     c.load_factor = lambda;
@@ -337,10 +341,14 @@ class EquilibriumPath {
     data_.qhat = qhat;
     for (int g : sys_.x_input) data_.x[g] = qhat[sys_.qhat_col_x[g]];
     for (int g : sys_.x_dyn) data_.x[g] = qhat[sys_.qhat_col_x[g]];
-    // Full Newton on the positions: the steps between static iterates are large, and the chord
-    // iteration with the last velocity block (meant for small time steps) would crawl.
+    // An open chain element by element (closed form for planar beams); otherwise full Newton on
+    // the positions: the steps between static iterates are large, and the chord iteration with
+    // the last velocity block (meant for small time steps) would crawl.
+    const int iterations = std::max(sys_.settings.maxiterat, 50);
+    const double tol = std::min(sys_.settings.epskin, 1e-10);
     data_.jacobian_reusable = false;
-    solve_positions(sys_, data_, std::max(sys_.settings.maxiterat, 50), std::min(sys_.settings.epskin, 1e-10), false);
+    if (chain_) chain_->solve_positions(sys_, data_, iterations, tol);
+    else solve_positions(sys_, data_, iterations, tol, false);
     res_.kinematic_iterations += data_.newton_iterations;
   }
 
@@ -353,6 +361,7 @@ class EquilibriumPath {
   const int nd_;
   ReducedSystem reduced_;
   SaddlePoint& tangent_;   // reduced_'s saddle-point system
+  std::unique_ptr<ExplicitChain> chain_;  // the kinematics of an open chain; nullptr otherwise
   bool factorized_ = false;
   Eigen::VectorXd scale_;        // characteristic size of each DOF: lengths vs angles
   Eigen::VectorXd p0_, p1_;

@@ -51,8 +51,13 @@ class ExplicitChain {
   // convective terms, and the blocks factorized there).
   void solve_accelerations(const System& sys, Data& data);
   // out = DFᵀ w (n_qhat), as transfer_transposed() with the velocity block: the blocks'
-  // transposed solves in reverse order.
+  // transposed solves in reverse order; leaves the multipliers μ of the rows in data.sol_V (by
+  // velocity row), as that does.
   void transfer_transposed(const System& sys, Data& data, const Eigen::VectorXd& w, Eigen::VectorXd& out);
+  // dx = DF v for rates v of q̂, as transfer_times() with the velocity block.
+  void transfer_times(const System& sys, Data& data, const Eigen::VectorXd& v, Eigen::VectorXd& dx) {
+    rates(sys, data, v, false, dx);
+  }
 
   int blocks() const { return static_cast<int>(blocks_.size()); }
   int closed_form_blocks() const {  // solved without iterations (Block::closed_end)

@@ -48,6 +48,11 @@ void solve_velocities(const System& sys, Data& data);
 // velocity block, ė = B ẋ, and the convective terms c.
 void solve_velocities_direct(const System& sys, Data& data);
 
+// The state at rest as solve_velocities_direct leaves it for zero rates (ẋ, ė and the convective
+// terms zero) and, if `factorize`, the velocity block factorized at the current positions: the
+// static analyses.
+void rest_velocities(const System& sys, Data& data, bool factorize = true);
+
 // ė = B ẋ and the convective terms c, element by element, for the current ẋ.
 void deformation_rates(const System& sys, Data& data);
 

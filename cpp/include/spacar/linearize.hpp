@@ -42,7 +42,7 @@ struct Linearization {
   }
 };
 
-// The linearized equations at rest in the nodal coordinates (formulation.md §8): for a state
+// The linearized equations at rest in the nodal coordinates (docs/formulation.md §10): for a state
 // without rates, inputs at rest and in static equilibrium, where C0 = N0 = 0, the matrices of
 // Linearization are M0 = Zᵀ M Z, D0 = Zᵀ D Z, K0 = Zᵀ K Z and G0 = Zᵀ G Z with Z = DF_z, the
 // transfer function of z; here M, D, K, G are the sparse nodal matrices (over all coordinates,

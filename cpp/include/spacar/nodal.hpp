@@ -1,4 +1,4 @@
-// The analyses of flexible structures in the nodal coordinates (formulation.md §8): the
+// The analyses of flexible structures in the nodal coordinates (docs/formulation.md §10): the
 // stiffness, geometric stiffness, mass and damping assembled element by element as sparse
 // matrices over the free coordinates x_f = (x^c, x^d), and the constraint rows A, the velocity
 // rows whose deformation is not a degree of freedom (rigid, input, LINE), restricted to x_f.
@@ -132,7 +132,7 @@ class SaddlePoint {
   bool singular_ = false, factorized_ = false;
   int sign_ = 1, negative_ = -1;
   Eigen::VectorXd rhs_, sol_, res_;
-  Eigen::MatrixXd local_;
+  Eigen::MatrixXd local_, rows_;  // an element's block of H and its rows of A (work space)
   std::vector<Eigen::MatrixXd> rest_;
 };
 

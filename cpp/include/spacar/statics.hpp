@@ -9,7 +9,7 @@
 // generalized form when a block continues from an equilibrium).
 // Full Newton with the exact tangent stiffness ∂R/∂q = K0 + G0 of the linearization (structural
 // plus geometric, formulation.md §7.2; C0 = N0 = 0 at rest), solved through the sparse
-// saddle-point system of the nodal coordinates (nodal.hpp, formulation.md §8): no dense matrix
+// saddle-point system of the nodal coordinates (nodal.hpp, docs/formulation.md §10): no dense matrix
 // of the model's size is formed. λ from 0 to 1 in equal load steps,
 // a step halved when Newton fails there. No mass is needed. With arc_length the path is followed
 // in (q, λ) instead (Riks' normal-plane arc-length method): past limit points, λ rising and
@@ -67,8 +67,9 @@ struct StaticResults {
 // functions formed): for tests and small models; the static path itself solves with the
 // sparse tangent of the nodal coordinates (nodal.hpp). Returns the scale of R: the largest
 // applied or elastic load on a coordinate (loads on lengths times the mean element length).
+// chain: the kinematics of an open chain (its blocks' solves instead of the velocity block's).
 double static_forces(const System& sys, Data& data, double lambda, Eigen::VectorXd& R, Eigen::MatrixXd* K = nullptr,
-                     Eigen::VectorXd* full_load = nullptr);
+                     Eigen::VectorXd* full_load = nullptr, ExplicitChain* chain = nullptr);
 
 // "DYNX node 3 component 2" / "DYNE element 2 (PLBEAM) deformation 3" of degree of freedom j.
 std::string dof_name(const System& sys, int j);

@@ -71,6 +71,71 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
     }
   }
 
+  // G = Σ σ_a ∂²e_a/∂x² written out (the static tangent and the linearization assemble it for
+  // every element at every Newton iteration; the nested jets cost 20 times more). In the
+  // variables (d, φp, φq), d = x_q − x_p: with g(d, φ) = (l0/l) d·n(φ), n = (−sin φ, cos φ),
+  // m = (cos φ, sin φ), u = d·n, t = d/l,
+  //   ∂²g/∂d² = (l0/l²)[(3 t tᵀ − I) u/l − (n tᵀ + t nᵀ)],  ∂²g/∂d∂φ = −(l0/l)(m − (t·m) t),
+  //   ∂²g/∂φ² = −(l0/l) u,  and ∂²l/∂d² = (I − t tᵀ)/l;
+  // e2 = −g(d, φp), e3 = g(d, φq); PLBEAMNL's elongation adds the bending term's Hessian.
+  void stress_hessian(const double* x, const double* sigma, double* G) const override {
+    const double dx = x[3] - x[0], dy = x[4] - x[1];
+    const double l = std::sqrt(dx * dx + dy * dy), inv = 1.0 / l;
+    const Eigen::Vector2d d(dx, dy), t = d * inv;
+    const double k = l0_ * inv;
+    // Per end: n, m, u; the gradient of g in (d, φ) and its Hessian blocks.
+    struct End {
+      Eigen::Vector2d n, m, gd;   // gd = ∂g/∂d
+      double u, gphi;            // gphi = ∂g/∂φ
+      Eigen::Matrix2d hdd;
+      Eigen::Vector2d hdphi;
+      double hphiphi;
+    };
+    auto end = [&](double phi) {
+      End e;
+      e.n << -std::sin(phi), std::cos(phi);
+      e.m << std::cos(phi), std::sin(phi);
+      e.u = d.dot(e.n);
+      e.gd = k * (e.n - e.u * inv * t);
+      e.gphi = -k * d.dot(e.m);
+      e.hdd = (k * inv) * ((3.0 * t * t.transpose() - Eigen::Matrix2d::Identity()) * (e.u * inv) -
+                           (e.n * t.transpose() + t * e.n.transpose()));
+      e.hdphi = -k * (e.m - t.dot(e.m) * t);
+      e.hphiphi = -k * e.u;
+      return e;
+    };
+    const End p = end(alpha0_ + x[2]), q = end(alpha0_ + x[5]);
+    // The Hessian in (dx, dy, φp, φq): σ1 ∇²e1 + σ2 ∇²e2 + σ3 ∇²e3, e2 = −g_p, e3 = g_q.
+    double s1 = sigma[0], s2 = sigma[1], s3 = sigma[2];
+    Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+    H.topLeftCorner<2, 2>() = s1 * (Eigen::Matrix2d::Identity() - t * t.transpose()) * inv;
+    if constexpr (Nonlinear) {
+      // e1 += c(e2, e3) = (2 e2² + e2 e3 + 2 e3²)/(30 l0): ∇²c = c22 ∇e2∇e2ᵀ + c23 (∇e2∇e3ᵀ +
+      // ∇e3∇e2ᵀ) + c33 ∇e3∇e3ᵀ + ∂c/∂e2 ∇²e2 + ∂c/∂e3 ∇²e3.
+      const double e2 = -k * p.u, e3 = k * q.u, w = 1.0 / (30.0 * l0_);
+      Eigen::Vector4d g2, g3;
+      g2 << -p.gd, -p.gphi, 0.0;
+      g3 << q.gd, 0.0, q.gphi;
+      H += s1 * w * (4.0 * g2 * g2.transpose() + g2 * g3.transpose() + g3 * g2.transpose() + 4.0 * g3 * g3.transpose());
+      s2 += s1 * w * (4.0 * e2 + e3);
+      s3 += s1 * w * (e2 + 4.0 * e3);
+    }
+    // −s2 ∇²g_p + s3 ∇²g_q.
+    H.topLeftCorner<2, 2>() += -s2 * p.hdd + s3 * q.hdd;
+    H.block<2, 1>(0, 2) += -s2 * p.hdphi;
+    H.block<2, 1>(0, 3) += s3 * q.hdphi;
+    H(2, 2) += -s2 * p.hphiphi;
+    H(3, 3) += s3 * q.hphiphi;
+    H.block<1, 2>(2, 0) = H.block<2, 1>(0, 2).transpose();
+    H.block<1, 2>(3, 0) = H.block<2, 1>(0, 3).transpose();
+    // To x = (x_p, y_p, βp, x_q, y_q, βq): d = x_q − x_p, φp = α0 + βp, φq = α0 + βq.
+    Eigen::Map<Eigen::Matrix<double, 6, 6>> Gm(G);
+    static const int where[6] = {0, 1, 2, 0, 1, 3};        // (dx, dy, φp, dx, dy, φq)
+    static const double sign[6] = {-1.0, -1.0, 1.0, 1.0, 1.0, 1.0};
+    for (int b = 0; b < 6; ++b)
+      for (int a = 0; a < 6; ++a) Gm(a, b) = sign[a] * sign[b] * H(where[a], where[b]);
+  }
+
   // The inverse of deform() for one end: l = l0 + e1 (less PLBEAMNL's bending elongation), the
   // chord angle α from the known end's tangent angle and its bending deformation
   // (e2 = l0 sin(φp − α), e3 = l0 sin(α − φq)), then the other end's position and tangent angle.
