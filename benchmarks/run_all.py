@@ -25,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import cantilever  # noqa: E402
 import chains  # noqa: E402
 import fourbar  # noqa: E402
+import modes  # noqa: E402
 import newton  # noqa: E402
 import slidercrank  # noqa: E402
 import slidercrank_exudyn  # noqa: E402
@@ -40,6 +41,7 @@ CASES = {
     "slidercrank_exudyn": slidercrank_exudyn,
     "stiff": stiff,
     "statics": statics,
+    "modes": modes,
 }
 
 

@@ -13,7 +13,7 @@ so C_ij is the displacement i of the node per unit load j on it (a small load ad
 block's loads). For a LAMBDA node the rows of T are the small rotation vector in global axes,
 δθ = 2 E(λ) δλ (docs/formulation.md §2): the rotations are compliant to moments in global axes.
 K is never formed: each column of C is one solve of the sparse saddle-point system of the nodal
-coordinates (docs/formulation.md §8), so the cost grows linearly with the size of the model.
+coordinates (docs/formulation.md §10), so the cost grows linearly with the size of the model.
 """
 from __future__ import annotations
 

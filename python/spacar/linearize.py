@@ -38,8 +38,9 @@ class Linearization:
 
     # Models with more degrees of freedom than this solve eigenfrequencies(k=...) and
     # buckling_factors(k=...) on the sparse nodal matrices (when they are available) rather than
-    # the dense reduced ones.
-    SPARSE_ABOVE = 200
+    # the dense reduced ones (benchmarks/modes.py: the sparse path is the faster from about 50
+    # degrees of freedom on).
+    SPARSE_ABOVE = 50
 
     def __init__(self, d: dict, coordinate_labels, deformation_labels):
         """From the dictionary of the core (``Simulation.linearize()``, the on_output state)."""
@@ -124,15 +125,16 @@ class Linearization:
         """Whether an eigen-analysis of k values takes the sparse nodal path."""
         if method not in ("auto", "dense", "sparse"):
             raise InputError(f"method must be 'auto', 'dense' or 'sparse', got {show(method)}")
-        nodal = "_sim" in self.__dict__
+        nodal, nz = "_sim" in self.__dict__, len(self.z_labels)
         if method == "sparse":
             if not nodal:
                 raise InputError("the sparse eigen-analysis needs a linearization at rest in static equilibrium "
                                  "from spacar.linearize(model) (this one is not)")
-            if k is None:
-                raise InputError("the sparse eigen-analysis computes the lowest k values: give k")
+            if k is None or not k < nz - 1:
+                raise InputError(f"the sparse eigen-analysis computes the lowest k values, k < {nz - 1} (the "
+                                 f"coordinates less one; use method='dense' for all): got k = {show(k)}")
             return True
-        return method == "auto" and nodal and k is not None and len(self.z_labels) > self.SPARSE_ABOVE
+        return method == "auto" and nodal and k is not None and nz > self.SPARSE_ABOVE and k < nz - 1
 
     @property
     def stiffness(self) -> np.ndarray:
@@ -188,10 +190,10 @@ class Linearization:
 
         ``k``: only the k lowest (by |ω²|; None: all). ``method``: "dense" solves the reduced
         matrices (all modes, small models); "sparse" the nodal matrices of a linearization at
-        rest in static equilibrium (formulation.md §8) for the k lowest, in shift-invert mode
+        rest in static equilibrium (docs/formulation.md §10) for the k lowest, in shift-invert mode
         (ARPACK), with a cost that grows linearly with the mesh; "auto" (default) takes the
-        sparse path when k is given, the linearization has it, and the model has more than
-        ``Linearization.SPARSE_ABOVE`` degrees of freedom."""
+        sparse path when k is given (fewer than the coordinates less one), the linearization has
+        it, and the model has more than ``Linearization.SPARSE_ABOVE`` (50) degrees of freedom."""
         w2 = self._modes(k, method)[0]
         return np.sign(w2) * np.sqrt(np.abs(w2)) / (2 * np.pi)
 
@@ -343,7 +345,7 @@ def _count(k, nz: int) -> int:
 
 
 class NodalMatrices:
-    """The linearized equations at rest in the nodal coordinates (formulation.md §8), sparse
+    """The linearized equations at rest in the nodal coordinates (docs/formulation.md §10), sparse
     (scipy.sparse, over all nx coordinates, those of fixed and input coordinates zero): ``M``
     mass, ``D`` damping (EDAMPP), ``K`` structural stiffness (ESTIFF), ``G`` geometric stiffness
     (the complete stresses and the loads' stiffness); ``A`` the constraint rows (rigid, input and
@@ -385,7 +387,6 @@ class NodalMatrices:
         op = sla.LinearOperator(M.shape, matvec=lambda b: sim.nodal_solve(np.asarray(b, dtype=float).ravel()),
                                 dtype=float)
         v0 = sim.nodal_solve(np.ones(M.shape[0]))
-        k = min(k, _arpack_max(M.shape[0]))
         if info["symmetric"]:
             w2, vf = sla.eigsh(M, k=k, M=M, sigma=sigma, OPinv=op, which="LM", v0=v0)
         else:
@@ -414,7 +415,6 @@ class NodalMatrices:
                               "the sparse buckling analysis needs a regular K0; use method='dense'")
         op = sla.LinearOperator(G.shape, matvec=lambda b: sim.nodal_solve(-(G @ np.asarray(b, dtype=float).ravel())),
                                 dtype=float)
-        k = min(k, _arpack_max(G.shape[0]))
         nu, vf = sla.eigs(op, k=k, which="LM", v0=sim.nodal_solve(np.ones(G.shape[0])))
         keep = np.abs(nu) > 0
         real = np.abs(np.imag(nu)) <= 1e-6 * np.abs(nu)
@@ -426,10 +426,6 @@ class NodalMatrices:
         order = np.argsort(np.abs(mu))
         return mu[order], self._scatter(vf[:, order])
 
-
-def _arpack_max(n: int) -> int:
-    """The most eigenvalues ARPACK computes of an n x n problem."""
-    return max(n - 2, 1)
 
 
 def linearize(model, state=None) -> Linearization:

@@ -67,6 +67,8 @@ def _int_pairs(labels) -> list:
     """Labels (node or element, index) as pairs of Python ints. The core's and a results file's
     are lists of int pairs already, taken as a whole (a short run's results stay cheap); others
     (NumPy integers) are converted."""
+    if isinstance(labels, np.ndarray):  # an (n, 2) integer array: converted in C
+        return list(map(tuple, labels.tolist()))
     pairs = list(map(tuple, labels))
     if pairs and not (set(map(len, pairs)) == {2} and type(pairs[0][0]) is int and type(pairs[0][1]) is int):
         pairs = [(int(a), int(b)) for a, b in pairs]
@@ -93,10 +95,14 @@ def dof_labels(system, core, coords=None, defs=None) -> list:
     # 20-link spatial chain): taken once (inside the loops, a chain of 4000 beams took minutes).
     coords = system.coord_label if coords is None else coords
     defs = system.def_label if defs is None else defs
+    coords, defs = (a.tolist() if isinstance(a, np.ndarray) else a for a in (coords, defs))
     out = [f"x({n},{c})" for n, c in (coords[g] for g in system.x_dyn)]
+    types = {}  # element → its type name: one call per element, not per deformation
     for k in system.e_dyn:
         e, i = defs[k]
-        out.append(f"e({e},{i}) {core.element_type_name(e)}")
+        if e not in types:
+            types[e] = core.element_type_name(e)
+        out.append(f"e({e},{i}) {types[e]}")
     return out
 
 

@@ -169,7 +169,7 @@ def state_space(source, at=None, inputs=None, outputs=None, *, modes=None) -> St
 
     ``modes``: the number k of the lowest undamped modes to keep (None: all degrees of freedom).
     The model is then built on the sparse nodal matrices of a state at rest in static equilibrium
-    (:func:`spacar.linearize`, formulation.md §8), with no dense matrix of the model's size: the
+    (:func:`spacar.linearize`, docs/formulation.md §10), with no dense matrix of the model's size: the
     states are the modal coordinates and their rates (Φᵀ M Φ = I), A = [[0, I], [−Ω², −Φᵀ D Φ]],
     and the static response of the truncated modes, C (K⁻¹ − Φ Ω⁻² Φᵀ) F, is kept as the direct
     feedthrough D, so that the static gain stays exact (the residual flexibility of the modal

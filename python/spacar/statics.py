@@ -45,9 +45,10 @@ def _results(arrays: dict, model) -> Results:
         "limit_points": [float(v) for v in arrays["limit_points"]],
         "wall_time": float(arrays["wall_time"]),
     }
-    # The degrees of freedom of the system the solve compiled.
-    system = SimpleNamespace(**{k: arrays[k] for k in ("coord_label", "def_label", "x_dyn", "e_dyn")})
-    res = Results(table, arrays["coord_label"], arrays["def_label"], stats, dof_labels=dof_labels(system, model.core))
+    # The degrees of freedom of the system the solve compiled; its labels converted once.
+    coords, defs = arrays["coord_label"].tolist(), arrays["def_label"].tolist()
+    system = SimpleNamespace(coord_label=coords, def_label=defs, x_dyn=arrays["x_dyn"], e_dyn=arrays["e_dyn"])
+    res = Results(table, coords, defs, stats, dof_labels=dof_labels(system, model.core))
     # A copy of the model at the end of the solve: res.geometry is built from it when first used,
     # and spacar.compliance(res, node) takes the loads and elements from it (not pickled).
     res._geometry_source = core = model.core.copy()
