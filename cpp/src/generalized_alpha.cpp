@@ -35,9 +35,8 @@ GeneralizedAlpha::GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf
   gamma_d_ = gamma_ * c;
   beta_d_ = beta_ * c;
   set_tolerances(Eigen::VectorXd::Constant(n, 1e-6), Eigen::VectorXd::Constant(n, 1e-6));
-  J_.setZero(n, n);
-  N_.setZero(nz_, nz_);
-  lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(nz_);
+  // J_, N_ and lu_ (dense, n² and nz²) are sized at the first Jacobian: a Newton system
+  // (set_newton_system) never needs them.
   for (Eigen::VectorXd* v : {&d_, &a_, &a_use_, &d_new_, &a_new_, &d_prev_, &dd_, &res_}) v->setZero(nz_);
   for (Eigen::VectorXd* v : {&y_new_, &fy_, &scale_, &y_out_}) v->setZero(n);
   wv_.setZero(m);
@@ -74,6 +73,10 @@ double GeneralizedAlpha::last_step() const { return h_last_; }
 void GeneralizedAlpha::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
 void GeneralizedAlpha::set_step_start(StepStart start) { step_start_ = std::move(start); }
 void GeneralizedAlpha::set_jacobian(Jacobian jac) { jac_ = std::move(jac); }
+void GeneralizedAlpha::set_newton_system(NewtonSystem system) {
+  if (nz_ != m_) throw std::invalid_argument("GeneralizedAlpha: a Newton system needs the rates as the only other states");
+  system_ = std::move(system);
+}
 void GeneralizedAlpha::set_residual(Residual residual, Weight weight) {
   residual_ = std::move(residual);
   weight_ = std::move(weight);
@@ -122,13 +125,41 @@ void GeneralizedAlpha::apply_weight(Eigen::VectorXd& v) {
 // respect to D⁺; in the residual form its rate rows times W_v.
 void GeneralizedAlpha::factorize(double h) {
   const double gh = gamma_d_ * h, bh2 = beta_d_ * h * h;
+  factorized_residual_form_ = in_residual_form_;
+  ++stats_.ndec;
+  if (system_.factorize) {  // S = W_v N, the same in both forms (newton_solve weighs the other)
+    system_.factorize(gh, bh2);
+    return;
+  }
   N_ = -gh * J_.bottomRightCorner(nz_, nz_);
   N_.diagonal().array() += 1.0;
   N_.middleCols(r0_ - m_, m_) -= bh2 * J_.bottomLeftCorner(nz_, m_);
   if (in_residual_form_) N_.middleRows(r0_ - m_, m_) = (W_ * N_.middleRows(r0_ - m_, m_)).eval();
   lu_.compute(N_);
-  factorized_residual_form_ = in_residual_form_;
-  ++stats_.ndec;
+}
+
+void GeneralizedAlpha::newton_solve(const Eigen::VectorXd& r, Eigen::VectorXd& x) {
+  if (!system_.solve) {
+    x = lu_.solve(r);
+    return;
+  }
+  // The residual form's r is W_v (D − f): S⁻¹ r; the other form's f − D: N⁻¹ = S⁻¹ W_v.
+  if (in_residual_form_) {
+    system_.solve(r, x);
+    return;
+  }
+  system_.weight(r, wv_);
+  system_.solve(wv_, x);
+}
+
+void GeneralizedAlpha::filter(Eigen::VectorXd& v, Eigen::VectorXd& x) {
+  if (!system_.solve) {
+    apply_weight(v);  // N⁻¹ = (W_v N)⁻¹ W_v in the residual form
+    x = lu_.solve(v);
+    return;
+  }
+  system_.weight(v, wv_);
+  system_.solve(wv_, x);
 }
 
 void GeneralizedAlpha::state_at(double h, const Eigen::VectorXd& y) {
@@ -167,7 +198,7 @@ GeneralizedAlpha::Attempt GeneralizedAlpha::newton(const Rhs& f, double t, doubl
     newton_its_ = it;
     state_at(h, y);
     if (!newton_residual(f, t + h)) return Attempt::Failed;
-    dd_ = lu_.solve(res_);
+    newton_solve(res_, dd_);
     // The increment's effect on the states, in units of the tolerance.
     const double sq = (bh2 * dd_.segment(r, m_).array() / scale_.head(m_).array()).square().sum() +
                       (gh * dd_.array() / scale_.tail(nz_).array()).square().sum();
@@ -219,8 +250,7 @@ double GeneralizedAlpha::error_norm(double h, const Eigen::VectorXd& y) {
     for (int j = 0; j < nz_; ++j)
       if (j < r || j >= r + m_) res_[j] = k * ((d_new_[j] - d_[j]) / h - (d_[j] - d_prev_[j]) / h_prev_);
   }
-  apply_weight(res_);  // the filter is N⁻¹ = (W_v N)⁻¹ W_v
-  dd_ = lu_.solve(res_);
+  filter(res_, dd_);
   double sum = 0.0;
   for (int j = 0; j < nz_; ++j) {
     const double sc = j >= r && j < r + m_ ? scale_[j - r] : scale_[m_ + j];
@@ -251,7 +281,8 @@ size_t GeneralizedAlpha::emit_outputs(const std::vector<double>& touts, size_t n
 double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
                                    const std::vector<double>& touts, const Output& out) {
   check_integration("GeneralizedAlpha", n_, t0, t_end, y, touts);
-  if (!jac_) throw std::invalid_argument("GeneralizedAlpha: no Jacobian callback set");
+  if (!jac_ && !system_.refresh) throw std::invalid_argument("GeneralizedAlpha: no Jacobian callback set");
+  if (system_.refresh && !residual_) throw std::invalid_argument("GeneralizedAlpha: a Newton system needs the residual form");
 
   failure_ = "none";
   size_t next = outputs_at_start(touts, t0, y, out);
@@ -301,8 +332,20 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
     Attempt result = Attempt::Failed;
     double err = 0.0;
     try {
-      if (need_jacobian) {
+      if (need_jacobian && system_.refresh) {
         ++stats_.njev;
+        system_.refresh(t, y);
+        need_jacobian = false;
+        jacobian_fresh = true;
+        h_factorized = 0.0;
+        in_residual_form_ = true;
+      } else if (need_jacobian) {
+        ++stats_.njev;
+        if (J_.rows() != n_) {
+          J_.setZero(n_, n_);
+          N_.setZero(nz_, nz_);
+          lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(nz_);
+        }
         jac_(t, y, J_);
         if (J_.rows() != n_ || J_.cols() != n_) throw std::invalid_argument("GeneralizedAlpha: the Jacobian has the wrong size");
         if (!J_.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite Jacobian at " + describe_step(t, h_try));

@@ -337,7 +337,26 @@ void Simulation::in_rhs(double t, F&& evaluate) {
 }
 
 bool Simulation::residual_form() const {
-  return chain_ && !tree_ && sys_->y_defs.empty() && n_energy_ == 0;
+  return (chain_ || sparse_newton()) && !tree_ && sys_->y_defs.empty() && n_energy_ == 0;
+}
+
+bool Simulation::sparse_newton() const {
+  return !tree_ && sys_->y_defs.empty() && n_energy_ == 0 && sys_->velocity_block_is_position_block &&
+         sys_->n_dof() >= kSparseNewtonDofs;
+}
+
+void Simulation::newton_refresh(double t, const Eigen::VectorXd& Y) {
+  try {
+    evaluate_state(t, Y);  // positions, rates, masses and the complete stresses there
+  } catch (const KinematicsError& err) {
+    throw StepRejected(err.what());
+  }
+  if (!newton_data_) {
+    newton_data_ = std::make_unique<Data>(*data_);
+    newton_system_ = std::make_unique<ReducedSystem>(*sys_, *newton_data_);
+  } else {
+    *newton_data_ = *data_;
+  }
 }
 
 void Simulation::residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& qdd, Eigen::VectorXd& R) {
@@ -798,6 +817,27 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
       integ.set_residual([this](double tt, const Eigen::VectorXd& y, const Eigen::VectorXd& D,
                                 Eigen::VectorXd& R) { residual(tt, y, D, R); },
                          [this](Eigen::MatrixXd& W) { W = jacobian_mass_; });
+    if (sparse_newton()) {
+      newton_data_.reset();  // the system of this segment (a repartition recompiles it)
+      newton_system_.reset();
+      GeneralizedAlpha::NewtonSystem s;
+      s.refresh = [this](double tt, const Eigen::VectorXd& y) { newton_refresh(tt, y); };
+      s.factorize = [this](double gh, double bh2) {
+        NodalCoefficients c;
+        c.mass = 1.0, c.damping = gh, c.stiffness = bh2, c.geometric = bh2;
+        newton_singular_ = !newton_system_->factorize(newton_data_->sigma, c) || newton_system_->saddle().singular();
+      };
+      s.solve = [this](const Eigen::VectorXd& r, Eigen::VectorXd& x) {
+        if (newton_singular_) {  // the integrator reports a singular Newton matrix and halves the step
+          x = Eigen::VectorXd::Constant(r.size(), std::numeric_limits<double>::quiet_NaN());
+          return;
+        }
+        Eigen::VectorXd dx;
+        newton_system_->solve(r, x, dx, 0);
+      };
+      s.weight = [this](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = newton_system_->mass_product(v); };
+      integ.set_newton_system(std::move(s));
+    }
     integ.set_fixed_step(options.fixed_step);
     return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
   }

@@ -167,7 +167,7 @@ def cantilever(n: int) -> str:
 
 def test_the_dense_linearization_has_its_own_memory_check():
     # The simulation runs on sparse matrices (a few MB for 300 beams), and so do the linearization
-    # at rest and its lowest modes (formulation.md §8); the dense reduced matrices need the dense
+    # at rest and its lowest modes (docs/formulation.md §10); the dense reduced matrices need the dense
     # transfer functions and mass matrices (65 MB) and are refused before allocating.
     old = spacar.memory_limit()
     try:

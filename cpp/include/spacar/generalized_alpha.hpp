@@ -66,6 +66,19 @@ class GeneralizedAlpha {
   using Residual = std::function<void(double t, const Eigen::VectorXd& y, const Eigen::VectorXd& D, Eigen::VectorXd& R)>;
   using Weight = std::function<void(Eigen::MatrixXd& W)>;
   void set_residual(Residual residual, Weight weight);
+  // A Newton matrix of the caller's own instead of the dense one from the Jacobian (large models,
+  // sparse): where the integrator would take a Jacobian, refresh(t, y) takes the state there;
+  // factorize(γ′h, β′h²) factorizes S = M̄ + γ′h C̄ + β′h² K̄ at it, the residual form's W_v N;
+  // solve(r, x): x = S⁻¹ r; weight(v, out): out = M̄ v at it (W_v). Requires the residual form
+  // (set_residual; its weight is not used then) and Z the rates alone (no other first-order
+  // states).
+  struct NewtonSystem {
+    std::function<void(double t, const Eigen::VectorXd& y)> refresh;
+    std::function<void(double gh, double bh2)> factorize;
+    std::function<void(const Eigen::VectorXd& r, Eigen::VectorXd& x)> solve;
+    std::function<void(const Eigen::VectorXd& v, Eigen::VectorXd& out)> weight;
+  };
+  void set_newton_system(NewtonSystem system);
   // Fixed steps of size h (the last one shortened to t_end) without error control, as structural
   // dynamics codes are used; the tolerances then only stop the Newton iterations. A step whose
   // Newton iterations fail is retried in halves. 0 (the default): error control.
@@ -86,6 +99,10 @@ class GeneralizedAlpha {
   bool newton_residual(const Rhs& f, double t);
   void apply_weight(Eigen::VectorXd& v);  // v's rate part times W_ (residual form)
   void factorize(double h);
+  // x = (the Newton matrix)⁻¹ r for a residual of the current form; x = N⁻¹ v, the filter of the
+  // error estimate (see error_norm).
+  void newton_solve(const Eigen::VectorXd& r, Eigen::VectorXd& x);
+  void filter(Eigen::VectorXd& v, Eigen::VectorXd& x);
   void shift_acceleration(double h);                  // a_use_: A for a step of size h
   void state_at(double h, const Eigen::VectorXd& y);  // y_new_, a_new_ from d_new_
   Attempt newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y);
@@ -104,6 +121,7 @@ class GeneralizedAlpha {
   Jacobian jac_;
   Residual residual_;
   Weight weight_;
+  NewtonSystem system_;  // set: it replaces J_, N_, W_ and lu_
   // The residual form is used from each Jacobian on until Newton contracts slowly (W_v has
   // drifted); lu_ holds the Newton matrix of factorized_residual_form_.
   bool in_residual_form_ = false, factorized_residual_form_ = false;

@@ -16,6 +16,7 @@
 #include "spacar/data.hpp"
 #include "spacar/integrator.hpp"
 #include "spacar/linearize.hpp"
+#include "spacar/nodal.hpp"
 #include "spacar/model.hpp"
 #include "spacar/system.hpp"
 #include "spacar/table.hpp"
@@ -184,11 +185,20 @@ class Simulation {
   void evaluate_state(double t, const Eigen::VectorXd& Y);
   // Right-hand side of the first-order system Y = (q, y, q̇).
   void rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY);
-  // The residual of the reduced equations of motion R = M̄ (q̈ − q̈(Y)) at a trial q̈ of an open
-  // chain (ExplicitChain), without the equations of motion: the accelerations and DF_qᵀ
-  // follow block by block. Generalized-α's residual form (Y = (q, q̇): no integrated
-  // deformations, no energy states); the state is left without its constraints' stresses.
+  // The residual of the reduced equations of motion R = M̄ (q̈ − q̈(Y)) at a trial q̈, without
+  // the equations of motion: the accelerations and DF_qᵀ follow block by block on an open chain
+  // (ExplicitChain), by solves with the velocity block otherwise. Generalized-α's residual form
+  // (Y = (q, q̇): no integrated deformations, no energy states), used on open chains and with the
+  // sparse Newton matrix; the state is left without its constraints' stresses.
   bool residual_form() const;
+  // Generalized-α's Newton matrix S = M̄ + γ′h (C0 + D0) + β′h² (K0 + G0) solved through the
+  // sparse saddle-point system of the nodal coordinates (nodal.hpp) instead of formed from a
+  // dense Jacobian, for models of at least kSparseNewtonDofs degrees of freedom (holonomic,
+  // without integrated deformations or energy states, not on the recursive path). Its C0 and N0
+  // (the velocity- and acceleration-dependent terms) are left out: a simplified Newton matrix,
+  // which the iterations' contraction monitors as that of a Jacobian taken at an earlier state.
+  bool sparse_newton() const;
+  static constexpr int kSparseNewtonDofs = 100;
   void residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& qdd, Eigen::VectorXd& R);
   // Its Jacobian ∂(q̇, ẏ, q̈)/∂(q, y, q̇) at (t, Y) from the linearized equations (simulate_jacobian.cpp).
   void jacobian(double t, const Eigen::VectorXd& Y, Eigen::MatrixXd& J);
@@ -311,6 +321,11 @@ class Simulation {
   // starts and at the output times.
   std::unique_ptr<ExplicitChain> chain_;
   Eigen::MatrixXd jacobian_mass_;  // M̄ at the state of the last jacobian()
+  // The sparse Newton matrix's state (a copy of data at its last refresh) and reduced system.
+  std::unique_ptr<Data> newton_data_;
+  std::unique_ptr<ReducedSystem> newton_system_;
+  bool newton_singular_ = false;
+  void newton_refresh(double t, const Eigen::VectorXd& Y);
   Eigen::VectorXd tree_qdd_;
   // The tree's state at (t, Y) into base_ (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.
