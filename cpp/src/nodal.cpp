@@ -3,7 +3,6 @@
 #include <Eigen/OrderingMethods>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numeric>
 
 #include "spacar/dynamics.hpp"
@@ -398,7 +397,6 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
 bool SaddlePoint::factorize(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c) {
   assemble(sys, data, sigma, c);
   const Eigen::SparseMatrix<double>& A = kkt_.matrix();
-  factorized_ = false;
   singular_ = false;
   negative_ = -1;
   double amax = 0.0;
@@ -418,11 +416,10 @@ bool SaddlePoint::factorize(const System& sys, Data& data, const Eigen::VectorXd
     }
     sign_ = lu_.sign_determinant() * (m % 2 ? -1 : 1);
   }
-  factorized_ = true;
   return true;
 }
 
-void SaddlePoint::solve_scaled(Eigen::VectorXd& rhs) {
+void SaddlePoint::solve_scaled(Eigen::VectorXd& rhs, bool refine) {
   auto once = [&](const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     if (symmetric_) {
       x.resize(n_);
@@ -432,6 +429,10 @@ void SaddlePoint::solve_scaled(Eigen::VectorXd& rhs) {
     }
   };
   once(rhs, sol_);
+  if (!refine) {
+    rhs = sol_;
+    return;
+  }
   // One step of iterative refinement: the factorization chose its pivots for no accuracy (the
   // error left is that of the assembled matrix itself, which ReducedSystem refines away).
   res_ = rhs;
@@ -442,20 +443,20 @@ void SaddlePoint::solve_scaled(Eigen::VectorXd& rhs) {
   rhs = sol_;
 }
 
-void SaddlePoint::solve_free(const double* r, double* dx) {
+void SaddlePoint::solve_free(const double* r, double* dx, bool refine) {
   const Eigen::VectorXd& s = layout_.scale;
   const int nf = layout_.n_free;
   for (int f = 0; f < nf; ++f) rhs_[f] = r[f] * s[f];
   rhs_.tail(layout_.n_rows).setZero();
-  solve_scaled(rhs_);
+  solve_scaled(rhs_, refine);
   for (int f = 0; f < nf; ++f) dx[f] = rhs_[f] * s[f];
 }
 
-void SaddlePoint::solve(const Eigen::VectorXd& r, Eigen::VectorXd& dx) {
+void SaddlePoint::solve(const Eigen::VectorXd& r, Eigen::VectorXd& dx, bool refine) {
   const int nf = layout_.n_free;
   Eigen::VectorXd rf(nf), xf(nf);
   for (int f = 0; f < nf; ++f) rf[f] = r[layout_.free[f]];
-  solve_free(rf.data(), xf.data());
+  solve_free(rf.data(), xf.data(), refine);
   dx = Eigen::VectorXd::Zero(r.size());
   for (int f = 0; f < nf; ++f) dx[layout_.free[f]] = xf[f];
 }
@@ -477,7 +478,7 @@ Eigen::VectorXd SaddlePoint::lowest_direction(int iterations, double& value) {
     if (!(norm > 0.0) || !std::isfinite(norm)) break;
     u /= norm;
     rhs_ = u;
-    solve_scaled(rhs_);
+    solve_scaled(rhs_, true);
     value = u.head(nf).dot(rhs_.head(nf));  // uᵀ H⁻¹ u on the constrained space: 1 / μ
     value = value != 0.0 ? 1.0 / value : 0.0;
     u = rhs_;
@@ -601,7 +602,7 @@ Eigen::VectorXd ReducedSystem::mass_product(const Eigen::VectorXd& q) {
 }
 
 void ReducedSystem::solve(const Eigen::VectorXd& r, Eigen::VectorXd& q, Eigen::VectorXd& dx, int refinements) {
-  saddle_.solve(load(r), dx);
+  saddle_.solve(load(r), dx, refinements > 0);
   q = dofs(dx);
   if (refinements <= 0) return;
   Eigen::VectorXd step;

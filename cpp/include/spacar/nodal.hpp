@@ -93,10 +93,11 @@ class SaddlePoint {
   // the values are not finite or (LU) the matrix is singular.
   bool factorize(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c);
   // δx (nx; zero on fixed and input coordinates) for a load r on the coordinates (nx; its
-  // entries on fixed and input coordinates ignored): δx = Z (Zᵀ H Z)⁻¹ Zᵀ r.
-  void solve(const Eigen::VectorXd& r, Eigen::VectorXd& dx);
+  // entries on fixed and input coordinates ignored): δx = Z (Zᵀ H Z)⁻¹ Zᵀ r; `refine`: with one
+  // step of iterative refinement (the factorization chose its pivots for no accuracy).
+  void solve(const Eigen::VectorXd& r, Eigen::VectorXd& dx, bool refine = true);
   // The same over the free coordinates (n_free), for the eigen-analyses.
-  void solve_free(const double* r, double* dx);
+  void solve_free(const double* r, double* dx, bool refine = true);
 
   bool symmetric() const { return symmetric_; }
   // Of the reduced matrix Zᵀ H Z: singular to working precision (a tiny pivot), the sign of
@@ -119,7 +120,7 @@ class SaddlePoint {
 
  private:
   void assemble(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c);
-  void solve_scaled(Eigen::VectorXd& rhs);  // in place, with one step of iterative refinement
+  void solve_scaled(Eigen::VectorXd& rhs, bool refine);  // in place
 
   const NodalLayout& layout_;
   int n_ = 0;
@@ -129,7 +130,7 @@ class SaddlePoint {
   std::vector<int> diagonal_;    // value position of each diagonal entry (free part)
   SparseLDLT ldlt_;
   LinearSolver lu_;
-  bool singular_ = false, factorized_ = false;
+  bool singular_ = false;
   int sign_ = 1, negative_ = -1;
   Eigen::VectorXd rhs_, sol_, res_;
   Eigen::MatrixXd local_, rows_;  // an element's block of H and its rows of A (work space)
