@@ -21,6 +21,24 @@ IMG = ROOT / "docs" / "img"
 HEADER = "# Performance\n\nMeasured figures of spacar; each section is written by the script named in it.\n\n"
 
 
+
+# --- fresh processes ------------------------------------------------------------------------------
+
+def fresh_process(worker: str, args, timeout: float, env: dict | None = None, what: str = "a fresh process"):
+    """Run the Python source ``worker`` in a new interpreter with the arguments ``args`` and return
+    the JSON of its last line of output; None (logged) if it fails. The interpreter is started
+    by a shell, not by this process: Linux carries the high-water mark of the process that execs
+    into ru_maxrss, and a child spawned from a benchmark would start from its own peak (the
+    shell's is about 2 MiB), so memory measured in the worker is its own."""
+    import json
+
+    proc = subprocess.run(["/bin/sh", "-c", '"$0" "$@"; exit $?', sys.executable, "-c", worker, *map(str, args)],
+                          capture_output=True, text=True, timeout=timeout, env=env)
+    if proc.returncode:
+        log(f"{what} failed: {proc.stderr[-500:]}")
+        return None
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
 # --- machine --------------------------------------------------------------------------------
 
 def cpu_model() -> str:

@@ -43,9 +43,7 @@ the solve.
 """
 from __future__ import annotations
 
-import json
 import os
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -402,16 +400,10 @@ print(json.dumps({"imports": imports, "built": built, "peak": peak, "vmhwm": hwm
 
 def in_fresh_process(kind, n):
     """One solve of ``kind`` on n elements in a new interpreter: ru_maxrss in MiB after the
-    imports, after the build, after the solve; None on failure. The interpreter is forked by a
-    shell, not by this process: Linux carries the high-water mark of the process that execs into
-    ru_maxrss, and a child of this benchmark would start from its own peak."""
-    proc = subprocess.run(["/bin/sh", "-c", '"$0" "$@"; exit $?', sys.executable, "-c", _WORKER, kind, str(n),
-                           str(HERE)], capture_output=True, text=True, timeout=900,
-                          env=dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1"))
-    if proc.returncode:
-        C.log(f"modes {kind} n={n} in a fresh process failed: {proc.stderr[-500:]}")
-        return None
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    imports, after the build, after the solve; None on failure (C.fresh_process)."""
+    return C.fresh_process(_WORKER, [kind, n, HERE], timeout=900,
+                           env=dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1"),
+                           what=f"modes {kind} n={n} in a fresh process")
 
 
 def memory(kind, n, ref):

@@ -28,9 +28,7 @@ solve; exudyn's module without range checks (``EXUDYN_MODULE=fast``) timed the s
 """
 from __future__ import annotations
 
-import json
 import os
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -298,20 +296,14 @@ print(json.dumps({"imports": imports, "built": built, "peak": peak, "vmhwm": hwm
 
 def in_fresh_process(kind, n, repeats=0, fast=False):
     """One solve of ``kind`` on n elements in a new interpreter (``repeats`` more timed):
-    ru_maxrss in MiB after the imports, after the build, after the solve; None on failure.
-    The interpreter is forked by a shell, not by this process: Linux carries the high-water
-    mark of the process that execs into ru_maxrss, and a child spawned from this benchmark
-    would start from its 150-odd MiB (the shell's is about 2 MiB)."""
+    ru_maxrss in MiB after the imports, after the build, after the solve; None on failure
+    (C.fresh_process)."""
     env = dict(os.environ)
     env.pop("EXUDYN_MODULE", None)
     if fast:
         env["EXUDYN_MODULE"] = "fast"
-    proc = subprocess.run(["/bin/sh", "-c", '"$0" "$@"; exit $?', sys.executable, "-c", _WORKER, kind, str(n),
-                           str(HERE), str(repeats), str(ALPHA)], capture_output=True, text=True, timeout=600, env=env)
-    if proc.returncode:
-        C.log(f"{kind} n={n} in a fresh process failed: {proc.stderr[-500:]}")
-        return None
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    return C.fresh_process(_WORKER, [kind, n, HERE, repeats, ALPHA], timeout=600, env=env,
+                           what=f"{kind} n={n} in a fresh process")
 
 
 def memory(kind, n, ref):
