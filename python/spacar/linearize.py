@@ -147,28 +147,17 @@ class Linearization:
         return self.C0 + self.D0
 
     def _undamped(self):
-        import scipy.linalg  # lazily: `import spacar` stays light
+        """(ω², vectors) of all undamped modes, sorted by |ω²|: in the modal basis of a symmetric
+        pencil (the inverse pencil when the stiffness is positive definite: the lowest modes to
+        full relative precision, see _modal_basis), SciPy's QZ otherwise."""
+        basis = _modal_basis(self.M0, self.stiffness)
+        if basis is None:
+            import scipy.linalg  # lazily: `import spacar` stays light
 
-        K, M = self.stiffness, self.M0
-        symmetric = (K.size == 0 or (np.abs(K - K.T).max() <= 1e-12 * np.abs(K).max()
-                                     and np.abs(M - M.T).max() <= 1e-12 * np.abs(M).max()))
-        try:
-            if not symmetric:
-                raise np.linalg.LinAlgError
-            # Symmetric with K positive definite (a stable structure): the inverse pencil
-            # M v = (1/ω²) K v, whose largest eigenvalues, the lowest modes, come with full
-            # relative precision (the condition of K of a fine mesh costs them digits in K v = ω² M v).
-            nu, v = scipy.linalg.eigh(0.5 * (M + M.T), 0.5 * (K + K.T))
-            with np.errstate(divide="ignore"):
-                w2 = np.where(nu > 0, 1.0 / np.where(nu > 0, nu, 1.0), np.inf)
-        except (np.linalg.LinAlgError, ValueError):
-            try:  # symmetric, M0 positive definite
-                if not symmetric:
-                    raise np.linalg.LinAlgError
-                w2, v = scipy.linalg.eigh(0.5 * (K + K.T), 0.5 * (M + M.T))
-            except (np.linalg.LinAlgError, ValueError):
-                w2, v = scipy.linalg.eig(K, M)
-                w2 = np.real_if_close(w2, tol=1e6)
+            w2, v = scipy.linalg.eig(self.stiffness, self.M0)
+            w2 = np.real_if_close(w2, tol=1e6)
+        else:
+            w2, v = basis
         order = np.argsort(np.abs(w2))
         return np.real(w2[order]), v[:, order]
 
