@@ -33,6 +33,19 @@ NodalLayout::NodalLayout(const System& sys) {
 
 namespace {
 
+// out += scale B(a, :)ᵀ r (n x n; r: n values `stride` apart).
+void add_outer(const Eigen::MatrixXd& B, int a, const double* r, Eigen::Index stride, double scale,
+               Eigen::MatrixXd& out) {
+  const int n = static_cast<int>(B.cols());
+  double* o = out.data();
+  for (int j = 0; j < n; ++j) {
+    const double rj = scale * r[j * stride];
+    if (rj == 0.0) continue;
+    double* column = o + static_cast<Eigen::Index>(j) * n;
+    for (int i = 0; i < n; ++i) column[i] += B(a, i) * rj;
+  }
+}
+
 // Bᵀ C B over the element's constitutive deformations (C: its S or D; σ_a = Σ_b C_ab e_b for
 // each constitutive a), the columns b of deformations that `layout` constrains left out when a
 // layout is given: they do not move on the constrained space (their B rows vanish there), and
@@ -40,11 +53,23 @@ namespace {
 void add_constitutive(const System& sys, const SystemElement& se, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
                       double coefficient, const NodalLayout* layout, Eigen::MatrixXd& out) {
   if (coefficient == 0.0 || !se.has_constitutive) return;
+  const int n = static_cast<int>(B.cols());
+  // Written out: Eigen's outer products of B's strided rows copied each row to the heap, and
+  // this runs for every element in every Newton iteration.
+  double stack[32];
+  std::vector<double> heap(n > 32 ? n : 0);
+  double* cb = n > 32 ? heap.data() : stack;  // Σ_b C(a, b) B(b, :), one constitutive a at a time
   for (int a = 0; a < se.nd; ++a) {
     if (!constitutive_class(sys.def_class[se.def_offset + a])) continue;
-    for (int b = 0; b < se.nd; ++b)
-      if (C(a, b) != 0.0 && !(layout && layout->row_of[se.def_offset + b] >= 0))
-        out.noalias() += (coefficient * C(a, b)) * B.row(a).transpose() * B.row(b);
+    std::fill(cb, cb + n, 0.0);
+    bool any = false;
+    for (int b = 0; b < se.nd; ++b) {
+      if (C(a, b) == 0.0 || (layout && layout->row_of[se.def_offset + b] >= 0)) continue;
+      const double w = coefficient * C(a, b);
+      for (int j = 0; j < n; ++j) cb[j] += w * B(b, j);
+      any = true;
+    }
+    if (any) add_outer(B, a, cb, 1, 1.0, out);
   }
 }
 
@@ -386,7 +411,7 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
       const double norm = As.row(a).norm();
       if (!(norm > 0.0)) continue;
       As.row(a) *= h / norm;
-      local_.noalias() += (1.0 / h) * As.row(a).transpose() * As.row(a);
+      add_outer(As, a, &As(a, 0), As.outerStride(), 1.0 / h, local_);  // as in add_constitutive
     }
     kkt_.add(element_block_[i], local_);
     kkt_.add(row_block_[i], As);
