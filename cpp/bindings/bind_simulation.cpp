@@ -51,6 +51,7 @@ py::dict block_results_to_dict(BlockResults&& r) {
 void bind_simulation(py::module_& m) {
   m.attr("linearization_arrays") = linearization_arrays();
   m.attr("integration_methods") = py::tuple(py::cast(method_names()));
+  m.attr("implicit_methods") = py::tuple(py::cast(implicit_method_names()));
   py::class_<Table>(m, "Table", "Values over time interpolated in C++ (table.hpp); spacar.Table wraps it.")
       .def(py::init([](std::vector<double> t, Eigen::MatrixXd values, const std::string& kind) {
              if (kind != "linear" && kind != "cubic")

@@ -15,4 +15,6 @@ PYBIND11_MODULE(_core, m) {
   bind_simulation(m);
   bind_topology(m);
   bind_statics(m);
+  bind_kernels(m);
+  bind_ode(m);
 }

@@ -148,10 +148,16 @@ void reduced_residual_direct(const System& sys, Data& data, Eigen::VectorXd& R, 
   for (int j = 0; j < nd; ++j) R[j] = data.qhat_load[sys.dof_cols[j]];
 }
 
+void set_dof_accelerations(const System& sys, Data& data, const Eigen::VectorXd& qdd) {
+  if (&qdd != &data.qdd) data.qdd = qdd;
+  for (int j = 0; j < sys.n_dof(); ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
+}
+
 void solve_dynamics(const System& sys, Data& data) {
   const int nd = sys.n_dof();
   // The residual at q̈ = 0 holds the inputs' accelerations, convective, applied and elastic forces.
-  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = 0.0;
+  data.qdd.setZero();
+  set_dof_accelerations(sys, data, data.qdd);
   reduced_residual(sys, data, data.rhs);
   data.rhs = -data.rhs;
   assemble_mass_matrix(sys, data);
@@ -161,7 +167,7 @@ void solve_dynamics(const System& sys, Data& data) {
     // singular matrix. Non-finite accelerations make the integrator reject the step and report
     // the non-finite values if no smaller step helps.
     data.qdd.setConstant(std::numeric_limits<double>::quiet_NaN());
-    for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
+    set_dof_accelerations(sys, data, data.qdd);
     solve_accelerations(sys, data);
     return;
   }
@@ -169,13 +175,12 @@ void solve_dynamics(const System& sys, Data& data) {
   if (nd == 0) return;
   if (data.llt.info() != Eigen::Success) throw_singular_mass(sys, data, data.Mbar);
   data.qdd = data.llt.solve(data.rhs);
-  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
+  set_dof_accelerations(sys, data, data.qdd);
   solve_accelerations(sys, data);
 }
 
 void solve_dynamics_direct(const System& sys, Data& data) {
   data.ensure_equations_of_motion(sys);
-  const int nd = sys.n_dof();
   const int nf = data.n_free;
   compute_inertia_and_loads(sys, data);
   constitutive_stresses(sys, data);
@@ -239,7 +244,7 @@ void solve_dynamics_direct(const System& sys, Data& data) {
   int j = 0;
   for (int g : sys.x_dyn) data.qdd[j++] = data.xdd[g];
   for (int k : sys.e_dyn) data.qdd[j++] = data.edd[k];
-  for (j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = data.qdd[j];
+  set_dof_accelerations(sys, data, data.qdd);
   if (!data.qdd.allFinite() || !data.xdd.allFinite()) {
     constexpr double kHuge = 1e150;  // entries whose products overflow
     if (data.kkt_rhs.cwiseAbs().maxCoeff() > kHuge || K_values.cwiseAbs().maxCoeff() > kHuge) throw overflow();
@@ -265,8 +270,7 @@ bool solve_dynamics_known(const System& sys, Data& data, const Eigen::VectorXd& 
   if (static_cast<int>(sys.defs_V.size()) != nc || qdd.size() != nd) return false;
   compute_inertia_and_loads(sys, data);
   constitutive_stresses(sys, data);
-  data.qdd = qdd;
-  for (int j = 0; j < nd; ++j) data.qhat_dd[sys.dof_cols[j]] = qdd[j];
+  set_dof_accelerations(sys, data, qdd);
   solve_accelerations_direct(sys, data);
   inertia_force(sys, data);
   if (nc > 0) {

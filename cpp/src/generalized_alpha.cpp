@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "spacar/errors.hpp"
+
 namespace spacar {
 namespace {
 
@@ -19,7 +21,7 @@ constexpr double kResidualDrift = 1e-3;
 }  // namespace
 
 GeneralizedAlpha::GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf)
-    : n_(n), m_(m), r0_(rate_offset), nz_(n - m), hmax_(std::numeric_limits<double>::infinity()) {
+    : Stepper("GeneralizedAlpha", n), m_(m), r0_(rate_offset), nz_(n - m) {
   if (n < 1 || m < 1 || rate_offset < m || rate_offset + m > n)
     throw std::invalid_argument("GeneralizedAlpha: needs m >= 1 positions with their rates among the n states");
   if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
@@ -34,34 +36,21 @@ GeneralizedAlpha::GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf
   const double c = (1.0 - alpha_f_) / (1.0 - alpha_m_);
   gamma_d_ = gamma_ * c;
   beta_d_ = beta_ * c;
-  set_tolerances(Eigen::VectorXd::Constant(n, 1e-6), Eigen::VectorXd::Constant(n, 1e-6));
   // J_, N_ and lu_ (dense, n² and nz²) are sized at the first Jacobian: a Newton system
   // (set_newton_system) never needs them.
   for (Eigen::VectorXd* v : {&d_, &a_, &a_use_, &d_new_, &a_new_, &d_prev_, &dd_, &res_}) v->setZero(nz_);
   for (Eigen::VectorXd* v : {&y_new_, &fy_, &scale_, &y_out_}) v->setZero(n);
   wv_.setZero(m);
-  failure_.reserve(256);
 }
 
-void GeneralizedAlpha::set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
-  check_tolerances("GeneralizedAlpha", n_, rtol, atol);
-  rtol_ = rtol;
-  atol_ = atol;
-}
-
-void GeneralizedAlpha::set_max_step(double hmax) {
-  if (!(hmax > 0)) throw std::invalid_argument("GeneralizedAlpha: the maximum step must be positive");
-  hmax_ = hmax;
-}
-
-void GeneralizedAlpha::set_max_steps(long n) {
-  if (n < 1) throw std::invalid_argument("GeneralizedAlpha: the step limit must be positive");
-  max_steps_ = n;
-}
-
-void GeneralizedAlpha::set_initial_step(double h) {
-  if (!(h >= 0) || !std::isfinite(h)) throw std::invalid_argument("GeneralizedAlpha: the initial step must be finite and >= 0");
-  h_initial_ = h;
+std::unique_ptr<Stepper> GeneralizedAlpha::make(Method, const StepperSetup& setup) {
+  if (setup.positions == 0) throw InputError("method generalized_alpha: the model has no degrees of freedom to integrate");
+  auto stepper = std::make_unique<GeneralizedAlpha>(setup.n, setup.positions, setup.rate_offset, setup.rho_inf);
+  stepper->set_jacobian(setup.jacobian);
+  if (setup.residual) stepper->set_residual(setup.residual, setup.weight);
+  if (setup.newton.refresh) stepper->set_newton_system(setup.newton);
+  stepper->set_fixed_step(setup.fixed_step);
+  return stepper;
 }
 
 void GeneralizedAlpha::set_fixed_step(double h) {
@@ -69,29 +58,13 @@ void GeneralizedAlpha::set_fixed_step(double h) {
   h_fixed_ = h;
 }
 
-double GeneralizedAlpha::last_step() const { return h_last_; }
-void GeneralizedAlpha::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
-void GeneralizedAlpha::set_step_start(StepStart start) { step_start_ = std::move(start); }
-void GeneralizedAlpha::set_jacobian(Jacobian jac) { jac_ = std::move(jac); }
 void GeneralizedAlpha::set_newton_system(NewtonSystem system) {
   if (nz_ != m_) throw std::invalid_argument("GeneralizedAlpha: a Newton system needs the rates as the only other states");
   system_ = std::move(system);
 }
-void GeneralizedAlpha::set_residual(Residual residual, Weight weight) {
+void GeneralizedAlpha::set_residual(Residual residual, ResidualWeight weight) {
   residual_ = std::move(residual);
   weight_ = std::move(weight);
-}
-const Radau5Stats& GeneralizedAlpha::stats() const { return stats_; }
-
-bool GeneralizedAlpha::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
-  ++stats_.nfev;
-  f(t, y, dy);
-  if (dy.size() != n_)
-    throw std::invalid_argument("GeneralizedAlpha: the rhs returned " + std::to_string(dy.size()) +
-                                " derivatives for " + std::to_string(n_) + " states");
-  if (dy.allFinite()) return true;
-  failure_ = "non-finite rhs value";
-  return false;
 }
 
 bool GeneralizedAlpha::newton_residual(const Rhs& f, double t) {
@@ -278,21 +251,27 @@ size_t GeneralizedAlpha::emit_outputs(const std::vector<double>& touts, size_t n
   return next;
 }
 
-double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
-                                   const std::vector<double>& touts, const Output& out) {
-  check_integration("GeneralizedAlpha", n_, t0, t_end, y, touts);
+void GeneralizedAlpha::check_ready() const {
   if (!jac_ && !system_.refresh) throw std::invalid_argument("GeneralizedAlpha: no Jacobian callback set");
   if (system_.refresh && !residual_) throw std::invalid_argument("GeneralizedAlpha: a Newton system needs the residual form");
+}
 
-  failure_ = "none";
-  size_t next = outputs_at_start(touts, t0, y, out);
-  if (t_end == t0) return t0;
+void GeneralizedAlpha::begin() {
+  rejected_ = jacobian_fresh_ = false;
+  need_jacobian_ = true;
+  h_factorized_ = 0.0;
+  faccon_ = 1.0;
+}
 
-  evaluate_start("GeneralizedAlpha", t0, failure_, [&] { return eval(f, t0, y, fy_); });
+bool GeneralizedAlpha::start(const Rhs& f, double t0, const Eigen::VectorXd& y) {
+  if (!eval(f, t0, y, fy_)) return false;
   d_ = fy_.tail(nz_);
   a_ = d_;  // A = D at the start (Arnold & Brüls): second order from the first step
   have_previous_ = false;
+  return true;
+}
 
+double GeneralizedAlpha::first_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y) {
   double h = h_fixed_ > 0 ? h_fixed_ : h_initial_;
   if (!(h > 0)) {
     // Hairer's starting step for a method of order 2.
@@ -310,123 +289,107 @@ double GeneralizedAlpha::integrate(const Rhs& f, double t0, double t_end, Eigen:
     const double h1 = dmax <= 1e-15 ? std::max(1e-6, 1e-3 * h0) : std::pow(0.01 / dmax, 1.0 / 3.0);
     h = std::min(100.0 * h0, h1);
   }
-  h = std::min({h, hmax_, t_end - t0});
-  bool rejected = false, need_jacobian = true, jacobian_fresh = false;
-  bool retry = false;  // the same step again in the other form of the iterations: not a new attempt
-  double h_factorized = 0.0;
-  faccon_ = 1.0;
-  double t = t0;
-  for (long steps = 0; t < t_end; ++steps) {
-    if (steps >= max_steps_)
-      throw IntegrationError("GeneralizedAlpha: more than " + std::to_string(max_steps_) + " steps at " + describe_step(t, h));
-    if (!(h >= Integrator::min_step(t)))
-      throw IntegrationError("GeneralizedAlpha: step size underflow at " + describe_step(t, h) + " (last rejection: " +
-                             failure_ + ")");
-    const bool last = t + std::min(1.01 * h, hmax_) >= t_end;
-    const double h_try = last ? t_end - t : h;
-    if (!retry) {
-      ++stats_.nsteps;
-      if (step_start_) step_start_(t, y);
+  return std::min({h, hmax_, t_end - t0});
+}
+
+GeneralizedAlpha::Attempt GeneralizedAlpha::attempt(const Rhs& f, double t, double h_try, const Eigen::VectorXd& y,
+                                                    double& err) {
+  if (need_jacobian_ && system_.refresh) {
+    ++stats_.njev;
+    system_.refresh(t, y);
+    need_jacobian_ = false;
+    jacobian_fresh_ = true;
+    h_factorized_ = 0.0;
+    in_residual_form_ = true;
+  } else if (need_jacobian_) {
+    ++stats_.njev;
+    if (J_.rows() != n_) {
+      J_.setZero(n_, n_);
+      N_.setZero(nz_, nz_);
+      lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(nz_);
     }
-    retry = false;
-    Attempt result = Attempt::Failed;
-    double err = 0.0;
-    try {
-      if (need_jacobian && system_.refresh) {
-        ++stats_.njev;
-        system_.refresh(t, y);
-        need_jacobian = false;
-        jacobian_fresh = true;
-        h_factorized = 0.0;
-        in_residual_form_ = true;
-      } else if (need_jacobian) {
-        ++stats_.njev;
-        if (J_.rows() != n_) {
-          J_.setZero(n_, n_);
-          N_.setZero(nz_, nz_);
-          lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(nz_);
-        }
-        jac_(t, y, J_);
-        if (J_.rows() != n_ || J_.cols() != n_) throw std::invalid_argument("GeneralizedAlpha: the Jacobian has the wrong size");
-        if (!J_.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite Jacobian at " + describe_step(t, h_try));
-        if (residual_) {
-          weight_(W_);
-          if (W_.rows() != m_ || W_.cols() != m_ || !W_.allFinite())
-            throw IntegrationError("GeneralizedAlpha: the residual's weight is not a finite " + std::to_string(m_) +
-                                   " x " + std::to_string(m_) + " matrix at " + describe_step(t, h_try));
-        }
-        need_jacobian = false;
-        jacobian_fresh = true;
-        h_factorized = 0.0;
-        in_residual_form_ = static_cast<bool>(residual_);  // W_v is fresh
-      }
-      if (h_try != h_factorized || in_residual_form_ != factorized_residual_form_) {
-        factorize(h_try);
-        h_factorized = h_try;
-      }
-      result = newton(f, t, h_try, y);
-      if (result == Attempt::Accepted && h_fixed_ > 0) {
-        err = 1.0;  // no control: keep the step
-      } else if (result == Attempt::Accepted) {
-        err = error_norm(h_try, y);
-        if (!std::isfinite(err)) {
-          failure_ = "non-finite error estimate";
-          result = Attempt::Failed;
-        } else if (err >= 1.0) {
-          failure_ = "local error above tolerance";
-          result = Attempt::ErrorTooLarge;
-        }
-      }
-    } catch (const StepRejected& e) {
-      failure_ = e.what();
-      result = Attempt::Rejected;
+    jac_(t, y, J_);
+    if (J_.rows() != n_ || J_.cols() != n_) throw std::invalid_argument("GeneralizedAlpha: the Jacobian has the wrong size");
+    if (!J_.allFinite()) throw IntegrationError("GeneralizedAlpha: non-finite Jacobian at " + describe_step(t, h_try));
+    if (residual_) {
+      weight_(W_);
+      if (W_.rows() != m_ || W_.cols() != m_ || !W_.allFinite())
+        throw IntegrationError("GeneralizedAlpha: the residual's weight is not a finite " + std::to_string(m_) + " x " +
+                               std::to_string(m_) + " matrix at " + describe_step(t, h_try));
     }
-    // The local error behaves as h³.
-    const double quot = std::clamp(std::cbrt(err) / kStepSafety, 0.2, 5.0);
-    if (result != Attempt::Accepted) {
-      if (in_residual_form_ && (result == Attempt::SlowNewton || result == Attempt::Failed) &&
-          failure_ != "non-finite residual") {
-        // W_v may have drifted from M̄ (the mechanism has moved since the Jacobian): the same
-        // step again in the form with the exact M̄, from the same anchor.
-        in_residual_form_ = false;
-        retry = true;
-        continue;
-      }
-      ++stats_.nreject;
-      rejected = true;
-      if (result == Attempt::ErrorTooLarge) h = h_try / quot;
-      else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
-      else h = 0.5 * h_try;
-      // A Jacobian from an earlier state may be why Newton failed; not when the step converged
-      // (its error was too large) or the right-hand side refused the state (the kinematics).
-      need_jacobian = !jacobian_fresh && result != Attempt::ErrorTooLarge && result != Attempt::Rejected;
-      continue;
-    }
-    ++stats_.naccept;
-    double h_new = std::min(h_try / quot, hmax_);
-    if (rejected) h_new = std::min(h_new, h_try);
-    if (h_fixed_ > 0) h_new = std::min(2.0 * h_try, h_fixed_);  // back to the fixed step after halvings
-    const double t_new = last ? t_end : t + h_try;
-    next = emit_outputs(touts, next, t, h_try, t_new, y, out);
-    d_prev_ = d_;
-    h_prev_ = h_try;
-    have_previous_ = true;
-    d_ = d_new_;
-    a_ = a_new_;
-    y = y_new_;
-    t = t_new;
-    rejected = jacobian_fresh = false;
-    // A Jacobian is a linearization: keep it while Newton contracts. In the residual form a
-    // contraction factor above kResidualDrift may be the drift of W_v alone: the form with the
-    // exact M̄ from here until the next Jacobian.
-    if (in_residual_form_ && theta_ > kResidualDrift) in_residual_form_ = false;
-    need_jacobian = theta_ > 0.1;
-    if (!need_jacobian && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;  // keep the factorization
-    h = last ? std::max(h_new, std::min(h, hmax_)) : h_new;
-    if (stop_ && t < t_end && stop_(t, y)) break;
+    need_jacobian_ = false;
+    jacobian_fresh_ = true;
+    h_factorized_ = 0.0;
+    in_residual_form_ = static_cast<bool>(residual_);  // W_v is fresh
   }
-  h_last_ = h;
-  return t;
+  if (h_try != h_factorized_ || in_residual_form_ != factorized_residual_form_) {
+    factorize(h_try);
+    h_factorized_ = h_try;
+  }
+  Attempt result = newton(f, t, h_try, y);
+  if (result == Attempt::Accepted && h_fixed_ > 0) {
+    err = 1.0;  // no control: keep the step
+  } else if (result == Attempt::Accepted) {
+    err = error_norm(h_try, y);
+    if (!std::isfinite(err)) {
+      failure_ = "non-finite error estimate";
+      result = Attempt::Failed;
+    } else if (err >= 1.0) {
+      failure_ = "local error above tolerance";
+      result = Attempt::ErrorTooLarge;
+    }
+  }
+  return result;
+}
+
+Stepper::Outcome GeneralizedAlpha::step(const Rhs& f, double t, double h_try, double t_new, Eigen::VectorXd& y,
+                                        Outputs& outputs, double& h) {
+  Attempt result = Attempt::Failed;
+  double err = 0.0;
+  try {
+    result = attempt(f, t, h_try, y, err);
+  } catch (const StepRejected& e) {
+    failure_ = e.what();
+    result = Attempt::Rejected;
+  }
+  // The local error behaves as h³.
+  const double quot = std::clamp(std::cbrt(err) / kStepSafety, 0.2, 5.0);
+  if (result != Attempt::Accepted) {
+    if (in_residual_form_ && (result == Attempt::SlowNewton || result == Attempt::Failed) &&
+        failure_ != "non-finite residual") {
+      // W_v may have drifted from M̄ (the mechanism has moved since the Jacobian): the same
+      // step again in the form with the exact M̄, from the same anchor.
+      in_residual_form_ = false;
+      return Outcome::Retry;
+    }
+    rejected_ = true;
+    if (result == Attempt::ErrorTooLarge) h = h_try / quot;
+    else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
+    else h = 0.5 * h_try;
+    // A Jacobian from an earlier state may be why Newton failed; not when the step converged
+    // (its error was too large) or the right-hand side refused the state (the kinematics).
+    need_jacobian_ = !jacobian_fresh_ && result != Attempt::ErrorTooLarge && result != Attempt::Rejected;
+    return Outcome::Rejected;
+  }
+  double h_new = std::min(h_try / quot, hmax_);
+  if (rejected_) h_new = std::min(h_new, h_try);
+  if (h_fixed_ > 0) h_new = std::min(2.0 * h_try, h_fixed_);  // back to the fixed step after halvings
+  outputs.next = emit_outputs(outputs.touts, outputs.next, t, h_try, t_new, y, outputs.out);
+  d_prev_ = d_;
+  h_prev_ = h_try;
+  have_previous_ = true;
+  d_ = d_new_;
+  a_ = a_new_;
+  y = y_new_;
+  rejected_ = jacobian_fresh_ = false;
+  // A Jacobian is a linearization: keep it while Newton contracts. In the residual form a
+  // contraction factor above kResidualDrift may be the drift of W_v alone: the form with the
+  // exact M̄ from here until the next Jacobian.
+  if (in_residual_form_ && theta_ > kResidualDrift) in_residual_form_ = false;
+  need_jacobian_ = theta_ > 0.1;
+  if (!need_jacobian_ && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;  // keep the factorization
+  h = h_new;
+  return Outcome::Accepted;
 }
 
 }  // namespace spacar

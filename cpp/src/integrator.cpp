@@ -16,37 +16,6 @@
 namespace spacar {
 
 namespace {
-constexpr Method kMethods[] = {Method::AUTO, Method::DOP853, Method::DOPRI5, Method::RADAU5,
-                               Method::GENERALIZED_ALPHA};
-}  // namespace
-
-std::vector<std::string> method_names() {
-  std::vector<std::string> names;
-  for (Method m : kMethods) names.emplace_back(method_name(m));
-  return names;
-}
-
-Method parse_method(const std::string& name) {
-  std::string known;
-  for (Method m : kMethods) {
-    if (name == method_name(m)) return m;
-    known += (known.empty() ? "" : ", ") + std::string(method_name(m));
-  }
-  throw InputError("unknown integration method '" + name + "' (" + known + ")");
-}
-
-const char* method_name(Method m) {
-  switch (m) {
-    case Method::DOP853: return "dop853";
-    case Method::DOPRI5: return "dopri5";
-    case Method::RADAU5: return "radau5";
-    case Method::GENERALIZED_ALPHA: return "generalized_alpha";
-    case Method::AUTO: return "auto";
-  }
-  return "?";
-}
-
-namespace {
 
 using Row = std::array<double, 16>;
 
@@ -220,43 +189,7 @@ void weighted_sum(const Row& row, int count, const std::vector<Eigen::VectorXd>&
 
 }  // namespace
 
-std::string describe_step(double t, double h) {
-  std::ostringstream s;
-  s.precision(12);
-  s << "t = " << t << ", step size h = " << h;
-  return s.str();
-}
-
-void check_tolerances(const char* who, int n, const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
-  if (rtol.size() != n || atol.size() != n)
-    throw std::invalid_argument(std::string(who) + ": tolerances need one entry per state");
-  for (int i = 0; i < n; ++i) {
-    const bool valid = std::isfinite(rtol[i]) && std::isfinite(atol[i]) && rtol[i] >= 0 && atol[i] >= 0 &&
-                       rtol[i] + atol[i] > 0;
-    if (!valid)
-      throw std::invalid_argument(std::string(who) +
-                                  ": tolerances must be finite, non-negative and not both zero (state " +
-                                  std::to_string(i) + ")");
-  }
-}
-
-void check_integration(const char* who, int n, double t0, double t_end, const Eigen::VectorXd& y,
-                       const std::vector<double>& touts) {
-  const std::string w(who);
-  if (y.size() != n) throw std::invalid_argument(w + ": the state has the wrong size");
-  if (!(t_end >= t0)) throw std::invalid_argument(w + ": t_end must not be before t0");
-  for (size_t i = 0; i < touts.size(); ++i)
-    if (!(touts[i] >= t0 && touts[i] <= t_end) || (i > 0 && touts[i] < touts[i - 1]))
-      throw std::invalid_argument(w + ": output times must be sorted and within [t0, t_end]");
-  if (!y.allFinite()) throw IntegrationError(w + ": non-finite initial state at " + describe_step(t0, 0.0));
-}
-
-Integrator::Integrator(int n, Method method)
-    : n_(n),
-      method_(method),
-      rtol_(Eigen::VectorXd::Constant(std::max(n, 0), 1e-6)),
-      atol_(Eigen::VectorXd::Constant(std::max(n, 0), 1e-6)),
-      hmax_(std::numeric_limits<double>::infinity()) {
+Integrator::Integrator(int n, Method method) : Stepper("Integrator", n), method_(method) {
   if (n < 1) throw std::invalid_argument("Integrator: the system needs at least one state");
   if (method != Method::DOP853 && method != Method::DOPRI5)
     throw std::invalid_argument("Integrator: only DOP853 and DOPRI5 (RADAU5 is the class Radau5)");
@@ -265,43 +198,19 @@ Integrator::Integrator(int n, Method method)
   dense_.assign(3 + sc.dense_rows, Eigen::VectorXd::Zero(n));
   for (Eigen::VectorXd* v : {&y_stage_, &y_new_, &scale_, &err_a_, &err_b_, &y_out_})
     v->setZero(n);
-  failure_.reserve(256);
 }
 
-void Integrator::set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
-  check_tolerances("Integrator", n_, rtol, atol);
-  rtol_ = rtol;
-  atol_ = atol;
+std::unique_ptr<Stepper> Integrator::make(Method method, const StepperSetup& setup) {
+  auto stepper = std::make_unique<Integrator>(setup.n, method);
+  stepper->set_stiffness_detection(setup.auto_switch, setup.stiff_steps_ahead);
+  return stepper;
 }
-
-void Integrator::set_max_step(double hmax) {
-  if (!(hmax > 0)) throw std::invalid_argument("Integrator: the maximum step must be positive");
-  hmax_ = hmax;
-}
-
-void Integrator::set_initial_step(double h) {
-  if (!(h >= 0) || !std::isfinite(h))
-    throw std::invalid_argument("Integrator: the initial step must be finite and >= 0");
-  h_initial_ = h;
-}
-
-void Integrator::set_max_steps(long n) {
-  if (n < 1) throw std::invalid_argument("Integrator: the step limit must be positive");
-  max_steps_ = n;
-}
-
-double Integrator::min_step(double t) { return 1e-12 * std::max(1.0, std::abs(t)); }
-
-double Integrator::last_step() const { return h_last_; }
-
-const IntegratorStats& Integrator::stats() const { return stats_; }
 
 void Integrator::set_stiffness_detection(bool on, double min_steps_ahead) {
   if (!(min_steps_ahead >= 0)) throw std::invalid_argument("Integrator: min_steps_ahead must be >= 0");
   detect_stiffness_ = on;
   min_steps_ahead_ = min_steps_ahead;
 }
-bool Integrator::stiffness_detected() const { return stiff_; }
 double Integrator::stiffness_estimate() const { return hlamb_; }
 double Integrator::stiffness_bound(Method m) {
   if (m != Method::DOP853 && m != Method::DOPRI5)
@@ -326,17 +235,6 @@ bool Integrator::stiff_after_step() {
     return ++stiff_steps_ >= kStiffSteps;
   }
   if (++nonstiff_steps_ >= kNonstiffSteps) stiff_steps_ = 0;
-  return false;
-}
-// Calls the rhs; false if it produced a non-finite value.
-bool Integrator::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
-  ++stats_.nfev;
-  f(t, y, dy);
-  if (dy.size() != n_)
-    throw std::invalid_argument("Integrator: the rhs returned " + std::to_string(dy.size()) +
-                                " derivatives for " + std::to_string(n_) + " states");
-  if (dy.allFinite()) return true;
-  failure_ = "non-finite rhs value";
   return false;
 }
 
@@ -473,77 +371,45 @@ size_t Integrator::emit_outputs(const std::vector<double>& touts, size_t next, d
   return next;
 }
 
-void Integrator::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
-
-void Integrator::set_step_start(StepStart start) { step_start_ = std::move(start); }
-
-double Integrator::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
-                             const std::vector<double>& touts, const Output& out) {
-  check_integration("Integrator", n_, t0, t_end, y, touts);
-
-  failure_ = "none";
-  stiff_ = false;
+void Integrator::begin() {
   hlamb_ = 0.0;
   stiff_steps_ = nonstiff_steps_ = 0;
-  size_t next = outputs_at_start(touts, t0, y, out);
-  if (t_end == t0) return t0;
+  rejected_ = false;
+}
 
+bool Integrator::start(const Rhs& f, double t0, const Eigen::VectorXd& y) { return eval(f, t0, y, k_[0]); }
+
+double Integrator::first_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y) {
+  return std::min(h_initial_ > 0 ? h_initial_ : initial_step(f, t0, t_end, y), hmax_);
+}
+
+Stepper::Outcome Integrator::step(const Rhs& f, double t, double h_try, double t_new, Eigen::VectorXd& y,
+                                  Outputs& outputs, double& h) {
   const Scheme& sc = scheme(method_);
-  evaluate_start("Integrator", t0, failure_, [&] { return eval(f, t0, y, k_[0]); });
-
-  double h = std::min(h_initial_ > 0 ? h_initial_ : initial_step(f, t0, t_end, y), hmax_);
-  bool rejected = false;   // the previous attempt failed: do not grow the step right after
-  double t = t0;
-  for (long steps = 0; t < t_end; ++steps) {
-    if (steps >= max_steps_)
-      throw IntegrationError("Integrator: more than " + std::to_string(max_steps_) +
-                             " steps at " + describe_step(t, h));
-    const double h_min = min_step(t);
-    if (!(h >= h_min))  // also a NaN step (from a non-finite error estimate)
-      throw IntegrationError("Integrator: step size underflow at " + describe_step(t, h) +
-                             " (last rejection: " + failure_ + ")");
-
-    // Stretch the step by up to 1% (within hmax) rather than leave a tiny last step before t_end.
-    const bool last = t + std::min(1.01 * h, hmax_) >= t_end;
-    const double h_try = last ? t_end - t : h;
-    const double t_new = last ? t_end : t + h;
-    const bool dense = next < touts.size() && touts[next] < t_new;
-
-    ++stats_.nsteps;
-    Attempt result = Attempt::Failed;
-    if (step_start_) step_start_(t, y);
-    try {
-      result = attempt_step(f, t, h_try, t_new, y, dense);
-    } catch (const StepRejected& e) {
-      failure_ = e.what();
-    }
-    if (result != Attempt::Accepted) {
-      ++stats_.nreject;
-      h = h_try * (result == Attempt::Failed ? 0.5 : std::max(sc.fac_min, step_factor()));
-      rejected = true;
-      continue;
-    }
-
-    ++stats_.naccept;
-    next = emit_outputs(touts, next, t, h_try, t_new, y, out);
-    double grow = std::clamp(step_factor(), sc.fac_min, sc.fac_max);
-    if (rejected) grow = std::min(grow, 1.0);
-    const double h_next = std::min(h_try * grow, hmax_);
-    // A last step shortened to hit t_end says little about the step the solution allows; keep the
-    // planned step if larger, so that a continuation (RESTART 0) does not start too small.
-    h = last ? std::max(h_next, std::min(h, hmax_)) : h_next;
-    t = t_new;
-    y = y_new_;
-    std::swap(k_[0], k_[sc.s]);
-    rejected = false;
-    if (detect_stiffness_ && stiff_after_step() && t_end - t > min_steps_ahead_ * h) {
-      stiff_ = true;
-      break;
-    }
-    if (stop_ && t < t_end && stop_(t, y)) break;
+  const bool dense = outputs.next < outputs.touts.size() && outputs.touts[outputs.next] < t_new;
+  Attempt result = Attempt::Failed;
+  try {
+    result = attempt_step(f, t, h_try, t_new, y, dense);
+  } catch (const StepRejected& e) {
+    failure_ = e.what();
   }
-  h_last_ = h;
-  return t;
+  if (result != Attempt::Accepted) {
+    h = h_try * (result == Attempt::Failed ? 0.5 : std::max(sc.fac_min, step_factor()));
+    rejected_ = true;
+    return Outcome::Rejected;
+  }
+  outputs.next = emit_outputs(outputs.touts, outputs.next, t, h_try, t_new, y, outputs.out);
+  double grow = std::clamp(step_factor(), sc.fac_min, sc.fac_max);
+  if (rejected_) grow = std::min(grow, 1.0);
+  h = std::min(h_try * grow, hmax_);
+  y = y_new_;
+  std::swap(k_[0], k_[sc.s]);
+  rejected_ = false;
+  return Outcome::Accepted;
+}
+
+bool Integrator::switch_after_step(double t, double t_end, double h) {
+  return detect_stiffness_ && stiff_after_step() && t_end - t > min_steps_ahead_ * h;
 }
 
 }  // namespace spacar

@@ -8,6 +8,8 @@
 // controller; the Newton iterations also reject steps whose convergence is too slow.
 #include "spacar/radau5.hpp"
 
+#include "spacar/integrator.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -64,8 +66,7 @@ double scaled_rms(const Eigen::VectorXd& v, const Eigen::VectorXd& scale) {
 
 }  // namespace
 
-Radau5::Radau5(int n)
-    : n_(n), hmax_(std::numeric_limits<double>::infinity()) {
+Radau5::Radau5(int n) : Stepper("Radau5", n) {
   if (n < 1) throw std::invalid_argument("Radau5: the system needs at least one state");
   set_tolerances(Eigen::VectorXd::Constant(n, 1e-6), Eigen::VectorXd::Constant(n, 1e-6));
   J_.setZero(n, n);
@@ -74,50 +75,35 @@ Radau5::Radau5(int n)
   ctmp_.setZero(n);
   for (int i = 0; i < 3; ++i)
     for (Eigen::VectorXd* v : {&z_[i], &w_[i], &fz_[i], &poly_[i]}) v->setZero(n);
-  failure_.reserve(256);
 }
 
-void Radau5::set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol) {
-  check_tolerances("Radau5", n_, rtol, atol);
-  Eigen::VectorXd r(n_), a(n_);
+std::unique_ptr<Stepper> Radau5::make(Method, const StepperSetup& setup) {
+  auto stepper = std::make_unique<Radau5>(setup.n);
+  stepper->set_jacobian(setup.jacobian);
+  // Y = (q, y, q̇): q̇ = dq/dt, the last components (not with quadrature states after them).
+  if (setup.rates_last) stepper->set_second_order(setup.positions);
+  stepper->set_jacobian_reuse(setup.jacobian_reuse);
+  // AUTO: back to DOP853 when its stability bound (|hλ| ≤ 6.1) would allow explicit_gain times
+  // Radau's steps.
+  if (setup.auto_switch)
+    stepper->set_nonstiffness_detection(Integrator::stiffness_bound(Method::DOP853) / setup.explicit_gain);
+  return stepper;
+}
+
+// Hairer's mapping of the tolerances and his default stopping criterion of the Newton iterations.
+void Radau5::tolerances_set() {
   double rmin = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n_; ++i) {
-    if (rtol[i] > 0) {
-      r[i] = 0.1 * std::pow(rtol[i], 2.0 / 3.0);
-      a[i] = atol[i] * r[i] / rtol[i];
-      rmin = std::min(rmin, r[i]);
-    } else {
-      r[i] = 0.0;
-      a[i] = atol[i];
+    if (rtol_[i] > 0) {
+      const double r = 0.1 * std::pow(rtol_[i], 2.0 / 3.0);
+      atol_[i] = atol_[i] * r / rtol_[i];
+      rtol_[i] = r;
+      rmin = std::min(rmin, r);
     }
   }
-  rtol_ = r;
-  atol_ = a;
-  // Hairer's default stopping criterion of the Newton iterations.
   const double tol = std::isfinite(rmin) ? rmin : 1e-6;
   fnewt_ = std::max(10.0 * kRound / tol, std::min(0.03, std::sqrt(tol)));
 }
-
-void Radau5::set_max_step(double hmax) {
-  if (!(hmax > 0)) throw std::invalid_argument("Radau5: the maximum step must be positive");
-  hmax_ = hmax;
-}
-
-void Radau5::set_max_steps(long n) {
-  if (n < 1) throw std::invalid_argument("Radau5: the step limit must be positive");
-  max_steps_ = n;
-}
-
-void Radau5::set_initial_step(double h) {
-  if (!(h >= 0) || !std::isfinite(h))
-    throw std::invalid_argument("Radau5: the initial step must be finite and >= 0");
-  h_initial_ = h;
-}
-
-double Radau5::last_step() const { return h_last_; }
-void Radau5::set_stop_condition(StopCondition stop) { stop_ = std::move(stop); }
-void Radau5::set_step_start(StepStart start) { step_start_ = std::move(start); }
-void Radau5::set_jacobian(Jacobian jac) { jac_ = std::move(jac); }
 
 void Radau5::set_second_order(int m) {
   if (m < 0 || 2 * m > n_) throw std::invalid_argument("Radau5: the second-order positions must be at most half the states");
@@ -138,26 +124,12 @@ void Radau5::set_jacobian_reuse(double theta) {
   theta_reuse_ = theta;
 }
 
-const Radau5Stats& Radau5::stats() const { return stats_; }
-
 void Radau5::set_nonstiffness_detection(double bound) {
   if (!(bound >= 0) || !std::isfinite(bound))
     throw std::invalid_argument("Radau5: the non-stiffness bound must be finite and >= 0");
   nonstiff_bound_ = bound;
 }
-bool Radau5::nonstiffness_detected() const { return nonstiff_; }
 double Radau5::spectral_radius() const { return rho_; }
-bool Radau5::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy) {
-  ++stats_.nfev;
-  f(t, y, dy);
-  if (dy.size() != n_)
-    throw std::invalid_argument("Radau5: the rhs returned " + std::to_string(dy.size()) + " derivatives for " +
-                                std::to_string(n_) + " states");
-  if (dy.allFinite()) return true;
-  failure_ = "non-finite rhs value";
-  return false;
-}
-
 // Hairer's starting step estimate (as Integrator's) for a method of order 5; uses f0_.
 double Radau5::initial_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y) {
   const double span = std::min(hmax_, t_end - t0);
@@ -403,123 +375,103 @@ size_t Radau5::emit_outputs(const std::vector<double>& touts, size_t next, doubl
   return next;
 }
 
-double Radau5::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
-                         const std::vector<double>& touts, const Output& out) {
-  check_integration("Radau5", n_, t0, t_end, y, touts);
+void Radau5::check_ready() const {
   if (!jac_) throw std::invalid_argument("Radau5: no Jacobian callback set");
+}
 
-  failure_ = "none";
-  size_t next = outputs_at_start(touts, t0, y, out);
-  if (t_end == t0) return t0;
-
-  evaluate_start("Radau5", t0, failure_, [&] { return eval(f, t0, y, f0_); });
-
-  double h = std::min(h_initial_ > 0 ? h_initial_ : initial_step(f, t0, t_end, y), hmax_);
-  bool first = true, rejected = false;
-  bool need_jacobian = true, jacobian_fresh = false;  // fresh: taken at the current step start
-  double h_factorized = 0.0;                           // step of the factorizations in place
-  double h_acc = 0.0, err_acc = 0.0;                   // last accepted step, for the predictive controller
-  long accepted_here = 0;
+void Radau5::begin() {
+  first_ = true;
+  rejected_ = false;
+  need_jacobian_ = true;
+  jacobian_fresh_ = false;
+  h_factorized_ = h_acc_ = err_acc_ = 0.0;
+  accepted_here_ = 0;
   have_polynomial_ = false;
   faccon_ = 1.0;
-  nonstiff_ = false;
   nonstiff_steps_ = 0;
   rho_ = 0.0;
-  double t = t0;
-  for (long steps = 0; t < t_end; ++steps) {
-    if (steps >= max_steps_)
-      throw IntegrationError("Radau5: more than " + std::to_string(max_steps_) + " steps at " + describe_step(t, h));
-    if (!(h >= Integrator::min_step(t)))
-      throw IntegrationError("Radau5: step size underflow at " + describe_step(t, h) + " (last rejection: " +
-                             failure_ + ")");
-    const bool last = t + std::min(1.01 * h, hmax_) >= t_end;
-    const double h_try = last ? t_end - t : h;
+}
 
-    ++stats_.nsteps;
-    if (step_start_) step_start_(t, y);
-    Attempt result = Attempt::Failed;
-    try {
-      if (need_jacobian) {
-        ++stats_.njev;
-        jac_(t, y, J_);
-        if (J_.rows() != n_ || J_.cols() != n_)
-          throw std::invalid_argument("Radau5: the Jacobian has the wrong size");
-        if (!J_.allFinite()) throw IntegrationError("Radau5: non-finite Jacobian at " + describe_step(t, h_try));
-        need_jacobian = false;
-        jacobian_fresh = true;
-        if (nonstiff_bound_ > 0) {
-          eigen_.compute(J_, false);
-          // No convergence of the eigenvalues: take the method for stiff (no return).
-          rho_ = eigen_.info() == Eigen::Success ? eigen_.eigenvalues().cwiseAbs().maxCoeff()
-                                                 : std::numeric_limits<double>::infinity();
-        }
-        h_factorized = 0.0;
+bool Radau5::start(const Rhs& f, double t0, const Eigen::VectorXd& y) { return eval(f, t0, y, f0_); }
+
+double Radau5::first_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y) {
+  return std::min(h_initial_ > 0 ? h_initial_ : initial_step(f, t0, t_end, y), hmax_);
+}
+
+Stepper::Outcome Radau5::step(const Rhs& f, double t, double h_try, double t_new, Eigen::VectorXd& y,
+                              Outputs& outputs, double& h) {
+  Attempt result = Attempt::Failed;
+  try {
+    if (need_jacobian_) {
+      ++stats_.njev;
+      jac_(t, y, J_);
+      if (J_.rows() != n_ || J_.cols() != n_) throw std::invalid_argument("Radau5: the Jacobian has the wrong size");
+      if (!J_.allFinite()) throw IntegrationError("Radau5: non-finite Jacobian at " + describe_step(t, h_try));
+      need_jacobian_ = false;
+      jacobian_fresh_ = true;
+      if (nonstiff_bound_ > 0) {
+        eigen_.compute(J_, false);
+        // No convergence of the eigenvalues: take the method for stiff (no return).
+        rho_ = eigen_.info() == Eigen::Success ? eigen_.eigenvalues().cwiseAbs().maxCoeff()
+                                               : std::numeric_limits<double>::infinity();
       }
-      if (h_try != h_factorized) {
-        factorize(h_try);
-        h_factorized = h_try;
-      }
-      result = attempt_step(f, t, h_try, y, first || rejected);
-    } catch (const StepRejected& e) {
-      failure_ = e.what();
-      result = Attempt::Failed;
+      h_factorized_ = 0.0;
     }
-
-    // Hairer's step-size proposal: the error behaves as h^4; fewer Newton iterations, more trust.
-    const double fac = std::min(kStepSafety, kStepSafety * (1 + 2 * kMaxNewton) / (newton_its_ + 2 * kMaxNewton));
-    double quot = std::clamp(std::pow(err_, 0.25) / fac, 0.125, 5.0);
-    if (result != Attempt::Accepted) {
-      ++stats_.nreject;
-      rejected = true;
-      if (result == Attempt::ErrorTooLarge) h = first ? 0.1 * h_try : h_try / quot;
-      else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
-      else h = 0.5 * h_try;
-      // A Jacobian from an earlier state may be why Newton failed: take it afresh at this state.
-      // (Hairer's code renews it after any rejection; a step rejected for its error had converged,
-      // and here a Jacobian is a linearization costing several right-hand sides per DOF.)
-      need_jacobian = !jacobian_fresh && result != Attempt::ErrorTooLarge;
-      continue;
+    if (h_try != h_factorized_) {
+      factorize(h_try);
+      h_factorized_ = h_try;
     }
-
-    ++stats_.naccept;
-    ++accepted_here;
-    if (accepted_here > 1) {
-      // Predictive controller (Gustafsson): use the trend of the last two errors.
-      const double gus = std::clamp((h_acc / h_try) * std::pow(err_ * err_ / err_acc, 0.25) / kStepSafety, 0.125, 5.0);
-      quot = std::max(quot, gus);
-    }
-    h_acc = h_try;
-    err_acc = std::max(1e-2, err_);
-    double h_new = std::min(h_try / quot, hmax_);
-    if (rejected) h_new = std::min(h_new, h_try);
-
-    const double t_new = last ? t_end : t + h_try;
-    h_old_ = h_try;
-    build_polynomial();
-    have_polynomial_ = true;
-    next = emit_outputs(touts, next, t_new, out);
-    t = t_new;
-    y = y_new_;
-    f0_ = tmp_;  // f(t_new, y_new) from attempt_step
-    first = rejected = false;
-    jacobian_fresh = false;
-    // Keep the Jacobian if Newton contracted fast; keep the step (and the factorizations) too
-    // if the proposal is only a little larger.
-    need_jacobian = theta_ > theta_reuse_;
-    if (!need_jacobian && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;
-    // A last step shortened to reach t_end says little about the step the solution allows.
-    h = last ? std::max(h_new, std::min(h, hmax_)) : h_new;
-    if (nonstiff_bound_ > 0) {
-      nonstiff_steps_ = rho_ * h_try <= nonstiff_bound_ ? nonstiff_steps_ + 1 : 0;
-      if (nonstiff_steps_ >= kNonstiffSteps && t < t_end) {
-        nonstiff_ = true;
-        break;
-      }
-    }
-    if (stop_ && t < t_end && stop_(t, y)) break;
+    result = attempt_step(f, t, h_try, y, first_ || rejected_);
+  } catch (const StepRejected& e) {
+    failure_ = e.what();
+    result = Attempt::Failed;
   }
-  h_last_ = h;
-  return t;
+
+  // Hairer's step-size proposal: the error behaves as h^4; fewer Newton iterations, more trust.
+  const double fac = std::min(kStepSafety, kStepSafety * (1 + 2 * kMaxNewton) / (newton_its_ + 2 * kMaxNewton));
+  double quot = std::clamp(std::pow(err_, 0.25) / fac, 0.125, 5.0);
+  if (result != Attempt::Accepted) {
+    rejected_ = true;
+    if (result == Attempt::ErrorTooLarge) h = first_ ? 0.1 * h_try : h_try / quot;
+    else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
+    else h = 0.5 * h_try;
+    // A Jacobian from an earlier state may be why Newton failed: take it afresh at this state.
+    // (Hairer's code renews it after any rejection; a step rejected for its error had converged,
+    // and here a Jacobian is a linearization costing several right-hand sides per DOF.)
+    need_jacobian_ = !jacobian_fresh_ && result != Attempt::ErrorTooLarge;
+    return Outcome::Rejected;
+  }
+
+  ++accepted_here_;
+  if (accepted_here_ > 1) {
+    // Predictive controller (Gustafsson): use the trend of the last two errors.
+    const double gus = std::clamp((h_acc_ / h_try) * std::pow(err_ * err_ / err_acc_, 0.25) / kStepSafety, 0.125, 5.0);
+    quot = std::max(quot, gus);
+  }
+  h_acc_ = h_try;
+  err_acc_ = std::max(1e-2, err_);
+  double h_new = std::min(h_try / quot, hmax_);
+  if (rejected_) h_new = std::min(h_new, h_try);
+
+  h_old_ = h_try;
+  build_polynomial();
+  have_polynomial_ = true;
+  outputs.next = emit_outputs(outputs.touts, outputs.next, t_new, outputs.out);
+  y = y_new_;
+  f0_ = tmp_;  // f(t_new, y_new) from attempt_step
+  first_ = rejected_ = false;
+  jacobian_fresh_ = false;
+  // Keep the Jacobian if Newton contracted fast; keep the step (and the factorizations) too
+  // if the proposal is only a little larger.
+  need_jacobian_ = theta_ > theta_reuse_;
+  if (!need_jacobian_ && h_new >= h_try && h_new <= 1.2 * h_try) h_new = h_try;
+  h = h_new;
+  if (nonstiff_bound_ > 0) nonstiff_steps_ = rho_ * h_try <= nonstiff_bound_ ? nonstiff_steps_ + 1 : 0;
+  return Outcome::Accepted;
+}
+
+bool Radau5::switch_after_step(double t, double t_end, double) {
+  return nonstiff_bound_ > 0 && nonstiff_steps_ >= kNonstiffSteps && t < t_end;
 }
 
 }  // namespace spacar

@@ -6,15 +6,13 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
-#include <type_traits>
 
 #include "spacar/diagnosis.hpp"
 #include "spacar/dynamics.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/kinematics.hpp"
 #include "spacar/limits.hpp"
-#include "spacar/generalized_alpha.hpp"
-#include "spacar/radau5.hpp"
+#include "spacar/stepper.hpp"
 
 namespace spacar {
 
@@ -365,8 +363,7 @@ void Simulation::residual(double t, const Eigen::VectorXd& Y, const Eigen::Vecto
   check_time(t);
   in_rhs(t, [&] {
     solve_motion(t, Y.data(), Y.data() + nd, Start::Taylor);
-    data_->qdd = qdd;
-    for (int j = 0; j < nd; ++j) data_->qhat_dd[sys.dof_cols[j]] = qdd[j];
+    set_dof_accelerations(sys, *data_, qdd);
     reduced_residual_direct(sys, *data_, R, chain_.get());
   });
   remember(base_);  // the next positions' predictor, and the anchor of the next step
@@ -514,15 +511,6 @@ void Simulation::check_time(double t) {
 
 namespace {
 
-// Method AUTO returns from Radau to DOP853 only where DOP853 would be stable at this many times
-// Radau's step (LSODA's RATIO).
-constexpr double kExplicitGain = 5.0;
-// Method AUTO leaves DOP853 for Radau only when, at the stiffness detected, at least this many
-// steps of DOP853's current size remain in the block (Hairer's NSTIFF: his DOP853 looks for
-// stiffness only after 1000 steps). A short stiff stretch costs DOP853 little, and where the
-// stiff modes are excited (the manual's slider-crank) Radau's steps are no longer than DOP853's.
-constexpr double kStiffStepsAhead = 1000.0;
-
 std::string format_g(double v, int digits) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*g", digits, v);
@@ -661,13 +649,13 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
     throw InputError("the controller's sample period " + num(options.sample_period) + " needs more than " +
                      std::to_string(options.max_steps) + " samples in the block");
   if (plan.integrate) {
-    const double h_min = Integrator::min_step(t_end);
+    const double h_min = Stepper::min_step(t_end);
     if (st.timestep_tp < h_min)
       throw InputError("TIMESTEP: the period Tp = " + num(st.timestep_tp) +
                        " is shorter than the smallest integration step " + num(h_min) + " at t = " + num(t_end));
-    if (st.hmax < Integrator::min_step(t0))
+    if (st.hmax < Stepper::min_step(t0))
       throw InputError("HMAX " + num(st.hmax) + " is below the smallest integration step " +
-                       num(Integrator::min_step(t0)) + " at t = " + num(t0));
+                       num(Stepper::min_step(t0)) + " at t = " + num(t0));
     if (st.timestep_tp / st.hmax > static_cast<double>(options.max_steps))
       throw InputError("HMAX " + num(st.hmax) + " needs at least Tp/HMAX = " + num(st.timestep_tp / st.hmax) +
                        " steps, more than the limit of " + std::to_string(options.max_steps) + " steps per block");
@@ -771,7 +759,7 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
     double t_stop = plan.t_end;
     if (sampled) {
       const double next = plan.t0 + static_cast<double>(k_sample + 1) * options.sample_period;
-      if (next < plan.t_end - Integrator::min_step(plan.t_end)) t_stop = next;
+      if (next < plan.t_end - Stepper::min_step(plan.t_end)) t_stop = next;
     }
     auto last = plan.times.begin() + k_out;
     while (last != plan.times.end() && *last <= t_stop) ++last;
@@ -796,11 +784,14 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   }
 }
 
-Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const RunOptions& options, Method method,
-                                                     bool auto_switch, const Settings& st, double t, double t_end,
-                                                     double h, Eigen::VectorXd& Y, const std::vector<double>& times,
-                                                     const Integrator::Output& output) {
-  auto jacobian_of_state = [this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
+StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_switch, int n_states) {
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  StepperSetup setup;
+  setup.n = n_states;
+  setup.positions = nd;
+  setup.rate_offset = nd + ny;
+  setup.rates_last = n_energy_ == 0;  // Y = (q, y, q̇); the energy's quadrature states come after q̇
+  setup.jacobian = [this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
     jacobian(tt, y, J);
     if (J.rows() < y.size()) {  // the energy's quadrature states: nothing depends on them
       Eigen::MatrixXd full = Eigen::MatrixXd::Zero(y.size(), y.size());
@@ -808,92 +799,71 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
       J.swap(full);
     }
   };
-  if (method == Method::GENERALIZED_ALPHA) {
-    const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
-    if (nd == 0) throw InputError("method generalized_alpha: the model has no degrees of freedom to integrate");
-    GeneralizedAlpha integ(static_cast<int>(Y.size()), nd, nd + ny, options.rho_inf);
-    integ.set_jacobian(jacobian_of_state);
-    if (residual_form())
-      integ.set_residual([this](double tt, const Eigen::VectorXd& y, const Eigen::VectorXd& D,
-                                Eigen::VectorXd& R) { residual(tt, y, D, R); },
-                         [this](Eigen::MatrixXd& W) { W = jacobian_mass_; });
-    if (sparse_newton()) {
-      newton_data_.reset();  // the system of this segment (a repartition recompiles it)
-      newton_system_.reset();
-      GeneralizedAlpha::NewtonSystem s;
-      s.refresh = [this](double tt, const Eigen::VectorXd& y) { newton_refresh(tt, y); };
-      s.factorize = [this](double gh, double bh2) {
-        NodalCoefficients c;
-        c.mass = 1.0, c.damping = gh, c.stiffness = bh2, c.geometric = bh2;
-        newton_singular_ = !newton_system_->factorize(newton_data_->sigma, c) || newton_system_->saddle().singular();
-      };
-      s.solve = [this](const Eigen::VectorXd& r, Eigen::VectorXd& x) {
-        if (newton_singular_) {  // the integrator reports a singular Newton matrix and halves the step
-          x = Eigen::VectorXd::Constant(r.size(), std::numeric_limits<double>::quiet_NaN());
-          return;
-        }
-        Eigen::VectorXd dx;
-        newton_system_->solve(r, x, dx, 0);
-      };
-      s.weight = [this](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = newton_system_->mass_product(v); };
-      integ.set_newton_system(std::move(s));
-    }
-    integ.set_fixed_step(options.fixed_step);
-    return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
+  if (residual_form()) {
+    setup.residual = [this](double tt, const Eigen::VectorXd& y, const Eigen::VectorXd& D, Eigen::VectorXd& R) {
+      residual(tt, y, D, R);
+    };
+    setup.weight = [this](Eigen::MatrixXd& W) { W = jacobian_mass_; };
   }
-  if (method == Method::RADAU5) {
-    Radau5 integ(static_cast<int>(Y.size()));
-    integ.set_jacobian(jacobian_of_state);
-    // Y = (q, y, q̇): q̇ = dq/dt, the last components (not with the energy's states after them).
-    if (n_energy_ == 0) integ.set_second_order(sys_->n_dof());
-    // The Jacobian (a linearization) costs several right-hand sides per DOF: keep it longer.
-    integ.set_jacobian_reuse(0.1);
-    // Back to DOP853 when its stability bound (|hλ| ≤ 6.1) would allow kExplicitGain times
-    // Radau's steps: LSODA's rule (Petzold 1983) with its factor, which pays for DOP853's 12
-    // right-hand sides per step against Radau's 4 to 10 and keeps the two from alternating.
-    if (auto_switch) integ.set_nonstiffness_detection(Integrator::stiffness_bound(Method::DOP853) / kExplicitGain);
-    return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
+  if (sparse_newton()) {
+    newton_data_.reset();  // the system of this segment (a repartition recompiles it)
+    newton_system_.reset();
+    setup.newton.refresh = [this](double tt, const Eigen::VectorXd& y) { newton_refresh(tt, y); };
+    setup.newton.factorize = [this](double gh, double bh2) {
+      NodalCoefficients c;
+      c.mass = 1.0, c.damping = gh, c.stiffness = bh2, c.geometric = bh2;
+      newton_singular_ = !newton_system_->factorize(newton_data_->sigma, c) || newton_system_->saddle().singular();
+    };
+    setup.newton.solve = [this](const Eigen::VectorXd& r, Eigen::VectorXd& x) {
+      if (newton_singular_) {  // the stepper reports a singular Newton matrix and halves the step
+        x = Eigen::VectorXd::Constant(r.size(), std::numeric_limits<double>::quiet_NaN());
+        return;
+      }
+      Eigen::VectorXd dx;
+      newton_system_->solve(r, x, dx, 0);
+    };
+    setup.newton.weight = [this](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+      out = newton_system_->mass_product(v);
+    };
   }
-  Integrator integ(static_cast<int>(Y.size()), method);
-  integ.set_stiffness_detection(auto_switch, kStiffStepsAhead);
-  return run_segment(integ, res, options, st, t, t_end, h, Y, times, output);
+  setup.rho_inf = options.rho_inf;
+  setup.fixed_step = options.fixed_step;
+  setup.auto_switch = auto_switch;
+  return setup;
 }
 
-// One segment with either integrator (the explicit Integrator or the implicit Radau5, which have
-// the same interface).
-template <class Integ>
-Simulation::SegmentEnd Simulation::run_segment(Integ& integ, BlockResults& res, const RunOptions& options,
-                                               const Settings& st, double t, double t_end, double h,
-                                               Eigen::VectorXd& Y, const std::vector<double>& times,
-                                               const Integrator::Output& output) {
+Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const RunOptions& options, Method method,
+                                                     bool auto_switch, const Settings& st, double t, double t_end,
+                                                     double h, Eigen::VectorXd& Y, const std::vector<double>& times,
+                                                     const Stepper::Output& output) {
+  const std::unique_ptr<Stepper> stepper =
+      make_stepper(method, stepper_setup(options, auto_switch, static_cast<int>(Y.size())));
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   Eigen::VectorXd rtol(Y.size());
   rtol.setConstant(st.epsint);
   rtol.segment(nd + ny, nd).setConstant(st.epsind);
-  integ.set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
-  integ.set_max_step(st.hmax);
-  integ.set_max_steps(options.max_steps - res.steps);
-  if (h > 0.0) integ.set_initial_step(h);
+  stepper->set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
+  stepper->set_max_step(st.hmax);
+  stepper->set_max_steps(options.max_steps - res.steps);
+  if (h > 0.0) stepper->set_initial_step(h);
   // Stop to repartition a free rotation whose dependent Euler parameter became small.
   if (!sys_->free_rotations.empty())
-    integ.set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
-  integ.set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
+    stepper->set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+  stepper->set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
   anchor_.valid = false;
   auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
   auto add_stats = [&]() {
-    const auto& s = integ.stats();
+    const StepperStats& s = stepper->stats();
     res.rhs_evaluations += s.nfev;
     res.steps += s.nsteps;
     res.accepted += s.naccept;
     res.rejected += s.nreject;
-    if constexpr (!std::is_same_v<Integ, Integrator>) {
-      res.jacobians += s.njev;
-      res.decompositions += s.ndec;
-    }
+    res.jacobians += s.njev;
+    res.decompositions += s.ndec;
   };
   double t_reached = t;
   try {
-    t_reached = integ.integrate(f, t, t_end, Y, times, output);
+    t_reached = stepper->integrate(f, t, t_end, Y, times, output);
   } catch (const IntegrationError& err) {
     add_stats();
     explain_collapse(err, Y);
@@ -903,10 +873,8 @@ Simulation::SegmentEnd Simulation::run_segment(Integ& integ, BlockResults& res, 
     throw;
   }
   add_stats();
-  res.last_step = integ.last_step();
-  if constexpr (std::is_same_v<Integ, Radau5>) return {t_reached, integ.nonstiffness_detected()};
-  else if constexpr (std::is_same_v<Integ, Integrator>) return {t_reached, integ.stiffness_detected()};
-  else return {t_reached, false};
+  res.last_step = stepper->last_step();
+  return {t_reached, stepper->wants_switch()};
 }
 
 void Simulation::explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y) {

@@ -32,7 +32,7 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     stats["method"] = _method_used(arrays)
     stats["switches"] = [tuple(s) for s in arrays["switches"]]
     # The implicit method's work, where it ran: Jacobians (linearizations), LU factorizations.
-    if method in ("radau5", "generalized_alpha") or arrays["switches"]:
+    if method in _core.implicit_methods or arrays["switches"]:
         stats.update(jacobians=arrays["jacobians"], decompositions=arrays["decompositions"])
     coords, defs = system.coord_label, system.def_label  # each a fresh copy of the list: taken once
     lins = [Linearization(d, coords, defs) for d in arrays["linearizations"]]
@@ -214,8 +214,10 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     if on_output is not None and not callable(on_output):
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
     if not isinstance(method, str):
-        raise InputError(f"method must be 'dop853' or 'dopri5' (explicit), 'radau5' or 'generalized_alpha' "
-                         f"(implicit) or 'auto', got {show(method)}")
+        implicit = _core.implicit_methods
+        explicit = [m for m in _core.integration_methods if m not in implicit and m != "auto"]
+        raise InputError(f"method must be {' or '.join(map(repr, explicit))} (explicit), "
+                         f"{' or '.join(map(repr, implicit))} (implicit) or 'auto', got {show(method)}")
     if rho_inf is not None and (isinstance(rho_inf, (bool, np.bool_))
                                 or not isinstance(rho_inf, (int, float, np.number)) or not 0.0 <= rho_inf <= 1.0):
         raise InputError(f"rho_inf (the spectral radius of generalized_alpha) must be a number in [0, 1], "

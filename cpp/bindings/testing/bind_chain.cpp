@@ -67,8 +67,7 @@ void bind_chain(py::module_& m) {
         std::unique_ptr<spacar::ExplicitChain> chain = chain_motion("chain_residual", sim, t, q, qd);
         if (!chain) return py::none();
         spacar::Data& d = sim.data();
-        d.qdd = qdd;
-        for (int j = 0; j < nd; ++j) d.qhat_dd[sys.dof_cols[j]] = qdd[j];
+        spacar::set_dof_accelerations(sys, d, qdd);
         Eigen::VectorXd R;
         spacar::reduced_residual_direct(sys, d, R, chain.get());
         py::dict out;

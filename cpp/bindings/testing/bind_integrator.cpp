@@ -36,7 +36,7 @@ py::dict solve_explicit(const py::function& f, double t0, const Eigen::VectorXd&
   Eigen::VectorXd y = y0;
   const double t_reached = integrator.integrate(rhs, t0, t_end, y, touts, out);
 
-  const spacar::IntegratorStats& stats = integrator.stats();
+  const spacar::StepperStats& stats = integrator.stats();
   py::dict result;
   result["t"] = py::array_t<double>(static_cast<py::ssize_t>(touts.size()), touts.data());
   result["y"] = ys;
@@ -44,7 +44,7 @@ py::dict solve_explicit(const py::function& f, double t0, const Eigen::VectorXd&
   result["naccept"] = stats.naccept;
   result["nreject"] = stats.nreject;
   result["t_reached"] = t_reached;
-  result["stiff"] = integrator.stiffness_detected();
+  result["stiff"] = integrator.wants_switch();
   result["hlamb"] = integrator.stiffness_estimate();
   return result;
 }

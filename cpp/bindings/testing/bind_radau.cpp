@@ -16,7 +16,7 @@ namespace py = pybind11;
 namespace {
 
 // The output times, the dense output at them and the counters of an implicit integrator.
-py::dict outputs(const std::vector<double>& touts, const Eigen::MatrixXd& ys, const spacar::Radau5Stats& s) {
+py::dict outputs(const std::vector<double>& touts, const Eigen::MatrixXd& ys, const spacar::StepperStats& s) {
   py::dict result;
   result["t"] = py::array_t<double>(static_cast<py::ssize_t>(touts.size()), touts.data());
   result["y"] = ys;
@@ -69,7 +69,7 @@ py::dict solve_radau5(const py::function& f, const py::function& jac, double t0,
 
   py::dict result = outputs(touts, ys, integrator.stats());
   result["t_reached"] = t_reached;
-  result["nonstiff"] = integrator.nonstiffness_detected();
+  result["nonstiff"] = integrator.wants_switch();
   result["rho"] = integrator.spectral_radius();
   return result;
 }

@@ -34,6 +34,8 @@ inline bool constitutive_class(DefClass c) {
   return c == DefClass::Released || c == DefClass::Dynamic || c == DefClass::Kinematic;
 }
 
+// The DOF accelerations q̈ into data: data.qdd and their columns of q̂̈ (qdd may be data.qdd).
+void set_dof_accelerations(const System& sys, Data& data, const Eigen::VectorXd& qdd);
 // Solve M̄ q̈ = rhs (3.1) and complete ẍ, ë. Requires positions, DF and velocities.
 // Throws SingularMassError naming the degrees of freedom without inertia.
 void solve_dynamics(const System& sys, Data& data);

@@ -13,10 +13,9 @@
 // frequency: ρ∞ = 1 conserves the amplitude of every mode (the trapezoidal rule), smaller values
 // damp the highest ones (ρ∞ = 0: annihilated in one step) while keeping second order.
 //
-// The interface has the shape of Radau5's (radau5.hpp): per-component tolerances, maximum step,
-// step limit, initial step, stop condition, step-start callback, dense output at the output
-// times, and the Jacobian ∂f/∂y from a callback, reused over steps while the simplified Newton
-// iterations converge well. The Newton matrix I − γ' h ∂f_Z/∂Z − β' h² ∂f_Z/∂q (size n − m) is
+// A Stepper (stepper.hpp), with the Jacobian ∂f/∂y from the Jacobian callback, reused over steps
+// while the simplified Newton iterations converge well, and dense output at the output times by
+// cubic Hermite interpolation over the step. The Newton matrix I − γ' h ∂f_Z/∂Z − β' h² ∂f_Z/∂q (size n − m) is
 // factorized once per step size.
 //
 // Error control: the local error of the positions, q⁺ minus the cubic Taylor step
@@ -28,73 +27,56 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <memory>
 #include <string>
 
-#include "spacar/integrator.hpp"
-#include "spacar/radau5.hpp"
+#include "spacar/stepper.hpp"
 
 namespace spacar {
 
-class GeneralizedAlpha {
+class GeneralizedAlpha : public Stepper {
  public:
-  using Rhs = Integrator::Rhs;
-  using Output = Integrator::Output;
-  using StopCondition = Integrator::StopCondition;
-  using StepStart = Integrator::StepStart;
-  using Jacobian = Radau5::Jacobian;
-
   // n states, of which the first m are positions with rates at rate_offset .. rate_offset + m − 1
-  // (m ≤ rate_offset ≤ n − m); rho_inf in [0, 1].
+  // (m ≤ rate_offset ≤ n − m); rho_inf in [0, 1]. The tolerances (Stepper::set_tolerances) are
+  // not mapped: sc = atol + rtol |y|; the method has order 2 and the global error follows rtol
+  // roughly in proportion.
   GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf);
+  // The stepper of GENERALIZED_ALPHA for a run (the method table, stepper.cpp).
+  static std::unique_ptr<Stepper> make(Method method, const StepperSetup& setup);
 
-  // Per component, sc = atol + rtol |y|, as for Integrator (not mapped: the method has order 2
-  // and the global error follows rtol roughly in proportion).
-  void set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol);
-  void set_max_step(double hmax);
-  void set_max_steps(long n);
-  void set_initial_step(double h);  // 0 = automatic
-  double last_step() const;
-  void set_stop_condition(StopCondition stop);
-  void set_step_start(StepStart start);
-  void set_jacobian(Jacobian jac);  // required before integrate()
   // The residual form of the Newton iterations (optional): R = W(y) (D − f_Z(t, y)) for a trial
   // D of Z, with W the identity except in the rates' rows, where it is a matrix W_v (m x m) of
   // the positions (the reduced mass matrix M̄(q) of equations of motion M̄ q̈ = r(q, q̇)). Where
   // the residual costs less than f_Z (no solve with M̄), the iterations use it with the Newton
   // matrix W_v N, W_v taken at the Jacobian's state: the same increments to first order.
   // `weight` gives W_v there, after each call of the Jacobian.
-  using Residual = std::function<void(double t, const Eigen::VectorXd& y, const Eigen::VectorXd& D, Eigen::VectorXd& R)>;
-  using Weight = std::function<void(Eigen::MatrixXd& W)>;
-  void set_residual(Residual residual, Weight weight);
+  void set_residual(Residual residual, ResidualWeight weight);
   // A Newton matrix of the caller's own instead of the dense one from the Jacobian (large models,
   // sparse): where the integrator would take a Jacobian, refresh(t, y) takes the state there;
   // factorize(γ′h, β′h²) factorizes S = M̄ + γ′h C̄ + β′h² K̄ at it, the residual form's W_v N;
   // solve(r, x): x = S⁻¹ r; weight(v, out): out = M̄ v at it (W_v). Requires the residual form
   // (set_residual; its weight is not used then) and Z the rates alone (no other first-order
   // states).
-  struct NewtonSystem {
-    std::function<void(double t, const Eigen::VectorXd& y)> refresh;
-    std::function<void(double gh, double bh2)> factorize;
-    std::function<void(const Eigen::VectorXd& r, Eigen::VectorXd& x)> solve;
-    std::function<void(const Eigen::VectorXd& v, Eigen::VectorXd& out)> weight;
-  };
   void set_newton_system(NewtonSystem system);
   // Fixed steps of size h (the last one shortened to t_end) without error control, as structural
   // dynamics codes are used; the tolerances then only stop the Newton iterations. A step whose
   // Newton iterations fail is retried in halves. 0 (the default): error control.
   void set_fixed_step(double h);
 
-  // As Integrator::integrate, with outputs from cubic Hermite interpolation over the step.
-  double integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
-                   const std::vector<double>& touts, const Output& out);
-
-  const Radau5Stats& stats() const;  // cumulative over all integrate calls; nnewton: iterations
-
  private:
   // Rejected: the right-hand side refused a state (StepRejected, e.g. its kinematics).
   enum class Attempt { Accepted, ErrorTooLarge, SlowNewton, Failed, Rejected };
 
-  bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
+  // The hooks of Stepper::integrate.
+  void check_ready() const override;
+  void begin() override;
+  bool start(const Rhs& f, double t0, const Eigen::VectorXd& y) override;
+  double first_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y) override;
+  Outcome step(const Rhs& f, double t, double h_try, double t_new, Eigen::VectorXd& y, Outputs& outputs,
+               double& h) override;
+  // One attempt of the step and its error (err: 1 under fixed steps).
+  Attempt attempt(const Rhs& f, double t, double h_try, const Eigen::VectorXd& y, double& err);
+
   // res_ = f_Z(t, y_new_) − d_new_, or its residual form −R (see set_residual).
   bool newton_residual(const Rhs& f, double t);
   void apply_weight(Eigen::VectorXd& v);  // v's rate part times W_ (residual form)
@@ -110,25 +92,22 @@ class GeneralizedAlpha {
   size_t emit_outputs(const std::vector<double>& touts, size_t next, double t, double h, double t_new,
                       const Eigen::VectorXd& y, const Output& out);
 
-  int n_, m_, r0_, nz_;
+  int m_, r0_, nz_;
   double alpha_m_, alpha_f_, gamma_, beta_, gamma_d_, beta_d_;
-  Eigen::VectorXd rtol_, atol_;
-  double hmax_;
-  long max_steps_ = Integrator::kMaxSteps;
-  double h_initial_ = 0.0, h_last_ = 0.0, h_fixed_ = 0.0;
-  StopCondition stop_;
-  StepStart step_start_;
-  Jacobian jac_;
+  double h_fixed_ = 0.0;
   Residual residual_;
-  Weight weight_;
+  ResidualWeight weight_;
   NewtonSystem system_;  // set: it replaces J_, N_, W_ and lu_
   // The residual form is used from each Jacobian on until Newton contracts slowly (W_v has
   // drifted); lu_ holds the Newton matrix of factorized_residual_form_.
   bool in_residual_form_ = false, factorized_residual_form_ = false;
-  Radau5Stats stats_;
-  std::string failure_;
   double theta_ = 0.0, faccon_ = 1.0, slow_factor_ = 0.5;
   int newton_its_ = 0;
+  // The step loop's state (Stepper::integrate's hooks): a rejection before this attempt, whether
+  // the Jacobian must be taken (fresh: at the current step start), the step of the factorization
+  // in place.
+  bool rejected_ = false, need_jacobian_ = true, jacobian_fresh_ = false;
+  double h_factorized_ = 0.0;
   bool have_previous_ = false;  // d_prev_ and h_prev_ hold the step before (error of Z)
   double h_prev_ = 0.0;
 

@@ -2,12 +2,10 @@
 // step-size control, simplified Newton iterations and dense output in the manner of Hairer's
 // RADAU5 (E. Hairer, G. Wanner, "Solving Ordinary Differential Equations II", Sec. IV.8).
 //
-// The interface has the shape of Integrator (integrator.hpp), so that the analysis can drive
-// either: tolerances per component, maximum step, step limit, initial step, stop condition and
-// step-start callback, integrate() with dense output at the output times. In addition the
-// Jacobian ∂f/∂y comes from a user callback (dense), evaluated at accepted states only and reused
-// over steps while the Newton iterations converge well; the factorizations of the Newton matrix
-// are reused while the step size stays put.
+// A Stepper (stepper.hpp): integrate() with dense output at the output times from the
+// collocation polynomial. The Jacobian ∂f/∂y comes from the Jacobian callback (dense), evaluated at
+// accepted states only and reused over steps while the Newton iterations converge well; the
+// factorizations of the Newton matrix are reused while the step size stays put.
 #pragma once
 
 #include <Eigen/Dense>
@@ -16,42 +14,23 @@
 #include <complex>
 #include <functional>
 #include <string>
+#include <memory>
 #include <vector>
 
-#include "spacar/integrator.hpp"
+#include "spacar/stepper.hpp"
 
 namespace spacar {
 
-struct Radau5Stats {
-  long nfev = 0, nsteps = 0, naccept = 0, nreject = 0;
-  long njev = 0;      // Jacobian evaluations
-  long ndec = 0;      // factorizations of the Newton matrix (one real and one complex each)
-  long nnewton = 0;   // simplified Newton iterations (three rhs and two solves each)
-  long nresidual = 0; // of nfev, residuals of the residual form (GeneralizedAlpha::set_residual)
-};
-
-class Radau5 {
+class Radau5 : public Stepper {
  public:
-  using Rhs = Integrator::Rhs;
-  using Output = Integrator::Output;
-  using StopCondition = Integrator::StopCondition;
-  using StepStart = Integrator::StepStart;
-  // J = ∂f/∂y at (t, y), n x n. May throw StepRejected like the rhs.
-  using Jacobian = std::function<void(double t, const Eigen::VectorXd& y, Eigen::MatrixXd& J)>;
-
   explicit Radau5(int n);
+  // The stepper of RADAU5 for a run (the method table, stepper.cpp).
+  static std::unique_ptr<Stepper> make(Method method, const StepperSetup& setup);
 
-  // Per component, as for Integrator. Internally the tolerances are mapped as in Hairer's code,
+  // The tolerances (Stepper::set_tolerances) are mapped as in Hairer's code,
   // rtol' = 0.1 rtol^(2/3), atol' = atol rtol'/rtol: the error estimate is that of an embedded
   // third-order formula, and this mapping makes the global error about rtol.
-  void set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol);
-  void set_max_step(double hmax);
-  void set_max_steps(long n);
-  void set_initial_step(double h);  // 0 = automatic
-  double last_step() const;
-  void set_stop_condition(StopCondition stop);
-  void set_step_start(StepStart start);
-  void set_jacobian(Jacobian jac);  // required before integrate()
+
   // The Jacobian is kept for the next step when the Newton contraction rate of the step was at
   // most this (Hairer's default 0.001; about 0.1 when the Jacobian is expensive).
   void set_jacobian_reuse(double theta);
@@ -62,28 +41,29 @@ class Radau5 {
   // Call before integrate(); 0 (the default): no structure assumed.
   void set_second_order(int m);
 
-  // As Integrator::integrate: y(t0) -> y(t_end) with out(t_k, y(t_k)) at the output times from
-  // the collocation polynomial of the step containing t_k.
-  double integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y,
-                   const std::vector<double>& touts, const Output& out);
-
-  const Radau5Stats& stats() const;  // cumulative over all integrate calls
-
   // Non-stiffness detection, for a return to an explicit method (bound > 0; 0: off): the spectral
   // radius ρ(J) of every Jacobian taken is computed (its eigenvalues, O(n³) like a
   // factorization, once per Jacobian), and an accepted step of size h with ρ h ≤ bound counts as
   // non-stiff: an explicit method whose stability region reaches out to |hλ| = bound would be
   // stable at this step size. After kNonstiffSteps such steps in a row integrate() stops there
-  // (as with the stop condition) and nonstiffness_detected() says so.
+  // (as with the stop condition) and wants_switch() says so.
   void set_nonstiffness_detection(double bound);
-  bool nonstiffness_detected() const;  // the last integrate() stopped because of it
   double spectral_radius() const;      // ρ(J) of the last Jacobian (0 if not detecting)
   static constexpr int kNonstiffSteps = 15;
 
  private:
   enum class Attempt { Accepted, ErrorTooLarge, SlowNewton, Failed };
 
-  bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
+  // The hooks of Stepper::integrate.
+  void check_ready() const override;
+  void begin() override;
+  bool start(const Rhs& f, double t0, const Eigen::VectorXd& y) override;
+  double first_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y) override;
+  Outcome step(const Rhs& f, double t, double h_try, double t_new, Eigen::VectorXd& y, Outputs& outputs,
+               double& h) override;
+  bool switch_after_step(double t, double t_end, double h) override;
+  void tolerances_set() override;
+
   double initial_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y);
   void factorize(double h);
   // x = (σ − J)⁻¹ r with the factorization of the real shift σ = γ/h (x may alias nothing).
@@ -98,23 +78,20 @@ class Radau5 {
   void polynomial_value(double s);  // y_out_ = u(t_new + s h_old), s in [-1, 0]
   size_t emit_outputs(const std::vector<double>& touts, size_t next, double t_new, const Output& out);
 
-  int n_;
   int m_ = 0;                     // second-order positions (set_second_order)
-  Eigen::VectorXd rtol_, atol_;   // mapped tolerances
   double fnewt_ = 0.03;           // Newton stopping criterion (scaled norm of the increment)
   double theta_reuse_ = 0.001;
-  double hmax_;
-  long max_steps_ = Integrator::kMaxSteps;
-  double h_initial_ = 0.0, h_last_ = 0.0;
-  StopCondition stop_;
-  StepStart step_start_;
-  Jacobian jac_;
-  Radau5Stats stats_;
   double nonstiff_bound_ = 0.0, rho_ = 0.0;
-  bool nonstiff_ = false;
   int nonstiff_steps_ = 0;
   Eigen::EigenSolver<Eigen::MatrixXd> eigen_;
-  std::string failure_;
+
+  // The step loop's state (Stepper::integrate's hooks): the first step, a rejection before this
+  // attempt, whether the Jacobian must be taken (fresh: at the current step start), the step of
+  // the factorizations in place, the last accepted step and its error (the predictive
+  // controller), and the steps accepted in this integrate() call.
+  bool first_ = true, rejected_ = false, need_jacobian_ = true, jacobian_fresh_ = false;
+  double h_factorized_ = 0.0, h_acc_ = 0.0, err_acc_ = 0.0;
+  long accepted_here_ = 0;
 
   // Newton state carried between steps (Hairer's FACCON and THETA).
   double faccon_ = 1.0, theta_ = 0.0, err_ = 0.0, slow_factor_ = 0.5;

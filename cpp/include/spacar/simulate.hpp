@@ -45,7 +45,7 @@ struct RunOptions {
   // against time_limit.
   double time_spent = 0.0;
   // Integration steps (accepted and rejected) over the whole block.
-  long max_steps = Integrator::kMaxSteps;
+  long max_steps = Stepper::kMaxSteps;
   // Planar and spatial trees of rigid bodies take the recursive (articulated-body) right-hand
   // side (tree.hpp, spatial_tree.hpp), other open chains the explicit positions (chain.hpp);
   // false: always the general constraint formulation.
@@ -253,16 +253,14 @@ class Simulation {
     double t;
     bool switch_method;
   };
-  // One run of the integrator `method` (not AUTO) from t towards t_end through `times`, until the
-  // end, a repartition of a free rotation or, with `auto_switch`, a change of stiffness.
+  // One run of the stepper of `method` (not AUTO) from t towards t_end through `times`, until
+  // the end, a repartition of a free rotation or, with `auto_switch`, a change of stiffness.
   // Counters and the last step go to res.
   SegmentEnd integrate_segment(BlockResults& res, const RunOptions& options, Method method, bool auto_switch,
                                const Settings& st, double t, double t_end, double h, Eigen::VectorXd& Y,
-                               const std::vector<double>& times, const Integrator::Output& output);
-  template <class Integ>
-  SegmentEnd run_segment(Integ& integ, BlockResults& res, const RunOptions& options, const Settings& st, double t,
-                         double t_end, double h, Eigen::VectorXd& Y, const std::vector<double>& times,
-                         const Integrator::Output& output);
+                               const std::vector<double>& times, const Stepper::Output& output);
+  // What this run offers a stepper (stepper.hpp): the shape of Y and the model's callbacks.
+  StepperSetup stepper_setup(const RunOptions& options, bool auto_switch, int n_states);
   void record(BlockResults& res, int k);
   // InputError unless q and q̇ have one value per degree of freedom (`what`: the entry point).
   void require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;

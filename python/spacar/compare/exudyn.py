@@ -74,7 +74,7 @@ try:
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
     raise ImportError("spacar.compare.exudyn needs exudyn: pip install 'spacar[compare]'") from exc
 
-from .. import _core, _testing
+from .. import _core
 from ._topology import (
     UnsupportedModelError,
     analyse,
@@ -435,7 +435,7 @@ class ExudynModel:
             for n in el.nodes:
                 size = _core.node_size(self.spacar_model.nodes[n].kind)
                 cols += [ci[(n, i)] for i in range(1, size + 1)]
-            kern = _testing.element_kernel(el.type_name, params=list(el.params),
+            kern = _core.element_kernel(el.type_name, params=list(el.params),
                                            l0=el.l0 if el.l0 is not None else 1.0, lgeomy=list(el.lgeomy))
             dcols = [di[(k, i)] for i in range(1, kern.n_deformations + 1)]
             kernels.append((kern, cols, dcols, el.type_name))

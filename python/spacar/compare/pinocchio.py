@@ -35,7 +35,7 @@ try:
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
     raise ImportError("spacar.compare.pinocchio needs Pinocchio: pip install 'spacar[compare]' (package pin)") from exc
 
-from .. import _core, _testing
+from .. import _core
 from ._topology import UnsupportedModelError, analyse
 
 
@@ -336,7 +336,7 @@ def simulate(spacar_model, t_end=None, n_out=None, rtol=None, atol=None, integra
     f = pm.rhs()
     touts = list(np.linspace(t0, t_end, n_out + 1))
     if integrator == "dop853":
-        r = _testing.explicit_rk_solve(f, t0, y0, t_end, touts, rtol, atol)
+        r = _core.solve_ode("dop853", f, None, t0, y0, t_end, touts, rtol, atol)
         Y, stats = np.asarray(r["y"]), {"rhs_evaluations": r["nfev"], "accepted": r["naccept"], "rejected": r["nreject"]}
     elif integrator == "scipy":
         import scipy.integrate
