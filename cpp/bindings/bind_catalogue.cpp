@@ -1,8 +1,13 @@
 // The element catalogue (catalogue.hpp) as seen from Python.
+#include <pybind11/eigen.h>
 #include <pybind11/stl.h>
+
+#include <memory>
+#include <string>
 
 #include "bindings.hpp"
 #include "spacar/catalogue.hpp"
+#include "spacar/errors.hpp"
 
 namespace spacar::bindings {
 
@@ -45,6 +50,27 @@ void bind_catalogue(py::module_& m) {
       .def_readonly("description", &ElementType::description)
       .def_property_readonly("n_deformations", &ElementType::n_deformations);
   m.def("element_catalogue", &element_catalogue, py::return_value_policy::reference);
+  m.def(
+      "element_deformations",
+      [](const std::string& type, const Eigen::VectorXd& x, const std::vector<double>& params, double l0,
+         const std::vector<double>& lgeomy) {
+        const int t = find_element_type(type);
+        if (t < 0) throw InputError("unknown element type " + type);
+        ElementSetup s;
+        s.params = params;
+        s.l0 = l0;
+        s.lgeomy = lgeomy;
+        const std::unique_ptr<ElementKernel> k = element_catalogue()[t].make(s);
+        if (x.size() != k->n_coords())
+          throw InputError(type + ": x must have " + std::to_string(k->n_coords()) + " values");
+        Eigen::VectorXd e(k->n_deformations());
+        k->deformations(x.data(), e.data());
+        return e;
+      },
+      py::arg("type"), py::arg("x"), py::arg("params") = std::vector<double>{}, py::arg("l0") = 1.0,
+      py::arg("lgeomy") = std::vector<double>{},
+      "The deformations of one element of the given type and properties at its nodal coordinates x "
+      "(spacar.compare maps a peer's state to spacar's deformations with it).");
 }
 
 }  // namespace spacar::bindings

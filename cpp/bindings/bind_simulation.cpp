@@ -21,16 +21,10 @@ py::dict block_results_to_dict(BlockResults&& r) {
   py::list lins;
   for (const Linearization& l : r.linearizations) lins.append(linearization_to_dict(l));
   d["linearizations"] = lins;
-  d["rhs_evaluations"] = r.rhs_evaluations;
-  d["steps"] = r.steps;
-  d["accepted"] = r.accepted;
-  d["rejected"] = r.rejected;
-  d["newton_iterations"] = r.newton_iterations;
+  for (const RunCounter& c : kRunCounters) d[c.name] = r.*c.value;
   d["last_step"] = r.last_step;
   d["wall_time"] = r.wall_time;
   d["recursive"] = r.recursive;
-  d["jacobians"] = r.jacobians;
-  d["decompositions"] = r.decompositions;
   d["method"] = method_name(r.method);
   py::list switches;
   for (const MethodSwitch& w : r.switches)
@@ -52,11 +46,29 @@ void bind_simulation(py::module_& m) {
   m.attr("linearization_arrays") = linearization_arrays();
   m.attr("integration_methods") = py::tuple(py::cast(method_names()));
   m.attr("implicit_methods") = py::tuple(py::cast(implicit_method_names()));
+  // The lists that cross into Python, from the core's tables: the output arrays (name, over
+  // "coordinate" or "deformation", what they hold), the energy columns, the run's counters
+  // (name, counted by the implicit methods only) and the run options' defaults.
+  py::list arrays, counters;
+  for (const OutputArray& a : kOutputArrays)
+    arrays.append(py::make_tuple(a.name, a.per_deformation ? "deformation" : "coordinate", a.what));
+  for (const RunCounter& c : kRunCounters) counters.append(py::make_tuple(c.name, c.implicit_only));
+  m.attr("output_arrays") = py::tuple(arrays);
+  m.attr("energy_columns") = py::tuple(py::cast(std::vector<std::string>(std::begin(kEnergyColumns), std::end(kEnergyColumns))));
+  m.attr("run_counters") = py::tuple(counters);
+  const RunOptions defaults;
+  py::dict run_defaults;
+  run_defaults["method"] = method_name(defaults.method);
+  run_defaults["rho_inf"] = defaults.rho_inf;
+  run_defaults["fixed_step"] = defaults.fixed_step;
+  run_defaults["recursive"] = defaults.recursive;
+  run_defaults["energy"] = defaults.energy;
+  run_defaults["predictor_order"] = defaults.predictor_order;
+  run_defaults["chord"] = defaults.chord;
+  m.attr("run_defaults") = run_defaults;
   py::class_<Table>(m, "Table", "Values over time interpolated in C++ (table.hpp); spacar.Table wraps it.")
       .def(py::init([](std::vector<double> t, Eigen::MatrixXd values, const std::string& kind) {
-             if (kind != "linear" && kind != "cubic")
-               throw InputError("Table: kind must be 'linear' or 'cubic', got '" + kind + "'");
-             return Table(std::move(t), std::move(values), kind == "cubic" ? Table::Kind::CUBIC : Table::Kind::LINEAR);
+             return Table(std::move(t), std::move(values), Table::parse_kind(kind));
            }),
            py::arg("t"), py::arg("values"), py::arg("kind"))
       .def_property_readonly("components", &Table::components)
@@ -219,13 +231,7 @@ void bind_simulation(py::module_& m) {
       .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))
       .def(
           "evaluate_state",
-          [](Simulation& s, double t, const Eigen::VectorXd& Y) {
-            const int n = 2 * s.system().n_dof() + static_cast<int>(s.system().y_defs.size());
-            if (Y.size() != n)
-              throw InputError("evaluate_state: the state (q, y, q̇) needs " + std::to_string(n) + " values, got " +
-                               std::to_string(Y.size()));
-            s.evaluate_state(t, Y);
-          },
+          [](Simulation& s, double t, const Eigen::VectorXd& Y) { s.evaluate_state(t, Y); },
           py::arg("t"), py::arg("Y"),
           "The state of the integrator, Y = (q, y, q̇) with y the integrated deformations (system.y_defs): "
           "positions, velocities, q̈ and stresses, the integrated values set from y (for differences over the "
@@ -271,16 +277,7 @@ void bind_simulation(py::module_& m) {
             opt.recursive = recursive;
             opt.initial_step = initial_step;
             opt.method = parse_method(method);
-            if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
-              throw InputError("rho_inf (the spectral radius of generalized_alpha) must be in [0, 1], not " +
-                               std::to_string(rho_inf));
-            opt.rho_inf = rho_inf;
-            if (!(fixed_step >= 0.0 && std::isfinite(fixed_step)))
-              throw InputError("fixed_step must be a finite step size >= 0 (0: error control), not " +
-                               std::to_string(fixed_step));
-            if (fixed_step > 0.0 && opt.method != Method::GENERALIZED_ALPHA)
-              throw InputError("fixed_step is an option of method generalized_alpha only (the other methods control "
-                               "their error)");
+            opt.rho_inf = rho_inf;  // checked with the other options at the block's start (plan_block)
             opt.fixed_step = fixed_step;
             if (!on_output.is_none()) {
               opt.on_output = [on_output](int k, const Data& d, const Linearization* lin) {
@@ -307,10 +304,13 @@ void bind_simulation(py::module_& m) {
             if (failure) raise_with_results(failure, block_results_to_dict(std::move(r)));
             return block_results_to_dict(std::move(r));
           },
-          py::arg("on_output") = py::none(), py::arg("initial_step") = 0.0, py::arg("method") = "dop853",
-          py::arg("time_limit") = 0.0, py::arg("recursive") = true, py::arg("sample_period") = 0.0,
-          py::arg("on_sample") = py::none(), py::arg("energy") = false, py::arg("rho_inf") = 0.9, py::arg("fixed_step") = 0.0,
-          py::arg("time_spent") = 0.0, py::arg("predictor_order") = 2, py::arg("chord") = true,
+          py::arg("on_output") = py::none(), py::arg("initial_step") = RunOptions().initial_step,
+          py::arg("method") = method_name(RunOptions().method), py::arg("time_limit") = RunOptions().time_limit,
+          py::arg("recursive") = RunOptions().recursive, py::arg("sample_period") = RunOptions().sample_period,
+          py::arg("on_sample") = py::none(), py::arg("energy") = RunOptions().energy,
+          py::arg("rho_inf") = RunOptions().rho_inf, py::arg("fixed_step") = RunOptions().fixed_step,
+          py::arg("time_spent") = RunOptions().time_spent, py::arg("predictor_order") = RunOptions().predictor_order,
+          py::arg("chord") = RunOptions().chord,
           "Run the block (`time_spent`: seconds of the analysis spent before it, counted against `time_limit`); on "
           "failure the exception has the results up to the failure as `results`. `predictor_order` (2, 1, 0) and "
           "`chord` change the start and the matrix of Newton's iterations on the positions, for measurements "

@@ -18,7 +18,6 @@ void bind_model(py::module_& m);
 void bind_simulation(py::module_& m);
 void bind_topology(py::module_& m);
 void bind_statics(py::module_& m);
-void bind_kernels(py::module_& m);
 void bind_ode(py::module_& m);
 
 // Raise the Python exception of a failed run with the results computed before the failure as

@@ -15,6 +15,5 @@ PYBIND11_MODULE(_core, m) {
   bind_simulation(m);
   bind_topology(m);
   bind_statics(m);
-  bind_kernels(m);
   bind_ode(m);
 }

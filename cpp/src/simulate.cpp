@@ -294,6 +294,9 @@ bool Simulation::linearize_nodal(NodalLinearization& out) { return linearizer().
 
 void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  if (Y.size() != 2 * nd + ny + n_energy_)
+    throw InputError("evaluate_state: the state (q, y, q̇) needs " + std::to_string(2 * nd + ny + n_energy_) +
+                     " values, got " + std::to_string(Y.size()));
   // On the recursive path the last solved state may be a stage a whole (large) step away: start
   // Newton from the tree's exact positions at (q, q̇) instead.
   // Its q̈ is the general path's solution, which then needs no equations of motion, where the
@@ -627,6 +630,14 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
     throw InputError("the predictor's order must be 0, 1 or 2, not " + std::to_string(options.predictor_order));
   if (!(options.sample_period >= 0.0) || !std::isfinite(options.sample_period))
     throw InputError("the controller's sample period must be a positive number of seconds");
+  if (!(options.rho_inf >= 0.0 && options.rho_inf <= 1.0))
+    throw InputError("rho_inf (the spectral radius of generalized_alpha) must be in [0, 1], not " +
+                     std::to_string(options.rho_inf));
+  if (!(options.fixed_step >= 0.0 && std::isfinite(options.fixed_step)))
+    throw InputError("fixed_step must be a finite step size >= 0 (0: error control), not " +
+                     std::to_string(options.fixed_step));
+  if (options.fixed_step > 0.0 && options.method != Method::GENERALIZED_ALPHA)
+    throw InputError("fixed_step is an option of method generalized_alpha only (the other methods control their error)");
   // The system may be recompiled during the run (repartition): keep copies, not references.
   BlockPlan plan;
   plan.st = sys_->settings;

@@ -51,6 +51,12 @@ Eigen::MatrixXd not_a_knot_second_derivatives(const std::vector<double>& t, cons
 
 }  // namespace
 
+Table::Kind Table::parse_kind(const std::string& name) {
+  if (name == "linear") return Kind::LINEAR;
+  if (name == "cubic") return Kind::CUBIC;
+  throw InputError("Table: kind must be 'linear' or 'cubic', got '" + name + "'");
+}
+
 Table::Table(std::vector<double> times, Eigen::MatrixXd values, Kind kind)
     : t_(std::move(times)), values_(std::move(values)), kind_(kind) {
   if (t_.size() < 2) throw InputError("Table: at least 2 times are needed");

@@ -5,7 +5,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
-KEYS = ("kinetic", "potential", "strain", "dissipated", "external_work")
+from . import _core
+
+KEYS = _core.energy_columns  # kEnergyColumns (simulate.hpp)
 
 
 class Energy(Mapping):

@@ -22,7 +22,7 @@ import numpy as np
 
 from .errors import InputError, SpacarError
 from .geometry import Geometry, shapes, frame_coordinates
-from .results import Results, parse_spec
+from .results import _ARRAYS, STATE_ARRAYS, Results, parse_spec
 
 
 def _widgets():
@@ -190,7 +190,7 @@ class Explorer:
         self.samples = np.array(values)
         current = rows[0]
         arrays = {name: np.concatenate([getattr(r, name) for r in rows + [current]])
-                  for name in ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")}
+                  for name in _ARRAYS}
         self.states = Results(arrays, current.coordinate_labels, current.deformation_labels, {},
                               geometry=self.geometry)
         self._draw(lambda k: f"{self.input_name} = {self.value:.4g}")
@@ -222,7 +222,7 @@ class Explorer:
         if self._move(self.value):
             self.message.value = self.note
             self.state = snapshot(self.sim, self.geometry)
-            for name in ("x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction"):
+            for name in STATE_ARRAYS:
                 getattr(self.states, name)[-1] = getattr(self.state, name)[0]
         self._show(len(self.states.t) - 1, self.value)
 

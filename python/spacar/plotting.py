@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt
 
 from .errors import InputError
 from .geometry import frame_coordinates, magnified, shapes
-from .results import Results, require_results
+from .results import _ARRAYS, STATE_ARRAYS, Results, require_results
 
 STYLE = {
     "beam": dict(color="C0", lw=2.5, solid_capstyle="round", zorder=3),
@@ -322,8 +322,8 @@ def _displaced(res: Results, k: int, mode, scale, amplitudes=(1.0,)) -> Results:
         if kinds.get(n) == "LAMBDA":
             x[:, c] /= np.linalg.norm(x[:, c], axis=1, keepdims=True)
     many = lambda a: np.repeat(np.asarray(a)[k:k + 1], len(x), axis=0)  # noqa: E731
-    arrays = {"t": many(res.t), "x": x, "xd": many(res.xd), "xdd": many(res.xdd), "e": many(res.e),
-              "ed": many(res.ed), "edd": many(res.edd), "sigma": many(res.sigma), "reaction": many(res.reaction)}
+    arrays = {name: many(getattr(res, name)) for name in _ARRAYS}
+    arrays["x"] = x
     return Results(arrays, res.coordinate_labels, res.deformation_labels, res.stats, geometry=res.geometry)
 
 
@@ -332,7 +332,7 @@ def snapshot(sim, geometry) -> Results:
     state that no run recorded: a linearization's, or one the explorer solved)."""
     d, system = sim.data, sim.system
     arrays = {name: np.array(getattr(d, name), dtype=float)[None, ...]
-              for name in ("x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")}
+              for name in STATE_ARRAYS}
     arrays["t"] = np.array([float(d.t)])
     return Results(arrays, system.coord_label, system.def_label, {}, geometry=geometry)
 

@@ -59,7 +59,10 @@ ALIASES = {
 # A label may end in the element type, as the DOF labels do ("e(3,1) HINGE").
 _LABEL_RE = re.compile(r"^\s*([A-Za-z]+)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)\s*(?:([A-Za-z][A-Za-z0-9]*)\s*)?$")
 _LINE_RE = re.compile(r"^\s*([A-Za-z]+)\s+(\d+)\s+(\d+)\s*$")
-_ARRAYS = ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")
+# The arrays recorded at every output time, from the core's table (kOutputArrays, simulate.hpp):
+# name, over "coordinate" or "deformation", what they hold.
+STATE_ARRAYS = tuple(name for name, _, _ in _core.output_arrays)
+_ARRAYS = ("t",) + STATE_ARRAYS
 _ELEMENT_TYPES = frozenset(t.name for t in _core.element_catalogue())
 
 
@@ -393,7 +396,7 @@ class Results:
         return [i for i, (n, c) in enumerate(self.coordinate_labels)
                 if c - 1 < len(cls.get(n, ())) and cls[n][c - 1] in ("fixed", "input")]
 
-    def to_pandas(self, quantities=("x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")):
+    def to_pandas(self, quantities=STATE_ARRAYS):
         """A ``pandas.DataFrame`` indexed by ``t`` with one column per quantity and coordinate
         or deformation, named by the MATASC labels (``x(8,1)``, ``e(2,2)``, ``s(2,1)``,
         ``r(1,1)``; reactions only on the fixed and input coordinates). Needs pandas."""
@@ -560,8 +563,8 @@ class Results:
 
 # --- reading a saved file -------------------------------------------------------------------------
 
-_FLOAT_ARRAYS = {"t": ("nt",), "x": ("nt", "nx"), "xd": ("nt", "nx"), "xdd": ("nt", "nx"), "reaction": ("nt", "nx"),
-                 "e": ("nt", "ne"), "ed": ("nt", "ne"), "edd": ("nt", "ne"), "sigma": ("nt", "ne")}
+_FLOAT_ARRAYS = {"t": ("nt",), **{name: ("nt", "ne" if over == "deformation" else "nx")
+                                  for name, over, _ in _core.output_arrays}}
 _LIN_RE = re.compile(r"^lin(\d+)_([A-Za-z0-9]+)$")
 
 

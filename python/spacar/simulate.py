@@ -27,13 +27,13 @@ def _method_used(arrays: dict) -> str:
 
 
 def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
-    stats = {k: arrays[k] for k in ("rhs_evaluations", "steps", "accepted", "rejected",
-                                    "newton_iterations", "wall_time", "recursive")}
+    # The counters of the core's table (kRunCounters); those of the implicit methods' work
+    # (Jacobians, i.e. linearizations, and LU factorizations) where one ran.
+    implicit = method in _core.implicit_methods or bool(arrays["switches"])
+    stats = {k: arrays[k] for k, implicit_only in _core.run_counters if implicit or not implicit_only}
+    stats.update(wall_time=arrays["wall_time"], recursive=arrays["recursive"])
     stats["method"] = _method_used(arrays)
     stats["switches"] = [tuple(s) for s in arrays["switches"]]
-    # The implicit method's work, where it ran: Jacobians (linearizations), LU factorizations.
-    if method in _core.implicit_methods or arrays["switches"]:
-        stats.update(jacobians=arrays["jacobians"], decompositions=arrays["decompositions"])
     coords, defs = system.coord_label, system.def_label  # each a fresh copy of the list: taken once
     lins = [Linearization(d, coords, defs) for d in arrays["linearizations"]]
     res = Results(arrays, coords, defs, stats, None, lins, model.settings.linear,
@@ -273,7 +273,7 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit,
                          recursive=bool(recursive),  # numpy booleans too
                          sample_period=0.0 if controller is None else 1.0 / controller.rate,
-                         on_sample=on_sample, energy=bool(energy), rho_inf=0.9 if rho_inf is None else float(rho_inf),
+                         on_sample=on_sample, energy=bool(energy), rho_inf=_core.run_defaults["rho_inf"] if rho_inf is None else float(rho_inf),
                          fixed_step=step_size, time_spent=time.monotonic() - started)
     except SpacarError as err:
         partial = getattr(err, "results", None)

@@ -33,6 +33,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from . import _core, progress as bars  # named so: sweep()'s argument is `progress`
+from .results import _ARRAYS
 from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
 from .keywords import INT, LOOKUP, SETTINGS, Keyword
@@ -44,7 +45,7 @@ __all__ = ["sweep", "SweepResult", "SweepError"]
 # and control lines change the model's structure or accumulate: use a factory for those.
 _SWEEPABLE_GROUPS = ("Nodes (§5.2)", "Initial values (§5.4)", "Dynamic properties (§5.5)", SETTINGS)
 
-RESULT_ARRAYS = ("t", "x", "xd", "xdd", "e", "ed", "edd", "sigma", "reaction")
+RESULT_ARRAYS = _ARRAYS  # t and the core's output arrays
 LINEARIZATION_OUTPUTS = ("eigenfrequencies", "eigenvalues", "buckling_factors", "M0", "C0", "D0", "K0", "N0",
                          "G0", "r0", "stiffness", "damping")
 

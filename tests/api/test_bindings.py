@@ -87,3 +87,39 @@ def test_simulate_and_linearize_prepare_the_model_once(monkeypatch):
     spacar.simulate(model)
     spacar.linearize(model)
     assert calls == [] and model._core.frozen
+
+
+def test_the_lists_that_cross_into_python_come_from_the_core():
+    """Issue 35: the output arrays, energy columns, run counters and run defaults are the core's
+    tables; the Python tables keyed by them (quantities, MATASC files, saved files) cover exactly
+    the core's output arrays."""
+    import spacar
+    from spacar import _core
+    from spacar.energy import KEYS
+    from spacar.io.matasc import STATE_FILES
+    from spacar.results import _ARRAYS, _FLOAT_ARRAYS, QUANTITIES, STATE_ARRAYS
+    from spacar.sweep import RESULT_ARRAYS
+
+    names = [name for name, _, _ in _core.output_arrays]
+    assert list(STATE_ARRAYS) == names and _ARRAYS == ("t", *names) and RESULT_ARRAYS == _ARRAYS
+    assert set(QUANTITIES) == set(names) and {a for a, _ in STATE_FILES.values()} == set(names)
+    for name, over, _ in _core.output_arrays:
+        assert QUANTITIES[name][1] == over
+        assert _FLOAT_ARRAYS[name] == ("nt", "ne" if over == "deformation" else "nx")
+    assert KEYS == _core.energy_columns
+    assert [k for k, _ in _core.run_counters][:4] == ["rhs_evaluations", "steps", "accepted", "rejected"]
+    from spacar.compare import models
+
+    m = models.cantilever(2, t_end=0.01, n_out=2)
+    res = spacar.simulate(m, method="dop853", progress=False)
+    assert "jacobians" not in res.stats and "rhs_evaluations" in res.stats
+    res = spacar.simulate(models.cantilever(2, t_end=0.01, n_out=2), method="radau5", progress=False)
+    assert {"jacobians", "decompositions"} <= set(res.stats)
+
+
+def test_the_package_does_not_import_the_test_bindings():
+    """Issue 35: spacar (spacar.compare included) runs without spacar._testing."""
+    from support.paths import ROOT
+
+    for path in (ROOT / "python" / "spacar").rglob("*.py"):
+        assert "_testing" not in path.read_text(encoding="utf-8"), path

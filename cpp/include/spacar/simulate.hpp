@@ -104,8 +104,9 @@ struct BlockResults {
   std::vector<Linearization> linearizations;  // at every output time if LINE or LINEAR ≥ 1
   // RunOptions::energy: nt x 5, the columns kEnergyColumns (else empty).
   RowMatrix energy;
+  // The counters of kRunCounters.
   long rhs_evaluations = 0, steps = 0, accepted = 0, rejected = 0, newton_iterations = 0;
-  long jacobians = 0, decompositions = 0;  // implicit method (RADAU5) only
+  long jacobians = 0, decompositions = 0;  // the implicit methods only
   Method method = Method::DOP853;          // the integrator the block started with
   std::vector<MethodSwitch> switches;      // method AUTO: the changes of integrator
   double last_step = 0.0;
@@ -134,6 +135,24 @@ inline constexpr OutputArray kOutputArrays[] = {
     {"edd", "deformation accelerations", true, &Data::edd, &BlockResults::edd},
     {"sigma", "stresses", true, &Data::sigma, &BlockResults::sigma},
     {"reaction", "reactions", false, &Data::reaction, &BlockResults::reaction},
+};
+
+// The counters of a run, listed once (the results handed to Python, spacar._core.run_counters and
+// the stats of spacar.simulate): name, member, whether only the implicit methods count it.
+struct RunCounter {
+  const char* name;
+  long BlockResults::*value;
+  bool implicit_only;
+};
+
+inline constexpr RunCounter kRunCounters[] = {
+    {"rhs_evaluations", &BlockResults::rhs_evaluations, false},
+    {"steps", &BlockResults::steps, false},
+    {"accepted", &BlockResults::accepted, false},
+    {"rejected", &BlockResults::rejected, false},
+    {"newton_iterations", &BlockResults::newton_iterations, false},
+    {"jacobians", &BlockResults::jacobians, true},
+    {"decompositions", &BlockResults::decompositions, true},
 };
 
 // The columns of BlockResults::energy: kinetic + potential + strain + dissipated − external_work

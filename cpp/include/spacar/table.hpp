@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <string>
 #include <vector>
 
 namespace spacar {
@@ -15,6 +16,8 @@ class Table {
   // values, rates and second derivatives, so that an input motion has continuous accelerations;
   // it reproduces polynomials up to degree 3 exactly (with 2 or 3 samples: the line or parabola).
   enum class Kind { LINEAR, CUBIC };
+  // The kind of its name, "linear" or "cubic"; InputError for any other.
+  static Kind parse_kind(const std::string& name);
 
   // times: strictly increasing, at least 2; values: one row per time, one column per component.
   // InputError on anything else.

@@ -44,6 +44,7 @@ same numbers (``ExudynResults.x``, ``.e`` against ``spacar.Results.x``, ``.e``).
 """
 from __future__ import annotations
 
+import functools
 import math
 import time as _time
 
@@ -429,15 +430,17 @@ class ExudynModel:
 
     def _element_kernels(self):
         kernels = []
+        n_deformations = {t.name: t.n_deformations for t in _core.element_catalogue()}
         ci, di = self.topology.coord_index, self.topology.def_index
         for k, el in sorted(self.spacar_model.elements.items()):
             cols = []
             for n in el.nodes:
                 size = _core.node_size(self.spacar_model.nodes[n].kind)
                 cols += [ci[(n, i)] for i in range(1, size + 1)]
-            kern = _core.element_kernel(el.type_name, params=list(el.params),
-                                           l0=el.l0 if el.l0 is not None else 1.0, lgeomy=list(el.lgeomy))
-            dcols = [di[(k, i)] for i in range(1, kern.n_deformations + 1)]
+            properties = {"params": list(el.params), "l0": el.l0 if el.l0 is not None else 1.0,
+                          "lgeomy": list(el.lgeomy)}
+            kern = functools.partial(_core.element_deformations, el.type_name, **properties)
+            dcols = [di[(k, i)] for i in range(1, n_deformations[el.type_name] + 1)]
             kernels.append((kern, cols, dcols, el.type_name))
         return kernels
 
@@ -446,7 +449,7 @@ class ExudynModel:
         for kern, cols, dcols, _ in self._kernels:
             xe = x[cols]
             if np.all(np.isfinite(xe)):
-                e[dcols] = kern.deformations(xe)
+                e[dcols] = kern(xe)
         return e
 
     def current_x(self, previous=None) -> np.ndarray:

@@ -1,11 +1,9 @@
-// spacar._core.element_kernel: direct access to one element kernel, for finite-difference tests,
-// teaching and the peer comparisons (spacar.compare): evaluate the deformations, their
-// derivatives, the convective terms and the mass model at any x.
+// Direct access to one element kernel, for finite-difference tests and teaching: evaluate the
+// deformations, their derivatives, the convective terms and the mass model at any x.
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "bindings.hpp"
 #include "spacar/catalogue.hpp"
 #include "spacar/elements/element.hpp"
 #include "spacar/errors.hpp"
@@ -26,7 +24,7 @@ struct KernelHandle {
 
 }  // namespace
 
-void spacar::bindings::bind_kernels(py::module_& m) {
+void bind_kernels(py::module_& m) {
   py::class_<KernelHandle>(m, "ElementKernel")
       .def_property_readonly("n_coords", &KernelHandle::nc)
       .def_property_readonly("n_deformations", &KernelHandle::nd)
