@@ -8,7 +8,7 @@ gravity, simulated over T = 0.3 s.
 
 * time per right-hand side: spacar — block wall time / right-hand-side evaluations of a run
   (EPSINT = 1e-6) on its default recursive path (a planar tree of rigid bodies: the
-  articulated-body algorithm, cpp/include/spacar/tree.hpp) and on the general path
+  articulated-body algorithm, cpp/include/spacar/recursive/tree.hpp) and on the general path
   (``recursive=False``: the sparse constraint formulation every other model takes), and
   ``Simulation.evaluate`` called from Python; Pinocchio — ``aba`` called
   from Python; exudyn — kinematic tree (``ObjectKinematicTree``) with fixed-step RK44, wall
@@ -23,7 +23,7 @@ gravity, simulated over T = 0.3 s.
 Spatial chains (spacar.compare.models.spatial_chain, seed N): N rigid BEAMs of random directions
 on HINGEs about random axes (DYNE e1), EMASS with rotary inertia, point masses and full inertia
 tensors, a rotated ground, gravity along a random direction; spacar takes the recursive path of
-spatial trees (cpp/include/spacar/spatial_tree.hpp). The same tables, with MuJoCo (the same tree
+spatial trees (cpp/include/spacar/recursive/spatial_tree.hpp). The same tables, with MuJoCo (the same tree
 written as MJCF: ``mj_forward`` per right-hand side, its RK4 at fixed steps for time to accuracy)
 in place of exudyn's redundant coordinates, and spacar's block time also over a run ten times as
 long: the line through the two (time against right-hand sides) splits it into the run's fixed
@@ -390,7 +390,7 @@ def spatial_section(r: dict, quick: bool) -> list:
              "`spacar.compare.models.spatial_chain(N, seed=N)` — N rigid BEAMs of random directions and lengths on "
              "HINGEs about random axes (DYNE e1), EMASS with rotary inertia, point masses and full inertia tensors, a "
              f"rotated ground, gravity along a random direction, released from rest, T = {r['t_end']} s. spacar takes "
-             "the recursive path of spatial trees (`cpp/include/spacar/spatial_tree.hpp`); MuJoCo runs the same tree "
+             "the recursive path of spatial trees (`cpp/include/spacar/recursive/spatial_tree.hpp`); MuJoCo runs the same tree "
              "written as MJCF (qpos = Pinocchio's q)" + ("" if r["mujoco"] else " — not installed in this run") + ". "
              "All programs in one process, one after the other.", "", *C.machine_table(r["machine"]), "",
              "| N | spacar in a run | spacar in a 10× longer run | spacar general path in a run (Newton iterations "

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "bindings.hpp"
-#include "spacar/catalogue.hpp"
+#include "spacar/model/catalogue.hpp"
 #include "spacar/errors.hpp"
 
 namespace spacar::bindings {

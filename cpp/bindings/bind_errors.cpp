@@ -4,7 +4,7 @@
 #include <string>
 
 #include "spacar/errors.hpp"
-#include "spacar/integrator.hpp"
+#include "spacar/integrators/integrator.hpp"
 
 namespace spacar::bindings {
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "bindings.hpp"
-#include "spacar/model.hpp"
-#include "spacar/serialize.hpp"
+#include "spacar/model/model.hpp"
+#include "spacar/model/serialize.hpp"
 
 namespace spacar::bindings {
 

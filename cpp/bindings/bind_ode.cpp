@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "bindings.hpp"
-#include "spacar/stepper.hpp"
+#include "spacar/integrators/stepper.hpp"
 
 namespace py = pybind11;
 

@@ -5,10 +5,10 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "spacar/diagnosis.hpp"
+#include "spacar/kinematics/diagnosis.hpp"
 #include "spacar/errors.hpp"
 #include "spacar/limits.hpp"
-#include "spacar/simulate.hpp"
+#include "spacar/analyses/simulate.hpp"
 
 namespace spacar::bindings {
 

@@ -7,7 +7,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "spacar/statics.hpp"
+#include "spacar/analyses/statics.hpp"
 
 namespace spacar::bindings {
 

@@ -2,7 +2,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "spacar/topology.hpp"
+#include "spacar/model/topology.hpp"
 
 namespace spacar::bindings {
 

@@ -6,7 +6,7 @@
 
 #include <exception>
 
-#include "spacar/linearize.hpp"
+#include "spacar/analyses/linearize.hpp"
 
 namespace py = pybind11;
 

@@ -5,7 +5,7 @@
     res.node(21).x[-1]                      # tip position at the full load
     res.stats["indefinite_at"]              # None, or where the equilibrium became unstable
 
-The solve runs in C++ (cpp/src/statics.cpp): full Newton on the reduced equations at rest with
+The solve runs in C++ (cpp/src/analyses/statics.cpp): full Newton on the reduced equations at rest with
 the exact tangent stiffness K0 + G0, the load factor λ raised from 0 to 1 in equal steps, a step
 halved when Newton fails in it; or, with ``arc_length=True``, the path followed in (q, λ) past
 limit points::

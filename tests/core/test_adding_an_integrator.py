@@ -35,8 +35,8 @@ def blocks():
 
 def test_the_section_has_its_blocks():
     paths = [p for p, _ in blocks()]
-    for path in ("cpp/include/spacar/stepper.hpp", "cpp/src/stepper.cpp", "cpp/src/integrator.cpp",
-                 "tests/core/test_steppers.py"):
+    for path in ("cpp/include/spacar/integrators/stepper.hpp", "cpp/src/integrators/stepper.cpp",
+                 "cpp/src/integrators/integrator.cpp", "tests/core/test_steppers.py"):
         assert path in paths
 
 
@@ -46,14 +46,14 @@ def test_excerpt_is_verbatim_in_its_file(path, code):
 
 
 def table_rows():
-    text = (ROOT / "cpp" / "src" / "stepper.cpp").read_text(encoding="utf-8")
+    text = (ROOT / "cpp" / "src" / "integrators" / "stepper.cpp").read_text(encoding="utf-8")
     body = text[text.index("const MethodEntry kMethods[] = {"):]
     body = body[:body.index("};")]
     return re.findall(r'\{Method::(\w+), "(\w+)", (true|false), (nullptr|&(\w+)::make)\}', body)
 
 
 def test_the_table_has_every_method_once():
-    header = (ROOT / "cpp" / "include" / "spacar" / "stepper.hpp").read_text(encoding="utf-8")
+    header = (ROOT / "cpp" / "include" / "spacar" / "integrators" / "stepper.hpp").read_text(encoding="utf-8")
     enum = re.search(r"enum class Method \{([^}]*)\}", header).group(1)
     values = [v.strip() for v in enum.split(",")]
     rows = table_rows()
@@ -68,14 +68,15 @@ def test_every_factory_is_a_stepper():
         if method == "AUTO":
             assert make == "nullptr"
             continue
-        declared = [p for p in include.glob("*.hpp") if re.search(rf"class {cls} : public Stepper\b", p.read_text())]
+        declared = [p for p in include.rglob("*.hpp") if re.search(rf"class {cls} : public Stepper\b", p.read_text())]
         assert len(declared) == 1, cls
         assert "static std::unique_ptr<Stepper> make(Method method, const StepperSetup& setup);" in declared[0].read_text()
 
 
 def test_the_run_names_no_method_class():
-    """simulate.cpp makes its steppers from the table only."""
-    text = re.sub(r'"[^"\n]*"', '""', (ROOT / "cpp" / "src" / "simulate.cpp").read_text(encoding="utf-8"))  # code only
+    """The run (simulate*.cpp) makes its steppers from the table only."""
+    run = "".join(p.read_text(encoding="utf-8") for p in (ROOT / "cpp" / "src" / "analyses").glob("simulate*.cpp"))
+    text = re.sub(r'"[^"\n]*"', '""', run)  # the code, not its messages
     for cls in {row[4] for row in table_rows() if row[4]}:
         assert not re.search(rf"\b{cls}\b", text), cls
     assert "make_stepper(" in text and "is_same_v" not in text

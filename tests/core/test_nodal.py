@@ -1,4 +1,4 @@
-"""The saddle-point system of the nodal coordinates (cpp/src/nodal.cpp, docs/formulation.md §10), on
+"""The saddle-point system of the nodal coordinates (cpp/src/analyses/nodal.cpp, docs/formulation.md §10), on
 which the static solve, the compliance and the sparse eigen-analyses stand: its solution for a
 load r on the coordinates must be δx = DF_q K⁻¹ DF_qᵀ r with the dense reduced tangent
 K = K0 + G0 (itself checked against differences of the residual in test_statics.py), its

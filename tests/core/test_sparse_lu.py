@@ -1,4 +1,4 @@
-"""The sparse LU of the constraint blocks and the equations of motion (cpp/src/sparse_lu.cpp):
+"""The sparse LU of the constraint blocks and the equations of motion (cpp/src/linalg/sparse_lu.cpp):
 solutions against dense solves, the replay of the pivot sequence on new values, re-pivoting
 when a replayed pivot is poor, singular and non-finite matrices, and linear fill on a chain."""
 from __future__ import annotations

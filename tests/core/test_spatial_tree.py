@@ -1,4 +1,4 @@
-"""The recursive path of spatial rigid trees (cpp/include/spacar/spatial_tree.hpp).
+"""The recursive path of spatial rigid trees (cpp/include/spacar/recursive/spatial_tree.hpp).
 
 Its accelerations, positions and velocities are checked against the constraint formulation
 (Newton and the sparse solve of the general path, which share nothing with it but the element mass

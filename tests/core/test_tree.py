@@ -1,4 +1,4 @@
-"""The recursive path of planar rigid trees (cpp/include/spacar/tree.hpp, formulation.md §7).
+"""The recursive path of planar rigid trees (cpp/include/spacar/recursive/tree.hpp, formulation.md §7).
 
 Its accelerations are checked against the constraint formulation's sparse solve at random states
 (the two share no code beyond the element mass matrices) and against Pinocchio's ABA; runs on

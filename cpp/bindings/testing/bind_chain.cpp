@@ -3,11 +3,11 @@
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 
-#include "spacar/chain.hpp"
-#include "spacar/dynamics.hpp"
+#include "spacar/recursive/chain.hpp"
+#include "spacar/kinematics/dynamics.hpp"
 #include "spacar/errors.hpp"
-#include "spacar/kinematics.hpp"
-#include "spacar/simulate.hpp"
+#include "spacar/kinematics/kinematics.hpp"
+#include "spacar/analyses/simulate.hpp"
 
 namespace py = pybind11;
 

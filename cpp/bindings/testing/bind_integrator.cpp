@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "spacar/integrator.hpp"
+#include "spacar/integrators/integrator.hpp"
 
 namespace py = pybind11;
 

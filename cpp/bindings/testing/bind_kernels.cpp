@@ -4,7 +4,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "spacar/catalogue.hpp"
+#include "spacar/model/catalogue.hpp"
 #include "spacar/elements/element.hpp"
 #include "spacar/errors.hpp"
 

@@ -8,8 +8,8 @@
 #include <limits>
 #include <vector>
 
-#include "spacar/generalized_alpha.hpp"
-#include "spacar/radau5.hpp"
+#include "spacar/integrators/generalized_alpha.hpp"
+#include "spacar/integrators/radau5.hpp"
 
 namespace py = pybind11;
 

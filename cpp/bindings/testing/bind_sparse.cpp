@@ -9,8 +9,8 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "spacar/sparse.hpp"
-#include "spacar/sparse_lu.hpp"
+#include "spacar/linalg/sparse.hpp"
+#include "spacar/linalg/sparse_lu.hpp"
 
 namespace py = pybind11;
 

@@ -4,9 +4,9 @@
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 
-#include "spacar/nodal.hpp"
-#include "spacar/simulate.hpp"
-#include "spacar/statics.hpp"
+#include "spacar/analyses/nodal.hpp"
+#include "spacar/analyses/simulate.hpp"
+#include "spacar/analyses/statics.hpp"
 
 namespace py = pybind11;
 

@@ -10,7 +10,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "spacar/catalogue.hpp"
+#include "spacar/model/catalogue.hpp"
 #include "spacar/elements/element.hpp"
 #include "spacar/errors.hpp"
 

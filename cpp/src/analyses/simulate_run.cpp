@@ -1,0 +1,499 @@
+// Simulation's run of a block (simulate.hpp): the plan checked before any work, the results
+// allocated, the block integrated segment by segment with the stepper of each (the method table,
+// stepper.hpp), repartitions of free rotations, the explanation of a collapse and the state
+// stored back into the model. The state at a time and the right-hand side are in simulate.cpp.
+#include "spacar/analyses/simulate.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "spacar/kinematics/diagnosis.hpp"
+#include "spacar/kinematics/dynamics.hpp"
+#include "spacar/errors.hpp"
+#include "spacar/kinematics/kinematics.hpp"
+#include "spacar/limits.hpp"
+#include "spacar/integrators/stepper.hpp"
+
+namespace spacar {
+
+namespace {
+
+std::string format_g(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+// Warnings for the position nodes that the first assembly moved far (more than 1e-3 of the
+// model's size, the spread of the X positions) from where X put them: the X positions do not
+// close a loop with the lengths given (LENGTHO), the targets of E or the inputs' start values.
+// An X position meant exactly then changed the mechanism; a rough one was closed as intended.
+// The first kMovedNodesNamed nodes are named one by one, the others summed up in one line (a
+// turned ground moves every node: a warning per node would bury the others, and cost a run's
+// fixed time in formatting).
+void warn_of_assembly_moves(const System& sys, const Eigen::VectorXd& given, const Eigen::VectorXd& x,
+                            std::vector<std::string>& warnings) {
+  constexpr int kMovedNodesNamed = 3;
+  auto is_position = [&](int g) {
+    return sys.coord_node_kind[g] == NodeKind::XY || sys.coord_node_kind[g] == NodeKind::XYZ;
+  };
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int g = 0; g < sys.nx; ++g)
+    if (is_position(g)) {
+      lo = std::min(lo, given[g]);
+      hi = std::max(hi, given[g]);
+    }
+  if (!(hi >= lo)) return;  // no position nodes
+  const double far = 1e-3 * (hi - lo);
+  int moved = 0, farthest = -1;
+  double largest = 0.0;
+  for (int g = 0, end; g < sys.nx; g = end) {  // node by node: its coordinates are consecutive
+    for (end = g + 1; end < sys.nx && sys.coord_label[end][0] == sys.coord_label[g][0];) ++end;
+    if (!is_position(g)) continue;
+    const double distance = (x.segment(g, end - g) - given.segment(g, end - g)).norm();
+    if (!(distance > far)) continue;
+    if (++moved > kMovedNodesNamed) {
+      if (distance > largest) {
+        largest = distance;
+        farthest = sys.coord_label[g][0];
+      }
+      continue;
+    }
+    auto point = [&](const Eigen::VectorXd& v) {
+      std::string s = "(";
+      for (int i = g; i < end; ++i) s += (i > g ? ", " : "") + format_g(v[i], 6);
+      return s + ")";
+    };
+    warnings.push_back("the assembly moved node " + std::to_string(sys.coord_label[g][0]) + " by " +
+                       format_g(distance, 4) + " from its X position " + point(given) + " to " + point(x) +
+                       ": the X positions do not close the loop with the lengths (LENGTHO), E targets and "
+                       "input values given");
+  }
+  if (moved > kMovedNodesNamed)
+    warnings.push_back("the assembly moved " + std::to_string(moved - kMovedNodesNamed) +
+                       " more nodes from their X positions, the farthest node " + std::to_string(farthest) +
+                       " by " + format_g(largest, 4));
+}
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+
+// Keep the first `rows` rows of every time-indexed array (a run that failed midway).
+void cut_rows(BlockResults& res, int rows) {
+  res.t.conservativeResize(rows);
+  for (const OutputArray& a : kOutputArrays) (res.*a.rows).conservativeResize(rows, (res.*a.rows).cols());
+  if (res.energy.size()) res.energy.conservativeResize(rows, res.energy.cols());
+}
+
+}  // namespace
+
+void Simulation::run(BlockResults& res, const RunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  res = BlockResults();
+  res.warnings = sys_->warnings;
+  const BlockPlan plan = plan_block(options, res.warnings);
+  n_energy_ = options.energy ? 2 : 0;
+  held_.resize(0);
+  predictor_order_ = options.predictor_order;
+  chord_ = options.chord;
+  // One deadline (limits.hpp), checked at every right-hand side and output time and inside the
+  // sparse factorizations; the time the set-up took counts against it.
+  const DeadlineScope deadline(options.time_limit, options.time_spent);
+  allocate_results(res, plan);
+  int k_out = 0;
+  auto finish = [&]() {
+    res.newton_iterations = data_->total_newton_iterations;
+    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    tree_.reset();
+    chain_.reset();
+    held_.resize(0);
+    predictor_order_ = RunOptions().predictor_order;
+    chord_ = RunOptions().chord;
+  };
+  try {
+    integrate_block(res, options, plan, k_out);
+  } catch (...) {
+    cut_rows(res, k_out);
+    finish();
+    throw;
+  }
+  finish();
+  store_state();
+}
+
+// Requests that cannot be carried out are refused before any work (formulation.md §8.1).
+Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vector<std::string>& warnings) const {
+  if (!(options.time_limit >= 0.0)) throw InputError("the time limit must not be negative");
+  if (!(options.time_spent >= 0.0)) throw InputError("the time spent before the run must not be negative");
+  if (options.max_steps < 1) throw InputError("the step limit must be positive");
+  if (options.predictor_order < 0 || options.predictor_order > 2)
+    throw InputError("the predictor's order must be 0, 1 or 2, not " + std::to_string(options.predictor_order));
+  if (!(options.sample_period >= 0.0) || !std::isfinite(options.sample_period))
+    throw InputError("the controller's sample period must be a positive number of seconds");
+  if (!(options.rho_inf >= 0.0 && options.rho_inf <= 1.0))
+    throw InputError("rho_inf (the spectral radius of generalized_alpha) must be in [0, 1], not " +
+                     std::to_string(options.rho_inf));
+  if (!(options.fixed_step >= 0.0 && std::isfinite(options.fixed_step)))
+    throw InputError("fixed_step must be a finite step size >= 0 (0: error control), not " +
+                     std::to_string(options.fixed_step));
+  if (options.fixed_step > 0.0 && options.method != Method::GENERALIZED_ALPHA)
+    throw InputError("fixed_step is an option of method generalized_alpha only (the other methods control their error)");
+  // The system may be recompiled during the run (repartition): keep copies, not references.
+  BlockPlan plan;
+  plan.st = sys_->settings;
+  Settings& st = plan.st;
+  const int n_out = st.timestep_n;
+  const double t0 = sys_->t0, t_end = t0 + st.timestep_tp;
+  plan.t0 = t0;
+  plan.t_end = t_end;
+  plan.linear = !sys_->e_line.empty() || st.linear.value_or(0) >= 1;
+  if (!std::isfinite(t_end))
+    throw InputError("TIMESTEP: the end time TIME + Tp = " + num(t0) + " + " + num(st.timestep_tp) +
+                     " is not a finite number");
+  if (n_out > 0 && st.timestep_tp > 0.0 && !(t0 + st.timestep_tp / n_out > t0))
+    throw InputError("TIMESTEP: the output interval Tp/n = " + num(st.timestep_tp / n_out) +
+                     " is lost in the rounding of the time t = " + num(t0) + " (TIME)");
+  plan.integrate = (sys_->n_dof() > 0 || !sys_->y_defs.empty()) && n_out > 0 && t_end > t0;
+  if (options.energy && !plan.integrate)
+    throw InputError("the energy balance needs an integrated block (degrees of freedom and a TIMESTEP period)");
+  if (options.sample_period > 0.0 && st.timestep_tp / options.sample_period > static_cast<double>(options.max_steps))
+    throw InputError("the controller's sample period " + num(options.sample_period) + " needs more than " +
+                     std::to_string(options.max_steps) + " samples in the block");
+  if (plan.integrate) {
+    const double h_min = Stepper::min_step(t_end);
+    if (st.timestep_tp < h_min)
+      throw InputError("TIMESTEP: the period Tp = " + num(st.timestep_tp) +
+                       " is shorter than the smallest integration step " + num(h_min) + " at t = " + num(t_end));
+    if (st.hmax < Stepper::min_step(t0))
+      throw InputError("HMAX " + num(st.hmax) + " is below the smallest integration step " +
+                       num(Stepper::min_step(t0)) + " at t = " + num(t0));
+    if (st.timestep_tp / st.hmax > static_cast<double>(options.max_steps))
+      throw InputError("HMAX " + num(st.hmax) + " needs at least Tp/HMAX = " + num(st.timestep_tp / st.hmax) +
+                       " steps, more than the limit of " + std::to_string(options.max_steps) + " steps per block");
+    for (auto [eps, name] : {std::pair<double*, const char*>{&st.epsint, "EPSINT"}, {&st.epsind, "EPSIND"}})
+      if (*eps < kMinTolerance) {
+        warnings.push_back(std::string(name) + " " + num(*eps) +
+                           " is below the attainable accuracy in double precision: " + num(kMinTolerance) +
+                           " (100 machine epsilons) is used");
+        *eps = kMinTolerance;
+      }
+  }
+  const int nt = n_out + 1;
+  plan.times.resize(nt);
+  for (int k = 0; k < nt; ++k) plan.times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
+  plan.times.back() = t_end;  // exactly the end of the block, whatever the rounding
+  return plan;
+}
+
+void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) const {
+  const int nt = static_cast<int>(plan.times.size());
+  const double nx = sys_->nx, ne = sys_->ne, nz = sys_->n_dof() + static_cast<double>(sys_->e_line.size());
+  double per_time = 8.0 * (1.0 + 4.0 * nx + 4.0 * ne);
+  if (plan.linear) per_time += 8.0 * (6.0 * nz * nz + nz + (nx + ne) * nz);
+  require_memory(per_time * nt,
+                 "the results of " + std::to_string(nt) + " output times (" + std::to_string(sys_->nx) +
+                     " coordinates, " + std::to_string(sys_->ne) + " deformations" +
+                     (plan.linear ? ", linearized equations" : "") + ")",
+                 "use fewer output intervals (TIMESTEP n) or split the period into blocks");
+  res.t.resize(nt);
+  for (const OutputArray& a : kOutputArrays) (res.*a.rows).resize(nt, a.per_deformation ? sys_->ne : sys_->nx);
+  res.reaction.setZero();
+  if (n_energy_) res.energy.resize(nt, std::size(kEnergyColumns));
+}
+
+void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out) {
+  assemble();
+  if (x_given_.size()) {
+    warn_of_assembly_moves(*sys_, x_given_, data_->x, res.warnings);
+    x_given_.resize(0);
+  }
+  // The recursive and explicit-chain paths know neither time-dependent loads nor the energy's
+  // quadrature states.
+  const bool plain = timed_.empty() && !options.energy && options.sample_period == 0.0;
+  tree_ = plan.integrate && options.recursive && plain ? RecursiveTree::detect(*sys_, *data_) : nullptr;
+  res.recursive = tree_ != nullptr;
+  chain_ = plan.integrate && options.recursive && plain && !tree_ ? ExplicitChain::detect(*sys_) : nullptr;
+  if (tree_) {
+    base_.xd = base_.xdd = Eigen::VectorXd::Zero(sys_->nx);
+    base_.t = plan.t0;
+  }
+  const Settings& st = plan.st;
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  auto output = [&](double t, const Eigen::VectorXd& Y) {
+    check_time(t);
+    evaluate_state(t, Y);
+    if (n_energy_) {
+      res.energy.row(k_out) << kinetic_energy(*sys_, *data_), gravity_potential(*sys_, *data_),
+          strain_energy(*sys_, *data_), Y[2 * nd + ny], Y[2 * nd + ny + 1];
+    }
+    if (st.forcemode >= 1 || plan.linear) forces();
+    else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
+    require_finite_state(t);
+    if (plan.linear) res.linearizations.push_back(linearize());
+    record(res, k_out);
+    if (options.on_output) options.on_output(k_out, *data_, plan.linear ? &res.linearizations.back() : nullptr);
+    ++k_out;
+  };
+  // State Y = (q, y, q̇, w): DOFs, integrated deformations, DOF rates, and with the energy balance
+  // the dissipated and external work (quadrature states: integrated with the motion, under the
+  // same error control, from the power at every stage; nothing depends on them).
+  Eigen::VectorXd Y(2 * nd + ny + n_energy_);
+  Y << sys_->q0, sys_->y0, sys_->qd0, Eigen::VectorXd::Zero(n_energy_);
+  if (!plan.integrate) {
+    // Kinematic analysis (or a single analysis at the current time).
+    for (double t : plan.times) output(t, Y);
+    return;
+  }
+  // A digital controller: its loads at a sample from the state there, held until the next.
+  const bool sampled = options.sample_period > 0.0 && options.on_sample;
+  long k_sample = 0;
+  auto sample = [&](double ts) {
+    evaluate_state(ts, Y);
+    Eigen::VectorXd held = Eigen::VectorXd::Zero(sys_->nx);
+    options.on_sample(ts, *data_, held);
+    held_ = held;
+  };
+  if (sampled) sample(plan.t0);
+  double t = plan.t0, h = options.initial_step;
+  kinematic_failure_.clear();
+  // AUTO starts explicit: most mechanisms are not stiff, and DOP853 tells when one is.
+  const bool auto_switch = options.method == Method::AUTO;
+  Method method = auto_switch ? Method::DOP853 : options.method;
+  res.method = method;
+  for (;;) {
+    // One segment: integrate until the end (or the next sample of the controller), until a free
+    // rotation must be repartitioned, or (AUTO) until the stiffness changes. The step limit
+    // holds for the block, whatever the number of segments.
+    if (res.steps >= options.max_steps)
+      throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
+                             " steps in the block at t = " + num(t));
+    double t_stop = plan.t_end;
+    if (sampled) {
+      const double next = plan.t0 + static_cast<double>(k_sample + 1) * options.sample_period;
+      if (next < plan.t_end - Stepper::min_step(plan.t_end)) t_stop = next;
+    }
+    auto last = plan.times.begin() + k_out;
+    while (last != plan.times.end() && *last <= t_stop) ++last;
+    const std::vector<double> remaining(plan.times.begin() + k_out, last);
+    const SegmentEnd end =
+        integrate_segment(res, options, method, auto_switch, st, t, t_stop, h, Y, remaining, output);
+    h = res.last_step;  // the other integrator continues with the step this one proposed
+    if (end.t >= plan.t_end) break;
+    t = end.t;
+    if (end.t >= t_stop) {  // a sample of the controller
+      ++k_sample;
+      sample(t);
+      continue;
+    }
+    if (end.switch_method) {
+      const Method other = method == Method::DOP853 ? Method::RADAU5 : Method::DOP853;
+      res.switches.push_back({t, method, other});
+      method = other;
+    }
+    const int rotation = rotation_to_repartition(Y);
+    if (rotation >= 0) repartition(rotation, t, Y);
+  }
+}
+
+StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_switch, int n_states) {
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  StepperSetup setup;
+  setup.n = n_states;
+  setup.positions = nd;
+  setup.rate_offset = nd + ny;
+  setup.rates_last = n_energy_ == 0;  // Y = (q, y, q̇); the energy's quadrature states come after q̇
+  setup.jacobian = [this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
+    jacobian(tt, y, J);
+    if (J.rows() < y.size()) {  // the energy's quadrature states: nothing depends on them
+      Eigen::MatrixXd full = Eigen::MatrixXd::Zero(y.size(), y.size());
+      full.topLeftCorner(J.rows(), J.cols()) = J;
+      J.swap(full);
+    }
+  };
+  if (residual_form()) {
+    setup.residual = [this](double tt, const Eigen::VectorXd& y, const Eigen::VectorXd& D, Eigen::VectorXd& R) {
+      residual(tt, y, D, R);
+    };
+    setup.weight = [this](Eigen::MatrixXd& W) { W = jacobian_mass_; };
+  }
+  if (sparse_newton()) {
+    newton_data_.reset();  // the system of this segment (a repartition recompiles it)
+    newton_system_.reset();
+    setup.newton.refresh = [this](double tt, const Eigen::VectorXd& y) { newton_refresh(tt, y); };
+    setup.newton.factorize = [this](double gh, double bh2) {
+      NodalCoefficients c;
+      c.mass = 1.0, c.damping = gh, c.stiffness = bh2, c.geometric = bh2;
+      newton_singular_ = !newton_system_->factorize(newton_data_->sigma, c) || newton_system_->saddle().singular();
+    };
+    setup.newton.solve = [this](const Eigen::VectorXd& r, Eigen::VectorXd& x) {
+      if (newton_singular_) {  // the stepper reports a singular Newton matrix and halves the step
+        x = Eigen::VectorXd::Constant(r.size(), std::numeric_limits<double>::quiet_NaN());
+        return;
+      }
+      Eigen::VectorXd dx;
+      newton_system_->solve(r, x, dx, 0);
+    };
+    setup.newton.weight = [this](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+      out = newton_system_->mass_product(v);
+    };
+  }
+  setup.rho_inf = options.rho_inf;
+  setup.fixed_step = options.fixed_step;
+  setup.auto_switch = auto_switch;
+  return setup;
+}
+
+Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const RunOptions& options, Method method,
+                                                     bool auto_switch, const Settings& st, double t, double t_end,
+                                                     double h, Eigen::VectorXd& Y, const std::vector<double>& times,
+                                                     const Stepper::Output& output) {
+  const std::unique_ptr<Stepper> stepper =
+      make_stepper(method, stepper_setup(options, auto_switch, static_cast<int>(Y.size())));
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  Eigen::VectorXd rtol(Y.size());
+  rtol.setConstant(st.epsint);
+  rtol.segment(nd + ny, nd).setConstant(st.epsind);
+  stepper->set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
+  stepper->set_max_step(st.hmax);
+  stepper->set_max_steps(options.max_steps - res.steps);
+  if (h > 0.0) stepper->set_initial_step(h);
+  // Stop to repartition a free rotation whose dependent Euler parameter became small.
+  if (!sys_->free_rotations.empty())
+    stepper->set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
+  stepper->set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
+  anchor_.valid = false;
+  auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
+  auto add_stats = [&]() {
+    const StepperStats& s = stepper->stats();
+    res.rhs_evaluations += s.nfev;
+    res.steps += s.nsteps;
+    res.accepted += s.naccept;
+    res.rejected += s.nreject;
+    res.jacobians += s.njev;
+    res.decompositions += s.ndec;
+  };
+  double t_reached = t;
+  try {
+    t_reached = stepper->integrate(f, t, t_end, Y, times, output);
+  } catch (const IntegrationError& err) {
+    add_stats();
+    explain_collapse(err, Y);
+    throw;
+  } catch (...) {
+    add_stats();
+    throw;
+  }
+  add_stats();
+  res.last_step = stepper->last_step();
+  return {t_reached, stepper->wants_switch()};
+}
+
+void Simulation::explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y) {
+  std::string integrator = err.what();
+  const size_t cut = integrator.find(" (last rejection");
+  if (cut != std::string::npos) integrator.resize(cut);
+  // At the last accepted state: is the velocity constraint block nearly singular (a dead point,
+  // where the accelerations grow without bound)?
+  std::string weak;
+  if (!sys_->x_calc.empty() && sys_->x_calc.size() <= 2000) {
+    try {
+      evaluate_state(data_->t, Y);
+      weak = weakest_constraint(*sys_, *data_);
+      if (!weak.empty())
+        weak = "\n  at t = " + std::to_string(data_->t) + " (max Newton residual " +
+               std::to_string(data_->residual.size() ? data_->residual.cwiseAbs().maxCoeff() : 0.0) + "):\n" + weak;
+    } catch (const Error&) {
+    }
+  }
+  // The step collapsed because the kinematics has no (continuous) solution ahead: a right-hand
+  // side failed in the Newton iteration since the last accepted step (formulation.md §2.2).
+  if (!kinematic_failure_.empty())
+    throw KinematicsError(kinematic_failure_ + "\nNo kinematic solution down to the minimum step (" + integrator +
+                          ")." + weak);
+  if (!weak.empty())
+    throw KinematicsError("the mechanism reaches a singular configuration (" + integrator + ")." + weak);
+}
+
+int Simulation::rotation_to_repartition(const Eigen::VectorXd& Y) const {
+  for (size_t r = 0; r < sys_->free_rotations.size(); ++r) {
+    const FreeRotation& fr = sys_->free_rotations[r];
+    double others = 0.0;
+    for (int j : fr.dofs) others += Y[j] * Y[j];
+    // On the unit sphere the dependent parameter squared is 1 − others; below ¼ another
+    // parameter is at least as large, and the normalisation row loses its strength.
+    if (1.0 - others < 0.25) return static_cast<int>(r);
+  }
+  return -1;
+}
+
+void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
+  evaluate_state(t, Y);
+  const FreeRotation fr = sys_->free_rotations[which];
+  int best = 0;
+  for (int i = 1; i < 4; ++i)
+    if (std::abs(data_->x[fr.coord + i]) > std::abs(data_->x[fr.coord + best])) best = i;
+  dependent_[fr.node] = best;
+  linearizer_.reset();
+  const Eigen::VectorXd x = data_->x, xd = data_->xd, e = data_->e, ed = data_->ed, angles = data_->angle_ref,
+                        integrated = data_->e_integrated;
+  const long newton = data_->total_newton_iterations;
+  sys_ = compile(model_, dependent_);
+  data_ = std::make_unique<Data>(*sys_);
+  if (chain_) chain_ = ExplicitChain::detect(*sys_);
+  data_->x = x;
+  data_->angle_ref = angles;
+  data_->e_integrated = integrated;
+  data_->total_newton_iterations = newton;
+  base_ = anchor_ = Solved();  // the next evaluation starts from x (q̂ has another meaning)
+  base_.x = x;
+  base_.angle_ref = angles;
+  have_transfer_ = false;
+  // Same sizes: the new partition only exchanges which Euler parameter is calculable.
+  const System& sys = *sys_;
+  const int n = sys.n_dof(), ny = static_cast<int>(sys.y_defs.size());
+  int j = 0;
+  for (int c : sys.x_dyn) {
+    Y[j] = x[c];
+    Y[n + ny + j++] = xd[c];
+  }
+  for (int k : sys.e_dyn) {
+    Y[j] = e[k];
+    Y[n + ny + j++] = ed[k];
+  }
+}
+
+void Simulation::store_state() {
+  const System& sys = *sys_;
+  int g = 0;
+  for (auto& [id, n] : model_.nodes)
+    for (size_t i = 0; i < n.x.size(); ++i, ++g) {
+      n.x[i] = data_->x[g];
+      n.xd[i] = data_->xd[g];
+      n.xdd[i] = data_->xdd[g];
+    }
+  int k = 0;
+  for (auto& [id, el] : model_.elements)
+    for (size_t i = 0; i < el.e.size(); ++i, ++k) {
+      const DefClass c = sys.def_class[k];
+      const bool target = (c == DefClass::Fixed || c == DefClass::Linearization) && el.e_given[i];
+      if (!target) el.e[i] = data_->e[k];  // a given target stays exact for the next block
+      el.ed[i] = data_->ed[k];
+      el.edd[i] = data_->edd[k];
+      // Values that are states continue in the next block: inputs, DOFs, kinematic coordinates
+      // and the integrated values of released velocity-level deformations (slips).
+      if (c == DefClass::Input || c == DefClass::Dynamic || c == DefClass::Kinematic ||
+          (c == DefClass::Released && sys.def_velocity_level[k]))
+        el.e_given[i] = true;
+    }
+  model_.time = data_->t;
+}
+
+}  // namespace spacar
