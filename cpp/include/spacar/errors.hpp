@@ -2,10 +2,20 @@
 // name in the `spacar` package, so C++ failures reach users as catchable, explained errors.
 #pragma once
 
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 namespace spacar {
+
+// A number in a message: printf's %g with `digits` significant digits (the one formatter of the
+// core's messages).
+inline std::string format_number(double v, int digits = 6) {
+  std::ostringstream os;
+  os.precision(digits);
+  os << v;
+  return os.str();
+}
 
 struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <sstream>
 
@@ -69,7 +68,7 @@ void Simulation::predict_from(const Solved& s, double t, const double* q) {
   for (int g : sys.x_input) data_->x[g] = data_->qhat[sys.qhat_col_x[g]];
   for (size_t j = 0; j < sys.x_dyn.size(); ++j) data_->x[sys.x_dyn[j]] = q[j];
   const double dt = t - s.t;
-  const double first = predictor_order_ >= 1 ? dt : 0.0, second = predictor_order_ >= 2 ? 0.5 * dt * dt : 0.0;
+  const double first = run_.predictor_order >= 1 ? dt : 0.0, second = run_.predictor_order >= 2 ? 0.5 * dt * dt : 0.0;
   for (int c : sys.x_calc) data_->x[c] += first * s.xd[c] + second * s.xdd[c];
 }
 
@@ -79,7 +78,7 @@ void Simulation::predict_from(const Solved& s, double t, const double* q) {
 // solution branch (a disc turned over, a linkage through its dead point).
 bool Simulation::continuous_with_step_start(std::string& why) const {
   const System& sys = *sys_;
-  const Solved& a = anchor_;
+  const Solved& a = run_.anchor;
   const double dt = data_->t - a.t;
   double dev = 0.0, inc = 0.0;
   int worst = -1;
@@ -111,14 +110,14 @@ bool Simulation::solved_dofs(const Solved& s, const Eigen::VectorXd& Y) const {
 }
 
 void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
-  if (t > kinematic_failure_t_) kinematic_failure_.clear();  // passed: the failure is history
+  if (t > run_.kinematic_failure_t) run_.kinematic_failure.clear();  // passed: the failure is history
   if (tree_) return;  // explicit positions: no Newton start to anchor, no branch to leave
-  if (anchor_.valid && anchor_.t == t) {  // the same step again, smaller
+  if (run_.anchor.valid && run_.anchor.t == t) {  // the same step again, smaller
     // A step from an approximate anchor failed: solve the accepted state itself, so that the
     // smaller steps are not held to a mismatch of the size of a Newton increment.
-    if (!anchor_.exact) {
+    if (!run_.anchor.exact) {
       evaluate_state(t, Y);
-      anchor_ = base_;
+      run_.anchor = run_.base;
     }
     return;
   }
@@ -127,9 +126,9 @@ void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
   // iterate after the last update, next to the state last evaluated: that state is the anchor
   // (its positions differ by the size of that update, far below the motion of a step) until a
   // step fails.
-  if (!(base_.valid && base_.t == t)) evaluate_state(t, Y);
-  anchor_ = base_;
-  anchor_.exact = solved_dofs(base_, Y);
+  if (!(run_.base.valid && run_.base.t == t)) evaluate_state(t, Y);
+  run_.anchor = run_.base;
+  run_.anchor.exact = solved_dofs(run_.base, Y);
 }
 
 void Simulation::assemble() {
@@ -139,9 +138,9 @@ void Simulation::assemble() {
   set_dofs(sys, *data_, sys.q0.data(), sys.qd0.data());
   check_constraint_counts(sys, *data_);
   solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, true);
-  base_ = anchor_ = Solved();
-  base_.x = data_->x;  // positions only: no velocities yet for the predictor
-  base_.angle_ref = data_->angle_ref;
+  run_.base = run_.anchor = Solved();
+  run_.base.x = data_->x;  // positions only: no velocities yet for the predictor
+  run_.base.angle_ref = data_->angle_ref;
   have_transfer_ = false;
 }
 
@@ -149,7 +148,7 @@ void Simulation::solve_state(double t, const double* q, const double* qd, Start 
                              const Eigen::VectorXd* known_qdd) {
   solve_motion(t, q, qd, start);
   if (!(known_qdd && solve_dynamics_known(*sys_, *data_, *known_qdd))) solve_dynamics_direct(*sys_, *data_);
-  remember(base_);
+  remember(run_.base);
   have_transfer_ = false;
 }
 
@@ -163,13 +162,13 @@ void Simulation::solve_motion(double t, const double* q, const double* qd, Start
   // the last solved state advanced by a second-order Taylor step in time (integration stages).
   predicted_.setZero();
   if (start == Start::Transfer && have_transfer_) {
-    predict_from(base_, base_.t, q);
+    predict_from(run_.base, run_.base.t, q);
     predicted_.noalias() = data_->DF * (data_->qhat - qhat_transfer_);
     for (int c : sys.x_calc) data_->x[c] += predicted_[c];
-  } else if (base_.valid) {
-    predict_from(base_, t, q);
+  } else if (run_.base.valid) {
+    predict_from(run_.base, t, q);
   } else {
-    Solved positions = base_;  // after assembly: positions only
+    Solved positions = run_.base;  // after assembly: positions only
     positions.t = t;
     positions.xd = positions.xdd = Eigen::VectorXd::Zero(sys.nx);
     predict_from(positions, t, q);
@@ -181,34 +180,34 @@ void Simulation::solve_motion(double t, const double* q, const double* qd, Start
   // explicit chain, whose elements' iterations start from their predicted positions one by one,
   // is held to that only from an exact anchor: an approximate one (generalized-α's last iterate)
   // differs by up to a Newton increment, which would reject good steps.
-  const bool anchored = in_rhs_ && anchor_.valid;
-  const bool check = anchored && !(chain && !anchor_.exact);
-  const Solved& solved = anchored ? anchor_ : base_;  // the chain's branches: of the step start
+  const bool anchored = run_.in_rhs && run_.anchor.valid;
+  const bool check = anchored && !(chain && !run_.anchor.exact);
+  const Solved& solved = anchored ? run_.anchor : run_.base;  // the chain's branches: of the step start
   auto positions = [&]() {
     if (chain)
       chain->solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, solved.valid ? &solved.x : nullptr);
     else solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false, start == Start::Exact);
   };
-  if (!chord_) data_->jacobian_reusable = false;
+  if (!run_.chord) data_->jacobian_reusable = false;
   std::string why;
   bool ok = false;
   try {
     positions();
     ok = !check || continuous_with_step_start(why);
   } catch (const KinematicsError& err) {
-    if (!anchored && !base_.valid) throw;
+    if (!anchored && !run_.base.valid) throw;
     why = err.what();
   }
   if (!ok) {
     // The last solved state may be a stage up to a full step ahead, solved before the step
     // failed elsewhere: start again from the step start (or, outside the integrator, from the
     // last solution itself); if the result is still not continuous, reject the step.
-    if (anchored) predict_from(anchor_, t, q);
-    else predict_from(base_, base_.t, q);
+    if (anchored) predict_from(run_.anchor, t, q);
+    else predict_from(run_.base, run_.base.t, q);
     positions();
     if (check && !continuous_with_step_start(why)) throw KinematicsError(why);
   }
-  if (chain && in_rhs_) chain->solve_velocities(sys, *data_);
+  if (chain && run_.in_rhs) chain->solve_velocities(sys, *data_);
   else solve_velocities_direct(sys, *data_);
 }
 
@@ -249,7 +248,7 @@ void Simulation::move_to(double t, const double* q, const double* qd) {
   };
   while (s < 1.0) {
     const double s1 = ds >= 1.0 - s ? 1.0 : s + ds;
-    const Solved from = base_;
+    const Solved from = run_.base;
     bool ok = true;
     try {
       evaluate(at(s1), qs.data(), qds.data());
@@ -274,7 +273,7 @@ void Simulation::move_to(double t, const double* q, const double* qd) {
       throw KinematicsError(os.str());
     }
     // Back to the last accepted state (exact positions, its DF for the predictor).
-    base_ = from;
+    run_.base = from;
     have_transfer_ = false;
     evaluate(at(s), qs.data(), qds.data());
     ds *= 0.5;
@@ -297,17 +296,17 @@ bool Simulation::linearize_nodal(NodalLinearization& out) { return linearizer().
 
 void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
-  if (Y.size() != 2 * nd + ny + n_energy_)
-    throw InputError("evaluate_state: the state (q, y, q̇) needs " + std::to_string(2 * nd + ny + n_energy_) +
+  if (Y.size() != 2 * nd + ny + run_.n_energy)
+    throw InputError("evaluate_state: the state (q, y, q̇) needs " + std::to_string(2 * nd + ny + run_.n_energy) +
                      " values, got " + std::to_string(Y.size()));
   // On the recursive path the last solved state may be a stage a whole (large) step away: start
   // Newton from the tree's exact positions at (q, q̇) instead.
   // Its q̈ is the general path's solution, which then needs no equations of motion, where the
   // tree knows all the loads (a run's tree; not with time-dependent or held loads set since
   // recursive_state).
-  const bool known = tree_ && tree_state(t, Y, tree_qdd_) && timed_.empty() && held_.size() == 0;
+  const bool known = tree_ && tree_state(t, Y, run_.tree_qdd) && timed_.empty() && run_.held.size() == 0;
   for (int i = 0; i < ny; ++i) data_->e_integrated[sys_->y_defs[i]] = Y[nd + i];
-  if (known) solve_state(t, Y.data(), Y.data() + nd + ny, Start::Exact, &tree_qdd_);
+  if (known) solve_state(t, Y.data(), Y.data() + nd + ny, Start::Exact, &run_.tree_qdd);
   else solve_state(t, Y.data(), Y.data() + nd + ny);
 }
 
@@ -315,11 +314,11 @@ bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd&
   const int nd = sys_->n_dof();
   qdd.resize(nd);
   // Outside a run (a tree kept from recursive_state) the last solved state may hold positions only.
-  for (Eigen::VectorXd* v : {&base_.x, &base_.xd, &base_.xdd})
+  for (Eigen::VectorXd* v : {&run_.base.x, &run_.base.xd, &run_.base.xdd})
     if (v->size() != sys_->nx) v->setZero(sys_->nx);
-  if (!tree_->solve(Y.data(), Y.data() + nd, base_.x, base_.xd, base_.xdd, qdd.data())) return false;
-  base_.valid = true;  // the start of Newton's iterations at the next general evaluation
-  base_.t = t;
+  if (!tree_->solve(Y.data(), Y.data() + nd, run_.base.x, run_.base.xd, run_.base.xdd, qdd.data())) return false;
+  run_.base.valid = true;  // the start of Newton's iterations at the next general evaluation
+  run_.base.t = t;
   return true;
 }
 
@@ -331,21 +330,21 @@ void Simulation::in_rhs(double t, F&& evaluate) {
     ~InRhs() { flag = false; }
   };
   try {
-    const InRhs guard(in_rhs_);
+    const InRhs guard(run_.in_rhs);
     evaluate();
   } catch (const KinematicsError& err) {
-    kinematic_failure_ = err.what();
-    kinematic_failure_t_ = t;
+    run_.kinematic_failure = err.what();
+    run_.kinematic_failure_t = t;
     throw StepRejected(err.what());
   }
 }
 
 bool Simulation::residual_form() const {
-  return (chain_ || sparse_newton()) && !tree_ && sys_->y_defs.empty() && n_energy_ == 0;
+  return (chain_ || sparse_newton()) && !tree_ && sys_->y_defs.empty() && run_.n_energy == 0;
 }
 
 bool Simulation::sparse_newton() const {
-  return !tree_ && sys_->y_defs.empty() && n_energy_ == 0 && sys_->velocity_block_is_position_block &&
+  return !tree_ && sys_->y_defs.empty() && run_.n_energy == 0 && sys_->velocity_block_is_position_block &&
          sys_->n_dof() >= kSparseNewtonDofs;
 }
 
@@ -355,11 +354,11 @@ void Simulation::newton_refresh(double t, const Eigen::VectorXd& Y) {
   } catch (const KinematicsError& err) {
     throw StepRejected(err.what());
   }
-  if (!newton_data_) {
-    newton_data_ = std::make_unique<Data>(*data_);
-    newton_system_ = std::make_unique<ReducedSystem>(*sys_, *newton_data_);
+  if (!run_.newton_data) {
+    run_.newton_data = std::make_unique<Data>(*data_);
+    run_.newton_system = std::make_unique<ReducedSystem>(*sys_, *run_.newton_data);
   } else {
-    *newton_data_ = *data_;
+    *run_.newton_data = *data_;
   }
 }
 
@@ -372,7 +371,7 @@ void Simulation::residual(double t, const Eigen::VectorXd& Y, const Eigen::Vecto
     set_dof_accelerations(sys, *data_, qdd);
     reduced_residual_direct(sys, *data_, R, chain_.get());
   });
-  remember(base_);  // the next positions' predictor, and the anchor of the next step
+  remember(run_.base);  // the next positions' predictor, and the anchor of the next step
   have_transfer_ = false;
 }
 
@@ -389,7 +388,7 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   dY.head(nd) = Y.segment(nd + ny, nd);
   for (int i = 0; i < ny; ++i) dY[nd + i] = data_->ed[sys_->y_defs[i]];
   dY.segment(nd + ny, nd) = data_->qdd;
-  if (n_energy_) {  // the quadrature states: dissipated and external work
+  if (run_.n_energy) {  // the quadrature states: dissipated and external work
     const EnergyRates r = energy_rates(*sys_, *data_);
     dY[2 * nd + ny] = r.dissipated;
     dY[2 * nd + ny + 1] = r.external;
@@ -420,7 +419,7 @@ void Simulation::apply_time_loads(double t) {
   Data& d = *data_;
   for (const TimeLoads::InputTable& in : timed_.input_tables)
     set_input(sys, d, in.input, in.table(t, 0, 0), in.table(t, 0, 1), in.table(t, 0, 2));
-  if (timed_.load_tables.empty() && !timed_.load_function && held_.size() == 0) {
+  if (timed_.load_tables.empty() && !timed_.load_function && run_.held.size() == 0) {
     d.time_load.resize(0);
     return;
   }
@@ -428,7 +427,7 @@ void Simulation::apply_time_loads(double t) {
   for (const TimeLoads::LoadTable& l : timed_.load_tables)
     for (size_t j = 0; j < l.coords.size(); ++j) d.time_load[l.coords[j]] += l.table(t, static_cast<int>(j));
   if (timed_.load_function) timed_.load_function(t, d.time_load);
-  if (held_.size()) d.time_load += held_;
+  if (run_.held.size()) d.time_load += run_.held;
 }
 
 bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,

@@ -25,8 +25,8 @@ void Simulation::jacobian(double t, const Eigen::VectorXd& Y, Eigen::MatrixXd& J
   J.setZero(n, n);
   J.block(0, nd + ny, nd, nd).setIdentity();
   if (nd > 0) {
-    jacobian_mass_ = lin.M0.topLeftCorner(nd, nd);  // the weight of generalized-α's residual form
-    const Eigen::LLT<Eigen::MatrixXd> mass(jacobian_mass_);
+    run_.jacobian_mass = lin.M0.topLeftCorner(nd, nd);  // the weight of generalized-α's residual form
+    const Eigen::LLT<Eigen::MatrixXd> mass(run_.jacobian_mass);
     if (mass.info() != Eigen::Success) throw Error("jacobian: the reduced mass matrix is not positive definite");
     J.block(nd + ny, 0, nd, nd) = -mass.solve((lin.K0 + lin.N0 + lin.G0).topLeftCorner(nd, nd));
     J.block(nd + ny, nd + ny, nd, nd) = -mass.solve((lin.C0 + lin.D0).topLeftCorner(nd, nd));

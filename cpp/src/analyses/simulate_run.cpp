@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <sstream>
 
@@ -21,12 +20,6 @@
 namespace spacar {
 
 namespace {
-
-std::string format_g(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
 
 // Warnings for the position nodes that the first assembly moved far (more than 1e-3 of the
 // model's size, the spread of the X positions) from where X put them: the X positions do not
@@ -65,25 +58,18 @@ void warn_of_assembly_moves(const System& sys, const Eigen::VectorXd& given, con
     }
     auto point = [&](const Eigen::VectorXd& v) {
       std::string s = "(";
-      for (int i = g; i < end; ++i) s += (i > g ? ", " : "") + format_g(v[i], 6);
+      for (int i = g; i < end; ++i) s += (i > g ? ", " : "") + format_number(v[i], 6);
       return s + ")";
     };
     warnings.push_back("the assembly moved node " + std::to_string(sys.coord_label[g][0]) + " by " +
-                       format_g(distance, 4) + " from its X position " + point(given) + " to " + point(x) +
+                       format_number(distance, 4) + " from its X position " + point(given) + " to " + point(x) +
                        ": the X positions do not close the loop with the lengths (LENGTHO), E targets and "
                        "input values given");
   }
   if (moved > kMovedNodesNamed)
     warnings.push_back("the assembly moved " + std::to_string(moved - kMovedNodesNamed) +
                        " more nodes from their X positions, the farthest node " + std::to_string(farthest) +
-                       " by " + format_g(largest, 4));
-}
-
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(12);
-  os << v;
-  return os.str();
+                       " by " + format_number(largest, 4));
 }
 
 // Keep the first `rows` rows of every time-indexed array (a run that failed midway).
@@ -100,10 +86,10 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   res = BlockResults();
   res.warnings = sys_->warnings;
   const BlockPlan plan = plan_block(options, res.warnings);
-  n_energy_ = options.energy ? 2 : 0;
-  held_.resize(0);
-  predictor_order_ = options.predictor_order;
-  chord_ = options.chord;
+  run_.n_energy = options.energy ? 2 : 0;
+  run_.held.resize(0);
+  run_.predictor_order = options.predictor_order;
+  run_.chord = options.chord;
   // One deadline (limits.hpp), checked at every right-hand side and output time and inside the
   // sparse factorizations; the time the set-up took counts against it.
   const DeadlineScope deadline(options.time_limit, options.time_spent);
@@ -114,9 +100,9 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     tree_.reset();
     chain_.reset();
-    held_.resize(0);
-    predictor_order_ = RunOptions().predictor_order;
-    chord_ = RunOptions().chord;
+    run_.held.resize(0);
+    run_.predictor_order = RunOptions().predictor_order;
+    run_.chord = RunOptions().chord;
   };
   try {
     integrate_block(res, options, plan, k_out);
@@ -156,32 +142,32 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
   plan.t_end = t_end;
   plan.linear = !sys_->e_line.empty() || st.linear.value_or(0) >= 1;
   if (!std::isfinite(t_end))
-    throw InputError("TIMESTEP: the end time TIME + Tp = " + num(t0) + " + " + num(st.timestep_tp) +
+    throw InputError("TIMESTEP: the end time TIME + Tp = " + format_number(t0, 12) + " + " + format_number(st.timestep_tp, 12) +
                      " is not a finite number");
   if (n_out > 0 && st.timestep_tp > 0.0 && !(t0 + st.timestep_tp / n_out > t0))
-    throw InputError("TIMESTEP: the output interval Tp/n = " + num(st.timestep_tp / n_out) +
-                     " is lost in the rounding of the time t = " + num(t0) + " (TIME)");
+    throw InputError("TIMESTEP: the output interval Tp/n = " + format_number(st.timestep_tp / n_out, 12) +
+                     " is lost in the rounding of the time t = " + format_number(t0, 12) + " (TIME)");
   plan.integrate = (sys_->n_dof() > 0 || !sys_->y_defs.empty()) && n_out > 0 && t_end > t0;
   if (options.energy && !plan.integrate)
     throw InputError("the energy balance needs an integrated block (degrees of freedom and a TIMESTEP period)");
   if (options.sample_period > 0.0 && st.timestep_tp / options.sample_period > static_cast<double>(options.max_steps))
-    throw InputError("the controller's sample period " + num(options.sample_period) + " needs more than " +
+    throw InputError("the controller's sample period " + format_number(options.sample_period, 12) + " needs more than " +
                      std::to_string(options.max_steps) + " samples in the block");
   if (plan.integrate) {
     const double h_min = Stepper::min_step(t_end);
     if (st.timestep_tp < h_min)
-      throw InputError("TIMESTEP: the period Tp = " + num(st.timestep_tp) +
-                       " is shorter than the smallest integration step " + num(h_min) + " at t = " + num(t_end));
+      throw InputError("TIMESTEP: the period Tp = " + format_number(st.timestep_tp, 12) +
+                       " is shorter than the smallest integration step " + format_number(h_min, 12) + " at t = " + format_number(t_end, 12));
     if (st.hmax < Stepper::min_step(t0))
-      throw InputError("HMAX " + num(st.hmax) + " is below the smallest integration step " +
-                       num(Stepper::min_step(t0)) + " at t = " + num(t0));
+      throw InputError("HMAX " + format_number(st.hmax, 12) + " is below the smallest integration step " +
+                       format_number(Stepper::min_step(t0), 12) + " at t = " + format_number(t0, 12));
     if (st.timestep_tp / st.hmax > static_cast<double>(options.max_steps))
-      throw InputError("HMAX " + num(st.hmax) + " needs at least Tp/HMAX = " + num(st.timestep_tp / st.hmax) +
+      throw InputError("HMAX " + format_number(st.hmax, 12) + " needs at least Tp/HMAX = " + format_number(st.timestep_tp / st.hmax, 12) +
                        " steps, more than the limit of " + std::to_string(options.max_steps) + " steps per block");
     for (auto [eps, name] : {std::pair<double*, const char*>{&st.epsint, "EPSINT"}, {&st.epsind, "EPSIND"}})
       if (*eps < kMinTolerance) {
-        warnings.push_back(std::string(name) + " " + num(*eps) +
-                           " is below the attainable accuracy in double precision: " + num(kMinTolerance) +
+        warnings.push_back(std::string(name) + " " + format_number(*eps, 12) +
+                           " is below the attainable accuracy in double precision: " + format_number(kMinTolerance, 12) +
                            " (100 machine epsilons) is used");
         *eps = kMinTolerance;
       }
@@ -206,7 +192,7 @@ void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) cons
   res.t.resize(nt);
   for (const OutputArray& a : kOutputArrays) (res.*a.rows).resize(nt, a.per_deformation ? sys_->ne : sys_->nx);
   res.reaction.setZero();
-  if (n_energy_) res.energy.resize(nt, std::size(kEnergyColumns));
+  if (run_.n_energy) res.energy.resize(nt, std::size(kEnergyColumns));
 }
 
 void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out) {
@@ -222,15 +208,15 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   res.recursive = tree_ != nullptr;
   chain_ = plan.integrate && options.recursive && plain && !tree_ ? ExplicitChain::detect(*sys_) : nullptr;
   if (tree_) {
-    base_.xd = base_.xdd = Eigen::VectorXd::Zero(sys_->nx);
-    base_.t = plan.t0;
+    run_.base.xd = run_.base.xdd = Eigen::VectorXd::Zero(sys_->nx);
+    run_.base.t = plan.t0;
   }
   const Settings& st = plan.st;
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   auto output = [&](double t, const Eigen::VectorXd& Y) {
     check_time(t);
     evaluate_state(t, Y);
-    if (n_energy_) {
+    if (run_.n_energy) {
       res.energy.row(k_out) << kinetic_energy(*sys_, *data_), gravity_potential(*sys_, *data_),
           strain_energy(*sys_, *data_), Y[2 * nd + ny], Y[2 * nd + ny + 1];
     }
@@ -245,8 +231,8 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   // State Y = (q, y, q̇, w): DOFs, integrated deformations, DOF rates, and with the energy balance
   // the dissipated and external work (quadrature states: integrated with the motion, under the
   // same error control, from the power at every stage; nothing depends on them).
-  Eigen::VectorXd Y(2 * nd + ny + n_energy_);
-  Y << sys_->q0, sys_->y0, sys_->qd0, Eigen::VectorXd::Zero(n_energy_);
+  Eigen::VectorXd Y(2 * nd + ny + run_.n_energy);
+  Y << sys_->q0, sys_->y0, sys_->qd0, Eigen::VectorXd::Zero(run_.n_energy);
   if (!plan.integrate) {
     // Kinematic analysis (or a single analysis at the current time).
     for (double t : plan.times) output(t, Y);
@@ -259,11 +245,11 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
     evaluate_state(ts, Y);
     Eigen::VectorXd held = Eigen::VectorXd::Zero(sys_->nx);
     options.on_sample(ts, *data_, held);
-    held_ = held;
+    run_.held = held;
   };
   if (sampled) sample(plan.t0);
   double t = plan.t0, h = options.initial_step;
-  kinematic_failure_.clear();
+  run_.kinematic_failure.clear();
   // AUTO starts explicit: most mechanisms are not stiff, and DOP853 tells when one is.
   const bool auto_switch = options.method == Method::AUTO;
   Method method = auto_switch ? Method::DOP853 : options.method;
@@ -274,7 +260,7 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
     // holds for the block, whatever the number of segments.
     if (res.steps >= options.max_steps)
       throw IntegrationError("Integrator: more than " + std::to_string(options.max_steps) +
-                             " steps in the block at t = " + num(t));
+                             " steps in the block at t = " + format_number(t, 12));
     double t_stop = plan.t_end;
     if (sampled) {
       const double next = plan.t0 + static_cast<double>(k_sample + 1) * options.sample_period;
@@ -309,7 +295,7 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
   setup.n = n_states;
   setup.positions = nd;
   setup.rate_offset = nd + ny;
-  setup.rates_last = n_energy_ == 0;  // Y = (q, y, q̇); the energy's quadrature states come after q̇
+  setup.rates_last = run_.n_energy == 0;  // Y = (q, y, q̇); the energy's quadrature states come after q̇
   setup.jacobian = [this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
     jacobian(tt, y, J);
     if (J.rows() < y.size()) {  // the energy's quadrature states: nothing depends on them
@@ -322,27 +308,27 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
     setup.residual = [this](double tt, const Eigen::VectorXd& y, const Eigen::VectorXd& D, Eigen::VectorXd& R) {
       residual(tt, y, D, R);
     };
-    setup.weight = [this](Eigen::MatrixXd& W) { W = jacobian_mass_; };
+    setup.weight = [this](Eigen::MatrixXd& W) { W = run_.jacobian_mass; };
   }
   if (sparse_newton()) {
-    newton_data_.reset();  // the system of this segment (a repartition recompiles it)
-    newton_system_.reset();
+    run_.newton_data.reset();  // the system of this segment (a repartition recompiles it)
+    run_.newton_system.reset();
     setup.newton.refresh = [this](double tt, const Eigen::VectorXd& y) { newton_refresh(tt, y); };
     setup.newton.factorize = [this](double gh, double bh2) {
       NodalCoefficients c;
       c.mass = 1.0, c.damping = gh, c.stiffness = bh2, c.geometric = bh2;
-      newton_singular_ = !newton_system_->factorize(newton_data_->sigma, c) || newton_system_->saddle().singular();
+      run_.newton_singular = !run_.newton_system->factorize(run_.newton_data->sigma, c) || run_.newton_system->saddle().singular();
     };
     setup.newton.solve = [this](const Eigen::VectorXd& r, Eigen::VectorXd& x) {
-      if (newton_singular_) {  // the stepper reports a singular Newton matrix and halves the step
+      if (run_.newton_singular) {  // the stepper reports a singular Newton matrix and halves the step
         x = Eigen::VectorXd::Constant(r.size(), std::numeric_limits<double>::quiet_NaN());
         return;
       }
       Eigen::VectorXd dx;
-      newton_system_->solve(r, x, dx, 0);
+      run_.newton_system->solve(r, x, dx, 0);
     };
     setup.newton.weight = [this](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
-      out = newton_system_->mass_product(v);
+      out = run_.newton_system->mass_product(v);
     };
   }
   setup.rho_inf = options.rho_inf;
@@ -369,7 +355,7 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
   if (!sys_->free_rotations.empty())
     stepper->set_stop_condition([this](double, const Eigen::VectorXd& y) { return rotation_to_repartition(y) >= 0; });
   stepper->set_step_start([this](double tt, const Eigen::VectorXd& y) { step_start(tt, y); });
-  anchor_.valid = false;
+  run_.anchor.valid = false;
   auto f = [this](double tt, const Eigen::VectorXd& y, Eigen::VectorXd& dy) { rhs(tt, y, dy); };
   auto add_stats = [&]() {
     const StepperStats& s = stepper->stats();
@@ -415,8 +401,8 @@ void Simulation::explain_collapse(const IntegrationError& err, const Eigen::Vect
   }
   // The step collapsed because the kinematics has no (continuous) solution ahead: a right-hand
   // side failed in the Newton iteration since the last accepted step (formulation.md §2.2).
-  if (!kinematic_failure_.empty())
-    throw KinematicsError(kinematic_failure_ + "\nNo kinematic solution down to the minimum step (" + integrator +
+  if (!run_.kinematic_failure.empty())
+    throw KinematicsError(run_.kinematic_failure + "\nNo kinematic solution down to the minimum step (" + integrator +
                           ")." + weak);
   if (!weak.empty())
     throw KinematicsError("the mechanism reaches a singular configuration (" + integrator + ")." + weak);
@@ -452,9 +438,9 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   data_->angle_ref = angles;
   data_->e_integrated = integrated;
   data_->total_newton_iterations = newton;
-  base_ = anchor_ = Solved();  // the next evaluation starts from x (q̂ has another meaning)
-  base_.x = x;
-  base_.angle_ref = angles;
+  run_.base = run_.anchor = Solved();  // the next evaluation starts from x (q̂ has another meaning)
+  run_.base.x = x;
+  run_.base.angle_ref = angles;
   have_transfer_ = false;
   // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;

@@ -22,13 +22,6 @@ namespace spacar {
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
-
 // Newton's iterations for one load factor from the current state, and the state to go back to.
 // The tangent stiffness K = K0 + G0 of the degrees of freedom is never formed: its solves go
 // through the sparse saddle-point system of the nodal coordinates (nodal.hpp), a load in q
@@ -476,10 +469,10 @@ void check_options(const StaticOptions& o) {
   if (o.max_cuts < 0 || o.max_cuts > 50)
     throw InputError("static: max_cuts must be between 0 and 50, got " + std::to_string(o.max_cuts));
   if (!(o.tolerance > 0.0 && o.tolerance < 1.0))
-    throw InputError("static: the tolerance must be between 0 and 1, got " + num(o.tolerance));
+    throw InputError("static: the tolerance must be between 0 and 1, got " + format_number(o.tolerance));
   if (o.max_steps < 1)
     throw InputError("static: max_steps must be at least 1, got " + std::to_string(o.max_steps));
-  if (!(o.time_limit >= 0.0)) throw InputError("static: the time limit must not be negative, got " + num(o.time_limit));
+  if (!(o.time_limit >= 0.0)) throw InputError("static: the time limit must not be negative, got " + format_number(o.time_limit));
 }
 
 }  // namespace
@@ -503,7 +496,7 @@ class Rows {
     const std::string dir = path_.indefinite();
     if (dir.empty()) return;
     res_.indefinite_at = lambda;
-    res_.warnings.push_back("the tangent stiffness is indefinite at load factor " + num(lambda) + " in " + dir +
+    res_.warnings.push_back("the tangent stiffness is indefinite at load factor " + format_number(lambda) + " in " + dir +
                             ": the equilibrium is unstable (a buckling or limit load was passed)");
   }
 
@@ -551,11 +544,11 @@ void follow_load_steps(const System& sys, EquilibriumPath& path, const StaticOpt
       const bool hopeless = a.singular_at_start || last_chance;
       if (hopeless) {
         std::ostringstream os;
-        os << "no static equilibrium found beyond load factor " << num(lambda) << " (of 1; tried " << num(next)
+        os << "no static equilibrium found beyond load factor " << format_number(lambda) << " (of 1; tried " << format_number(next)
            << "): " << a.why;
-        if (a.worst >= 0) os << "; worst residual " << num(a.worst_residual) << " on " << dof_name(sys, a.worst);
+        if (a.worst >= 0) os << "; worst residual " << format_number(a.worst_residual) << " on " << dof_name(sys, a.worst);
         if (!a.singular_at_start) {
-          os << " (load step cut " << res.step_cuts << " times, down to " << num(step)
+          os << " (load step cut " << res.step_cuts << " times, down to " << format_number(step)
              << "). The load may exceed a limit point (snap-through or collapse): follow the path past it with "
                 "the arc-length method (arc_length=True, --arc-length); or the model has a degree of freedom "
                 "without stiffness";
@@ -598,8 +591,8 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
       if (++cuts > opt.max_cuts) {
         res.load_reached = a.lambda;
         std::ostringstream os;
-        os << "the arc-length method failed beyond load factor " << num(a.lambda) << ": " << s.why;
-        if (s.worst >= 0) os << "; worst residual " << num(s.worst_residual) << " on " << dof_name(sys, s.worst);
+        os << "the arc-length method failed beyond load factor " << format_number(a.lambda) << ": " << s.why;
+        if (s.worst >= 0) os << "; worst residual " << format_number(s.worst_residual) << " on " << dof_name(sys, s.worst);
         os << " (step halved " << opt.max_cuts << " times in a row)";
         throw StaticError(os.str());
       }
@@ -614,7 +607,7 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
     auto report_limit = [&]() {
       if (!turned) return;
       res.limit_points.push_back(limit);
-      res.warnings.push_back("limit point at load factor " + num(limit) +
+      res.warnings.push_back("limit point at load factor " + format_number(limit) +
                              (b.tau[nd] < 0.0 ? " (a maximum: snap-through)" : " (a minimum)"));
     };
     if (b.lambda >= 1.0 && a.lambda < 1.0) {
@@ -639,7 +632,7 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
       }
       if (++cuts > opt.max_cuts) {  // no equilibrium at λ = 1 from there: a shorter step, or give up
         res.load_reached = a.lambda;
-        throw StaticError("the arc-length method passed load factor 1 after " + num(a.lambda) +
+        throw StaticError("the arc-length method passed load factor 1 after " + format_number(a.lambda) +
                           " but Newton at load factor 1 failed from there: " + last.why + " (step halved " +
                           std::to_string(opt.max_cuts) + " times in a row)");
       }
@@ -665,10 +658,10 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
   res.load_reached = a.lambda;
   std::ostringstream os;
   os << "the arc-length method did not reach load factor 1 in " << opt.max_steps << " steps: load factor "
-     << num(a.lambda) << " reached";
+     << format_number(a.lambda) << " reached";
   if (!res.limit_points.empty()) {
     os << " after limit points at";
-    for (double l : res.limit_points) os << " " << num(l);
+    for (double l : res.limit_points) os << " " << format_number(l);
   }
   os << ". Allow more steps (max_steps) or longer ones (fewer steps)";
   throw StaticError(os.str());

@@ -181,20 +181,9 @@ GeneralizedAlpha::Attempt GeneralizedAlpha::newton(const Rhs& f, double t, doubl
       return Attempt::Failed;
     }
     if (it > 1) {
-      const double thq = dn / dn_old;
-      theta_ = it == 2 ? thq : std::sqrt(thq * thq_old);
-      thq_old = thq;
-      if (!(theta_ < 0.99)) {
-        failure_ = "Newton iterations diverge";
-        return Attempt::Failed;
-      }
-      faccon_ = theta_ / (1.0 - theta_);
-      const double predicted = faccon_ * dn * std::pow(theta_, kMaxNewton - 1 - it) / kNewtonTolerance;
-      if (predicted >= 1.0) {
-        slow_factor_ = 0.8 * std::pow(std::clamp(predicted, 1e-4, 20.0), -1.0 / (4.0 + kMaxNewton - 1 - it));
-        failure_ = "Newton iterations converge too slowly";
-        return Attempt::SlowNewton;
-      }
+      const Contraction c = newton_contraction(it, dn, dn_old, thq_old, kNewtonTolerance);
+      if (c == Contraction::Diverges) return Attempt::Failed;
+      if (c == Contraction::TooSlow) return Attempt::SlowNewton;
     }
     dn_old = std::max(dn, kRound);
     d_new_ += dd_;

@@ -283,22 +283,9 @@ Radau5::Attempt Radau5::newton(const Rhs& f, double t, double h, const Eigen::Ve
     for (int j = 0; j < 3; ++j) sum += (fz_[j].array() / scale_.array()).square().sum();
     const double dyno = std::sqrt(sum / (3.0 * n_));
     if (it > 1 && it < kMaxNewton) {
-      const double thq = dyno / dyno_old;
-      theta_ = it == 2 ? thq : std::sqrt(thq * thq_old);
-      thq_old = thq;
-      if (!(theta_ < 0.99)) {
-        failure_ = "Newton iterations diverge";
-        return Attempt::Failed;
-      }
-      faccon_ = theta_ / (1.0 - theta_);
-      const double predicted = faccon_ * dyno * std::pow(theta_, kMaxNewton - 1 - it) / fnewt_;
-      if (predicted >= 1.0) {
-        // Not converged within the allowed iterations: a smaller step converges faster.
-        const double q = std::clamp(predicted, 1e-4, 20.0);
-        slow_factor_ = 0.8 * std::pow(q, -1.0 / (4.0 + kMaxNewton - 1 - it));
-        failure_ = "Newton iterations converge too slowly";
-        return Attempt::SlowNewton;
-      }
+      const Contraction c = newton_contraction(it, dyno, dyno_old, thq_old, fnewt_);
+      if (c == Contraction::Diverges) return Attempt::Failed;
+      if (c == Contraction::TooSlow) return Attempt::SlowNewton;
     }
     dyno_old = std::max(dyno, kRound);
     for (int j = 0; j < 3; ++j) w_[j] += fz_[j];

@@ -131,6 +131,26 @@ bool Stepper::eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::Vect
   return false;
 }
 
+Stepper::Contraction Stepper::newton_contraction(int it, double dn, double dn_old, double& thq_old,
+                                                 double tolerance) {
+  const double thq = dn / dn_old;
+  theta_ = it == 2 ? thq : std::sqrt(thq * thq_old);
+  thq_old = thq;
+  if (!(theta_ < 0.99)) {
+    failure_ = "Newton iterations diverge";
+    return Contraction::Diverges;
+  }
+  faccon_ = theta_ / (1.0 - theta_);
+  const double predicted = faccon_ * dn * std::pow(theta_, kMaxNewton - 1 - it) / tolerance;
+  if (predicted >= 1.0) {
+    // Not converged within the allowed iterations: a smaller step converges faster.
+    slow_factor_ = 0.8 * std::pow(std::clamp(predicted, 1e-4, 20.0), -1.0 / (4.0 + kMaxNewton - 1 - it));
+    failure_ = "Newton iterations converge too slowly";
+    return Contraction::TooSlow;
+  }
+  return Contraction::Converging;
+}
+
 double Stepper::integrate(const Rhs& f, double t0, double t_end, Eigen::VectorXd& y, const std::vector<double>& touts,
                           const Output& out) {
   const std::string who(name_);

@@ -253,25 +253,34 @@ void check_auto_released(const System& sys, const Data& data, double tol) {
   }
 }
 
-void solve_transfer(const System& sys, Data& data) {
-  data.ensure_dense(sys);
-  const int nc = static_cast<int>(sys.x_calc.size());
-  // Right-hand sides: −∂D^V/∂x̄ for the independent coordinates, unit rates of e^p and e^d.
-  data.rhs_DF.setZero();
+namespace {
+// f(r, element, B, a) for every deformation a of an element that is the velocity row r.
+template <class F>
+void for_velocity_rows(const System& sys, const Data& data, F&& f) {
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
     const Eigen::MatrixXd& B = data.work[i].B;
     for (int a = 0; a < se.nd; ++a) {
       const int r = sys.row_V[se.def_offset + a];
-      if (r < 0) continue;
-      for (size_t j = 0; j < se.coords.size(); ++j) {
-        const int col = sys.qhat_col_x[se.coords[j]];
-        if (col >= 0) data.rhs_DF(r, col) -= B(a, j);
-      }
-      const int ecol = sys.qhat_col_e[se.def_offset + a];
-      if (ecol >= 0) data.rhs_DF(r, ecol) += 1.0;
+      if (r >= 0) f(r, se, B, a);
     }
   }
+}
+}  // namespace
+
+void solve_transfer(const System& sys, Data& data) {
+  data.ensure_dense(sys);
+  const int nc = static_cast<int>(sys.x_calc.size());
+  // Right-hand sides: −∂D^V/∂x̄ for the independent coordinates, unit rates of e^p and e^d.
+  data.rhs_DF.setZero();
+  for_velocity_rows(sys, data, [&](int r, const SystemElement& se, const Eigen::MatrixXd& B, int a) {
+    for (size_t j = 0; j < se.coords.size(); ++j) {
+      const int col = sys.qhat_col_x[se.coords[j]];
+      if (col >= 0) data.rhs_DF(r, col) -= B(a, j);
+    }
+    const int ecol = sys.qhat_col_e[se.def_offset + a];
+    if (ecol >= 0) data.rhs_DF(r, ecol) += 1.0;
+  });
   data.DF.setZero();
   for (int g = 0; g < sys.nx; ++g)
     if (sys.qhat_col_x[g] >= 0) data.DF(g, sys.qhat_col_x[g]) = 1.0;
@@ -347,15 +356,9 @@ void calculable_rates(const System& sys, Data& data, const Eigen::VectorXd& qhat
     const int col = sys.qhat_col_e[k];
     data.rhs_V[r] = (col >= 0 ? qhat_rate[col] : 0.0) - (convective ? data.conv[k] : 0.0);
   }
-  for (size_t i = 0; i < sys.elements.size(); ++i) {
-    const SystemElement& se = sys.elements[i];
-    const Eigen::MatrixXd& B = data.work[i].B;
-    for (int a = 0; a < se.nd; ++a) {
-      const int r = sys.row_V[se.def_offset + a];
-      if (r < 0) continue;
-      for (size_t j = 0; j < se.coords.size(); ++j) data.rhs_V[r] -= B(a, j) * y[se.coords[j]];
-    }
-  }
+  for_velocity_rows(sys, data, [&](int r, const SystemElement& se, const Eigen::MatrixXd& B, int a) {
+    for (size_t j = 0; j < se.coords.size(); ++j) data.rhs_V[r] -= B(a, j) * y[se.coords[j]];
+  });
   data.luV.solve(data.rhs_V, data.sol_V);
   for (int j = 0; j < nc; ++j) y[sys.x_calc[j]] = data.sol_V[j];
 }

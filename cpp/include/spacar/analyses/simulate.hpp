@@ -160,6 +160,40 @@ inline constexpr RunCounter kRunCounters[] = {
 // FORCE, TORQUEL, the time-dependent loads and the drivers of prescribed inputs (their reactions).
 inline constexpr const char* kEnergyColumns[] = {"kinetic", "potential", "strain", "dissipated", "external_work"};
 
+// What changes while a block runs, apart from Data (the state of the mechanism at the current
+// time): where Newton starts, the run's choices, the implicit steppers' matrices, the controller's
+// held loads, the last kinematic failure. Simulation keeps one; each run sets what it chooses.
+struct RunState {
+  // A solved state: the starting point of the Newton iterations of later evaluations.
+  struct Solved {
+    bool valid = false;
+    // As an anchor: solved at the accepted state itself, not at the last Newton iterate of an
+    // implicit integrator next to it (generalized-α accepts the iterate after its last update).
+    bool exact = true;
+    double t = 0.0;
+    Eigen::VectorXd x, xd, xdd, qhat, angle_ref;
+  };
+  // Newton starts from the last solved state (base); in a right-hand side, if that fails or
+  // leaves the branch of the step start, again from the step start (anchor).
+  Solved base, anchor;
+  bool in_rhs = false;  // evaluating a right-hand side of the stepper
+  int predictor_order = RunOptions().predictor_order;  // of the run (measurements)
+  bool chord = RunOptions().chord;
+  Eigen::MatrixXd jacobian_mass;  // M̄ at the state of the last jacobian()
+  // The sparse Newton matrix's state (a copy of data at its last refresh) and reduced system.
+  std::unique_ptr<Data> newton_data;
+  std::unique_ptr<ReducedSystem> newton_system;
+  bool newton_singular = false;
+  Eigen::VectorXd tree_qdd;  // the tree's q̈ at an output time
+  // Message and time of the last right-hand side that failed in Newton, kept while the
+  // integration has not passed that time: at a step-size collapse it says that the kinematics
+  // has no solution ahead (formulation.md §2.2), whatever rejected the very last attempt.
+  std::string kinematic_failure;
+  double kinematic_failure_t = 0.0;
+  Eigen::VectorXd held;  // loads of the controller held since its last sample (nx), or empty
+  int n_energy = 0;      // 2 with RunOptions::energy: the last states of Y (dissipated, external work)
+};
+
 class Simulation {
  public:
   // Prepares (first END) and compiles the model; the model must outlive the simulation.
@@ -252,6 +286,7 @@ class Simulation {
   void store_state();
 
  private:
+  using Solved = RunState::Solved;
   // A block's run in three stages: plan (the requests checked before any work, the output
   // times), allocate (the result arrays, within the memory limit), integrate (assemble, then
   // the output times reached by integration or, without degrees of freedom, by kinematics).
@@ -290,15 +325,6 @@ class Simulation {
   // Make the largest Euler parameter of that node the dependent one: recompile the system and
   // map the state (t, Y) to the new degrees of freedom.
   void repartition(int which, double t, Eigen::VectorXd& Y);
-  // A solved state: the starting point of the Newton iterations of later evaluations.
-  struct Solved {
-    bool valid = false;
-    // As an anchor: solved at the accepted state itself, not at the last Newton iterate of an
-    // implicit integrator next to it (generalized-α accepts the iterate after its last update).
-    bool exact = true;
-    double t = 0.0;
-    Eigen::VectorXd x, xd, xdd, qhat, angle_ref;
-  };
   void remember(Solved& s) const;
   // solve_state up to the velocities: positions, velocities, no dynamics, not remembered.
   void solve_motion(double t, const double* q, const double* qd, Start start);
@@ -308,7 +334,7 @@ class Simulation {
   void in_rhs(double t, F&& evaluate);
   // Start the positions from s: its solution advanced by a second-order Taylor step in time.
   void predict_from(const Solved& s, double t, const double* q);
-  // The positions just solved against the prediction from the step start (anchor_): false if
+  // The positions just solved against the prediction from the step start (run_.anchor): false if
   // they deviate by more than the predicted motion (another branch of the constraints).
   bool continuous_with_step_start(std::string& why) const;
   // The integrator starts a step at (t, Y): that accepted state becomes the anchor.
@@ -321,12 +347,7 @@ class Simulation {
   std::map<int, int> dependent_;  // dependent Euler parameter of free rotations, by node
   std::unique_ptr<System> sys_;
   std::unique_ptr<Data> data_;  // replaced when the system is recompiled (repartition)
-  // Newton starts from the last solved state (base_); in a right-hand side, if that fails or
-  // leaves the branch of the step start, again from the step start (anchor_).
-  Solved base_, anchor_;
-  bool in_rhs_ = false;          // evaluating a right-hand side of the integrator
-  int predictor_order_ = RunOptions().predictor_order;  // of the run (measurements)
-  bool chord_ = RunOptions().chord;
+  RunState run_;
   Eigen::VectorXd qhat_transfer_;  // q̂ at which data holds DF (set by evaluate)
   Eigen::VectorXd predicted_;    // change of the positions predicted by the transfer function
   bool have_transfer_ = false;
@@ -337,26 +358,13 @@ class Simulation {
   // the system is one and no tree_: in the right-hand sides (with their velocities), at the step
   // starts and at the output times.
   std::unique_ptr<ExplicitChain> chain_;
-  Eigen::MatrixXd jacobian_mass_;  // M̄ at the state of the last jacobian()
-  // The sparse Newton matrix's state (a copy of data at its last refresh) and reduced system.
-  std::unique_ptr<Data> newton_data_;
-  std::unique_ptr<ReducedSystem> newton_system_;
-  bool newton_singular_ = false;
   void newton_refresh(double t, const Eigen::VectorXd& Y);
-  Eigen::VectorXd tree_qdd_;
-  // The tree's state at (t, Y) into base_ (positions, rates, accelerations) and qdd; false if a
+  // The tree's state at (t, Y) into run_.base (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.
   bool tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& qdd);
-  // Message and time of the last right-hand side that failed in Newton, kept while the
-  // integration has not passed that time: at a step-size collapse it says that the kinematics
-  // has no solution ahead (formulation.md §2.2), whatever rejected the very last attempt.
-  std::string kinematic_failure_;
-  double kinematic_failure_t_ = 0.0;
   void check_time(double t);       // TimeLimitError past the deadline of the running block
   void require_finite_state(double t) const;  // SpacarError if an output would hold inf or NaN
   TimeLoads timed_;
-  Eigen::VectorXd held_;  // loads of the controller held since its last sample (nx), or empty
-  int n_energy_ = 0;      // 2 with RunOptions::energy: the last states of Y (dissipated, external work)
   // The time-dependent loads and inputs at t into data (after set_inputs): input tables replace
   // the inputs' constant-acceleration motion, loads go to Data::time_load.
   void apply_time_loads(double t);

@@ -101,7 +101,6 @@ class GeneralizedAlpha : public Stepper {
   // The residual form is used from each Jacobian on until Newton contracts slowly (W_v has
   // drifted); lu_ holds the Newton matrix of factorized_residual_form_.
   bool in_residual_form_ = false, factorized_residual_form_ = false;
-  double theta_ = 0.0, faccon_ = 1.0, slow_factor_ = 0.5;
   int newton_its_ = 0;
   // The step loop's state (Stepper::integrate's hooks): a rejection before this attempt, whether
   // the Jacobian must be taken (fresh: at the current step start), the step of the factorization

@@ -93,8 +93,8 @@ class Radau5 : public Stepper {
   double h_factorized_ = 0.0, h_acc_ = 0.0, err_acc_ = 0.0;
   long accepted_here_ = 0;
 
-  // Newton state carried between steps (Hairer's FACCON and THETA).
-  double faccon_ = 1.0, theta_ = 0.0, err_ = 0.0, slow_factor_ = 0.5;
+  // Newton state carried between steps (with Stepper's theta_ and faccon_); the last error norm.
+  double err_ = 0.0;
   int newton_its_ = 0;
   bool have_polynomial_ = false;  // a previous step's collocation polynomial predicts Z
   double h_old_ = 0.0, t_new_ = 0.0;

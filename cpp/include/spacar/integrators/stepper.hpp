@@ -154,6 +154,15 @@ class Stepper {
   // a StepRejected passes through).
   bool eval(const Rhs& f, double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy);
 
+  // Simplified Newton's contraction, Hairer's test in RADAU5 (the implicit methods share it):
+  // after iteration it ≥ 2 with the scaled increment dn (dn_old the one before; thq_old carried
+  // between iterations), the rate theta_ and faccon_. Diverges when theta_ ≥ 0.99; TooSlow when
+  // the iterations left cannot reach `tolerance`, with slow_factor_ for the smaller retry;
+  // failure_ says which.
+  enum class Contraction { Converging, Diverges, TooSlow };
+  Contraction newton_contraction(int it, double dn, double dn_old, double& thq_old, double tolerance);
+  double theta_ = 0.0, faccon_ = 1.0, slow_factor_ = 0.5;  // Hairer's THETA, FACCON
+
   const char* name_;  // in the messages: "Integrator", "Radau5", "GeneralizedAlpha"
   int n_;
   Eigen::VectorXd rtol_, atol_;
