@@ -292,17 +292,8 @@ void bind_simulation(py::module_& m) {
             opt.time_limit = time_limit;
             opt.time_spent = time_spent;
             BlockResults r;
-            std::exception_ptr failure;
-            {
-              py::gil_scoped_release release;
-              try {
-                s.run(r, opt);
-              } catch (...) {
-                failure = std::current_exception();
-              }
-            }
-            if (failure) raise_with_results(failure, block_results_to_dict(std::move(r)));
-            return block_results_to_dict(std::move(r));
+            return run_released(r, [&] { s.run(r, opt); }, block_results_to_dict,
+                                [](const std::exception_ptr&) { return true; });
           },
           py::arg("on_output") = py::none(), py::arg("initial_step") = RunOptions().initial_step,
           py::arg("method") = method_name(RunOptions().method), py::arg("time_limit") = RunOptions().time_limit,

@@ -60,21 +60,19 @@ void bind_statics(py::module_& m) {
         opt.max_steps = max_steps;
         opt.time_limit = time_limit;
         StaticResults r;
-        std::exception_ptr failure;
-        {
-          py::gil_scoped_release release;
-          try {
-            solve_static(model, r, opt);
-          } catch (const StaticError&) {  // with the converged steps
-            failure = std::current_exception();
-          } catch (const TimeLimitError&) {
-            // With the converged steps once the rows exist; stopped in the set-up, without.
-            if (r.x.cols() == 0) throw;
-            failure = std::current_exception();
-          }
-        }
-        if (failure) raise_with_results(failure, static_results_to_dict(std::move(r)));
-        return static_results_to_dict(std::move(r));
+        return run_released(
+            r, [&] { solve_static(model, r, opt); }, static_results_to_dict,
+            [&r](const std::exception_ptr& failure) {
+              try {
+                std::rethrow_exception(failure);
+              } catch (const StaticError&) {  // with the converged steps
+                return true;
+              } catch (const TimeLimitError&) {
+                return r.x.cols() > 0;  // with the converged steps once the rows exist, not in the set-up
+              } catch (...) {
+                return false;
+              }
+            });
       },
       py::arg("model"), py::arg("steps") = 10, py::arg("max_iterations") = 30, py::arg("max_cuts") = 12,
       py::arg("tolerance") = 1e-10, py::arg("arc_length") = false, py::arg("max_steps") = 200,

@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 
 #include <exception>
+#include <utility>
 
 #include "spacar/analyses/linearize.hpp"
 
@@ -24,6 +25,28 @@ void bind_ode(py::module_& m);
 // its attribute `results`. Exceptions of Python code called by the run (the on_output callback)
 // and foreign C++ exceptions propagate unchanged.
 [[noreturn]] void raise_with_results(const std::exception_ptr& p, py::object results);
+
+// An analysis run without the GIL: work() fills `results`; the dict of the results (to_dict)
+// is returned, or, if work() fails and partial(failure) says that the results computed before
+// it are worth keeping, attached to the Python exception (raise_with_results); any other
+// failure propagates as it is.
+template <class Results, class Work, class ToDict, class Partial>
+py::dict run_released(Results& results, Work&& work, ToDict&& to_dict, Partial&& partial) {
+  std::exception_ptr failure;
+  {
+    py::gil_scoped_release release;
+    try {
+      work();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  if (failure) {
+    if (!partial(failure)) std::rethrow_exception(failure);
+    raise_with_results(failure, to_dict(std::move(results)));
+  }
+  return to_dict(std::move(results));
+}
 
 py::dict linearization_to_dict(const Linearization& l);
 py::dict nodal_linearization_to_dict(NodalLinearization&& n);
