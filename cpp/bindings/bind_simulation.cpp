@@ -40,15 +40,13 @@ py::dict block_results_to_dict(BlockResults&& r) {
   return d;
 }
 
-}  // namespace
-
-void bind_simulation(py::module_& m) {
+// The lists that cross into Python, from the core's tables: the output arrays (name, over
+// "coordinate" or "deformation", what they hold), the energy columns, the run's counters (name,
+// counted by the implicit methods only), the run options' defaults and the method names.
+void bind_lists(py::module_& m) {
   m.attr("linearization_arrays") = linearization_arrays();
   m.attr("integration_methods") = py::tuple(py::cast(method_names()));
   m.attr("implicit_methods") = py::tuple(py::cast(implicit_method_names()));
-  // The lists that cross into Python, from the core's tables: the output arrays (name, over
-  // "coordinate" or "deformation", what they hold), the energy columns, the run's counters
-  // (name, counted by the implicit methods only) and the run options' defaults.
   py::list arrays, counters;
   for (const OutputArray& a : kOutputArrays)
     arrays.append(py::make_tuple(a.name, a.per_deformation ? "deformation" : "coordinate", a.what));
@@ -66,6 +64,9 @@ void bind_simulation(py::module_& m) {
   run_defaults["predictor_order"] = defaults.predictor_order;
   run_defaults["chord"] = defaults.chord;
   m.attr("run_defaults") = run_defaults;
+}
+
+void bind_table(py::module_& m) {
   py::class_<Table>(m, "Table", "Values over time interpolated in C++ (table.hpp); spacar.Table wraps it.")
       .def(py::init([](std::vector<double> t, Eigen::MatrixXd values, const std::string& kind) {
              return Table(std::move(t), std::move(values), Table::parse_kind(kind));
@@ -73,6 +74,9 @@ void bind_simulation(py::module_& m) {
            py::arg("t"), py::arg("values"), py::arg("kind"))
       .def_property_readonly("components", &Table::components)
       .def("__call__", &Table::operator(), py::arg("t"), py::arg("component"), py::arg("derivative") = 0);
+}
+
+void bind_system(py::module_& m) {
   py::class_<System>(m, "System")
       .def_readonly("nx", &System::nx)
       .def_readonly("ne", &System::ne)
@@ -98,6 +102,9 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("n_dof", &System::n_dof)
       .def_property_readonly("n_qhat", &System::n_qhat);
 
+}
+
+void bind_data(py::module_& m) {
   py::class_<Data>(m, "Data")
       .def_readonly("t", &Data::t)
       .def_readonly("x", &Data::x)
@@ -122,7 +129,11 @@ void bind_simulation(py::module_& m) {
       .def_readonly("sigma_equilibrium", &Data::sigma_equilibrium)
       .def_readonly("newton_iterations", &Data::newton_iterations);
 
-  py::class_<Simulation>(m, "Simulation")
+}
+
+// The set-up of a Simulation and its compiled system and data.
+void bind_setup(py::class_<Simulation>& sim) {
+  sim
       .def(py::init([](Model& model, double time_limit, double time_spent) {
              // The set-up (the model's preparation, compilation and work arrays) is bounded by
              // the analysis's time limit as the run is.
@@ -136,7 +147,12 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", &Simulation::assemble)
       .def("forces", &Simulation::forces)
-      .def("reduced_accelerations", &Simulation::reduced_accelerations)
+      .def("reduced_accelerations", &Simulation::reduced_accelerations);
+}
+
+// Linearizations: about a state, and in the nodal coordinates at rest with their solves.
+void bind_linearization(py::class_<Simulation>& sim) {
+  sim
       .def("linearize",
            [](Simulation& s, bool differences) {
              return linearization_to_dict(
@@ -186,7 +202,12 @@ void bind_simulation(py::module_& m) {
            [](Simulation& s, const Eigen::VectorXd& v) { return s.linearizer().nodal_energies(v); },
            py::arg("v"),
            "(vᵀKv, vᵀGv, vᵀMv, vᵀDv) of linearize_nodal's state for v over the free coordinates, element by "
-           "element (the Rayleigh quotients of the sparse eigen-analyses).")
+           "element (the Rayleigh quotients of the sparse eigen-analyses).");
+}
+
+// The state at a time on each path, and the constraint diagnosis.
+void bind_states(py::class_<Simulation>& sim) {
+  sim
       .def("diagnose",
            [](Simulation& s, double time_limit, double time_spent) {
              const DeadlineScope deadline(time_limit, time_spent);
@@ -235,7 +256,12 @@ void bind_simulation(py::module_& m) {
           py::arg("t"), py::arg("Y"),
           "The state of the integrator, Y = (q, y, q̇) with y the integrated deformations (system.y_defs): "
           "positions, velocities, q̈ and stresses, the integrated values set from y (for differences over the "
-          "kinematic coordinates of nonholonomic constraints).")
+          "kinematic coordinates of nonholonomic constraints).");
+}
+
+// The run of a block, with its time-dependent loads.
+void bind_run(py::class_<Simulation>& sim) {
+  sim
       .def(
           "set_time_loads",
           [](Simulation& s, const std::vector<std::pair<std::vector<int>, Table>>& load_tables,
@@ -306,6 +332,20 @@ void bind_simulation(py::module_& m) {
           "failure the exception has the results up to the failure as `results`. `predictor_order` (2, 1, 0) and "
           "`chord` change the start and the matrix of Newton's iterations on the positions, for measurements "
           "(benchmarks/newton.py).");
+}
+
+}  // namespace
+
+void bind_simulation(py::module_& m) {
+  bind_lists(m);
+  bind_table(m);
+  bind_system(m);
+  bind_data(m);
+  py::class_<Simulation> sim(m, "Simulation");
+  bind_setup(sim);
+  bind_linearization(sim);
+  bind_states(sim);
+  bind_run(sim);
 }
 
 }  // namespace spacar::bindings
