@@ -192,29 +192,19 @@ Eigen::Vector4d Linearizer::nodal_energies(const Eigen::VectorXd& v_free) {
   return spacar::nodal_energies(*lin_, *ld_, nodal_sigma_, v);
 }
 
-Linearization Linearizer::compute(const System& sys, const Data& data, Differences differences) {
-  const bool precise = differences == Differences::Precise;
+// The nominal state and the matrices that need no differences: r0, DF in z, Zᵀ M Z and Zᵀ G Z of
+// the nodal matrices (nodal.hpp), the mass at the nominal velocities; K0 and D0 from the
+// deformations, DFeᵀ S DFe: the same matrices, without the cancellation of the nodal
+// stiffness's large entries along a fine mesh (the static compliance of a 100-beam cantilever
+// stays at 1e-12 instead of 1e-9); AK0. Returns the nominal positions (and angles' branches),
+// from which the differences start.
+Linearizer::Nominal Linearizer::nominal_matrices(const System& sys, const Data& data, const ZState& zs,
+                                                 Linearization& lin) {
   const System& L = *lin_;
   const int nz = L.n_dof();
-  Linearization lin;
-  lin.t = data.t;
-  const ZState zs = z_state(sys, data, lin.z_label, lin.n_line);
-  const Eigen::VectorXd &z = zs.z, &zd = zs.zd, &zdd = zs.zdd, &scale = zs.scale;
-
-  // Kinematic coordinates of nonholonomic constraints: y^k, integrated in the motion.
-  Eigen::VectorXd y(sys.e_kinematic.size()), yscale(sys.e_kinematic.size());
-  for (size_t j = 0; j < sys.e_kinematic.size(); ++j) {
-    const int k = sys.e_kinematic[j];
-    y[j] = data.e_integrated[k];
-    yscale[j] = sys.def_is_length[k] ? L.length_scale : 1.0;
-    lin.y_label.push_back({1, sys.def_label[k][0], sys.def_label[k][1]});
-  }
-  const int nk = static_cast<int>(y.size());
-
-  // Nominal state.
   set_nominal(sys, data, zs, true);
-  const Eigen::VectorXd x_nominal = ld_->x, angles_nominal = ld_->angle_ref;
-  residual(zdd, lin.r0);
+  const Nominal nominal{ld_->x, ld_->angle_ref};
+  residual(zs.zdd, lin.r0);
   lin.r0 = -lin.r0;
   lin.DFz.resize(L.nx, nz);
   lin.DFez.resize(L.ne, nz);
@@ -222,36 +212,26 @@ Linearization Linearizer::compute(const System& sys, const Data& data, Differenc
     lin.DFz.col(i) = ld_->DF.col(L.dof_cols[order_[i]]);
     lin.DFez.col(i) = ld_->DFe.col(L.dof_cols[order_[i]]);
   }
-  // Zᵀ M Z and Zᵀ G Z of the nodal matrices (nodal.hpp), the mass at the nominal velocities;
-  // K0 and D0 from the deformations, DFeᵀ S DFe: the same matrices, without the cancellation of
-  // the nodal stiffness's large entries along a fine mesh (the static compliance of a
-  // 100-beam cantilever stays at 1e-12 instead of 1e-9).
   compute_inertia_and_loads(L, *ld_);
   lin.M0 = lin.DFz.transpose() * (nodal_part(L, *ld_, data.sigma, kMass) * lin.DFz);
   lin.G0 = lin.DFz.transpose() * (nodal_part(L, *ld_, data.sigma, kGeometric) * lin.DFz);
   lin.K0 = lin.DFez.transpose() * (nodal_constitutive(L, false) * lin.DFez);
   lin.D0 = lin.DFez.transpose() * (nodal_constitutive(L, true) * lin.DFez);
+  const int nk = static_cast<int>(sys.e_kinematic.size());
   lin.AK0.resize(nk, nz);
   for (int j = 0; j < nk; ++j) lin.AK0.row(j) = lin.DFez.row(sys.e_kinematic[j]);
+  return nominal;
+}
 
-  auto refuse = [&](const char* name) {
-    std::ostringstream os;
-    os << "the linearized equations at t = " << data.t << " are not finite (" << name
-       << " has infinite or NaN entries): the model's values exceed double precision";
-    throw Error(os.str());
-  };
-  if (differences == Differences::None) {  // at rest in static equilibrium (compute_nodal)
-    if (nk > 0) throw Error("linearize: a state with kinematic coordinates needs the differences");
-    lin.C0 = lin.N0 = Eigen::MatrixXd::Zero(nz, nz);
-    lin.Kk.resize(nz, 0);
-    lin.BK0.resize(0, nz);
-    lin.for_each_array([&](const char* name, const auto& m) {
-      if (!m.allFinite()) refuse(name);
-    });
-    return lin;
-  }
-
-  // Residual R and kinematic rates ẏ^k at perturbed positions (kinematics re-solved) or rates.
+// C0, N0, Kk and BK0 by differences of the residual R and of the kinematic rates ẏ^k at
+// perturbed positions (kinematics re-solved), rates and kinematic coordinates y, about the
+// nominal state (positions `at`) of nominal_matrices.
+void Linearizer::differenced_matrices(const System& sys, const ZState& zs, const Nominal& at, const Eigen::VectorXd& y,
+                                      const Eigen::VectorXd& yscale, bool precise, Linearization& lin) {
+  const System& L = *lin_;
+  const int nz = L.n_dof(), nk = static_cast<int>(y.size());
+  const Eigen::VectorXd &z = zs.z, &zd = zs.zd, &zdd = zs.zdd, &scale = zs.scale;
+  const Eigen::VectorXd &x_nominal = at.x, &angles_nominal = at.angles;
   auto response = [&](const Eigen::VectorXd& zz, const Eigen::VectorXd& zzd, const Eigen::VectorXd& yy) {
     ld_->x = x_nominal;
     ld_->angle_ref = angles_nominal;
@@ -298,10 +278,39 @@ Linearization Linearizer::compute(const System& sys, const Data& data, Differenc
   lin.Kk = dy.topRows(nz);
   lin.BK0.resize(nk, nz + nk);
   lin.BK0 << dz.bottomRows(nk), dy.bottomRows(nk);
+}
+
+Linearization Linearizer::compute(const System& sys, const Data& data, Differences differences) {
+  const System& L = *lin_;
+  const int nz = L.n_dof();
+  Linearization lin;
+  lin.t = data.t;
+  const ZState zs = z_state(sys, data, lin.z_label, lin.n_line);
+  // Kinematic coordinates of nonholonomic constraints: y^k, integrated in the motion.
+  Eigen::VectorXd y(sys.e_kinematic.size()), yscale(sys.e_kinematic.size());
+  for (size_t j = 0; j < sys.e_kinematic.size(); ++j) {
+    const int k = sys.e_kinematic[j];
+    y[j] = data.e_integrated[k];
+    yscale[j] = sys.def_is_length[k] ? L.length_scale : 1.0;
+    lin.y_label.push_back({1, sys.def_label[k][0], sys.def_label[k][1]});
+  }
+  const Nominal nominal = nominal_matrices(sys, data, zs, lin);
+  if (differences == Differences::None) {  // at rest in static equilibrium (compute_nodal)
+    if (y.size() > 0) throw Error("linearize: a state with kinematic coordinates needs the differences");
+    lin.C0 = lin.N0 = Eigen::MatrixXd::Zero(nz, nz);
+    lin.Kk.resize(nz, 0);
+    lin.BK0.resize(0, nz);
+  } else {
+    differenced_matrices(sys, zs, nominal, y, yscale, differences == Differences::Precise, lin);
+  }
   // Values beyond double precision (e.g. GRAVITY 1e308) give infinities and NaNs here: refuse them
   // rather than hand non-finite matrices to the eigen-analyses.
   lin.for_each_array([&](const char* name, const auto& m) {
-    if (!m.allFinite()) refuse(name);  // throws: the first non-finite array is named
+    if (m.allFinite()) return;  // else the first non-finite array is named
+    std::ostringstream os;
+    os << "the linearized equations at t = " << data.t << " are not finite (" << name
+       << " has infinite or NaN entries): the model's values exceed double precision";
+    throw Error(os.str());
   });
   return lin;
 }

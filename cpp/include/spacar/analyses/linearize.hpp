@@ -98,6 +98,13 @@ class Linearizer {
   ZState z_state(const System& sys, const Data& data, std::vector<std::array<int, 3>>& labels, int& n_line);
   // The nominal state in ld_: the analysed one's inputs, time loads, positions; z, ż.
   void set_nominal(const System& sys, const Data& data, const ZState& zs, bool transfer);
+  // The stages of compute(): the matrices at the nominal state, then those by differences.
+  struct Nominal {
+    Eigen::VectorXd x, angles;  // the nominal positions and the branches of their angles
+  };
+  Nominal nominal_matrices(const System& sys, const Data& data, const ZState& zs, Linearization& lin);
+  void differenced_matrices(const System& sys, const ZState& zs, const Nominal& at, const Eigen::VectorXd& y,
+                            const Eigen::VectorXd& yscale, bool precise, Linearization& lin);
   void residual(const Eigen::VectorXd& zdd, Eigen::VectorXd& R);
   // Kinematics at z, ż; the dense transfer functions only if asked (the nominal state: the
   // perturbed states of the finite differences need the residual only).
