@@ -305,6 +305,91 @@ def _check_zero_targets(el):
                 "the converters need rigid deformations at their reference value 0")
 
 
+def _convertible(model) -> bool:
+    """Whether the model is planar; UnsupportedModelError for what the converters cannot carry
+    over (element types, planar and spatial mixed, loads other than GRAVITY, prescribed
+    positions)."""
+    nodes = model.nodes
+    types = {el.type_name for el in model.elements.values()}
+    unsupported = sorted(types - set(PLANAR_TYPES) - set(SPATIAL_TYPES))
+    if unsupported:
+        raise UnsupportedModelError(
+            f"element type(s) {', '.join(unsupported)} cannot be converted; supported: "
+            f"{', '.join(PLANAR_TYPES)} (planar), {', '.join(SPATIAL_TYPES)} (spatial)")
+    planar = bool(types & set(PLANAR_TYPES))
+    if planar and types & set(SPATIAL_TYPES):
+        raise UnsupportedModelError("the model mixes planar and spatial elements")
+    if not types:
+        raise UnsupportedModelError("the model has no elements")
+    # Loads the converters do not carry over.
+    for n, nd in nodes.items():
+        if any(abs(v) > 0 for v in nd.force):
+            raise UnsupportedModelError(f"node {n} has a FORCE; loads other than GRAVITY are not converted")
+        if any(abs(v) > 0 for v in nd.torquel):
+            raise UnsupportedModelError(f"node {n} has a TORQUEL; loads other than GRAVITY are not converted")
+        if nd.kind in POSITION_KINDS and any(c == CC.input for c in nd.cls):
+            raise UnsupportedModelError(f"node {n}: prescribed positions (INPUTX) are not converted")
+        if nd.kind == NK.LAMBDA and any(c == CC.input for c in nd.cls):
+            raise UnsupportedModelError(f"node {n}: prescribed LAMBDA coordinates (INPUTX) are not converted")
+    return planar
+
+
+def _mass_properties(nodes, flexible, rigid_beams, bodies, bodies_of_point, body_of_orientation) -> dict:
+    """The masses onto the bodies (point masses, rotary inertias, rigid beams' EMASS); returns
+    the point masses on flexible beams' nodes, which belong to no body."""
+    point_masses = {}
+    flexible_pos = {el.nodes[0] for el in flexible} | {el.nodes[2] for el in flexible}
+    for n, nd in nodes.items():
+        if not nd.mass or not nd.used:
+            continue
+        if nd.kind in POSITION_KINDS:
+            owners = bodies_of_point.get(n, [])
+            if 0 in owners:
+                continue  # a mass on the ground does not move
+            if owners:
+                b = bodies[min(owners)]
+                b.add_point_mass(nd.mass[0], b.points[n])
+            elif n in flexible_pos:
+                point_masses[n] = nd.mass[0]
+            else:
+                raise UnsupportedModelError(f"node {n} has a MASS but belongs to no body or beam")
+        else:
+            b = body_of_orientation.get(n)
+            if b is None:
+                if nd.kind == NK.BETA and nd.mass[0] != 0:
+                    raise UnsupportedModelError(
+                        f"BETA node {n} of a flexible beam has a MASS (rotary inertia); not converted")
+                continue
+            if b == 0:
+                continue
+            if nd.kind == NK.BETA:
+                bodies[b].add_rotary_inertia(np.diag([0.0, 0.0, nd.mass[0]]))
+            else:
+                m = list(nd.mass) + [0.0] * (6 - len(nd.mass))
+                ixx, ixy, ixz, iyy, iyz, izz = m[:6]
+                bodies[b].add_rotary_inertia(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
+    for el in rigid_beams:
+        if not el.emass or el.emass[0] == 0:
+            if len(el.emass) > 1 and any(v != 0 for v in el.emass[1:]):
+                raise UnsupportedModelError(f"element {el.id}: rotary inertia without EMASS ρA is not converted")
+            continue
+        b = body_of_orientation[el.nodes[1]]
+        if b == 0:
+            continue
+        bd = bodies[b]
+        c = _chord(el)
+        m = el.emass[0] * el.l0
+        e = c / np.linalg.norm(c)
+        J = m * el.l0**2 / 12.0 * (np.eye(3) - np.outer(e, e))
+        bd.add_rigid_mass(m, bd.points[el.nodes[0]] + 0.5 * c, J)
+        if el.type_name in SPATIAL_BEAMS and len(el.emass) > 1:
+            rot = list(el.emass[1:4]) + [0.0] * (4 - len(el.emass))
+            rho_ip, rho_iy, rho_iz = rot[:3]
+            C0 = np.column_stack([np.asarray(el.lgeomy[3 * i:3 * i + 3], dtype=float) for i in range(3)])
+            bd.add_rotary_inertia(el.l0 * C0 @ np.diag([rho_ip, rho_iy, rho_iz]) @ C0.T)
+    return point_masses
+
+
 def analyse(model, sim=None) -> Topology:
     """Analyse a :class:`spacar.Model` (prepared and assembled here if no ``sim`` is given)."""
     model.prepare()
@@ -322,29 +407,8 @@ def analyse(model, sim=None) -> Topology:
 
     nodes = model.nodes
     elements = model.elements
-    types = {el.type_name for el in elements.values()}
-    unsupported = sorted(types - set(PLANAR_TYPES) - set(SPATIAL_TYPES))
-    if unsupported:
-        raise UnsupportedModelError(
-            f"element type(s) {', '.join(unsupported)} cannot be converted; supported: "
-            f"{', '.join(PLANAR_TYPES)} (planar), {', '.join(SPATIAL_TYPES)} (spatial)")
-    planar = bool(types & set(PLANAR_TYPES))
-    if planar and types & set(SPATIAL_TYPES):
-        raise UnsupportedModelError("the model mixes planar and spatial elements")
-    if not types:
-        raise UnsupportedModelError("the model has no elements")
+    planar = _convertible(model)
     node_kind = {n: nd.kind for n, nd in nodes.items()}
-
-    # Loads the converters do not carry over.
-    for n, nd in nodes.items():
-        if any(abs(v) > 0 for v in nd.force):
-            raise UnsupportedModelError(f"node {n} has a FORCE; loads other than GRAVITY are not converted")
-        if any(abs(v) > 0 for v in nd.torquel):
-            raise UnsupportedModelError(f"node {n} has a TORQUEL; loads other than GRAVITY are not converted")
-        if nd.kind in POSITION_KINDS and any(c == CC.input for c in nd.cls):
-            raise UnsupportedModelError(f"node {n}: prescribed positions (INPUTX) are not converted")
-        if nd.kind == NK.LAMBDA and any(c == CC.input for c in nd.cls):
-            raise UnsupportedModelError(f"node {n}: prescribed LAMBDA coordinates (INPUTX) are not converted")
 
     # Classify elements.
     flexible, rigid_beams, hinges = [], [], []
@@ -500,56 +564,8 @@ def analyse(model, sim=None) -> Topology:
             bodies[0].points[n] = np.pad(np.asarray(nodes[n].x[:3], dtype=float), (0, 3 - len(nodes[n].x[:3])))
 
     # Mass properties.
-    point_masses = {}
+    point_masses = _mass_properties(nodes, flexible, rigid_beams, bodies, bodies_of_point, body_of_orientation)
     flexible_pos = {el.nodes[0] for el in flexible} | {el.nodes[2] for el in flexible}
-    for n, nd in nodes.items():
-        if not nd.mass or not nd.used:
-            continue
-        if nd.kind in POSITION_KINDS:
-            owners = bodies_of_point.get(n, [])
-            if 0 in owners:
-                continue  # a mass on the ground does not move
-            if owners:
-                b = bodies[min(owners)]
-                b.add_point_mass(nd.mass[0], b.points[n])
-            elif n in flexible_pos:
-                point_masses[n] = nd.mass[0]
-            else:
-                raise UnsupportedModelError(f"node {n} has a MASS but belongs to no body or beam")
-        else:
-            b = body_of_orientation.get(n)
-            if b is None:
-                if nd.kind == NK.BETA and nd.mass[0] != 0:
-                    raise UnsupportedModelError(
-                        f"BETA node {n} of a flexible beam has a MASS (rotary inertia); not converted")
-                continue
-            if b == 0:
-                continue
-            if nd.kind == NK.BETA:
-                bodies[b].add_rotary_inertia(np.diag([0.0, 0.0, nd.mass[0]]))
-            else:
-                m = list(nd.mass) + [0.0] * (6 - len(nd.mass))
-                ixx, ixy, ixz, iyy, iyz, izz = m[:6]
-                bodies[b].add_rotary_inertia(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
-    for el in rigid_beams:
-        if not el.emass or el.emass[0] == 0:
-            if len(el.emass) > 1 and any(v != 0 for v in el.emass[1:]):
-                raise UnsupportedModelError(f"element {el.id}: rotary inertia without EMASS ρA is not converted")
-            continue
-        b = body_of_orientation[el.nodes[1]]
-        if b == 0:
-            continue
-        bd = bodies[b]
-        c = _chord(el)
-        m = el.emass[0] * el.l0
-        e = c / np.linalg.norm(c)
-        J = m * el.l0**2 / 12.0 * (np.eye(3) - np.outer(e, e))
-        bd.add_rigid_mass(m, bd.points[el.nodes[0]] + 0.5 * c, J)
-        if el.type_name in SPATIAL_BEAMS and len(el.emass) > 1:
-            rot = list(el.emass[1:4]) + [0.0] * (4 - len(el.emass))
-            rho_ip, rho_iy, rho_iz = rot[:3]
-            C0 = np.column_stack([np.asarray(el.lgeomy[3 * i:3 * i + 3], dtype=float) for i in range(3)])
-            bd.add_rotary_inertia(el.l0 * C0 @ np.diag([rho_ip, rho_iy, rho_iz]) @ C0.T)
 
     # Joints.
     joints = []
