@@ -11,6 +11,10 @@
 
 namespace spacar::bindings {
 
+namespace {
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+}  // namespace
+
 void bind_catalogue(py::module_& m) {
   py::enum_<NodeKind>(m, "NodeKind")
       .value("X", NodeKind::Any)
@@ -52,7 +56,7 @@ void bind_catalogue(py::module_& m) {
   m.def("element_catalogue", &element_catalogue, py::return_value_policy::reference);
   m.def(
       "element_deformations",
-      [](const std::string& type, const Eigen::VectorXd& x, const std::vector<double>& params, double l0,
+      [](const std::string& type, const RowMatrix& x, const std::vector<double>& params, double l0,
          const std::vector<double>& lgeomy) {
         const int t = find_element_type(type);
         if (t < 0) throw InputError("unknown element type " + type);
@@ -61,16 +65,17 @@ void bind_catalogue(py::module_& m) {
         s.l0 = l0;
         s.lgeomy = lgeomy;
         const std::unique_ptr<ElementKernel> k = element_catalogue()[t].make(s);
-        if (x.size() != k->n_coords())
-          throw InputError(type + ": x must have " + std::to_string(k->n_coords()) + " values");
-        Eigen::VectorXd e(k->n_deformations());
-        k->deformations(x.data(), e.data());
+        if (x.cols() != k->n_coords())
+          throw InputError(type + ": x must have " + std::to_string(k->n_coords()) + " columns");
+        RowMatrix e(x.rows(), k->n_deformations());
+        for (Eigen::Index r = 0; r < x.rows(); ++r) k->deformations(x.row(r).data(), e.row(r).data());
         return e;
       },
       py::arg("type"), py::arg("x"), py::arg("params") = std::vector<double>{}, py::arg("l0") = 1.0,
       py::arg("lgeomy") = std::vector<double>{},
-      "The deformations of one element of the given type and properties at its nodal coordinates x "
-      "(spacar.compare maps a peer's state to spacar's deformations with it).");
+      "The deformations of one element of the given type and properties at its nodal coordinates: one row of "
+      "x per state, one row of the result per state (spacar.compare maps a peer's states to spacar's "
+      "deformations with it, the element's kernel made once for all of them).");
 }
 
 }  // namespace spacar::bindings

@@ -26,7 +26,6 @@ py::dict solve(const std::string& method, const py::function& f, const py::objec
   setup.n = n;
   setup.positions = positions;
   setup.rate_offset = n - positions;
-  setup.rates_last = positions > 0;
   if (!jac.is_none())
     setup.jacobian = [jac](double t, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
       J = jac(t, y).cast<Eigen::MatrixXd>();

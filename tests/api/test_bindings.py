@@ -3,9 +3,12 @@ the pickled records and the properties list the same fields in the same order, a
 points that take an integration method refuse an unknown one alike."""
 from __future__ import annotations
 
+import numpy as np
+import pytest
+
 import spacar
 from spacar import _core, _testing
-from support.paths import EXAMPLES
+from support.paths import EXAMPLES, ROOT
 
 EXAMPLE = EXAMPLES / "slidercrank.dat"
 
@@ -93,8 +96,7 @@ def test_the_lists_that_cross_into_python_come_from_the_core():
     """Issue 35: the output arrays, energy columns, run counters and run defaults are the core's
     tables; the Python tables keyed by them (quantities, MATASC files, saved files) cover exactly
     the core's output arrays."""
-    import spacar
-    from spacar import _core
+    from spacar.compare import models
     from spacar.energy import KEYS
     from spacar.io.matasc import STATE_FILES
     from spacar.results import _ARRAYS, _FLOAT_ARRAYS, QUANTITIES, STATE_ARRAYS
@@ -108,8 +110,6 @@ def test_the_lists_that_cross_into_python_come_from_the_core():
         assert _FLOAT_ARRAYS[name] == ("nt", "ne" if over == "deformation" else "nx")
     assert KEYS == _core.energy_columns
     assert [k for k, _ in _core.run_counters][:4] == ["rhs_evaluations", "steps", "accepted", "rejected"]
-    from spacar.compare import models
-
     m = models.cantilever(2, t_end=0.01, n_out=2)
     res = spacar.simulate(m, method="dop853", progress=False)
     assert "jacobians" not in res.stats and "rhs_evaluations" in res.stats
@@ -119,7 +119,18 @@ def test_the_lists_that_cross_into_python_come_from_the_core():
 
 def test_the_package_does_not_import_the_test_bindings():
     """Issue 35: spacar (spacar.compare included) runs without spacar._testing."""
-    from support.paths import ROOT
-
     for path in (ROOT / "python" / "spacar").rglob("*.py"):
         assert "_testing" not in path.read_text(encoding="utf-8"), path
+
+
+def test_element_deformations_of_many_states_are_the_elongations():
+    """`_core.element_deformations` (spacar.compare's map of a peer's states): a PLTRUSS's
+    deformation is its length minus its reference length, one row per state."""
+    rng = np.random.default_rng(7)
+    x = rng.normal(size=(5, 4))
+    e = _core.element_deformations("PLTRUSS", x, l0=2.0)
+    np.testing.assert_allclose(e[:, 0], np.hypot(x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]) - 2.0, rtol=1e-14)
+    with pytest.raises(spacar.InputError, match="4 columns"):
+        _core.element_deformations("PLTRUSS", x[:, :3])
+    with pytest.raises(spacar.InputError, match="unknown element type"):
+        _core.element_deformations("NOSUCH", x)

@@ -295,7 +295,6 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
   setup.n = n_states;
   setup.positions = nd;
   setup.rate_offset = nd + ny;
-  setup.rates_last = run_.n_energy == 0;  // Y = (q, y, q̇); the energy's quadrature states come after q̇
   setup.jacobian = [this](double tt, const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
     jacobian(tt, y, J);
     if (J.rows() < y.size()) {  // the energy's quadrature states: nothing depends on them

@@ -81,7 +81,7 @@ std::unique_ptr<Stepper> Radau5::make(Method, const StepperSetup& setup) {
   auto stepper = std::make_unique<Radau5>(setup.n);
   stepper->set_jacobian(setup.jacobian);
   // Y = (q, y, q̇): q̇ = dq/dt, the last components (not with quadrature states after them).
-  if (setup.rates_last) stepper->set_second_order(setup.positions);
+  if (setup.rate_offset + setup.positions == setup.n) stepper->set_second_order(setup.positions);
   stepper->set_jacobian_reuse(setup.jacobian_reuse);
   // AUTO: back to DOP853 when its stability bound (|hλ| ≤ 6.1) would allow explicit_gain times
   // Radau's steps.

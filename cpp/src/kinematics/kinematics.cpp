@@ -53,12 +53,7 @@ void compute_residual(const System& sys, Data& data) {
 }
 
 // A number for a message: non-finite values are named as such, never printed as "nan".
-std::string number(double v) {
-  if (!std::isfinite(v)) return "non-finite";
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+std::string number(double v) { return std::isfinite(v) ? format_number(v) : "non-finite"; }
 
 std::string worst_rows(const System& sys, const Data& data, int count) {
   std::vector<int> order(data.residual.size());

@@ -444,12 +444,15 @@ class ExudynModel:
             kernels.append((kern, cols, dcols, el.type_name))
         return kernels
 
-    def _deformations(self, x):
-        e = np.full(len(self.def_labels), np.nan)
+    def _deformations(self, xs):
+        """spacar's deformations of the states xs (one row each); NaN for an element with a
+        non-finite coordinate."""
+        e = np.full((len(xs), len(self.def_labels)), np.nan)
         for kern, cols, dcols, _ in self._kernels:
-            xe = x[cols]
-            if np.all(np.isfinite(xe)):
-                e[dcols] = kern(xe)
+            xe = xs[:, cols]
+            finite = np.all(np.isfinite(xe), axis=1)
+            if finite.any():
+                e[np.ix_(finite, dcols)] = kern(xe[finite])
         return e
 
     def current_x(self, previous=None) -> np.ndarray:
@@ -584,10 +587,9 @@ class ExudynModel:
         sd = mbs.systemData
         initial = sd.GetSystemState(exu.ConfigurationType.Initial)
         xs = np.empty((len(times), len(self.labels)))
-        es = np.empty((len(times), len(self.def_labels)))
         qs = [] if self.formulation == "tree" else None
         prev, q = self.current_x_initial()
-        xs[0], es[0] = prev, self._deformations(prev)
+        xs[0] = prev
         if qs is not None:
             qs.append(q)
         stats = {"wall_time": 0.0, "steps": 0, "rejected": 0}
@@ -606,13 +608,14 @@ class ExudynModel:
                 stats["steps"] += it.currentStepIndex
                 stats["rejected"] += getattr(it, "rejectedAutomaticStepSizeSteps", 0)
                 x, q = self.current_x(prev)
-                xs[k], es[k] = x, self._deformations(x)
+                xs[k] = x
                 if qs is not None:
                     qs.append(q)
                 prev = x
                 sd.SetSystemState(sd.GetSystemState(exu.ConfigurationType.Current), exu.ConfigurationType.Initial)
         finally:
             sd.SetSystemState(initial, exu.ConfigurationType.Initial)
+        es = self._deformations(xs)  # each element's kernel made once for all output times
         stats["solver"] = solver
         stats["stages"] = mbs.sys["dynamicSolver"].GetNumberOfStages() if solver in EXPLICIT else None
         return ExudynResults(times, xs, es, None if qs is None else np.array(qs), stats, self.labels, self.def_labels)

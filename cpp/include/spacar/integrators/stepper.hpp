@@ -194,8 +194,8 @@ struct NewtonSystem {
 struct StepperSetup {
   int n = 0;            // states Y = (q, y, q̇, w)
   int positions = 0;    // m: the first m states are positions (the DOFs q) ...
-  int rate_offset = 0;  // ... whose rates q̇ are the m states from here on
-  bool rates_last = false;  // q̇ are the last m states (no quadrature states after them)
+  int rate_offset = 0;  // ... whose rates q̇ are the m states from here on (the last m: no
+                        // quadrature states after them)
   Stepper::Jacobian jacobian;
   Residual residual;          // optional: the residual form of the equations of motion ...
   ResidualWeight weight;      // ... and its weight W_v = M̄
