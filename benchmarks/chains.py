@@ -8,7 +8,7 @@ gravity, simulated over T = 0.3 s.
 
 * time per right-hand side: spacar — block wall time / right-hand-side evaluations of a run
   (EPSINT = 1e-6) on its default recursive path (a planar tree of rigid bodies: the
-  articulated-body algorithm, cpp/include/spacar/recursive/tree.hpp) and on the general path
+  articulated-body algorithm, cpp/include/spacar/recursive/planar_tree.hpp) and on the general path
   (``recursive=False``: the sparse constraint formulation every other model takes), and
   ``Simulation.evaluate`` called from Python; Pinocchio — ``aba`` called
   from Python; exudyn — kinematic tree (``ObjectKinematicTree``) with fixed-step RK44, wall

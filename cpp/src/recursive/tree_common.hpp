@@ -1,15 +1,19 @@
-// Pieces shared by the recognizers of planar (tree.cpp) and spatial (spatial_tree.cpp) rigid
-// trees: the nodes of a system, the nodes of an element, and an element's mass projected on the
-// rigid motions of a body.
+// Pieces shared by the recognizers of planar (planar_tree.cpp) and spatial (spatial_tree.cpp)
+// rigid trees: the nodes of a system, the nodes of an element, an element's mass projected on the
+// rigid motions of a body, and the steps of recognizing a tree (TreeBuilder).
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <map>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "spacar/model/catalogue.hpp"
 #include "spacar/model/system.hpp"
+#include "spacar/recursive/articulated.hpp"
 
 namespace spacar {
 namespace tree_detail {
@@ -68,6 +72,193 @@ Eigen::Matrix<double, N, N> element_inertia(const SystemElement& se, const Eigen
   constexpr int kOnStack = 16;
   if (se.coords.size() <= kOnStack) return projected_mass<N, kOnStack>(se, x, row);
   return projected_mass<N, Eigen::Dynamic>(se, x, row);
+}
+
+// The steps of recognizing a tree of rigid bodies in a system, shared by the planar and the
+// spatial recognizer (Derived, which adds its own: the hinges it accepts, the joint a hinge
+// makes, the body's inertia, coordinates and loads). Any step may find that the system is not
+// such a tree: it says why (refuse) and returns false.
+template <class Derived, class Algebra>
+class TreeBuilder {
+ public:
+  const std::string& why() const { return why_; }
+
+ protected:
+  using Point = typename Algebra::Point;
+  using Model = BodyModel<Algebra>;
+  static constexpr int kDim = Point::RowsAtCompileTime;
+
+  // A hinge between orientation nodes a and b (its rotation turns b relative to a).
+  struct Hinge {
+    int element;
+    int a, b;
+    int dof;  // position in q, −1: released (a spring, or a measuring hinge)
+    bool used = false;
+  };
+
+  TreeBuilder(const System& sys, const Data& data, NodeKind point, NodeKind orientation)
+      : sys_(sys), x_(data.x), point_kind_(point), orientation_kind_(orientation) {}
+
+  bool refuse(const std::string& why) {
+    why_ = why;
+    return false;
+  }
+
+  std::string element_name(const SystemElement& se) const {
+    return "element " + std::to_string(se.id) + " (" + element_catalogue()[se.type].name + ")";
+  }
+
+  // The nodes of the system; a partly fixed node is neither a pin nor a body's.
+  bool read_nodes() {
+    nodes_ = system_nodes(sys_);
+    for (const auto& [id, n] : nodes_)
+      if (!n.fixed && !n.free) return refuse("node " + std::to_string(id) + " is partly fixed");
+    return true;
+  }
+
+  // Rigid beams (joined into bodies in group_bodies) and hinges (Derived::read_hinge); the
+  // automatic element (L2MIN1) is the normalisation the tree keeps exactly.
+  bool read_elements(const char* accepted) {
+    for (size_t i = 0; i < sys_.elements.size(); ++i) {
+      const SystemElement& se = sys_.elements[i];
+      const ElementType& type = element_catalogue()[se.type];
+      const std::vector<int> ids = element_nodes(sys_, se);
+      if (type.family == ElementFamily::Beam) {
+        if (!read_beam(static_cast<int>(i), se, ids)) return false;
+      } else if (type.family == ElementFamily::Hinge) {
+        if (!static_cast<Derived*>(this)->read_hinge(static_cast<int>(i), se, ids)) return false;
+      } else if (!type.automatic) {
+        return refuse(element_name(se) + " is not a " + accepted);
+      }
+    }
+    return true;
+  }
+
+  bool read_beam(int i, const SystemElement& se, const std::vector<int>& ids) {
+    for (int a = 0; a < se.nd; ++a)
+      if (sys_.def_class[se.def_offset + a] != DefClass::Fixed) return refuse(element_name(se) + " is not rigid");
+    bool all_fixed = true, orientation_fixed = false;
+    for (int id : ids) {
+      all_fixed = all_fixed && nodes_[id].fixed;
+      orientation_fixed = orientation_fixed || (nodes_[id].kind == orientation_kind_ && nodes_[id].fixed);
+    }
+    if (all_fixed) return true;  // part of the ground
+    if (orientation_fixed) return refuse(element_name(se) + " has a fixed orientation and moving points");
+    beams_.push_back({i, ids});
+    return true;
+  }
+
+  // The position of hinge element se's DOF in q (its rotation, deformation 1), −1 if released.
+  int hinge_dof(const SystemElement& se) const {
+    const int k = se.def_offset;
+    if (sys_.def_class[k] != DefClass::Dynamic) return -1;
+    return static_cast<int>(sys_.x_dyn.size() +
+                            (std::lower_bound(sys_.e_dyn.begin(), sys_.e_dyn.end(), k) - sys_.e_dyn.begin()));
+  }
+
+  // The bodies: moving rigid beams sharing an orientation node are one.
+  bool group_bodies() {
+    g_ = group_beams(beams_, nodes_, orientation_kind_);
+    if (g_.stray >= 0) return refuse("node " + std::to_string(g_.stray) + " moves with no rigid beam");
+    placed_.assign(g_.points.size(), -1);
+    pin_.assign(g_.points.size(), -1);
+    for (const auto& [id, n] : nodes_)
+      if (n.kind == point_kind_ && n.fixed) owner_[id] = kGround;
+    return true;
+  }
+
+  int body_of(int orientation_node) const {
+    return nodes_.at(orientation_node).fixed ? kGround : g_.body_of.at(orientation_node);
+  }
+  bool is_placed(int body) const { return body == kGround || placed_[body] >= 0; }
+  Point point(int id) const { return x_.template segment<kDim>(nodes_.at(id).coord); }
+
+  // The one point of the body on a placed body (or fixed): its pin, −1 if none, −2 if more.
+  int pin_of(int body) const {
+    int pin = -1;
+    for (int id : g_.points[body])
+      if (owner_.count(id)) pin = pin == -1 ? id : -2;
+    return pin;
+  }
+
+  // From the ground outwards, breadth first: a body joins the tree at its pin, turned by the one
+  // DOF hinge to its parent (Derived::hinge_joint, Derived::place), or, planar, by its own
+  // rotation (Derived::place_rotated, called for every body placed and the ground).
+  bool place_bodies() {
+    std::map<int, std::vector<int>> hinges_at;  // body (or kGround) → its DOF hinges
+    for (size_t i = 0; i < hinges_.size(); ++i) {
+      if (hinges_[i].dof < 0) continue;
+      hinges_at[body_of(hinges_[i].a)].push_back(static_cast<int>(i));
+      hinges_at[body_of(hinges_[i].b)].push_back(static_cast<int>(i));
+    }
+    Derived& self = *static_cast<Derived*>(this);
+    std::vector<int> queue = {kGround};
+    for (size_t k = 0; k < queue.size(); ++k) {
+      const int parent = queue[k];
+      for (int i : hinges_at[parent]) {
+        Hinge& h = hinges_[i];
+        if (h.used) continue;  // the parent's own joint
+        const bool forward = body_of(h.a) == parent;
+        const int child = forward ? body_of(h.b) : body_of(h.a);
+        const std::string name = element_name(sys_.elements[h.element]);
+        if (child == parent) return refuse(name + " joins a body (or the ground) to itself");
+        if (is_placed(child)) return refuse(name + " closes a loop");
+        h.used = true;
+        Model bd;
+        if (!self.hinge_joint(h, forward, child, bd) || !self.place(child, parent, bd, name)) return false;
+        queue.push_back(child);
+      }
+      if (!self.place_rotated(parent, queue)) return false;
+    }
+    for (size_t b = 0; b < placed_.size(); ++b)
+      if (placed_[b] < 0)
+        return refuse("the body of node " + std::to_string(*g_.points[b].begin()) +
+                      " does not hang from the ground by joints (a spherical joint, or a loop)");
+    for (const Hinge& h : hinges_)
+      if (h.dof >= 0 && !h.used) return refuse(element_name(sys_.elements[h.element]) + " joins no placed body");
+    return true;
+  }
+
+  // The first step of placing a body under the placed body `parent_body` (or kGround) with its
+  // joint `bd`: its pin, its parent and its points; index and p0 are its place in the tree and
+  // its pin's reference position.
+  bool attach(int body, int parent_body, Model& bd, const std::string& joint, int index, Point& p0) {
+    const int parent = parent_body == kGround ? kGround : placed_[parent_body];
+    const int pin = pin_of(body);
+    if (pin < 0 || owner_.at(pin) != parent)
+      return refuse(joint + " turns a body with no point, or more than one, on its parent");
+    placed_[body] = index;
+    pin_[body] = pin;
+    p0 = point(pin);
+    bd.parent = parent;
+    bd.r = parent == kGround ? p0 : Point(p0 - pin0_[parent]);
+    for (int id : g_.points[body])
+      if (id != pin) owner_[id] = index;
+    pin0_.push_back(p0);
+    return true;
+  }
+
+  const System& sys_;
+  const Eigen::VectorXd& x_;
+  const NodeKind point_kind_, orientation_kind_;
+  std::string why_;
+  std::map<int, NodeInfo> nodes_;
+  std::vector<std::pair<int, std::vector<int>>> beams_;  // moving rigid beams: element, nodes
+  std::vector<Hinge> hinges_;
+  BeamBodies g_;                 // the bodies' nodes and beams
+  std::vector<int> placed_;      // body → index in the tree, −1: not yet
+  std::vector<int> pin_;         // body → its pin node, −1: not placed
+  std::map<int, int> owner_;     // point node → body (index in the tree) it moves with, kGround
+  std::vector<Point> pin0_;      // reference pin of each placed body
+};
+
+// Runs a recognizer (a TreeBuilder); false and, if why is given, its reason if the system is not
+// its tree.
+template <class Builder>
+bool build(Builder&& builder, std::string* why) {
+  if (builder.build()) return true;
+  if (why) *why = builder.why();
+  return false;
 }
 
 }  // namespace tree_detail

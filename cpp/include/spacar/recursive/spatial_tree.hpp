@@ -1,5 +1,5 @@
 // Recursive dynamics of spatial open trees of rigid bodies (formulation.md §7, the spatial
-// counterpart of tree.hpp).
+// counterpart of planar_tree.hpp).
 //
 // A spatial model of rigid BEAMs (every deformation fixed) connected as an open tree is a
 // kinematic tree of rigid bodies with revolute joints: beams sharing a LAMBDA node are one body,
@@ -7,11 +7,11 @@
 // the rotation e1 of a HINGE to the parent (DYNE, e2 and e3 fixed). MASS (point masses, inertia
 // tensors on LAMBDA nodes), EMASS, FORCE on points, TORQUEL, GRAVITY and the hinges' ESTIFF and
 // EDAMPP load it. The equations of motion are solved in O(N) by the articulated-body algorithm
-// in spatial algebra, with explicit positions instead of Newton's method: the same equations as
+// (articulated.hpp) in spatial algebra, with explicit positions instead of Newton's method: the same equations as
 // the constraint formulation (each body's spatial inertia is the element and nodal mass matrices
 // projected on its rigid motions).
 //
-// Refused (the general path runs, and detect() says why): planar models (tree.hpp), DYNX
+// Refused (the general path runs, and detect() says why): planar models (planar_tree.hpp), DYNX
 // rotations (free Euler parameters), spherical joints (a shared XYZ node without a DOF hinge),
 // HINGEs with released or rigid e1, or released e2, e3 (unless all three are released, without
 // stiffness: a measuring hinge), flexible or partly fixed beams, elements other than BEAM,
@@ -20,17 +20,127 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "spacar/kinematics/data.hpp"
-#include "spacar/model/system.hpp"
-#include "spacar/recursive/tree.hpp"
+#include "spacar/elements/spatial.hpp"
+#include "spacar/recursive/articulated.hpp"
 
 namespace spacar {
 
-class SpatialTree : public RecursiveTree {
+namespace tree_detail {
+
+// The Euler parameters of the composed rotation R(p ⊗ r) = R(p) R(r).
+inline Eigen::Vector4d compose(const Eigen::Vector4d& p, const Eigen::Vector4d& r) {
+  const Eigen::Vector3d pv = p.tail<3>(), rv = r.tail<3>();
+  Eigen::Vector4d out;
+  out[0] = p[0] * r[0] - pv.dot(rv);
+  out.tail<3>() = p[0] * rv + r[0] * pv + pv.cross(rv);
+  return out;
+}
+
+}  // namespace tree_detail
+
+// Spatial algebra: vectors (angular; linear) in body coordinates, origin at the body's pin,
+// axes those of the world rotated by the body's rotation since the reference state.
+struct SpatialAlgebra {
+  using Point = Eigen::Vector3d;
+  using Vector = Eigen::Matrix<double, 6, 1>;
+  using Inertia = Eigen::Matrix<double, 6, 6>;
+  using Axis = Eigen::Vector3d;  // unit joint axis, the same in the parent's and the body's coordinates
+  struct Frame {
+    Eigen::Matrix3d E;       // parent coordinates → body coordinates
+    Eigen::Matrix3d R;       // body coordinates → world
+    Eigen::Vector4d lambda;  // Euler parameters (λ0, λ1, λ2, λ3) of R
+  };
+  using Model = BodyModel<SpatialAlgebra>;
+  using Work = BodyData<SpatialAlgebra>;
+
+  static double joint_angle(const Model& m, const Work*, const double* q, const double* qd, Work& d) {
+    return hinge_angle(m, q, qd, d);
+  }
+
+  static void place(const Model& m, const Work* p, double theta, Work& d) {
+    const double ch = std::cos(0.5 * theta), sh = std::sin(0.5 * theta);  // of the half angle, for λ too
+    const double c = 1.0 - 2.0 * sh * sh, s = 2.0 * sh * ch;
+    const Eigen::Vector3d& k = m.axis;
+    const Eigen::Matrix3d rel = c * Eigen::Matrix3d::Identity() + s * skew(k) + (1.0 - c) * k * k.transpose();  // body → parent
+    Frame& f = d.frame;
+    f.E = rel.transpose();
+    Eigen::Vector4d q_rel;
+    q_rel << ch, sh * k;
+    if (!p) {
+      f.R = rel;
+      f.lambda = q_rel;
+      d.pin = m.r;
+    } else {
+      f.R = p->frame.R * rel;
+      f.lambda = tree_detail::compose(p->frame.lambda, q_rel);
+      d.pin = p->pin + p->frame.R * m.r;
+    }
+  }
+
+  static Vector joint_motion(const Model& m, double ud) {
+    Vector v = Vector::Zero();
+    v.head<3>() = ud * m.axis;
+    return v;
+  }
+
+  static Vector to_child(const Model& m, const Frame& f, const Vector& v) {
+    Vector out;
+    out.head<3>() = f.E * v.head<3>();
+    out.tail<3>() = f.E * (v.tail<3>() + v.head<3>().cross(m.r));
+    return out;
+  }
+
+  // The transpose of to_child.
+  static Vector to_parent(const Model& m, const Frame& f, const Vector& g) {
+    Vector out;
+    out.tail<3>() = f.E.transpose() * g.tail<3>();
+    out.head<3>() = f.E.transpose() * g.head<3>() + m.r.cross(out.tail<3>());
+    return out;
+  }
+
+  // Xᵀ I X with X = [E 0; −E r̃ E] (parent → body, motion vectors), by blocks: rotated,
+  // I' = [A B; Bᵀ C] in the parent's axes, then moved to its origin,
+  // [A + r̃Bᵀ + (r̃Bᵀ)ᵀ − r̃Cr̃, B + r̃C; (B + r̃C)ᵀ, C] — a third of the full 6×6 products.
+  static void add_inertia_to_parent(const Model& m, const Frame& f, const Inertia& I, Inertia& parent) {
+    using Mat3 = Eigen::Matrix3d;
+    const Mat3& E = f.E;
+    const Mat3 Ib = I.topLeftCorner<3, 3>(), Bb = I.topRightCorner<3, 3>(), Cb = I.bottomRightCorner<3, 3>();
+    const Mat3 A = E.transpose() * Ib * E, B = E.transpose() * Bb * E, C = E.transpose() * Cb * E;
+    const Mat3 rx = skew(m.r);
+    const Mat3 rC = rx * C, rBt = rx * B.transpose();
+    parent.topLeftCorner<3, 3>() += A + rBt + rBt.transpose() - rC * rx;
+    const Mat3 coupling = B + rC;
+    parent.topRightCorner<3, 3>() += coupling;
+    parent.bottomLeftCorner<3, 3>() += coupling.transpose();
+    parent.bottomRightCorner<3, 3>() += C;
+  }
+
+  static Vector bias(const Model& m, const Vector& v, double ud) {
+    const Eigen::Vector3d s_w = ud * m.axis;
+    Vector b;
+    b << v.head<3>().cross(s_w), v.tail<3>().cross(s_w);
+    return b;
+  }
+
+  static Vector cross_force(const Vector& v, const Vector& h) {
+    const Eigen::Vector3d w = v.head<3>(), vl = v.tail<3>();
+    Vector out;
+    out << w.cross(h.head<3>()) + vl.cross(h.tail<3>()), w.cross(h.tail<3>());
+    return out;
+  }
+
+  static Vector joint_column(const Model& m, const Inertia& I) { return I.leftCols<3>() * m.axis; }
+  static double joint_component(const Model& m, const Vector& g) { return m.axis.dot(g.head<3>()); }
+  static void add_joint_acceleration(const Model& m, double udd, Vector& a) { a.head<3>() += udd * m.axis; }
+  static double dof_acceleration(const Model& m, const Vector&, double udd) { return m.sign * udd; }
+};
+
+class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
  public:
   // The tree of the system if it is one, else nullptr and (if why is given) the reason. The
   // body geometry and inertia are taken at the positions in data, which must satisfy the
@@ -39,31 +149,7 @@ class SpatialTree : public RecursiveTree {
 
  private:
   using Vec3 = Eigen::Vector3d;
-  using Mat3 = Eigen::Matrix3d;
-  using Vec6 = Eigen::Matrix<double, 6, 1>;
-  using Mat6 = Eigen::Matrix<double, 6, 6>;
-  using Quat = Eigen::Vector4d;  // Euler parameters (λ0, λ1, λ2, λ3)
-  // Spatial vectors are (angular; linear) in body coordinates: origin at the body's pin, axes
-  // those of the world rotated by the body's rotation since the reference state.
-  struct Body {
-    int parent = -1;              // index into bodies_ (parents first), −1: the ground
-    int dof = 0;                  // position of the hinge rotation in q
-    double sign = 1.0;            // joint angle u = sign · (q − offset) (the hinge may point to the parent)
-    double offset = 0.0;          // the hinge rotation at the reference state
-    double stiffness = 0.0, damping = 0.0;  // hinge σ = S e + D ė, joint torque −σ
-    Vec3 axis;                    // unit joint axis, the same in the parent's and the body's coordinates
-    Vec3 r;                       // pin in the parent's coordinates (ground: the world)
-    Mat6 inertia;                 // about the pin, in body coordinates
-    Vec3 torque = Vec3::Zero();   // constant body-fixed torque (TORQUEL), body coordinates
-    // Work of one evaluation.
-    Mat3 E;                       // parent coordinates → body coordinates
-    Mat3 R;                       // body coordinates → world
-    Quat lambda;                  // Euler parameters of R
-    Vec3 pin;                     // world position of the pin
-    double ud = 0.0, tau = 0.0, u = 0.0, d = 0.0;
-    Vec6 v, bias, pA, a, U;
-    Mat6 IA;
-  };
+  using Quat = Eigen::Vector4d;
   // A coordinate moving with a body: an XYZ node at body point b, or a LAMBDA node turned by the
   // body from its reference parameters.
   struct Follower {
@@ -79,22 +165,11 @@ class SpatialTree : public RecursiveTree {
   };
   class Builder;
 
-  void outward(const double* q, const double* qd) override;
   void applied_loads() override;
-  bool articulate() override;
-  void accelerations(double* qdd) override;
   void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
 
-  // Motion vectors from the parent's coordinates to the body's; force vectors back (the transpose).
-  static Vec6 to_child(const Body& bd, const Vec6& m);
-  static Vec6 to_parent(const Body& bd, const Vec6& f);
-  // The body's (articulated) inertia I, body coordinates, added to its parent's in the parent's.
-  static void add_inertia_to_parent(const Body& bd, const Mat6& I, Mat6& parent);
-
-  std::vector<Body> bodies_;
   std::vector<Follower> followers_;
   std::vector<Load> loads_;
-  Vec6 base_acceleration_ = Vec6::Zero();  // −gravity, the fictitious acceleration of the ground
 };
 
 }  // namespace spacar

@@ -1,0 +1,158 @@
+// One articulated-body algorithm over two algebras (formulation.md §7).
+//
+// A tree of rigid bodies, each turned about its pin by one revolute joint, solved in O(N) by
+// the articulated-body algorithm: outwards the bodies' placements, velocities and bias terms,
+// inwards the articulated inertias, outwards the accelerations. The passes are written once;
+// the algebra (planar_tree.hpp: 3-vectors (ω, vx, vy); spatial_tree.hpp: 6-vectors (ω; v))
+// supplies the vectors, the transforms between a body's and its parent's coordinates, the cross
+// products and the joint's motion subspace, as Pinocchio runs one ABA over its joint types.
+//
+// Each body is split, as Pinocchio's JointModel and JointData: BodyModel holds what detect()
+// found (joint, pin, inertia), BodyData the work of one evaluation.
+//
+// An Algebra provides the types Point (a pin), Vector (motion and force vectors), Inertia and
+// Frame (a body's rotation relative to its parent and in the world), and the static functions
+//   joint_angle(m, parent, q, qd, d)   the joint's rotation; sets d.ud, d.tau
+//   place(m, parent, theta, d)         d.frame and d.pin from the parent's
+//   joint_motion(m, ud)                S u̇, the joint's motion in body coordinates
+//   to_child(m, frame, v)              motion vectors, parent → body coordinates
+//   to_parent(m, frame, f)             force vectors, body → parent coordinates
+//   add_inertia_to_parent(m, frame, I, parent)
+//   bias(m, v, ud)                     v ×ₘ S u̇
+//   cross_force(v, f)                  v ×* f
+//   joint_column(m, I), joint_component(m, f), add_joint_acceleration(m, udd, a)   I S, Sᵀ f, a += S ü
+//   dof_acceleration(m, a, udd)        q̈ of the body's degree of freedom
+#pragma once
+
+#include <vector>
+
+#include "spacar/recursive/tree.hpp"
+
+namespace spacar {
+
+// A body's constants: its joint to the parent, its pin and its inertia.
+template <class Algebra>
+struct BodyModel {
+  using Vector = typename Algebra::Vector;
+  int parent = -1;              // index into the bodies (parents first), −1: the ground
+  int dof = 0;                  // position of the joint's coordinate in q
+  bool absolute = false;        // q is the body's rotation (a planar DYNX), else a hinge's
+  double sign = 1.0;            // hinge: joint angle u = sign · q + offset (the hinge may point to the parent)
+  double offset = 0.0;          // absolute: the body's rotation is q − offset
+  double stiffness = 0.0, damping = 0.0;  // hinge σ = S e + D ė, joint torque −σ
+  typename Algebra::Axis axis = Algebra::Axis::Zero();  // the joint's axis (in the plane: its normal)
+  typename Algebra::Point r = Algebra::Point::Zero();  // pin in the parent's coordinates (ground: the world)
+  typename Algebra::Inertia inertia = Algebra::Inertia::Zero();  // about the pin, in body coordinates
+  Vector load = Vector::Zero();  // constant body-fixed force vector (TORQUEL), body coordinates
+};
+
+// A body's work of one evaluation.
+template <class Algebra>
+struct BodyData {
+  using Vector = typename Algebra::Vector;
+  typename Algebra::Frame frame;  // rotation relative to the parent and in the world
+  typename Algebra::Point pin;    // world position of the pin
+  double ud = 0.0;   // joint rate u̇
+  double tau = 0.0;  // joint torque
+  double u = 0.0;    // joint force left after the bias forces
+  double d = 0.0;    // the joint's articulated inertia Sᵀ Iᴬ S
+  Vector v, bias, pA, a, U;
+  typename Algebra::Inertia IA;
+};
+
+// The joint angle of a hinge, with its rate and torque (τ_q = −σ).
+template <class Algebra>
+double hinge_angle(const BodyModel<Algebra>& m, const double* q, const double* qd, BodyData<Algebra>& d) {
+  d.ud = m.sign * qd[m.dof];
+  d.tau = -m.sign * (m.stiffness * q[m.dof] + m.damping * qd[m.dof]);
+  return m.sign * q[m.dof] + m.offset;
+}
+
+template <class Algebra>
+class ArticulatedTree : public RecursiveTree {
+ public:
+  using Model = BodyModel<Algebra>;
+  using BodyWork = BodyData<Algebra>;
+  using Vector = typename Algebra::Vector;
+  using Inertia = typename Algebra::Inertia;
+
+  int n_bodies() const { return static_cast<int>(bodies_.size()); }
+
+  bool solve(const double* q, const double* qd, double* qdd) final {
+    outward(q, qd);
+    applied_loads();
+    if (!articulate()) return false;
+    accelerations(qdd);
+    return true;
+  }
+
+ protected:
+  // Adds a body (its parent placed before it).
+  void add_body(const Model& m) {
+    bodies_.push_back(m);
+    work_.emplace_back();
+  }
+  // The applied loads on the bodies, subtracted from their bias forces.
+  virtual void applied_loads() = 0;
+
+  std::vector<Model> bodies_;
+  std::vector<BodyWork> work_;
+  Vector base_acceleration_ = Vector::Zero();  // −gravity, the fictitious acceleration of the ground
+
+ private:
+  // Outwards: placements, velocities, velocity-product accelerations and the bias forces of the
+  // bodies' inertia, with the joint torques; the articulated inertias start as the bodies'.
+  void outward(const double* q, const double* qd) {
+    for (size_t i = 0; i < bodies_.size(); ++i) {
+      const Model& m = bodies_[i];
+      BodyWork& d = work_[i];
+      const BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
+      const double theta = Algebra::joint_angle(m, p, q, qd, d);  // rotation relative to the parent
+      Algebra::place(m, p, theta, d);
+      Vector v = Algebra::joint_motion(m, d.ud);
+      if (p) v += Algebra::to_child(m, d.frame, p->v);
+      d.v = v;
+      d.bias = Algebra::bias(m, v, d.ud);
+      d.IA = m.inertia;
+      d.pA = Algebra::cross_force(v, m.inertia * v) - m.load;
+    }
+  }
+
+  // Inwards: articulated inertias and bias forces; false if a joint's articulated inertia is not
+  // positive.
+  bool articulate() {
+    for (int i = static_cast<int>(bodies_.size()) - 1; i >= 0; --i) {
+      const Model& m = bodies_[i];
+      BodyWork& d = work_[i];
+      d.U = Algebra::joint_column(m, d.IA);
+      d.d = Algebra::joint_component(m, d.U);
+      // Not positive: a body that moves no mass. Not finite (a trial state out of range): the
+      // integrator rejects the non-finite q̈ like the general path's.
+      if (d.d <= 0.0) return false;
+      d.u = d.tau - Algebra::joint_component(m, d.pA);
+      if (m.parent < 0) continue;
+      const Inertia Ia = d.IA - d.U * d.U.transpose() / d.d;
+      const Vector pa = d.pA + Ia * d.bias + d.U * (d.u / d.d);
+      BodyWork& p = work_[m.parent];
+      Algebra::add_inertia_to_parent(m, d.frame, Ia, p.IA);
+      p.pA += Algebra::to_parent(m, d.frame, pa);
+    }
+    return true;
+  }
+
+  // Outwards: joint and body accelerations (relative to the fictitious acceleration −g of the
+  // ground), q̈.
+  void accelerations(double* qdd) {
+    for (size_t i = 0; i < bodies_.size(); ++i) {
+      const Model& m = bodies_[i];
+      BodyWork& d = work_[i];
+      Vector a = Algebra::to_child(m, d.frame, m.parent < 0 ? base_acceleration_ : work_[m.parent].a) + d.bias;
+      const double udd = (d.u - d.U.dot(a)) / d.d;
+      Algebra::add_joint_acceleration(m, udd, a);
+      d.a = a;
+      qdd[m.dof] = Algebra::dof_acceleration(m, a, udd);
+    }
+  }
+};
+
+}  // namespace spacar

@@ -1,0 +1,260 @@
+"""Trees of rigid bodies for the recursive path's tests (tests/core/test_recursive_trees.py):
+planar (PLBEAMs on PLHINGEs or DYNX rotations) and spatial (BEAMs on HINGEs), and models near
+them that are not trees."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import spacar
+from spacar.compare import models
+
+G = 9.81
+
+
+def planar_branched_tree(spring=False):
+    """A trunk hinged to the ground, two branches hinged at its tip (one hinge points from the
+    child to the parent), one branch two beams rigidly joined at a shared BETA node; masses on XY
+    and BETA nodes, FORCE on points and a rotation, a hinge spring-damper, gravity with an x
+    component; ``spring``: a released hinge with stiffness and damping between the branches."""
+    m = spacar.Model()
+    for node, xy in {1: (0, 0), 2: (1, 0.2), 3: (1.8, 0.9), 4: (1.6, -0.7), 5: (2.4, -0.5)}.items():
+        m.x(node, *xy)
+    m.plbeam(1, 1, 11, 2, 12)
+    m.plbeam(2, 2, 21, 3, 22)
+    m.plbeam(3, 2, 31, 4, 32)
+    m.plbeam(4, 4, 32, 5, 42)
+    m.plhinge(101, 100, 11)
+    m.plhinge(102, 12, 21)
+    m.plhinge(103, 31, 12)
+    for h in (101, 102, 103):
+        m.dyne(h, 1)
+    m.fix(1)
+    m.fix(100)
+    for e, rho in ((1, 1.0), (2, 0.7), (3, 1.3), (4, 0.4)):
+        m.emass(e, rho)
+    m.mass(3, 0.2)
+    m.mass(5, 0.1)
+    m.mass(21, 0.05)
+    m.force(3, 0.5, -0.2)
+    m.force(5, 0.0, 1.0)
+    m.force(31, 0.3)
+    m.estiff(103, 2.0)
+    m.edampp(103, 0.1)
+    if spring:
+        m.plhinge(104, 22, 42)
+        m.rlse(104, 1)
+        m.estiff(104, 1.5)
+        m.edampp(104, 0.3)
+    m.gravity(1.0, -G)
+    m.epsint(1e-10)
+    m.epsind(1e-10)
+    m.epskin(1e-12)
+    m.timestep(4, 0.4)
+    return m
+
+
+def plbeamnl_chain():
+    """Two rigid PLBEAMNL links, the second hinged by its own DYNX rotation (no PLHINGE)."""
+    m = spacar.Model()
+    m.x(2, 0.8, 0.3)
+    m.x(3, 1.5, -0.2)
+    m.plbeamnl(1, 1, 11, 2, 12)
+    m.plbeamnl(2, 2, 21, 3, 22)
+    m.fix(1)
+    m.dynx(11, 1)
+    m.dynx(21, 1)
+    m.emass(1, 1.0)
+    m.emass(2, 0.5)
+    m.mass(3, 0.2)
+    m.gravity(0.0, -G)
+    m.epskin(1e-12)
+    m.timestep(1, 0.1)
+    return m
+
+
+def planar_held_hinge():
+    """A 2-link chain whose second hinge is not a DOF (its rotation held fixed)."""
+    m = models.planar_chain(1)
+    m.x(3, 2.0, 0.0)
+    m.plbeam(2, 2, 21, 3, 22)
+    m.plhinge(9, models.END + 1, 21)
+    m.emass(2, 1.0)
+    return m
+
+
+def position_dof():
+    """A pendulum whose DOF is the x coordinate of its tip (DYNX on an XY node)."""
+    m = spacar.Model()
+    m.x(2, 0.6, -0.8)
+    m.plbeam(1, 1, 11, 2, 12)
+    m.fix(1)
+    m.dynx(2, 1)
+    m.emass(1, 1.0)
+    m.gravity(0.0, -G)
+    return m
+
+
+def truss_brace():
+    """A pendulum braced by a PLTRUSS (an element the recursive path does not take)."""
+    m = models.planar_chain(1)
+    m.x(5, 0.5, -0.5)
+    m.pltruss(9, 2, 5)
+    m.fix(5)
+    m.rlse(9, 1)
+    return m
+
+
+def _box(mass, a, b, c, rng):
+    """A full inertia tensor: a box turned by a random rotation."""
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    return Q @ (mass / 12.0 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])) @ Q.T
+
+
+def spatial_branched_tree(loads=True, seed=5):
+    """A trunk hinged to a rotated ground, two branches hinged at its tip about different axes (one
+    hinge points from the child to the parent, one body is two beams rigidly joined at a shared
+    LAMBDA node), a grandchild on one branch at an offset point; EMASS with rotary inertia, point
+    masses, full inertia tensors on LAMBDA nodes, a hinge spring-damper, gravity off the axes;
+    ``loads``: TORQUEL on two bodies and FORCE on two points."""
+    rng = np.random.default_rng(seed)
+    m = spacar.Model()
+    for node, p in {1: (0.1, -0.2, 0.3), 2: (0.5, 0.1, 0.8), 3: (0.9, 0.6, 0.7), 4: (0.3, 0.5, 1.2),
+                    5: (0.1, 0.9, 1.3), 6: (1.2, 0.4, 1.1), 7: (1.0, 0.3, 0.2)}.items():
+        m.xyz(node, *p)
+    m.beam(1, 1, 11, 2, 12, 0.0, 0.0, 1.0)
+    m.beam(2, 2, 21, 3, 22, 0.0, 1.0, 0.0)
+    m.beam(3, 2, 31, 4, 32, 1.0, 0.0, 0.0)
+    m.beam(4, 4, 32, 5, 42, 0.0, 0.0, 1.0)     # rigidly joined to beam 3 (LAMBDA node 32)
+    m.beam(5, 3, 51, 6, 52, 1.0, 1.0, 0.0)     # the grandchild, hinged at node 3 of beam 2
+    m.beam(6, 6, 52, 7, 62, 0.0, 1.0, 1.0)     # its second beam: node 7 is an offset point
+    m.hinge(101, 100, 11, 0.3, -0.5, 0.8)
+    m.hinge(102, 12, 21, 1.0, 0.2, -0.1)
+    m.hinge(103, 31, 12, -0.2, 1.0, 0.4)       # from the child to the parent
+    m.hinge(104, 22, 51, 0.1, 0.3, 1.0)
+    for h in (101, 102, 103, 104):
+        m.dyne(h, 1)
+    m.fix(1)
+    m.fix(100)
+    m.lambda_(100, math.cos(0.2), *(math.sin(0.2) * np.array([0.6, 0.0, 0.8])))
+    for e in range(1, 7):
+        m.emass(e, 0.5 + rng.random(), 1e-3, 2e-3, 3e-3)
+    m.mass(3, 0.2)
+    m.mass(5, 0.1)
+    m.mass(7, 0.3)
+    for node, mass in ((21, 0.4), (32, 0.3), (52, 0.6)):
+        J = _box(mass, *(0.1 + 0.2 * rng.random(3)), rng)
+        m.mass(node, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
+    m.estiff(103, 2.0)
+    m.edampp(103, 0.1)
+    if loads:
+        m.torquel(21, 0.2, -0.1, 0.3)
+        m.torquel(52, -0.1, 0.05, 0.2)
+        m.force(5, 0.5, -0.2, 0.1)
+        m.force(7, 0.0, 0.3, -0.4)
+    m.gravity(1.0, -2.0, -G)
+    m.epsint(1e-10)
+    m.epsind(1e-10)
+    m.epskin(1e-13)
+    m.timestep(3, 0.3)
+    return m
+
+
+def random_tree(n, seed, loads=True):
+    """n bodies hung at random from the ground or an earlier body, at its end point or at an
+    offset point of a second beam rigidly joined to it; hinges about random axes pointing either
+    way, some with springs and dampers; random masses, inertia tensors and gravity; ``loads``:
+    random TORQUEL and FORCE."""
+    rng = np.random.default_rng(seed)
+    m = spacar.Model()
+    m.xyz(1, *rng.normal(size=3) * 0.1)
+    points = {0: [1]}  # body → its points where children may hang (the ground: node 1)
+    position = {1: np.array(m.nodes[1].x)}
+    for i in range(1, n + 1):
+        parent = int(rng.integers(0, i))
+        pin = int(rng.choice(points[parent]))
+        end, offset = 100 + i, 300 + i
+        position[end] = position[pin] + rng.normal(size=3) * 0.4
+        position[offset] = position[end] + rng.normal(size=3) * 0.2
+        m.xyz(end, *position[end])
+        m.xyz(offset, *position[offset])
+        m.beam(i, pin, 1000 + i, end, 2000 + i, *rng.normal(size=3))
+        m.beam(500 + i, end, 2000 + i, offset, 3000 + i, *rng.normal(size=3))  # rigidly joined
+        parent_lambda = 10 if parent == 0 else 2000 + parent
+        ends = (parent_lambda, 1000 + i) if rng.random() < 0.5 else (1000 + i, parent_lambda)
+        m.hinge(700 + i, *ends, *rng.normal(size=3))
+        m.dyne(700 + i, 1)
+        m.emass(i, 0.5 + rng.random(), *(1e-3 * rng.random(3)))
+        m.mass(offset, 0.1 + 0.2 * rng.random())
+        J = _box(0.2 + 0.3 * rng.random(), *(0.1 + 0.2 * rng.random(3)), rng)
+        m.mass(2000 + i, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
+        torque, force = 0.2 * rng.normal(size=3), 0.3 * rng.normal(size=3)
+        if loads:
+            m.torquel(3000 + i, *torque)
+            m.force(offset, *force)
+        if rng.random() < 0.5:
+            m.estiff(700 + i, rng.random())
+            m.edampp(700 + i, 0.1 * rng.random())
+        points[i] = [end, offset]
+    m.fix(1)
+    m.fix(10)
+    m.gravity(*rng.normal(size=3) * 5.0)
+    m.epskin(1e-13)
+    return m
+
+
+def spherical_joint():
+    """A chain whose second link hangs from a shared node without a hinge (DYNX on its Euler
+    parameters)."""
+    return models.spatial_chain(2, seed=4, joints="spherical")
+
+
+def rsur():
+    from support.spatial_models import rssr_model
+
+    return rssr_model(coupler="beam", dynamic=True)
+
+
+def spatial_held_hinge():
+    """A chain whose second hinge is held (e1 fixed): the two links are one body."""
+    m = models.spatial_chain(1, seed=1)
+    m.xyz(3, 2.0, 0.5, 0.0)
+    m.beam(2, 2, 21, 3, 22, 0.0, 0.0, 1.0)
+    m.hinge(9, models.END + 1, 21, 0.0, 1.0, 0.0)
+    m.emass(2, 1.0)
+    return m
+
+
+def flexible_beam():
+    from support.spatial_models import cantilever
+
+    return cantilever(2)
+
+
+def lambda_force():
+    m = models.spatial_chain(2, seed=1)
+    m.force(models.START + 1, 0.0, 0.1, 0.0, 0.0)
+    return m
+
+
+def planar_massless_chain():
+    return models.planar_chain(2, rho_a=0.0, tip_mass=0.0)
+
+
+def spatial_massless_chain():
+    """Two links on parallel hinges, only the first with mass."""
+    model = spacar.Model()
+    model.xyz(1, 0.0, 0.0, 0.0)
+    model.xyz(2, 1.0, 0.0, 0.0)
+    model.xyz(3, 2.0, 0.0, 0.0)
+    model.beam(1, 1, 11, 2, 12, 0.0, 1.0, 0.0)
+    model.beam(2, 2, 21, 3, 22, 0.0, 1.0, 0.0)
+    model.hinge(3, 10, 11, 0.0, 0.0, 1.0)
+    model.hinge(4, 12, 21, 0.0, 0.0, 1.0)
+    model.dyne(3, 1)
+    model.dyne(4, 1)
+    model.fix(1)
+    model.fix(10)
+    model.emass(1, 1.0)
+    return model
