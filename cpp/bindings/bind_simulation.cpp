@@ -25,6 +25,7 @@ py::dict block_results_to_dict(BlockResults&& r) {
   d["last_step"] = r.last_step;
   d["wall_time"] = r.wall_time;
   d["recursive"] = r.recursive;
+  d["path"] = r.path;
   d["method"] = method_name(r.method);
   py::list switches;
   for (const MethodSwitch& w : r.switches)

@@ -31,7 +31,7 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     # (Jacobians, i.e. linearizations, and LU factorizations) where one ran.
     implicit = method in _core.implicit_methods or bool(arrays["switches"])
     stats = {k: arrays[k] for k, implicit_only in _core.run_counters if implicit or not implicit_only}
-    stats.update(wall_time=arrays["wall_time"], recursive=arrays["recursive"])
+    stats.update(wall_time=arrays["wall_time"], recursive=arrays["recursive"], path=arrays["path"])
     stats["method"] = _method_used(arrays)
     stats["switches"] = [tuple(s) for s in arrays["switches"]]
     coords, defs = system.coord_label, system.def_label  # each a fresh copy of the list: taken once

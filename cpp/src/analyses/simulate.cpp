@@ -111,7 +111,7 @@ bool Simulation::solved_dofs(const Solved& s, const Eigen::VectorXd& Y) const {
 
 void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
   if (t > run_.kinematic_failure_t) run_.kinematic_failure.clear();  // passed: the failure is history
-  if (tree_) return;  // explicit positions: no Newton start to anchor, no branch to leave
+  if (!path_->anchors_steps()) return;  // the tree's explicit positions: no Newton start to anchor
   if (run_.anchor.valid && run_.anchor.t == t) {  // the same step again, smaller
     // A step from an approximate anchor failed: solve the accepted state itself, so that the
     // smaller steps are not held to a mismatch of the size of a Newton increment.
@@ -173,21 +173,12 @@ void Simulation::solve_motion(double t, const double* q, const double* qd, Start
     positions.xd = positions.xdd = Eigen::VectorXd::Zero(sys.nx);
     predict_from(positions, t, q);
   }
-  // An open chain's positions element by element (chain.hpp), and in right-hand sides also its
-  // velocities; other evaluations factorize the velocity block, which the forces and transfer use.
-  ExplicitChain* chain = chain_.get();
-  // Inside the integrator the positions must continue those of the step start (the anchor). An
-  // explicit chain, whose elements' iterations start from their predicted positions one by one,
-  // is held to that only from an exact anchor: an approximate one (generalized-α's last iterate)
-  // differs by up to a Newton increment, which would reject good steps.
+  // Inside the integrator the positions must continue those of the step start (the anchor), as
+  // far as the path holds them to it (an open chain from an exact anchor only).
   const bool anchored = run_.in_rhs && run_.anchor.valid;
-  const bool check = anchored && !(chain && !run_.anchor.exact);
+  const bool check = anchored && path_->held_to_step_start(run_.anchor.exact);
   const Solved& solved = anchored ? run_.anchor : run_.base;  // the chain's branches: of the step start
-  auto positions = [&]() {
-    if (chain)
-      chain->solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, solved.valid ? &solved.x : nullptr);
-    else solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, false, start == Start::Exact);
-  };
+  auto positions = [&]() { path_->positions(sys, *data_, solved.valid ? &solved.x : nullptr, start == Start::Exact); };
   if (!run_.chord) data_->jacobian_reusable = false;
   std::string why;
   bool ok = false;
@@ -207,8 +198,7 @@ void Simulation::solve_motion(double t, const double* q, const double* qd, Start
     positions();
     if (check && !continuous_with_step_start(why)) throw KinematicsError(why);
   }
-  if (chain && run_.in_rhs) chain->solve_velocities(sys, *data_);
-  else solve_velocities_direct(sys, *data_);
+  path_->velocities(sys, *data_, run_.in_rhs);
 }
 
 void Simulation::evaluate(double t, const double* q, const double* qd) {
@@ -304,7 +294,7 @@ void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   // Its q̈ is the general path's solution, which then needs no equations of motion, where the
   // tree knows all the loads (a run's tree; not with time-dependent or held loads set since
   // recursive_state).
-  const bool known = tree_ && tree_state(t, Y, run_.tree_qdd) && timed_.empty() && run_.held.size() == 0;
+  const bool known = path_->tree() && tree_state(t, Y, run_.tree_qdd) && timed_.empty() && run_.held.size() == 0;
   for (int i = 0; i < ny; ++i) data_->e_integrated[sys_->y_defs[i]] = Y[nd + i];
   if (known) solve_state(t, Y.data(), Y.data() + nd + ny, Start::Exact, &run_.tree_qdd);
   else solve_state(t, Y.data(), Y.data() + nd + ny);
@@ -316,7 +306,7 @@ bool Simulation::tree_state(double t, const Eigen::VectorXd& Y, Eigen::VectorXd&
   // Outside a run (a tree kept from recursive_state) the last solved state may hold positions only.
   for (Eigen::VectorXd* v : {&run_.base.x, &run_.base.xd, &run_.base.xdd})
     if (v->size() != sys_->nx) v->setZero(sys_->nx);
-  if (!tree_->solve(Y.data(), Y.data() + nd, run_.base.x, run_.base.xd, run_.base.xdd, qdd.data())) return false;
+  if (!path_->tree()->solve(Y.data(), Y.data() + nd, run_.base.x, run_.base.xd, run_.base.xdd, qdd.data())) return false;
   run_.base.valid = true;  // the start of Newton's iterations at the next general evaluation
   run_.base.t = t;
   return true;
@@ -340,11 +330,12 @@ void Simulation::in_rhs(double t, F&& evaluate) {
 }
 
 bool Simulation::residual_form() const {
-  return (chain_ || sparse_newton()) && !tree_ && sys_->y_defs.empty() && run_.n_energy == 0;
+  return (path_->residual_form() || sparse_newton()) && !path_->tree() && sys_->y_defs.empty() &&
+         run_.n_energy == 0;
 }
 
 bool Simulation::sparse_newton() const {
-  return !tree_ && sys_->y_defs.empty() && run_.n_energy == 0 && sys_->velocity_block_is_position_block &&
+  return !path_->tree() && sys_->y_defs.empty() && run_.n_energy == 0 && sys_->velocity_block_is_position_block &&
          sys_->n_dof() >= kSparseNewtonDofs;
 }
 
@@ -369,7 +360,7 @@ void Simulation::residual(double t, const Eigen::VectorXd& Y, const Eigen::Vecto
   in_rhs(t, [&] {
     solve_motion(t, Y.data(), Y.data() + nd, Start::Taylor);
     set_dof_accelerations(sys, *data_, qdd);
-    reduced_residual_direct(sys, *data_, R, chain_.get());
+    path_->residual(sys, *data_, R);
   });
   remember(run_.base);  // the next positions' predictor, and the anchor of the next step
   have_transfer_ = false;
@@ -380,7 +371,8 @@ void Simulation::rhs(double t, const Eigen::VectorXd& Y, Eigen::VectorXd& dY) {
   check_time(t);
   // The recursive path: q̈ only; the coordinates follow where a general evaluation needs them.
   // Y = (q, y, q̇[, energy]): trees have no integrated deformations and no energy states.
-  if (tree_ && tree_->solve(Y.data(), Y.data() + nd + ny, dY.data() + nd + ny)) {
+  RecursiveTree* tree = path_->tree();
+  if (tree && tree->solve(Y.data(), Y.data() + nd + ny, dY.data() + nd + ny)) {
     dY.head(nd) = Y.segment(nd + ny, nd);
     return;
   }
@@ -433,10 +425,13 @@ void Simulation::apply_time_loads(double t) {
 bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
                                  Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
   require_dof_sizes("recursive_state", q, qd);
-  if (!tree_) tree_ = RecursiveTree::detect(*sys_, *data_);
-  if (!tree_) return false;
+  if (!path_->tree()) {
+    std::unique_ptr<RecursiveTree> tree = RecursiveTree::detect(*sys_, *data_);
+    if (!tree) return false;
+    path_ = std::make_unique<TreePath>(std::move(tree));
+  }
   Eigen::VectorXd x1 = data_->x, xd1 = Eigen::VectorXd::Zero(sys_->nx), xdd1 = xd1, qdd1(sys_->n_dof());
-  if (!tree_->solve(q.data(), qd.data(), x1, xd1, xdd1, qdd1.data())) return false;
+  if (!path_->tree()->solve(q.data(), qd.data(), x1, xd1, xdd1, qdd1.data())) return false;
   qdd = qdd1;
   x = x1;
   xd = xd1;

@@ -98,8 +98,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   auto finish = [&]() {
     res.newton_iterations = data_->total_newton_iterations;
     res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    tree_.reset();
-    chain_.reset();
+    path_ = std::make_unique<GeneralPath>();
     run_.held.resize(0);
     run_.predictor_order = RunOptions().predictor_order;
     run_.chord = RunOptions().chord;
@@ -204,10 +203,10 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   // The recursive and explicit-chain paths know neither time-dependent loads nor the energy's
   // quadrature states.
   const bool plain = timed_.empty() && !options.energy && options.sample_period == 0.0;
-  tree_ = plan.integrate && options.recursive && plain ? RecursiveTree::detect(*sys_, *data_) : nullptr;
-  res.recursive = tree_ != nullptr;
-  chain_ = plan.integrate && options.recursive && plain && !tree_ ? ExplicitChain::detect(*sys_) : nullptr;
-  if (tree_) {
+  path_ = RhsPath::choose(*sys_, *data_, plan.integrate && options.recursive && plain);
+  res.recursive = path_->tree() != nullptr;
+  res.path = path_->name();
+  if (res.recursive) {
     run_.base.xd = run_.base.xdd = Eigen::VectorXd::Zero(sys_->nx);
     run_.base.t = plan.t0;
   }
@@ -432,7 +431,6 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   const long newton = data_->total_newton_iterations;
   sys_ = compile(model_, dependent_);
   data_ = std::make_unique<Data>(*sys_);
-  if (chain_) chain_ = ExplicitChain::detect(*sys_);
   data_->x = x;
   data_->angle_ref = angles;
   data_->e_integrated = integrated;
@@ -440,6 +438,8 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   run_.base = run_.anchor = Solved();  // the next evaluation starts from x (q̂ has another meaning)
   run_.base.x = x;
   run_.base.angle_ref = angles;
+  // The chain of the recompiled system (one with free rotations is no tree).
+  if (path_->residual_form()) path_ = RhsPath::choose(*sys_, *data_, true);
   have_transfer_ = false;
   // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;

@@ -390,27 +390,9 @@ def _mass_properties(nodes, flexible, rigid_beams, bodies, bodies_of_point, body
     return point_masses
 
 
-def analyse(model, sim=None) -> Topology:
-    """Analyse a :class:`spacar.Model` (prepared and assembled here if no ``sim`` is given)."""
-    model.prepare()
-    if sim is None:
-        sim = _core.Simulation(model.core)
-        sim.assemble()
-    system = sim.system
-    # assemble() solves the positions only; the rates come with an evaluation at the initial state
-    sim.evaluate(float(model.current_time), np.asarray(system.q0, dtype=float), np.asarray(system.qd0, dtype=float))
-    data = sim.data
-    x0 = np.array(data.x, dtype=float)
-    xd0 = np.array(data.xd, dtype=float)
-    coord_index = {tuple(lbl): i for i, lbl in enumerate(system.coord_label)}
-    def_index = {tuple(lbl): i for i, lbl in enumerate(system.def_label)}
-
-    nodes = model.nodes
-    elements = model.elements
-    planar = _convertible(model)
-    node_kind = {n: nd.kind for n, nd in nodes.items()}
-
-    # Classify elements.
+def _classify_elements(elements):
+    """The rigid beams, the flexible (planar) beams and the hinges of a model; the elements the
+    converters cannot carry over raise UnsupportedModelError."""
     flexible, rigid_beams, hinges = [], [], []
     for k, el in sorted(elements.items()):
         t = el.type_name
@@ -434,10 +416,14 @@ def analyse(model, sim=None) -> Topology:
                 raise UnsupportedModelError(f"element {k} (HINGE): released misalignments e2, e3 are not converted")
             _check_zero_targets(el)
             hinges.append(el)
+    return flexible, rigid_beams, hinges
 
-    # Orientation nodes: rigid beams and rigid hinges join them into rigid bodies (the core's
-    # union-find); the bodies holding a fixed one are together the ground.
-    orient = [n for n, kd in node_kind.items() if kd in ORIENTATION_KINDS and nodes[n].used]
+
+def _rigid_bodies(nodes, orient, flexible, rigid_beams, hinges):
+    """The bodies (body 0 the ground, then the moving bodies by their first node) and the body of
+    every orientation node: rigid beams and rigid hinges join orientation nodes into rigid
+    bodies (the core's union-find), the bodies holding a fixed one are together the ground; a
+    BETA node of flexible beams only is no rigid body, and must not join one that moves."""
     flexible_orient = {el.nodes[1] for el in flexible} | {el.nodes[3] for el in flexible}
     links = [[el.nodes[1], el.nodes[3]] for el in rigid_beams]
     links += [[el.nodes[0], el.nodes[1]] for el in hinges if el.cls[0] == DC.fixed]
@@ -452,8 +438,6 @@ def analyse(model, sim=None) -> Topology:
         cls = nodes[n].cls
         if any(c == CC.fixed for c in cls) and not all(c == CC.fixed for c in cls):
             raise UnsupportedModelError(f"orientation node {n} is partly fixed; fix all or none of its components")
-
-    # Flexible beams: their BETA nodes must not be part of a moving rigid body.
     rigid_orient = {el.nodes[1] for el in rigid_beams} | {el.nodes[3] for el in rigid_beams}
     for el in hinges:
         rigid_orient |= set(el.nodes[:2])
@@ -462,9 +446,6 @@ def analyse(model, sim=None) -> Topology:
             raise UnsupportedModelError(
                 f"BETA node {n} joins a flexible beam to a rigid body (clamped connection to a moving body); "
                 "only clamping to the ground, pins (shared position nodes) and free ends are converted")
-
-    # Body 0 is the ground, then the moving bodies by their first node; a BETA node of flexible
-    # beams only (checked above) is no rigid body.
     groups = [sorted(ground)]
     for group in moving:
         body = [n for n in group if n not in flexible_orient]
@@ -476,23 +457,31 @@ def analyse(model, sim=None) -> Topology:
         for n in group:
             bodies[i].orientation_nodes.append(n)
             body_of_orientation[n] = i
+    return bodies, body_of_orientation
 
-    # Ground rotation: every fixed orientation node must have the same rotation.
-    ground_rotation = np.eye(3)
-    gnodes = bodies[0].orientation_nodes
-    if gnodes:
-        def node_rot(n):
-            if planar:
-                return rot_z(x0[coord_index[(n, 1)]])
-            return rotation([x0[coord_index[(n, i)]] for i in range(1, 5)])
-        ground_rotation = node_rot(gnodes[0])
-        for n in gnodes[1:]:
-            if np.abs(node_rot(n) - ground_rotation).max() > 1e-9:
-                raise UnsupportedModelError(f"fixed orientation nodes {gnodes[0]} and {n} differ in rotation")
 
-    # Driven (INPUTX) BETA nodes.
+def _ground_rotation(ground, planar, x0, coord_index):
+    """The rotation of the ground: every fixed orientation node must have the same."""
+    gnodes = ground.orientation_nodes
+    if not gnodes:
+        return np.eye(3)
+
+    def node_rot(n):
+        if planar:
+            return rot_z(x0[coord_index[(n, 1)]])
+        return rotation([x0[coord_index[(n, i)]] for i in range(1, 5)])
+    ground_rotation = node_rot(gnodes[0])
+    for n in gnodes[1:]:
+        if np.abs(node_rot(n) - ground_rotation).max() > 1e-9:
+            raise UnsupportedModelError(f"fixed orientation nodes {gnodes[0]} and {n} differ in rotation")
+    return ground_rotation
+
+
+def _driven_rotations(model, orient, bodies, body_of_orientation, x0, coord_index):
+    """The bodies turned by an INPUTX BETA node get its motion."""
+    nodes = model.nodes
     for n in orient:
-        if node_kind[n] == NK.BETA and nodes[n].cls[0] == CC.input:
+        if nodes[n].kind == NK.BETA and nodes[n].cls[0] == CC.input:
             b = body_of_orientation.get(n)
             if b is None or b == 0:
                 raise UnsupportedModelError(f"INPUTX on BETA node {n} of a flexible beam is not converted")
@@ -502,57 +491,59 @@ def analyse(model, sim=None) -> Topology:
             bodies[b].driven = DrivenRotation(n, model.current_time, float(x0[coord_index[(n, 1)]]),
                                               float(nd.xd[0]), float(nd.xdd[0]))
 
-    # Points of the bodies, in body-frame coordinates (ground: global), from the chords.
-    pos_nodes = [n for n, kd in node_kind.items() if kd in POSITION_KINDS and nodes[n].used]
+
+def _ground_point(node) -> np.ndarray:
+    return np.pad(np.asarray(node.x[:3], dtype=float), (0, 3 - len(node.x[:3])))
+
+
+def _place_points(body, edges, nodes, fully_fixed, planar, x0, coord_index):
+    """The points of a body in its frame (the ground's: global), propagated along its rigid
+    beams' chords from a fixed node (the ground) or its first point, the cycles checked."""
+    pts = body.points
+    if body.index == 0:
+        for n in sorted(fully_fixed):
+            pts[n] = _ground_point(nodes[n])
+    elif edges:
+        pts[edges[0][0]] = np.zeros(3)
+    changed = True
+    while changed:
+        changed = False
+        for p, q, c, eid in edges:
+            if p in pts and q not in pts:
+                pts[q] = pts[p] + c
+                changed = True
+            elif q in pts and p not in pts:
+                pts[p] = pts[q] - c
+                changed = True
+            elif p in pts and q in pts:
+                if np.abs(pts[q] - pts[p] - c).max() > 1e-9 * max(1.0, np.abs(c).max()):
+                    raise UnsupportedModelError(
+                        f"element {eid}: its reference chord does not fit the rigid body it belongs to "
+                        "(inconsistent LENGTHO/LGEOMY or an over-constrained ground)")
+        if not changed:
+            # a ground sub-structure not connected to a fixed node: start it from its assembled position
+            missing = [(p, q) for p, q, _, _ in edges if p not in pts and q not in pts]
+            if missing and body.index == 0:
+                p0 = missing[0][0]
+                pts[p0] = np.pad(x0[[coord_index[(p0, i)] for i in range(1, 3 if planar else 4)]], (0, 1 if planar else 0))
+                changed = True
+            elif missing:
+                raise UnsupportedModelError(f"body {body.orientation_nodes}: its rigid elements are not connected")
+    if body.index > 0 and not pts:
+        raise UnsupportedModelError(
+            f"orientation node(s) {body.orientation_nodes} belong to no element with a position node")
+
+
+def _body_points(nodes, pos_nodes, rigid_beams, bodies, body_of_orientation, ground_rotation, planar, x0, coord_index):
+    """Every body's points (_place_points) and the bodies of every point, fixed points on the ground."""
     fully_fixed = {n for n in pos_nodes if all(c == CC.fixed for c in nodes[n].cls)}
-    partial_fix = {n: [i for i, c in enumerate(nodes[n].cls) if c == CC.fixed]
-                   for n in pos_nodes if n not in fully_fixed and any(c == CC.fixed for c in nodes[n].cls)}
     edges = {b.index: [] for b in bodies}
     for el in rigid_beams:
         b = body_of_orientation[el.nodes[1]]
         R = ground_rotation if b == 0 else np.eye(3)
-        c = R @ _chord(el)
-        edges[b].append((el.nodes[0], el.nodes[2], c, el.id))
+        edges[b].append((el.nodes[0], el.nodes[2], R @ _chord(el), el.id))
     for b in bodies:
-        pts = b.points
-        seeds = []
-        if b.index == 0:
-            for n in sorted(fully_fixed):
-                pts[n] = np.pad(np.asarray(nodes[n].x[:3], dtype=float), (0, 3 - len(nodes[n].x[:3])))
-                seeds.append(n)
-        elif edges[b.index]:
-            first = edges[b.index][0][0]
-            pts[first] = np.zeros(3)
-            seeds.append(first)
-        # propagate along the chords until nothing changes; check consistency of cycles
-        changed = True
-        while changed:
-            changed = False
-            for p, q, c, eid in edges[b.index]:
-                if p in pts and q not in pts:
-                    pts[q] = pts[p] + c
-                    changed = True
-                elif q in pts and p not in pts:
-                    pts[p] = pts[q] - c
-                    changed = True
-                elif p in pts and q in pts:
-                    if np.abs(pts[q] - pts[p] - c).max() > 1e-9 * max(1.0, np.abs(c).max()):
-                        raise UnsupportedModelError(
-                            f"element {eid}: its reference chord does not fit the rigid body it belongs to "
-                            "(inconsistent LENGTHO/LGEOMY or an over-constrained ground)")
-            if not changed:
-                # a ground sub-structure not connected to a fixed node: start it from its assembled position
-                missing = [(p, q) for p, q, _, _ in edges[b.index] if p not in pts and q not in pts]
-                if missing and b.index == 0:
-                    p0 = missing[0][0]
-                    pts[p0] = np.pad(x0[[coord_index[(p0, i)] for i in range(1, 3 if planar else 4)]], (0, 1 if planar else 0))
-                    changed = True
-                elif missing:
-                    raise UnsupportedModelError(f"body {b.orientation_nodes}: its rigid elements are not connected")
-        if b.index > 0 and not pts:
-            raise UnsupportedModelError(
-                f"orientation node(s) {b.orientation_nodes} belong to no element with a position node")
-
+        _place_points(b, edges[b.index], nodes, fully_fixed, planar, x0, coord_index)
     bodies_of_point = {}
     for b in bodies:
         for n in b.points:
@@ -561,20 +552,17 @@ def analyse(model, sim=None) -> Topology:
         bodies_of_point.setdefault(n, [])
         if 0 not in bodies_of_point[n]:
             bodies_of_point[n].insert(0, 0)
-            bodies[0].points[n] = np.pad(np.asarray(nodes[n].x[:3], dtype=float), (0, 3 - len(nodes[n].x[:3])))
+            bodies[0].points[n] = _ground_point(nodes[n])
+    return bodies_of_point
 
-    # Mass properties.
-    point_masses = _mass_properties(nodes, flexible, rigid_beams, bodies, bodies_of_point, body_of_orientation)
-    flexible_pos = {el.nodes[0] for el in flexible} | {el.nodes[2] for el in flexible}
 
-    # Joints.
-    joints = []
+def _hinge_joints(hinges, body_of_orientation) -> dict:
+    """The revolute joints of the hinge elements by their pair of bodies (their pivots found later)."""
     hinge_pairs = {}
     for el in hinges:
         if el.cls[0] == DC.fixed:
             continue
-        o1, o2 = el.nodes[0], el.nodes[1]
-        a, b = body_of_orientation.get(o1), body_of_orientation.get(o2)
+        a, b = body_of_orientation.get(el.nodes[0]), body_of_orientation.get(el.nodes[1])
         if a is None or b is None:
             raise UnsupportedModelError(f"element {el.id} ({el.type_name}) joins a flexible beam; not converted")
         if a == b:
@@ -590,6 +578,14 @@ def analyse(model, sim=None) -> Topology:
         if key in hinge_pairs:
             raise UnsupportedModelError(f"bodies {key} are joined by two hinge elements")
         hinge_pairs[key] = Joint("revolute", (a, b), -1, axis, (el.id, 1), st, dp)
+    return hinge_pairs
+
+
+def _joints(hinges, body_of_orientation, bodies_of_point, planar):
+    """The joints: at every point shared by bodies, the hinge element's revolute joint there or, without
+    one, a pin (planar) or a spherical joint; no two joints between the same bodies (a weld)."""
+    hinge_pairs = _hinge_joints(hinges, body_of_orientation)
+    joints = []
     for n, owners in sorted(bodies_of_point.items()):
         if len(owners) < 2:
             continue
@@ -609,7 +605,6 @@ def analyse(model, sim=None) -> Topology:
     for key, j in hinge_pairs.items():
         raise UnsupportedModelError(
             f"hinge element {j.hinge[0]} joins bodies that share no position node (its pivot is undefined)")
-    # a body must not have two joints to the same body through different nodes (weld)
     seen = {}
     for j in joints:
         key = tuple(sorted(j.bodies))
@@ -618,8 +613,11 @@ def analyse(model, sim=None) -> Topology:
                 f"bodies {key} share the position nodes {seen[key]} and {j.node}: a rigid connection; "
                 "model it as one body")
         seen[key] = j.node
+    return joints
 
-    # Flexible beams.
+
+def _flexible_beams(flexible):
+    """The flexible beams' properties; beams through a shared BETA node must be straight there."""
     flex = []
     for el in flexible:
         ea = None
@@ -633,7 +631,6 @@ def analyse(model, sim=None) -> Topology:
         flex.append(FlexibleBeam(el.id, el.type_name, tuple(el.nodes), el.l0,
                                  el.lgeomy[0] if el.lgeomy else 0.0,
                                  el.emass[0] if el.emass else 0.0, ei, ea, el.type_name == "PLBEAMNL"))
-    # straight beams through shared BETA nodes
     alpha_at = {}
     for fb in flex:
         for n in (fb.nodes[1], fb.nodes[3]):
@@ -641,6 +638,43 @@ def analyse(model, sim=None) -> Topology:
                 raise UnsupportedModelError(
                     f"BETA node {n} joins flexible beams with different reference angles (a kink); not converted")
             alpha_at[n] = fb.alpha0
+    return flex
+
+
+def analyse(model, sim=None) -> Topology:
+    """Analyse a :class:`spacar.Model` (prepared and assembled here if no ``sim`` is given)."""
+    model.prepare()
+    if sim is None:
+        sim = _core.Simulation(model.core)
+        sim.assemble()
+    system = sim.system
+    # assemble() solves the positions only; the rates come with an evaluation at the initial state
+    sim.evaluate(float(model.current_time), np.asarray(system.q0, dtype=float), np.asarray(system.qd0, dtype=float))
+    data = sim.data
+    x0 = np.array(data.x, dtype=float)
+    xd0 = np.array(data.xd, dtype=float)
+    coord_index = {tuple(lbl): i for i, lbl in enumerate(system.coord_label)}
+    def_index = {tuple(lbl): i for i, lbl in enumerate(system.def_label)}
+
+    nodes = model.nodes
+    planar = _convertible(model)
+    node_kind = {n: nd.kind for n, nd in nodes.items()}
+    flexible, rigid_beams, hinges = _classify_elements(model.elements)
+    orient = [n for n, kd in node_kind.items() if kd in ORIENTATION_KINDS and nodes[n].used]
+    bodies, body_of_orientation = _rigid_bodies(nodes, orient, flexible, rigid_beams, hinges)
+    ground_rotation = _ground_rotation(bodies[0], planar, x0, coord_index)
+    _driven_rotations(model, orient, bodies, body_of_orientation, x0, coord_index)
+    pos_nodes = [n for n, kd in node_kind.items() if kd in POSITION_KINDS and nodes[n].used]
+    bodies_of_point = _body_points(nodes, pos_nodes, rigid_beams, bodies, body_of_orientation, ground_rotation,
+                                   planar, x0, coord_index)
+    point_masses = _mass_properties(nodes, flexible, rigid_beams, bodies, bodies_of_point, body_of_orientation)
+    joints = _joints(hinges, body_of_orientation, bodies_of_point, planar)
+    flex = _flexible_beams(flexible)
+
+    flexible_pos = {el.nodes[0] for el in flexible} | {el.nodes[2] for el in flexible}
+    partial_fix = {n: [i for i, c in enumerate(nodes[n].cls) if c == CC.fixed]
+                   for n in pos_nodes if any(c == CC.fixed for c in nodes[n].cls)
+                   and not all(c == CC.fixed for c in nodes[n].cls)}
     for n in partial_fix:
         if n not in flexible_pos and len(bodies_of_point.get(n, [])) != 1:
             raise UnsupportedModelError(f"node {n}: a partly fixed node must belong to one body or to beams")

@@ -12,15 +12,14 @@
 #include <string>
 #include <vector>
 
-#include "spacar/recursive/chain.hpp"
 #include "spacar/kinematics/data.hpp"
 #include "spacar/integrators/integrator.hpp"
 #include "spacar/analyses/linearize.hpp"
 #include "spacar/analyses/nodal.hpp"
+#include "spacar/analyses/rhs_path.hpp"
 #include "spacar/model/model.hpp"
 #include "spacar/model/system.hpp"
 #include "spacar/model/table.hpp"
-#include "spacar/recursive/tree.hpp"
 
 namespace spacar {
 
@@ -112,6 +111,7 @@ struct BlockResults {
   double last_step = 0.0;
   double wall_time = 0.0;      // seconds spent in the block
   bool recursive = false;      // the right-hand sides took the recursive path (tree.hpp)
+  const char* path = "general";  // the right-hand-side path the run chose (RhsPath::name)
   std::vector<std::string> warnings;
 };
 
@@ -352,12 +352,9 @@ class Simulation {
   Eigen::VectorXd predicted_;    // change of the positions predicted by the transfer function
   bool have_transfer_ = false;
   std::unique_ptr<Linearizer> linearizer_;
-  // The recursive right-hand side of planar and spatial rigid trees, set for a run (RunOptions::recursive).
-  std::unique_ptr<RecursiveTree> tree_;
-  // The explicit positions of open chains (chain.hpp), set for a run (RunOptions::recursive) when
-  // the system is one and no tree_: in the right-hand sides (with their velocities), at the step
-  // starts and at the output times.
-  std::unique_ptr<ExplicitChain> chain_;
+  // How the states are evaluated (rhs_path.hpp): chosen for a run (RunOptions::recursive), the
+  // general path outside runs, except that recursive_state() keeps the tree it took.
+  std::unique_ptr<RhsPath> path_ = std::make_unique<GeneralPath>();
   void newton_refresh(double t, const Eigen::VectorXd& Y);
   // The tree's state at (t, Y) into run_.base (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.
