@@ -90,6 +90,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   run_.held.resize(0);
   run_.predictor_order = options.predictor_order;
   run_.chord = options.chord;
+  run_.fixed_step = plan.fixed_step;
   // One deadline (limits.hpp), checked at every right-hand side and output time and inside the
   // sparse factorizations; the time the set-up took counts against it.
   const DeadlineScope deadline(options.time_limit, options.time_spent);
@@ -102,6 +103,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     run_.held.resize(0);
     run_.predictor_order = RunOptions().predictor_order;
     run_.chord = RunOptions().chord;
+    run_.fixed_step = 0.0;
   };
   try {
     integrate_block(res, options, plan, k_out);
@@ -163,6 +165,7 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
     if (st.timestep_tp / st.hmax > static_cast<double>(options.max_steps))
       throw InputError("HMAX " + format_number(st.hmax, 12) + " needs at least Tp/HMAX = " + format_number(st.timestep_tp / st.hmax, 12) +
                        " steps, more than the limit of " + std::to_string(options.max_steps) + " steps per block");
+    plan.fixed_step = planned_fixed_step(options, st, t0, n_out, warnings);
     for (auto [eps, name] : {std::pair<double*, const char*>{&st.epsint, "EPSINT"}, {&st.epsind, "EPSIND"}})
       if (*eps < kMinTolerance) {
         warnings.push_back(std::string(name) + " " + format_number(*eps, 12) +
@@ -176,6 +179,30 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
   for (int k = 0; k < nt; ++k) plan.times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
   plan.times.back() = t_end;  // exactly the end of the block, whatever the rounding
   return plan;
+}
+
+// Generalized-α's fixed step, checked against the block before any work: a step longer than the
+// output interval would interpolate the outputs across whole periods of the motion (cut to the
+// interval, with a warning); one so short that the block needs more steps than the limit, or
+// below the smallest step, is refused as HMAX is.
+double Simulation::planned_fixed_step(const RunOptions& options, const Settings& st, double t0, int n_out,
+                                      std::vector<std::string>& warnings) {
+  double h = options.fixed_step;
+  if (h == 0.0) return h;
+  const double interval = st.timestep_tp / n_out;
+  if (h > interval) {
+    warnings.push_back("fixed_step " + format_number(h, 12) + " is longer than the output interval Tp/n = " +
+                       format_number(interval, 12) + ": the steps are cut to the output interval");
+    h = interval;
+  }
+  if (h < Stepper::min_step(t0 + st.timestep_tp))
+    throw InputError("fixed_step " + format_number(h, 12) + " is below the smallest integration step " +
+                     format_number(Stepper::min_step(t0 + st.timestep_tp), 12) + " at the end of the block");
+  if (st.timestep_tp / h > static_cast<double>(options.max_steps))
+    throw InputError("fixed_step " + format_number(h, 12) + " needs Tp/fixed_step = " +
+                     format_number(st.timestep_tp / h, 12) + " steps, more than the limit of " +
+                     std::to_string(options.max_steps) + " steps per block");
+  return h;
 }
 
 void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) const {
@@ -330,7 +357,7 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
     };
   }
   setup.rho_inf = options.rho_inf;
-  setup.fixed_step = options.fixed_step;
+  setup.fixed_step = run_.fixed_step;
   setup.auto_switch = auto_switch;
   return setup;
 }

@@ -179,6 +179,7 @@ struct RunState {
   bool in_rhs = false;  // evaluating a right-hand side of the stepper
   int predictor_order = RunOptions().predictor_order;  // of the run (measurements)
   bool chord = RunOptions().chord;
+  double fixed_step = 0.0;  // generalized-α's fixed step of the run (BlockPlan::fixed_step)
   Eigen::MatrixXd jacobian_mass;  // M̄ at the state of the last jacobian()
   // The sparse Newton matrix's state (a copy of data at its last refresh) and reduced system.
   std::unique_ptr<Data> newton_data;
@@ -296,8 +297,11 @@ class Simulation {
     bool integrate = false;      // degrees of freedom or integrated deformations, and a period
     bool linear = false;         // linearized equations at every output time
     std::vector<double> times;   // the output times, the last exactly t_end
+    double fixed_step = 0.0;     // generalized-α's fixed step (planned_fixed_step), 0: error control
   };
   BlockPlan plan_block(const RunOptions& options, std::vector<std::string>& warnings) const;
+  static double planned_fixed_step(const RunOptions& options, const Settings& st, double t0, int n_out,
+                                   std::vector<std::string>& warnings);
   void allocate_results(BlockResults& res, const BlockPlan& plan) const;
   // k_out: the output times recorded (also when it throws).
   void integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out);
