@@ -26,6 +26,14 @@ void GeneralPath::residual(const System& sys, Data& data, Eigen::VectorXd& R) co
   reduced_residual_direct(sys, data, R);
 }
 
+void GeneralPath::transfer(const System& sys, Data& data, const Eigen::VectorXd& v, Eigen::VectorXd& dx) const {
+  transfer_times(sys, data, v, dx);
+}
+
+void ChainPath::transfer(const System& sys, Data& data, const Eigen::VectorXd& v, Eigen::VectorXd& dx) const {
+  chain_->transfer_times(sys, data, v, dx);
+}
+
 void ChainPath::positions(const System& sys, Data& data, const Eigen::VectorXd* step_start, bool) const {
   chain_->solve_positions(sys, data, sys.settings.maxiterat, sys.settings.epskin, step_start);
 }

@@ -335,6 +335,19 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
     };
     setup.weight = [this](Eigen::MatrixXd& W) { W = run_.jacobian_mass; };
   }
+  if (!path_->tree()) {  // the step control of the nodal positions (generalized-α)
+    setup.position_error = [this](const Eigen::VectorXd& dq, Eigen::VectorXd& scaled) {
+      const System& sys = *sys_;
+      Eigen::VectorXd v = Eigen::VectorXd::Zero(sys.n_qhat());
+      for (int j = 0; j < sys.n_dof(); ++j) v[sys.dof_cols[j]] = dq[j];
+      Eigen::VectorXd dx;
+      path_->transfer(sys, *data_, v, dx);
+      scaled.resize(static_cast<Eigen::Index>(sys.x_calc.size() + sys.x_dyn.size()));
+      Eigen::Index k = 0;
+      for (const std::vector<int>* list : {&sys.x_calc, &sys.x_dyn})
+        for (int c : *list) scaled[k++] = dx[c] / (1e-3 + std::abs(data_->x[c]));
+    };
+  }
   if (sparse_newton()) {
     run_.newton_data.reset();  // the system of this segment (a repartition recompiles it)
     run_.newton_system.reset();

@@ -41,6 +41,8 @@ class RhsPath {
   // The residual of the reduced equations at the q̂̈ set in data (reduced_residual_direct), after
   // positions() and velocities() in a right-hand side.
   virtual void residual(const System& sys, Data& data, Eigen::VectorXd& R) const = 0;
+  // dx = DF v (nx) for rates v of q̂, at the state of the last right-hand side.
+  virtual void transfer(const System& sys, Data& data, const Eigen::VectorXd& v, Eigen::VectorXd& dx) const = 0;
   // Whether a right-hand side's positions are held to the prediction from the step start (the
   // check that Newton stayed on the branch), given whether the step start is exact.
   virtual bool held_to_step_start(bool start_exact) const = 0;
@@ -57,6 +59,7 @@ class GeneralPath : public RhsPath {
   void positions(const System& sys, Data& data, const Eigen::VectorXd* step_start, bool exact) const override;
   void velocities(const System& sys, Data& data, bool in_rhs) const override;
   void residual(const System& sys, Data& data, Eigen::VectorXd& R) const override;
+  void transfer(const System& sys, Data& data, const Eigen::VectorXd& v, Eigen::VectorXd& dx) const override;
   const char* name() const override { return "general"; }
   bool held_to_step_start(bool) const override { return true; }
 };
@@ -68,6 +71,7 @@ class ChainPath : public GeneralPath {
   void positions(const System& sys, Data& data, const Eigen::VectorXd* step_start, bool exact) const override;
   void velocities(const System& sys, Data& data, bool in_rhs) const override;
   void residual(const System& sys, Data& data, Eigen::VectorXd& R) const override;
+  void transfer(const System& sys, Data& data, const Eigen::VectorXd& v, Eigen::VectorXd& dx) const override;
   // The chain's element iterations start from their predicted positions one by one: held to the
   // step start only from an exact one (an approximate one, generalized-α's last iterate, differs
   // by up to a Newton increment, which would reject good steps).

@@ -95,6 +95,8 @@ class GeneralizedAlpha : public Stepper {
   int m_, r0_, nz_;
   double alpha_m_, alpha_f_, gamma_, beta_, gamma_d_, beta_d_;
   double h_fixed_ = 0.0;
+  std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)> position_error_;  // StepperSetup's
+  Eigen::VectorXd dq_, dx_;  // its argument and result
   Residual residual_;
   ResidualWeight weight_;
   NewtonSystem system_;  // set: it replaces J_, N_, W_ and lu_

@@ -202,6 +202,10 @@ struct StepperSetup {
   NewtonSystem newton;        // optional: a sparse Newton matrix (large models)
   double rho_inf = 0.9;       // generalized-α's spectral radius at infinite frequency
   double fixed_step = 0.0;    // generalized-α: fixed steps without error control (0: controlled)
+  // Optional, generalized-α: the error of the positions q mapped to the coordinates the model
+  // moves, each divided by (10⁻³ + |x|): the step control then bounds the nodal positions' error
+  // as well as the DOFs' (a flexible beam's DOFs are deformations, which its tip adds up).
+  std::function<void(const Eigen::VectorXd& dq, Eigen::VectorXd& scaled_dx)> position_error;
   // Radau5 keeps a Jacobian while Newton contracts at least this fast (Hairer's default 0.001;
   // a run's Jacobian is a linearization costing several right-hand sides per DOF).
   double jacobian_reuse = 0.1;
