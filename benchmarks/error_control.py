@@ -1,12 +1,15 @@
 """What EPSINT bounds (issue 36, docs/stiff-integration.md "What EPSINT bounds, measured"): the tip
-error of the undamped steel cantilever (PLBEAMs, EI 175 N m², ρA 0.785 kg/m, gravity, 0.2 s,
-EPSKIN 1e-12) against a Richardson-extrapolated reference (generalized-α, ρ∞ = 1, fixed steps 4e-5
-and 2e-5 s), as a multiple of the EPSINT asked for, with the step counts: generalized-α (its error estimate
-in the nodal positions) on meshes of 8 … 128 elements, DOP853 and Radau5 on the small meshes
-(they resolve every mode and take seconds).
+error of steel cantilevers (EI 175 N m², ρA 0.785 kg/m, gravity, 0.2 s, EPSKIN 1e-12) against a
+Richardson-extrapolated reference (generalized-α, ρ∞ = 1, fixed steps 4e-5 and 2e-5 s), as a
+multiple of the EPSINT asked for, with the step counts:
 
-    python benchmarks/error_control.py            # n = 8, 16, 32, 64, 128 (about two minutes)
-    python benchmarks/error_control.py 8 32       # some meshes
+* planar, n PLBEAMs, undamped and with stiffness-proportional damping (EDAMPP 1e-3 EI, as
+  benchmarks/stiff.py): generalized-α on meshes of 8 … 128 elements, DOP853 and Radau5 on the
+  small meshes (they resolve every mode and take seconds);
+* spatial, 16 BEAMs bending about both axes (EIz = 4 EIy, gravity off both), undamped.
+
+    python benchmarks/error_control.py            # every case (about five minutes)
+    python benchmarks/error_control.py 8 32       # the planar cases of some meshes, and the spatial one
 """
 from __future__ import annotations
 
@@ -16,31 +19,67 @@ import spacar
 from spacar.compare import models
 
 TOLERANCES = (1e-4, 1e-6)
+EI, RHO_A, DAMPING, G = 175.0, 0.785, 1e-3, 9.81
 
 
-def tip(n: int, method: str, eps: float, **options):
-    """The tip's vertical position at the end, and the run's step count."""
-    model = models.cantilever(n, ei=175.0, rho_a=0.785, t_end=0.2, n_out=1, eps=eps, epskin=1e-12)
-    res = spacar.simulate(model, method=method, progress=False, **options)
-    return res.node(n + 1).x[-1, 1], res.stats["steps"]
+def planar(n: int, eps: float, damped: bool) -> spacar.Model:
+    m = models.cantilever(n, ei=EI, rho_a=RHO_A, t_end=0.2, n_out=1, eps=eps, epskin=1e-12)
+    if damped:
+        for i in range(1, n + 1):
+            m.edampp(i, 0.0, DAMPING * EI)
+    return m
 
 
-def reference(n: int) -> float:
-    coarse, _ = tip(n, "generalized_alpha", 1e-10, rho_inf=1.0, fixed_step=4e-5)
-    fine, _ = tip(n, "generalized_alpha", 1e-10, rho_inf=1.0, fixed_step=2e-5)
-    return fine + (fine - coarse) / 3.0  # second order
+def spatial(n: int, eps: float, damped: bool = False) -> spacar.Model:
+    """n BEAMs along x, clamped at x = 0, bending about y and z (EIz = 4 EIy), gravity off both."""
+    m = spacar.Model()
+    for i in range(n):
+        m.beam(i + 1, i + 1, 101 + i, i + 2, 102 + i, 0.0, 1.0, 0.0)
+    for i in range(n + 1):
+        m.xyz(i + 1, i / n, 0.0, 0.0)
+    m.fix(1)
+    m.fix(101)
+    for i in range(n):
+        m.dyne(i + 1, 2, 3, 4, 5, 6)
+        m.estiff(i + 1, 0.0, EI, EI, 4.0 * EI)
+        m.emass(i + 1, RHO_A, 1e-4, 0.0, 0.0)
+    m.gravity(0.0, -G, -0.5 * G)
+    m.epsint(eps)
+    m.epsind(eps)
+    m.epskin(1e-12)
+    m.timestep(1, 0.2)
+    return m
+
+
+def tip(build, n: int, method: str, eps: float, **options):
+    """The tip's displacement vector at the end (y, and z in space) and the run's step count."""
+    res = spacar.simulate(build(n, eps), method=method, progress=False, **options)
+    return res.node(n + 1).x[-1, 1:], res.stats["steps"]
+
+
+def error(build, n: int):
+    coarse, _ = tip(build, n, "generalized_alpha", 1e-10, rho_inf=1.0, fixed_step=4e-5)
+    fine, _ = tip(build, n, "generalized_alpha", 1e-10, rho_inf=1.0, fixed_step=2e-5)
+    reference = fine + (fine - coarse) / 3.0  # second order
+    return lambda y: float(abs(y - reference).max())
+
+
+def table(name, build, meshes, small=16) -> None:
+    for n in meshes:
+        err = error(build, n)
+        methods = ("generalized_alpha", "dop853", "radau5") if n <= small else ("generalized_alpha",)
+        for method in methods:
+            for eps in TOLERANCES:
+                y, steps = tip(build, n, method, eps)
+                print(f"| {name} | {n} | {method} | {eps:.0e} | {err(y) / eps:.3g} | {steps} |", flush=True)
 
 
 def main(meshes) -> None:
-    print("| elements | method | EPSINT | tip error / EPSINT | steps |")
-    print("|---|---|---|---|---|")
-    for n in meshes:
-        ref = reference(n)
-        methods = ("generalized_alpha", "dop853", "radau5") if n <= 16 else ("generalized_alpha",)
-        for method in methods:
-            for eps in TOLERANCES:
-                y, steps = tip(n, method, eps)
-                print(f"| {n} | {method} | {eps:.0e} | {abs(y - ref) / eps:.3g} | {steps} |", flush=True)
+    print("| case | elements | method | EPSINT | tip error / EPSINT | steps |")
+    print("|---|---|---|---|---|---|")
+    table("planar, undamped", lambda n, eps: planar(n, eps, False), meshes)
+    table("planar, damped", lambda n, eps: planar(n, eps, True), meshes, small=8)
+    table("spatial, undamped", spatial, [16], small=0)
 
 
 if __name__ == "__main__":
