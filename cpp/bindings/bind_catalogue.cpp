@@ -11,10 +11,6 @@
 
 namespace spacar::bindings {
 
-namespace {
-using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-}  // namespace
-
 void bind_catalogue(py::module_& m) {
   py::enum_<NodeKind>(m, "NodeKind")
       .value("X", NodeKind::Any)

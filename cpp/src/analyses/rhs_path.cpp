@@ -7,12 +7,15 @@
 namespace spacar {
 
 std::unique_ptr<RhsPath> RhsPath::choose(const System& sys, const Data& data, bool recursive) {
-  if (recursive) {
-    if (std::unique_ptr<RecursiveTree> tree = RecursiveTree::detect(sys, data))
-      return std::make_unique<TreePath>(std::move(tree));
-    if (std::unique_ptr<ExplicitChain> chain = ExplicitChain::detect(sys))
-      return std::make_unique<ChainPath>(std::move(chain));
-  }
+  if (!recursive) return std::make_unique<GeneralPath>();
+  if (std::unique_ptr<RecursiveTree> tree = RecursiveTree::detect(sys, data))
+    return std::make_unique<TreePath>(std::move(tree));
+  return chain_or_general(sys);
+}
+
+std::unique_ptr<RhsPath> RhsPath::chain_or_general(const System& sys) {
+  if (std::unique_ptr<ExplicitChain> chain = ExplicitChain::detect(sys))
+    return std::make_unique<ChainPath>(std::move(chain));
   return std::make_unique<GeneralPath>();
 }
 

@@ -195,9 +195,10 @@ double Simulation::planned_fixed_step(const RunOptions& options, const Settings&
                        format_number(interval, 12) + ": the steps are cut to the output interval");
     h = interval;
   }
-  if (h < Stepper::min_step(t0 + st.timestep_tp))
+  const double h_min = Stepper::min_step(t0 + st.timestep_tp);
+  if (h < h_min)
     throw InputError("fixed_step " + format_number(h, 12) + " is below the smallest integration step " +
-                     format_number(Stepper::min_step(t0 + st.timestep_tp), 12) + " at the end of the block");
+                     format_number(h_min, 12) + " at the end of the block");
   if (st.timestep_tp / h > static_cast<double>(options.max_steps))
     throw InputError("fixed_step " + format_number(h, 12) + " needs Tp/fixed_step = " +
                      format_number(st.timestep_tp / h, 12) + " steps, more than the limit of " +
@@ -336,11 +337,12 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
     setup.weight = [this](Eigen::MatrixXd& W) { W = run_.jacobian_mass; };
   }
   if (!path_->tree()) {  // the step control of the nodal positions (generalized-α)
-    setup.position_error = [this](const Eigen::VectorXd& dq, Eigen::VectorXd& scaled) {
+    // v and dx: the lambda's own work space, sized at the first step.
+    setup.position_error = [this, v = Eigen::VectorXd(), dx = Eigen::VectorXd()](const Eigen::VectorXd& dq,
+                                                                                 Eigen::VectorXd& scaled) mutable {
       const System& sys = *sys_;
-      Eigen::VectorXd v = Eigen::VectorXd::Zero(sys.n_qhat());
+      v.setZero(sys.n_qhat());
       for (int j = 0; j < sys.n_dof(); ++j) v[sys.dof_cols[j]] = dq[j];
-      Eigen::VectorXd dx;
       path_->transfer(sys, *data_, v, dx);
       scaled.resize(static_cast<Eigen::Index>(sys.x_calc.size() + sys.x_dyn.size()));
       Eigen::Index k = 0;
@@ -478,8 +480,9 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   run_.base = run_.anchor = Solved();  // the next evaluation starts from x (q̂ has another meaning)
   run_.base.x = x;
   run_.base.angle_ref = angles;
-  // The chain of the recompiled system (one with free rotations is no tree).
-  if (path_->residual_form()) path_ = RhsPath::choose(*sys_, *data_, true);
+  // The chain of the recompiled system (residual_form(): the chain's path; a system with free
+  // rotations is no tree).
+  if (path_->residual_form()) path_ = RhsPath::chain_or_general(*sys_);
   have_transfer_ = false;
   // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;

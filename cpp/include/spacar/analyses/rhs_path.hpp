@@ -28,6 +28,8 @@ class RhsPath {
   // turns off where those paths do not apply: time-dependent loads, a controller, energy
   // states), else the general path. Taken at the solved positions in data.
   static std::unique_ptr<RhsPath> choose(const System& sys, const Data& data, bool recursive);
+  // The open chain's path if the system is one, else the general path.
+  static std::unique_ptr<RhsPath> chain_or_general(const System& sys);
   // "general", "chain" or "tree" (the run's stats).
   virtual const char* name() const = 0;
 

@@ -23,8 +23,6 @@
 
 namespace spacar {
 
-using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-
 struct RunOptions {
   // AUTO: DOP853 until it detects stiffness, RADAU5 until the stiffness goes (integrate_block).
   Method method = Method::DOP853;

@@ -10,6 +10,9 @@
 
 namespace spacar {
 
+// Row-major results, one row per state (the output arrays, Python's layout).
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
 struct ElementWork {
   Eigen::VectorXd x, v, a;      // local coordinates, velocities, accelerations (nc)
   Eigen::MatrixXd B;            // ∂e/∂x (nd x nc)
