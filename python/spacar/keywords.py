@@ -141,7 +141,7 @@ _OTHER = [
             "integrate over a time period Tp with n constant output intervals"),
     Keyword("HMAX", SETTINGS, (_p("h", REAL),), "maximum integration step size h"),
     Keyword("MAXITERAT", SETTINGS, (_p("n"),), "maximum number n of kinematic iterations per step"),
-    Keyword("EPSKIN", SETTINGS, (_p("eps", REAL),), "kinematic convergence tolerance on the deformations"),
+    Keyword("EPSKIN", SETTINGS, (_p("eps", REAL),), "kinematic convergence tolerance on the deformations (in a simulation at most 1e-4 of EPSINT and EPSIND)"),
     Keyword("EPSINT", SETTINGS, (_p("eps", REAL),), "local integration error tolerance for the deformations"),
     Keyword("EPSIND", SETTINGS, (_p("eps", REAL),),
             "local integration error tolerance for the deformation rates"),

@@ -361,7 +361,8 @@ class Model:
         self._core.set_maxiterat(*self._call("MAXITERAT", n))
 
     def epskin(self, eps):
-        """EPSKIN eps: kinematic convergence tolerance on the deformations."""
+        """EPSKIN eps: kinematic convergence tolerance on the deformations (a simulation uses at most
+        1e-4 of EPSINT and EPSIND, so that Newton's residual stays below the step control's scale)."""
         self._core.set_epskin(*self._call("EPSKIN", eps))
 
     def epsint(self, eps):

@@ -20,7 +20,7 @@ std::unique_ptr<RhsPath> RhsPath::chain_or_general(const System& sys) {
 }
 
 void GeneralPath::positions(const System& sys, Data& data, const Eigen::VectorXd*, bool exact) const {
-  solve_positions(sys, data, sys.settings.maxiterat, sys.settings.epskin, false, exact);
+  solve_positions(sys, data, sys.settings.maxiterat, simulation_kinematic_tolerance(sys), false, exact);
 }
 
 void GeneralPath::velocities(const System& sys, Data& data, bool) const { solve_velocities_direct(sys, data); }
@@ -38,7 +38,7 @@ void ChainPath::transfer(const System& sys, Data& data, const Eigen::VectorXd& v
 }
 
 void ChainPath::positions(const System& sys, Data& data, const Eigen::VectorXd* step_start, bool) const {
-  chain_->solve_positions(sys, data, sys.settings.maxiterat, sys.settings.epskin, step_start);
+  chain_->solve_positions(sys, data, sys.settings.maxiterat, simulation_kinematic_tolerance(sys), step_start);
 }
 
 // Other evaluations factorize the velocity block, which the forces and transfer use.

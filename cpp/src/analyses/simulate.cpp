@@ -137,7 +137,7 @@ void Simulation::assemble() {
   apply_time_loads(sys.t0);
   set_dofs(sys, *data_, sys.q0.data(), sys.qd0.data());
   check_constraint_counts(sys, *data_);
-  solve_positions(sys, *data_, sys.settings.maxiterat, sys.settings.epskin, true);
+  solve_positions(sys, *data_, sys.settings.maxiterat, simulation_kinematic_tolerance(sys), true);
   run_.base = run_.anchor = Solved();
   run_.base.x = data_->x;  // positions only: no velocities yet for the predictor
   run_.base.angle_ref = data_->angle_ref;

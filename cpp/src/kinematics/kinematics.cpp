@@ -235,6 +235,12 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
   check_auto_released(sys, data, tol);
 }
 
+double simulation_kinematic_tolerance(const System& sys) {
+  const Settings& st = sys.settings;
+  const double roundoff = 1e-13 * std::max(1.0, sys.length_scale);
+  return std::min(st.epskin, std::max(1e-4 * std::min(st.epsint, st.epsind), roundoff));
+}
+
 void check_auto_released(const System& sys, const Data& data, double tol) {
   // Deformations without calculable coordinates are not in the block: check them directly.
   for (int k : sys.auto_released) {

@@ -37,6 +37,11 @@ void check_auto_released(const System& sys, const Data& data, double tol);
 // iteration at all when the residual is within tol. Throws KinematicsError.
 void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly,
                      bool exact_start = false);
+// The tolerance of the position solves of a simulation: EPSKIN, tightened to 1e-4 of the smaller
+// of EPSINT and EPSIND (the step control's scale of a small coordinate is 1e-3 EPS: a looser
+// residual is noise in the right-hand side that drives the step size and makes the implicit
+// methods refactorize; benchmarks/error_control.py, the spin-up case), not below round-off.
+double simulation_kinematic_tolerance(const System& sys);
 
 // DF (∂x/∂q̂) and DFe (∂e/∂q̂) at the current positions; factorizes the velocity block.
 void solve_transfer(const System& sys, Data& data);
