@@ -1,6 +1,7 @@
 """method="auto": DOP853 until it detects stiffness (Hairer's test), then Radau IIA until the
-stiffness goes (ρ(J)·h below DOP853's stability bound over LSODA's factor 5); the switches in
-res.stats. The rules on scalar ODEs through the test bindings, then the analysis: a stiffly damped
+stiffness goes (ρ(J)·h below DOP853's stability bound over LSODA's factor 5), or, for an undamped
+structure at EPSINT ≥ 1e-6, generalized-α as soon as DOP853's steps are set by its fastest
+vibration; the switches in res.stats. The rules on scalar ODEs through the test bindings, then the analysis: a stiffly damped
 steel cantilever goes to radau5 early and costs about what radau5 costs, the manual's slider-crank
 stays on DOP853 with the very same numbers."""
 
@@ -76,6 +77,41 @@ def test_damped_cantilever_switches_to_radau_early():
     assert res.stats["rhs_evaluations"] < 3 * rad.stats["rhs_evaluations"], (res.stats, rad.stats)
     scale = np.abs(rad.x - rad.x[0]).max()
     assert np.abs(res.x - rad.x).max() < 1e-2 * scale
+
+
+def tip_reference(n=8, t_end=0.2):
+    """The undamped steel cantilever's tip (x, y) at t_end, Richardson-extrapolated from
+    generalized-α at ρ∞ = 1 and fixed steps 4e-5 and 2e-5 s (second order; as
+    benchmarks/error_control.py)."""
+    def tip(h):
+        res = spacar.simulate(steel_cantilever(n, t_end=t_end, n_out=1, eps=1e-10), method="generalized_alpha",
+                              rho_inf=1.0, fixed_step=h, progress=False)
+        return res.node(n + 1).x[-1]
+    coarse, fine = tip(4e-5), tip(2e-5)
+    return fine + (fine - coarse) / 3.0
+
+
+def test_undamped_structure_goes_to_generalized_alpha():
+    # 8 PLBEAMs of steel, undamped, EPSINT 1e-4: DOP853's steps are set by the fastest vibration
+    # the release excites (h|λ| > 1), which generalized-α need not resolve. Before, auto went to
+    # radau5 at EPSINT 1e-3 (3 349 steps, 0.23 s) and stayed on DOP853 at 1e-4 (2 740 steps); now
+    # it hands over within the first millisecond and costs what generalized-α costs.
+    eps = 1e-4
+    ga = spacar.simulate(steel_cantilever(n_out=1, eps=eps), method="generalized_alpha", progress=False)
+    res = spacar.simulate(steel_cantilever(n_out=1, eps=eps), method="auto", progress=False)
+    assert [s[1:] for s in res.stats["switches"]] == [("dop853", "generalized_alpha")]
+    assert res.stats["switches"][0][0] < 5e-3, res.stats
+    assert res.stats["steps"] < 1.2 * ga.stats["steps"], (res.stats, ga.stats)
+    error = np.abs(res.node(9).x[-1] - tip_reference()).max()
+    assert error < 0.5 * eps, error  # measured: 0.12 EPSINT
+
+
+def test_tight_tolerances_and_damped_structures_keep_off_generalized_alpha():
+    # Below EPSINT 1e-6 a second-order method does not pay: the old rules (radau5 where stiff).
+    tight = spacar.simulate(steel_cantilever(t_end=0.005, eps=1e-7), method="auto", progress=False)
+    assert all(s[2] != "generalized_alpha" for s in tight.stats["switches"]), tight.stats
+    damped = spacar.simulate(steel_cantilever(t_end=0.005, eps=1e-4, damping=1e-3), method="auto", progress=False)
+    assert [s[1:] for s in damped.stats["switches"]] == [("dop853", "radau5")]
 
 
 def test_slider_crank_stays_on_dop853_with_the_same_numbers():

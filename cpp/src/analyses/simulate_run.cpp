@@ -277,8 +277,13 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   if (sampled) sample(plan.t0);
   double t = plan.t0, h = options.initial_step;
   run_.kinematic_failure.clear();
-  // AUTO starts explicit: most mechanisms are not stiff, and DOP853 tells when one is.
+  // AUTO starts explicit: most mechanisms are not stiff, and DOP853 tells when one is. An
+  // undamped structure goes on with generalized-α where DOP853's steps are set by its fastest
+  // vibration (h|λ| > 1): generalized-α's are set by the motion EPSINT asks for, and it stays;
+  // a stiff damped model goes on with Radau, which returns to DOP853 where the stiffness goes
+  // (docs/stiff-integration.md).
   const bool auto_switch = options.method == Method::AUTO;
+  const Method stiff_method = auto_takes_generalized_alpha() ? Method::GENERALIZED_ALPHA : Method::RADAU5;
   Method method = auto_switch ? Method::DOP853 : options.method;
   res.method = method;
   for (;;) {
@@ -307,13 +312,28 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
       continue;
     }
     if (end.switch_method) {
-      const Method other = method == Method::DOP853 ? Method::RADAU5 : Method::DOP853;
+      const Method other = method == Method::DOP853 ? stiff_method : Method::DOP853;
       res.switches.push_back({t, method, other});
       method = other;
     }
     const int rotation = rotation_to_repartition(Y);
     if (rotation >= 0) repartition(rotation, t, Y);
   }
+}
+
+bool Simulation::auto_takes_generalized_alpha() const {
+  const System& sys = *sys_;
+  // Below 1e-6 generalized-α's steps grow as EPS^(-1/3) and its error stops following EPS
+  // (docs/stiff-integration.md): radau5 and dop853 are the methods for tight tolerances.
+  if (std::min(sys.settings.epsint, sys.settings.epsind) < 1e-6) return false;
+  bool elastic = false;
+  for (const SystemElement& se : sys.elements) {
+    if (!se.has_constitutive) continue;
+    if (!se.D.isZero(0.0)) return false;
+    for (int a = 0; a < se.nd; ++a)
+      elastic = elastic || (sys.def_class[se.def_offset + a] == DefClass::Dynamic && (se.S.row(a).array() != 0.0).any());
+  }
+  return elastic;
 }
 
 StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_switch, int n_states) {
@@ -374,6 +394,7 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
   setup.rho_inf = options.rho_inf;
   setup.fixed_step = run_.fixed_step;
   setup.auto_switch = auto_switch;
+  if (auto_switch && auto_takes_generalized_alpha()) setup.stiff_bound = 1.0;
   return setup;
 }
 

@@ -202,14 +202,16 @@ Integrator::Integrator(int n, Method method) : Stepper("Integrator", n), method_
 
 std::unique_ptr<Stepper> Integrator::make(Method method, const StepperSetup& setup) {
   auto stepper = std::make_unique<Integrator>(setup.n, method);
-  stepper->set_stiffness_detection(setup.auto_switch, setup.stiff_steps_ahead);
+  stepper->set_stiffness_detection(setup.auto_switch, setup.stiff_steps_ahead, setup.stiff_bound);
   return stepper;
 }
 
-void Integrator::set_stiffness_detection(bool on, double min_steps_ahead) {
+void Integrator::set_stiffness_detection(bool on, double min_steps_ahead, double bound) {
   if (!(min_steps_ahead >= 0)) throw std::invalid_argument("Integrator: min_steps_ahead must be >= 0");
+  if (!(bound >= 0)) throw std::invalid_argument("Integrator: the stiffness bound must be >= 0");
   detect_stiffness_ = on;
   min_steps_ahead_ = min_steps_ahead;
+  stiff_bound_ = bound > 0.0 ? bound : scheme(method_).stiff_bound;
 }
 double Integrator::stiffness_estimate() const { return hlamb_; }
 double Integrator::stiffness_bound(Method m) {
@@ -230,7 +232,7 @@ void Integrator::estimate_stiffness(double h) {
 // Hairer's counting after an accepted step: true once kStiffSteps steps were stiff with no run of
 // kNonstiffSteps non-stiff ones between them.
 bool Integrator::stiff_after_step() {
-  if (hlamb_ > scheme(method_).stiff_bound) {
+  if (hlamb_ > stiff_bound_) {
     nonstiff_steps_ = 0;
     return ++stiff_steps_ >= kStiffSteps;
   }

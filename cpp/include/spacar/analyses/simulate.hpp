@@ -317,6 +317,10 @@ class Simulation {
                                const std::vector<double>& times, const Stepper::Output& output);
   // What this run offers a stepper (stepper.hpp): the shape of Y and the model's callbacks.
   StepperSetup stepper_setup(const RunOptions& options, bool auto_switch, int n_states);
+  // Whether AUTO takes this model from DOP853 to generalized-α rather than Radau: an undamped
+  // structure (some degree-of-freedom deformation has a stiffness, no element has damping) at
+  // EPSINT and EPSIND of at least 1e-6, where a second-order method pays (integrate_block).
+  bool auto_takes_generalized_alpha() const;
   void record(BlockResults& res, int k);
   // InputError unless q and q̇ have one value per degree of freedom (`what`: the entry point).
   void require_dof_sizes(const char* what, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;

@@ -34,7 +34,8 @@ class Integrator : public Stepper {
   // codes make the first test only after 1000 steps, then every 1000th until a first stiff one;
   // here every step is tested, two norms beside 12 right-hand sides, so that an expensive stiff
   // problem is recognized after a few tens of steps, and the steps ahead decide whether to act.)
-  void set_stiffness_detection(bool on, double min_steps_ahead = 0.0);
+  // bound: h|λ| beyond which a step counts as stiff (0: the edge of the stability region).
+  void set_stiffness_detection(bool on, double min_steps_ahead = 0.0, double bound = 0.0);
   double stiffness_estimate() const;  // h|λ| of the last accepted step (0 if not detecting)
   static double stiffness_bound(Method m);  // that bound for h|λ| (DOP853 or DOPRI5)
   static constexpr int kStiffSteps = 15, kNonstiffSteps = 6;
@@ -67,7 +68,7 @@ class Integrator : public Stepper {
   double err_ = 0.0;                 // error norm of the last attempted step
   bool rejected_ = false;            // the previous attempt failed: do not grow the step right after
   bool detect_stiffness_ = false;
-  double hlamb_ = 0.0, min_steps_ahead_ = 0.0;
+  double hlamb_ = 0.0, min_steps_ahead_ = 0.0, stiff_bound_ = 0.0;
   int stiff_steps_ = 0, nonstiff_steps_ = 0;   // Hairer's IASTI and NONSTI
   // Work space, allocated once so that the step loop never touches the heap.
   std::vector<Eigen::VectorXd> k_;       // stages; k_[0] = f(t, y)

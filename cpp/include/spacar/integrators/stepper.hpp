@@ -217,6 +217,10 @@ struct StepperSetup {
   // stiffness only after 1000 steps). A short stiff stretch costs DOP853 little, and where the
   // stiff modes are excited (the manual's slider-crank) Radau's steps are no longer than DOP853's.
   double stiff_steps_ahead = 1000.0;
+  // AUTO: h|λ| beyond which a DOP853 step counts as stiff (0: the edge of its stability region,
+  // 6.1). An undamped structure takes 1: a step shorter than a sixth of its fastest period is
+  // set by that vibration, which generalized-α need not resolve (Simulation::integrate_block).
+  double stiff_bound = 0.0;
   // AUTO returns from Radau to DOP853 only where DOP853 would be stable at this many times
   // Radau's step (LSODA's RATIO, Petzold 1983: it pays for DOP853's 12 right-hand sides per step
   // against Radau's 4 to 10 and keeps the two from alternating).
