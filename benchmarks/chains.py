@@ -112,12 +112,13 @@ def mujoco_model(pm, step):
     return mujoco.MjModel.from_xml_string(xml)
 
 
-def mujoco_run(pm, q0, t_end, step):
-    """Joint angles at t_end from (q0, 0) by MuJoCo's RK4 at a fixed step."""
+def mujoco_run(model, data, q0, t_end, step):
+    """Joint angles at t_end from (q0, 0) by MuJoCo's RK4 at a fixed step, with the model compiled
+    and its data made before (outside the timing, as a MuJoCo user does and as spacar's model is
+    built outside its own): the run resets the data and steps."""
     import mujoco
 
-    model = mujoco_model(pm, step)
-    data = mujoco.MjData(model)
+    mujoco.mj_resetData(model, data)
     data.qpos[:] = q0
     mj_step = mujoco.mj_step
     for _ in range(int(round(t_end / step))):
@@ -212,8 +213,12 @@ def accuracy_runs(n, t_end, tols, ga_steps, build=chain, mujoco_steps=()):
     if mujoco_steps:
         out["MuJoCo RK4"] = []
         pm = sp.build(build(n, t_end))
+        import mujoco
+
         for h in mujoco_steps:
-            wall, q = C.best_time(lambda: mujoco_run(pm, q_start, t_end, h), repeat=REPEAT, budget=REPEAT_BUDGET,
+            mm = mujoco_model(pm, h)
+            md = mujoco.MjData(mm)
+            wall, q = C.best_time(lambda: mujoco_run(mm, md, q_start, t_end, h), repeat=REPEAT, budget=REPEAT_BUDGET,
                                   min_time=MIN_TIME)
             out["MuJoCo RK4"].append((float(np.abs(q - q_ref).max()), wall, h))
             C.log(f"  N={n} MuJoCo RK4 h={h:g}: err {out['MuJoCo RK4'][-1][0]:.2e}, {wall:.3f} s")
@@ -391,7 +396,9 @@ def spatial_section(r: dict, quick: bool) -> list:
              "HINGEs about random axes (DYNE e1), EMASS with rotary inertia, point masses and full inertia tensors, a "
              f"rotated ground, gravity along a random direction, released from rest, T = {r['t_end']} s. spacar takes "
              "the recursive path of spatial trees (`cpp/include/spacar/recursive/spatial_tree.hpp`); MuJoCo runs the same tree "
-             "written as MJCF (qpos = Pinocchio's q)" + ("" if r["mujoco"] else " — not installed in this run") + ". "
+             "written as MJCF (qpos = Pinocchio's q), compiled once per step size outside its timing (its run: "
+             "`mj_resetData` and the steps), as spacar's model is built outside spacar's" +
+             ("" if r["mujoco"] else " — not installed in this run") + ". "
              "All programs in one process, one after the other.", "", *C.machine_table(r["machine"]), "",
              "| N | spacar in a run | spacar in a 10× longer run | spacar general path in a run (Newton iterations "
              "per rhs) | Pinocchio `aba` | ratio spacar/ABA | MuJoCo `mj_forward` | exudyn tree, RK44 stage | "
