@@ -248,6 +248,16 @@ void bind_states(py::class_<Simulation>& sim) {
           "The recursive path of planar and spatial rigid trees at (q, q̇), its tree taken at the solved state "
           "of the first call: a dict of qdd, x, xd, xdd (None for other systems); a check of it against "
           "solve_state() and move_to().")
+      .def(
+          "inverse_dynamics",
+          [](Simulation& s, const RowMatrix& q, const RowMatrix& qd, const RowMatrix& qdd) {
+            std::string path;
+            RowMatrix force = s.inverse_dynamics(q, qd, qdd, path);
+            return py::make_tuple(force, path);
+          },
+          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          "Inverse dynamics at the states in the rows of q, qd, qdd: (the generalized forces on the DOFs beyond "
+          "the model's own loads, 'tree' or 'general'), spacar.inverse_dynamics.")
       .def("recursive_refusal", &Simulation::recursive_refusal,
            "Why the system takes the general path rather than the recursive one ('' if it is a rigid tree).")
       .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))

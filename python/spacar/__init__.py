@@ -21,6 +21,7 @@ from . import section
 from .check import Check, Diagnosis, Summary, check, summary
 from .compliance import compliance, support_stiffness
 from .control import Controller
+from .dynamics import inverse_dynamics
 from .energy import Energy
 from .table import Table
 from .errors import (
@@ -115,6 +116,7 @@ __all__ = [
     "parse",
     "dump",
     "simulate",
+    "inverse_dynamics",
     "static",
     "StaticError",
     "compliance",

@@ -1,6 +1,7 @@
 """spacar.from_urdf (issue 21): URDF robots against Pinocchio, which reads the same files with
 its own parser (urdfdom): the joint order, the link frames' positions, M(q) against
-pinocchio.crba and q̈ against pinocchio.aba at random (q, q̇, τ), a gravity swing against ABA
+pinocchio.crba, q̈ against pinocchio.aba at random (q, q̇, τ), spacar.inverse_dynamics against
+pinocchio.rnea, a gravity swing against ABA
 integrated by SciPy; and the reporting of what a URDF holds that the model leaves out.
 
 The small robots are hand-written (tests/data/*.urdf); UR5 and Panda come from the PyPI package
@@ -229,6 +230,27 @@ def test_mass_matrix_and_accelerations_match_crba_and_aba(name):
         a = pin.aba(peer.pin, peer.data, qp, qd, peer.tau)
         assert np.abs(np.array(d.Mbar) - M).max() <= 1e-10 * max(1.0, np.abs(M).max())
         assert np.abs(np.array(d.qdd) - a).max() <= 1e-10 * max(1.0, np.abs(a).max())
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_inverse_dynamics_matches_rnea(name):
+    """spacar.inverse_dynamics against pinocchio.rnea on a batch of states along a path (the general
+    path solves each state's positions from the previous one's). UR5 and the small trees of hinges
+    take the recursive Newton–Euler algorithm; Panda, the prismatic joint and the fixed joints
+    the reduced equations (issue 37: not yet on the recursive path)."""
+    rng = np.random.default_rng(sum(map(ord, name)) + 1)
+    peer = Peer(name)
+    nv = peer.pin.nv
+    end = rng.uniform(-1.5, 1.5, nv)
+    q = np.outer(np.linspace(0.0, 1.0, 16), end)  # steps of at most 0.1 rad
+    qd, qdd = rng.uniform(-2.0, 2.0, (16, nv)), rng.uniform(-3.0, 3.0, (16, nv))
+    force, path = peer.sim.inverse_dynamics(q, qd, qdd)
+    assert path == ("tree" if name in ("ur5", "two_link_arm", "branched_tree") else "general")
+    ref = np.array([pin.rnea(peer.pin, peer.data, peer.pin_q(q[k]), qd[k], qdd[k]) for k in range(len(q))])
+    assert np.abs(np.asarray(force) - ref).max() <= 1e-10 * max(1.0, np.abs(ref).max())
+    # the public function: one state, the same numbers
+    one = spacar.inverse_dynamics(peer.model, q[3], qd[3], qdd[3])
+    assert one.shape == (nv,) and np.abs(one - ref[3]).max() <= 1e-10 * max(1.0, np.abs(ref).max())
 
 
 def test_ur5_gravity_swing_matches_aba_integrated_by_scipy():

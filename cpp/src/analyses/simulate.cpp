@@ -422,14 +422,19 @@ void Simulation::apply_time_loads(double t) {
   if (run_.held.size()) d.time_load += run_.held;
 }
 
+RecursiveTree* Simulation::recursive_tree() {
+  if (!path_->tree()) {
+    std::unique_ptr<RecursiveTree> tree = RecursiveTree::detect(*sys_, *data_);
+    if (!tree) return nullptr;
+    path_ = std::make_unique<TreePath>(std::move(tree));
+  }
+  return path_->tree();
+}
+
 bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
                                  Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
   require_dof_sizes("recursive_state", q, qd);
-  if (!path_->tree()) {
-    std::unique_ptr<RecursiveTree> tree = RecursiveTree::detect(*sys_, *data_);
-    if (!tree) return false;
-    path_ = std::make_unique<TreePath>(std::move(tree));
-  }
+  if (!recursive_tree()) return false;
   Eigen::VectorXd x1 = data_->x, xd1 = Eigen::VectorXd::Zero(sys_->nx), xdd1 = xd1, qdd1(sys_->n_dof());
   if (!path_->tree()->solve(q.data(), qd.data(), x1, xd1, xdd1, qdd1.data())) return false;
   qdd = qdd1;
@@ -437,6 +442,27 @@ bool Simulation::recursive_state(const Eigen::VectorXd& q, const Eigen::VectorXd
   xd = xd1;
   xdd = xdd1;
   return true;
+}
+
+RowMatrix Simulation::inverse_dynamics(const RowMatrix& q, const RowMatrix& qd, const RowMatrix& qdd,
+                                       std::string& path) {
+  const int nd = sys_->n_dof();
+  if (q.cols() != nd || qd.cols() != nd || qdd.cols() != nd || qd.rows() != q.rows() || qdd.rows() != q.rows())
+    throw InputError("inverse_dynamics(): q, qd and qdd must have the same number of states (rows) and one column "
+                     "per degree of freedom (" + std::to_string(nd) + ")");
+  RowMatrix force(q.rows(), nd);
+  if (RecursiveTree* tree = recursive_tree()) {
+    path = "tree";
+    for (Eigen::Index k = 0; k < q.rows(); ++k)
+      tree->inverse_dynamics(q.row(k).data(), qd.row(k).data(), qdd.row(k).data(), force.row(k).data());
+    return force;
+  }
+  path = "general";
+  for (Eigen::Index k = 0; k < q.rows(); ++k) {
+    evaluate(data_->t, q.row(k).data(), qd.row(k).data());
+    force.row(k) = (data_->Mbar * (qdd.row(k).transpose() - data_->qdd)).transpose();
+  }
+  return force;
 }
 
 std::string Simulation::recursive_refusal() const {

@@ -263,6 +263,14 @@ class Simulation {
   // Why the system is not a tree for the recursive path, at the current (solved) state; empty
   // if it is one.
   std::string recursive_refusal() const;
+  // Inverse dynamics at a batch of states (the rows of q, q̇, q̈, one column per DOF): the
+  // generalized forces on the DOFs, beyond the model's own loads, gravity, springs and dampers,
+  // under which the system has the accelerations q̈ (pinocchio.rnea's τ for a robot). A tree of
+  // rigid bodies by the recursive Newton–Euler algorithm, O(N) per state with no Newton
+  // iteration; any other system by its reduced equations, M̄ (q̈ − q̈₀), q̈₀ its accelerations
+  // under its own loads, each state's positions solved by Newton from the previous state's (so
+  // successive rows should be near each other). `path` is set to "tree" or "general".
+  RowMatrix inverse_dynamics(const RowMatrix& q, const RowMatrix& qd, const RowMatrix& qdd, std::string& path);
   // q̈ of the reduced equations (3.1) with transfer functions at the last evaluated state, the
   // state left as it was: an independent check of the integration path's sparse solve.
   Eigen::VectorXd reduced_accelerations();
@@ -328,6 +336,9 @@ class Simulation {
   void explain_collapse(const IntegrationError& err, const Eigen::VectorXd& Y);
   // A free rotation whose dependent Euler parameter has become small, or −1.
   int rotation_to_repartition(const Eigen::VectorXd& Y) const;
+  // The tree of rigid bodies of the system, detected at the current state on the first call
+  // and kept until the next run; nullptr if the system is not one.
+  RecursiveTree* recursive_tree();
   // Make the largest Euler parameter of that node the dependent one: recompile the system and
   // map the state (t, Y) to the new degrees of freedom.
   void repartition(int which, double t, Eigen::VectorXd& Y);

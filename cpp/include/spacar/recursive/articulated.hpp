@@ -22,6 +22,7 @@
 //   cross_force(v, f)                  v ×* f
 //   joint_column(m, I), joint_component(m, f), add_joint_acceleration(m, udd, a)   I S, Sᵀ f, a += S ü
 //   dof_acceleration(m, a, udd)        q̈ of the body's degree of freedom
+//   joint_acceleration(m, a, qdd)      its inverse: ü from q̈ and the body's acceleration a before S ü
 #pragma once
 
 #include <vector>
@@ -54,7 +55,7 @@ struct BodyData {
   typename Algebra::Point pin;    // world position of the pin
   double ud = 0.0;   // joint rate u̇
   double tau = 0.0;  // joint torque
-  double u = 0.0;    // joint force left after the bias forces
+  double u = 0.0;    // joint force left after the bias forces (inverse dynamics: the torque on the body's rotation)
   double d = 0.0;    // the joint's articulated inertia Sᵀ Iᴬ S
   Vector v, bias, pA, a, U;
   typename Algebra::Inertia IA;
@@ -84,6 +85,41 @@ class ArticulatedTree : public RecursiveTree {
     if (!articulate()) return false;
     accelerations(qdd);
     return true;
+  }
+
+  void inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) final {
+    outward(q, qd);
+    applied_loads();
+    // Outwards: the accelerations the given q̈ make, and each body's force f = I a + pA (its bias
+    // forces of inertia less the applied loads).
+    for (size_t i = 0; i < bodies_.size(); ++i) {
+      const Model& m = bodies_[i];
+      BodyWork& d = work_[i];
+      Vector a = Algebra::to_child(m, d.frame, m.parent < 0 ? base_acceleration_ : work_[m.parent].a) + d.bias;
+      Algebra::add_joint_acceleration(m, Algebra::joint_acceleration(m, a, qdd), a);
+      d.a = a;
+      d.pA += m.inertia * a;
+    }
+    // Inwards: the joint torque Sᵀ f beyond the joint's spring and damper, the forces summed into
+    // the parents. Then to the DOFs by virtual work: a hinge's q is its angle (u = sign q + offset);
+    // a planar body's absolute rotation q (a DYNX BETA) turns its joint by q − θ_parent, so its
+    // torque also acts on the parent's rotation, which the parent's own joint and its ancestors'
+    // hinges carry (d.u holds what acts on a body's rotation from its subtree).
+    for (BodyWork& d : work_) d.u = 0.0;
+    for (int i = static_cast<int>(bodies_.size()) - 1; i >= 0; --i) {
+      const Model& m = bodies_[i];
+      BodyWork& d = work_[i];
+      const double torque = Algebra::joint_component(m, d.pA) - d.tau;
+      BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
+      if (p) p->pA += Algebra::to_parent(m, d.frame, d.pA);
+      if (m.absolute) {
+        force[m.dof] = torque + d.u;
+        if (p) p->u -= torque;
+      } else {
+        force[m.dof] = m.sign * (torque + d.u);
+        if (p) p->u += d.u;
+      }
+    }
   }
 
  protected:

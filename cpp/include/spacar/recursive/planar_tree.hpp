@@ -92,6 +92,9 @@ struct PlanarAlgebra {
   static double dof_acceleration(const Model& m, const Vector& a, double udd) {
     return m.absolute ? a[0] : m.sign * udd;
   }
+  static double joint_acceleration(const Model& m, const Vector& a, const double* qdd) {
+    return m.absolute ? qdd[m.dof] - a[0] : m.sign * qdd[m.dof];
+  }
 };
 
 class PlanarTree : public ArticulatedTree<PlanarAlgebra> {

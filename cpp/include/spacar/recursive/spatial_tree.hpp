@@ -138,6 +138,7 @@ struct SpatialAlgebra {
   static double joint_component(const Model& m, const Vector& g) { return m.axis.dot(g.head<3>()); }
   static void add_joint_acceleration(const Model& m, double udd, Vector& a) { a.head<3>() += udd * m.axis; }
   static double dof_acceleration(const Model& m, const Vector&, double udd) { return m.sign * udd; }
+  static double joint_acceleration(const Model& m, const Vector&, const double* qdd) { return m.sign * qdd[m.dof]; }
 };
 
 class SpatialTree : public ArticulatedTree<SpatialAlgebra> {

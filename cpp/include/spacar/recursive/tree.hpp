@@ -37,6 +37,10 @@ class RecursiveTree {
              double* qdd);
   // The DOF accelerations only (nothing written if false).
   virtual bool solve(const double* q, const double* qd, double* qdd) = 0;
+  // Inverse dynamics (the recursive Newton–Euler algorithm, as pinocchio.rnea): the generalized
+  // forces on the DOFs, beyond the model's own loads, gravity and joint springs and dampers, under
+  // which the tree has the accelerations qdd at (q, q̇).
+  virtual void inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) = 0;
 
  protected:
   // The coordinates moving with the bodies, after solve().

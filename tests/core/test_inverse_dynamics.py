@@ -1,0 +1,80 @@
+"""spacar.inverse_dynamics on planar and spatial trees of rigid bodies (the recursive Newton–Euler
+algorithm of cpp/include/spacar/recursive/articulated.hpp) against the general path's reduced
+equations, M̄ (q̈ − q̈₀) from its own mass matrix and accelerations at the same state (an
+independent computation: transfer functions, no recursion), with hinge springs and dampers,
+absolute rotations as DOFs (DYNX BETA), applied forces and gravity; and at the forward dynamics'
+accelerations the forces vanish. (Against pinocchio.rnea: tests/api/test_urdf.py.)"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import spacar
+from spacar import InputError, _core
+from spacar.compare import models
+from support import trees
+
+MODELS = {
+    "planar branched tree, springs": lambda: trees.planar_branched_tree(spring=False),
+    "planar chain, absolute rotations, springs": lambda: models.planar_chain(
+        4, dof="absolute", stiffness=3.0, damping=0.4, tip_mass=0.3, joint_inertia=0.01, angle=0.3),
+    "planar chain, relative angles": lambda: models.planar_chain(5, tip_mass=0.2, angle=-0.4),
+    "spatial branched tree": lambda: trees.spatial_branched_tree(),
+    "spatial chain": lambda: models.spatial_chain(6, seed=3),
+}
+
+
+def general_path(model, q, qd, qdd):
+    """M̄ (q̈ − q̈₀) by the general path, state by state from the assembled one."""
+    sim = _core.Simulation(model.core)
+    sim.assemble()
+    out = []
+    for k in range(len(q)):
+        sim.evaluate(0.0, q[k], qd[k])
+        out.append(np.asarray(sim.data.Mbar) @ (qdd[k] - np.asarray(sim.data.qdd)))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_recursive_inverse_dynamics_matches_the_reduced_equations(name):
+    model = MODELS[name]()
+    sim = _core.Simulation(model.copy().core)
+    sim.assemble()
+    n = sim.system.n_dof
+    q0 = np.asarray(sim.system.q0)
+    rng = np.random.default_rng(7)
+    q = q0 + np.outer(np.linspace(0.0, 1.0, 12), rng.uniform(-1.0, 1.0, n))  # steps of at most 0.1
+    qd, qdd = rng.uniform(-2.0, 2.0, (12, n)), rng.uniform(-3.0, 3.0, (12, n))
+    force, path = sim.inverse_dynamics(q, qd, qdd)
+    assert path == "tree"
+    ref = general_path(model.copy(), q, qd, qdd)
+    scale = max(1.0, np.abs(ref).max())
+    assert np.abs(np.asarray(force) - ref).max() <= 1e-10 * scale
+    # At the forward dynamics' accelerations (the tree's ABA) nothing more is needed.
+    free = np.array([sim.recursive_state(q[k], qd[k])["qdd"] for k in range(len(q))])
+    zero, _ = sim.inverse_dynamics(q, qd, free)
+    assert np.abs(np.asarray(zero)).max() <= 1e-10 * scale
+
+
+def test_other_systems_take_the_reduced_equations():
+    # A four-bar is a closed loop: no tree; its one DOF's force is M̄ (q̈ − q̈₀).
+    model = models.four_bar()
+    sim = _core.Simulation(model.copy().core)
+    sim.assemble()
+    q, qd, qdd = np.asarray(sim.system.q0)[None, :], np.array([[0.7]]), np.array([[1.3]])
+    force, path = sim.inverse_dynamics(q, qd, qdd)
+    assert path == "general"
+    np.testing.assert_allclose(force, general_path(model.copy(), q, qd, qdd), rtol=1e-12, atol=1e-14)
+    assert spacar.inverse_dynamics(model, q[0], qd[0], qdd[0]).shape == (1,)
+
+
+def test_bad_arguments_are_input_errors():
+    model = models.planar_chain(2)
+    with pytest.raises(InputError, match="same shape"):
+        spacar.inverse_dynamics(model, np.zeros(2), np.zeros(2), np.zeros(3))
+    with pytest.raises(InputError, match="one column per degree of freedom"):
+        spacar.inverse_dynamics(model, np.zeros(3), np.zeros(3), np.zeros(3))
+    with pytest.raises(InputError, match="finite"):
+        spacar.inverse_dynamics(model, [np.nan, 0.0], np.zeros(2), np.zeros(2))
+    with pytest.raises(InputError, match="spacar.Model"):
+        spacar.inverse_dynamics("model", np.zeros(2), np.zeros(2), np.zeros(2))
