@@ -25,7 +25,8 @@ void bind_catalogue(py::module_& m) {
       .value("Truss", ElementFamily::Truss)
       .value("Hinge", ElementFamily::Hinge)
       .value("Belt", ElementFamily::Belt)
-      .value("Wheel", ElementFamily::Wheel);
+      .value("Wheel", ElementFamily::Wheel)
+      .value("Bearing", ElementFamily::Bearing);
   py::class_<ElementType>(m, "ElementType")
       .def_readonly("name", &ElementType::name)
       .def_readonly("nodes", &ElementType::nodes)

@@ -46,8 +46,8 @@ def _families() -> dict:
 
 
 def family(type_name: str) -> str:
-    """The catalogue family of an element type ("Beam", "Truss", "Hinge", "Belt", "Wheel"), or
-    "Other" (also for a type the catalogue does not know)."""
+    """The catalogue family of an element type ("Beam", "Truss", "Hinge", "Belt", "Wheel",
+    "Bearing"), or "Other" (also for a type the catalogue does not know)."""
     return _families().get(type_name, "Other")
 
 

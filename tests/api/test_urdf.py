@@ -32,7 +32,9 @@ def robot_file(package: str, name: str) -> Path:
 
 def urdf_path(name: str) -> Path:
     return {"ur5": lambda: robot_file("ur_description", "ur5_robot.urdf"),
-            "panda": lambda: robot_file("panda_description", "panda.urdf")}.get(name, lambda: DATA / f"{name}.urdf")()
+            "panda": lambda: robot_file("panda_description", "panda.urdf"),
+            "xarm7": lambda: robot_file("xarm_description", "xarm7.urdf"),
+            "g1": lambda: robot_file("g1_description", "g1_29dof_rev_1_0.urdf")}.get(name, lambda: DATA / f"{name}.urdf")()
 
 
 def load(path) -> spacar.Model:
@@ -205,7 +207,7 @@ class Peer:
         return err
 
 
-ROBOTS = SMALL + ["ur5", "panda"]
+ROBOTS = SMALL + ["ur5", "panda", "xarm7", "g1"]
 
 
 @pytest.mark.parametrize("name", ROBOTS)
@@ -234,10 +236,10 @@ def test_mass_matrix_and_accelerations_match_crba_and_aba(name):
 
 @pytest.mark.parametrize("name", ROBOTS)
 def test_inverse_dynamics_matches_rnea(name):
-    """spacar.inverse_dynamics against pinocchio.rnea on a batch of states along a path (the general
-    path solves each state's positions from the previous one's). UR5 and the small trees of hinges
-    take the recursive Newton–Euler algorithm; Panda, the prismatic joint and the fixed joints
-    the reduced equations (issue 37: not yet on the recursive path)."""
+    """spacar.inverse_dynamics against pinocchio.rnea on a batch of states, and the recursive path's
+    q̈ against pinocchio.aba: every robot here is a tree of the recursive path (since issue 37 also
+    xArm7's and G1's joints at one origin, Panda's sliding fingers on bodies without a beam, the
+    prismatic joints of tests/data/prismatic.urdf)."""
     rng = np.random.default_rng(sum(map(ord, name)) + 1)
     peer = Peer(name)
     nv = peer.pin.nv
@@ -245,7 +247,11 @@ def test_inverse_dynamics_matches_rnea(name):
     q = np.outer(np.linspace(0.0, 1.0, 16), end)  # steps of at most 0.1 rad
     qd, qdd = rng.uniform(-2.0, 2.0, (16, nv)), rng.uniform(-3.0, 3.0, (16, nv))
     force, path = peer.sim.inverse_dynamics(q, qd, qdd)
-    assert path == ("tree" if name in ("ur5", "two_link_arm", "branched_tree") else "general")
+    assert path == "tree"  # every robot here (issue 37: joints at one origin, sliding joints)
+    for k in (0, 7, 15):  # and the tree's forward dynamics against pinocchio.aba
+        a = pin.aba(peer.pin, peer.data, peer.pin_q(q[k]), qd[k], np.zeros(nv))
+        qdd_tree = peer.sim.recursive_state(q[k], qd[k])["qdd"]
+        assert np.abs(qdd_tree - a).max() <= 1e-10 * max(1.0, np.abs(a).max())
     ref = np.array([pin.rnea(peer.pin, peer.data, peer.pin_q(q[k]), qd[k], qdd[k]) for k in range(len(q))])
     assert np.abs(np.asarray(force) - ref).max() <= 1e-10 * max(1.0, np.abs(ref).max())
     # the public function: one state, the same numbers
@@ -292,3 +298,26 @@ def test_initial_joint_values_place_the_links_as_pinocchio_does():
     np.testing.assert_allclose(res.qd[0], np.linspace(0.1, 0.9, 9), rtol=0, atol=1e-14)
     peer.column = {lbl: i for i, lbl in enumerate(res.coordinate_labels)}
     assert peer.link_position_error(res.x[0], q0) < 1e-12
+
+
+# Of the URDFs of example-robot-data that from_urdf reads, those not on the recursive path, and why.
+NOT_TREES = {"simple_humanoid.urdf": "turns a body with no point", "simple_humanoid_classical.urdf":
+             "turns a body with no point"}
+
+
+def test_example_robot_data_takes_the_recursive_path():
+    """Every URDF of example-robot-data that from_urdf accepts is a tree of the recursive path, but
+    the simple humanoid (a link with no point of its own that carries another joint)."""
+    robots = robot_file("ur_description", "ur5_robot.urdf").parents[2]
+    seen = 0
+    for path in sorted(robots.glob("*/urdf/*.urdf")):
+        try:
+            model = load(path)
+            sim = _core.Simulation(model.core)
+            sim.assemble()
+        except spacar.SpacarError:
+            continue  # refused by from_urdf (a missing mesh package, an inertia that is not positive)
+        seen += 1
+        why = sim.recursive_refusal()
+        assert (NOT_TREES[path.name] in why) if path.name in NOT_TREES else why == "", (path.name, why)
+    assert seen >= 40

@@ -13,6 +13,7 @@ import spacar
 from spacar import InputError, _core
 from spacar.compare import models
 from support import trees
+from support.paths import DATA
 
 MODELS = {
     "planar branched tree, springs": lambda: trees.planar_branched_tree(spring=False),
@@ -21,6 +22,8 @@ MODELS = {
     "planar chain, relative angles": lambda: models.planar_chain(5, tip_mass=0.2, angle=-0.4),
     "spatial branched tree": lambda: trees.spatial_branched_tree(),
     "spatial chain": lambda: models.spatial_chain(6, seed=3),
+    "spatial URDF wrist (joints at one origin, a sliding joint, a body without a beam)":
+        lambda: trees.urdf(DATA / "wrist.urdf"),
 }
 
 

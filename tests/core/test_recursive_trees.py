@@ -17,6 +17,7 @@ import pytest
 import spacar
 from spacar.compare import models
 from support import trees
+from support.paths import DATA
 from support.simulation import assembled, assert_start_rows_agree
 
 TREES = {
@@ -33,6 +34,8 @@ TREES = {
     "spatial chain springs": lambda: models.spatial_chain(4, seed=7, stiffness=2.5, epskin=1e-13),
     "spatial chain straight ground": lambda: models.spatial_chain(3, seed=3, ground_rotation=False, epskin=1e-13),
     "spatial branched": trees.spatial_branched_tree,
+    "spatial URDF wrist": lambda: trees.urdf(DATA / "wrist.urdf"),
+    "spatial URDF prismatic": lambda: trees.urdf(DATA / "prismatic.urdf"),
 }
 
 # The states of the comparison with the constraint formulation: the random generator's seed and
@@ -127,7 +130,8 @@ def test_spatial_recursive_accelerations_equal_pinocchio_aba(name):
 
 
 @pytest.mark.parametrize("name", ["planar chain springs", "planar chain absolute springs", "planar branched spring",
-                                  "spatial chain springs", "spatial branched"])
+                                  "spatial chain springs", "spatial branched", "spatial URDF wrist",
+                                  "spatial URDF prismatic"])
 def test_runs_on_both_paths_agree(name):
     """Output times and everything reported there (positions and velocities solved by the
     general path from the tree's, accelerations and stresses from the tree's q̈) agree with a
@@ -182,7 +186,7 @@ def test_the_refusal_says_why(name):
     assert reason in assembled(build()).recursive_refusal()
 
 
-@pytest.mark.parametrize("name", ["planar branched", "spatial branched"])
+@pytest.mark.parametrize("name", ["planar branched", "spatial branched", "spatial URDF wrist"])
 def test_a_tree_is_not_refused(name):
     assert assembled(TREES[name]()).recursive_refusal() == ""
 

@@ -7,6 +7,7 @@ import re
 import pytest
 
 import spacar
+import spacar._testing  # noqa: F401  (element_kernel, also when this file runs alone)
 from support.manual import ELEMENTS, KEYWORDS
 from support.paths import ROOT
 
@@ -147,6 +148,7 @@ def test_catalogue_flags():
     assert [n for n, f in families.items() if f == "Truss"] == ["TRUSS", "PLTRUSS"]
     assert [n for n, f in families.items() if f == "Wheel"] == ["PLWHEEL", "WHEEL"]
     assert [n for n, f in families.items() if f == "Belt"] == ["PLBELT"]
+    assert sorted(n for n, f in families.items() if f == "Bearing") == ["BEARING", "PLBEAR"]
 
 
 def test_plbelt_winding_factors_may_be_negative_other_emass_not():

@@ -258,3 +258,18 @@ def spatial_massless_chain():
     model.fix(10)
     model.emass(1, 1.0)
     return model
+
+
+def urdf(path):
+    """A robot read by spacar.from_urdf (joints at one origin, sliding joints, bodies without a
+    beam: tests/data/wrist.urdf), at tight tolerances, nothing left out reported."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = spacar.from_urdf(path)
+    m.epsint(1e-10)
+    m.epsind(1e-10)
+    m.epskin(1e-13)
+    m.timestep(4, 0.4)
+    return m

@@ -61,6 +61,7 @@ ElementType bearing_element_type() {
   t.n_lgeomy = 3;
   t.has_direction = true;
   t.reference = reference_bearing;
+  t.family = ElementFamily::Bearing;
   return t;
 }
 

@@ -49,6 +49,7 @@ ElementType plbear_element_type() {
   set_stiffness(t, 3, "Sx Sy St (linear and torsional stiffness)");
   t.n_lgeomy = 2;
   t.reference = reference_plbear;
+  t.family = ElementFamily::Bearing;
   return t;
 }
 

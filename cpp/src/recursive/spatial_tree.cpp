@@ -57,7 +57,7 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
 
   bool build() {
     return supported_classes() && read_coordinates() && read_nodes() &&
-           read_elements("BEAM, BEAMNL, HINGE or L2MIN1") && group_bodies() && place_bodies() && attach_loads();
+           read_elements("BEAM, BEAMNL, HINGE, BEARING or L2MIN1") && group_bodies() && place_bodies() && attach_loads();
   }
 
  private:
@@ -93,6 +93,43 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     return true;
   }
 
+  // A prismatic joint: a BEARING sliding along its axis (DYNE e1, e2 … e6 rigid), or a measuring
+  // one (all released, no law).
+  bool read_other(int i, const SystemElement& se, const std::vector<int>& ids, const char* accepted) {
+    if (element_catalogue()[se.type].family != ElementFamily::Bearing)
+      return refuse(element_name(se) + " is not a " + accepted);
+    const int k = se.def_offset;
+    bool released = !se.has_constitutive, rigid = true;
+    for (int a = 0; a < 6; ++a) {
+      released = released && sys_.def_class[k + a] == DefClass::Released;
+      if (a > 0) rigid = rigid && sys_.def_class[k + a] == DefClass::Fixed;
+    }
+    if (released) return true;
+    if (sys_.def_class[k] != DefClass::Dynamic || !rigid)
+      return refuse(element_name(se) + " is not a prismatic joint (DYNE e1, rigid e2 … e6)");
+    hinges_.push_back({i, ids[1], ids[3], hinge_dof(se), false, ids[0], ids[2]});
+    return true;
+  }
+
+  // Bodies without a beam: a joint's moving LAMBDA node on no beam is a body of its own (a rotor,
+  // a link whose centre of mass is its joint's origin, as URDF's Panda fingers), with the joint's
+  // point on its side if that is on no beam either (a sliding joint's). They join the grouping as
+  // beams without an element (−1).
+  bool group_bodies() {
+    std::set<int> on_beams;
+    for (const auto& [i, ids] : beams_) on_beams.insert(ids.begin(), ids.end());
+    auto loose = [&](int id) { return id >= 0 && !nodes_.at(id).fixed && !on_beams.count(id); };
+    for (const Hinge& h : hinges_)
+      for (const auto& [o, p] : {std::pair{h.a, h.pa}, std::pair{h.b, h.pb}}) {
+        if (!loose(o)) continue;
+        std::vector<int> ids = {o};
+        if (loose(p)) ids.push_back(p);
+        beams_.push_back({-1, ids});
+        on_beams.insert(ids.begin(), ids.end());
+      }
+    return TreeBuilder::group_bodies();
+  }
+
   Eigen::Vector4d lambda(int id) const { return x_.segment<4>(nodes_.at(id).coord); }
 
   // The joint of a DOF hinge, from the parent's end (forward: node o1) to the child's. The axis
@@ -105,9 +142,14 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     for (int a = 0; a < n; ++a) xl[a] = x_[se.coords[a]];
     se.kernel->first_derivatives(xl.data(), e.data(), B.data());
     bd.dof = h.dof;
-    bd.sign = forward ? 1.0 : -1.0;  // e1 turns o2 relative to o1
+    bd.sign = forward ? 1.0 : -1.0;  // e1 turns (slides) o2's body relative to o1's
     bd.offset = -bd.sign * e_[se.def_offset];  // u = sign · (e1 − e1 at the reference state)
-    bd.axis = (0.5 * euler_E(lambda(h.b)) * B.block<1, 4>(0, 4).transpose()).normalized();
+    if (h.pa >= 0) {  // sliding: the axis is ∂e1/∂x_p2, in the world's axes, which are both bodies' here
+      bd.prismatic = true;
+      bd.axis = B.block<1, 3>(0, 7).transpose().normalized();
+    } else {
+      bd.axis = (0.5 * euler_E(lambda(h.b)) * B.block<1, 4>(0, 4).transpose()).normalized();
+    }
     if (se.has_constitutive) {
       bd.stiffness = se.S(0, 0);
       bd.damping = se.D(0, 0);
@@ -134,9 +176,10 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     if (!attach(body, parent_body, bd, joint, index, p0)) return false;
     Inertia I = Inertia::Zero();
     auto row = [&](int g) { return rigid_row_of(g, p0); };
-    for (int i : g_.beams[body]) I += tree_detail::element_inertia<6>(sys_.elements[i], x_, row);
+    for (int i : g_.beams[body])
+      if (i >= 0) I += tree_detail::element_inertia<6>(sys_.elements[i], x_, row);
     for (int id : g_.points[body]) {
-      if (id == pin_[body]) continue;  // its point mass and loads move with the parent
+      if (id == pin_[body] && !own_pin_[body]) continue;  // a hinge's pin: its mass and loads move with the parent
       for (int c = 0; c < 3; ++c) {
         const int g = nodes_[id].coord + c;
         I += sys_.point_mass[g] * row(g).transpose() * row(g);

@@ -88,12 +88,15 @@ class TreeBuilder {
   using Model = BodyModel<Algebra>;
   static constexpr int kDim = Point::RowsAtCompileTime;
 
-  // A hinge between orientation nodes a and b (its rotation turns b relative to a).
+  // A joint between orientation nodes a and b: a hinge (its rotation turns b relative to a, about
+  // a point the two bodies share) or a sliding joint (its translation moves b's point pb relative
+  // to a's point pa; the bodies share no point).
   struct Hinge {
     int element;
     int a, b;
     int dof;  // position in q, −1: released (a spring, or a measuring hinge)
     bool used = false;
+    int pa = -1, pb = -1;  // a sliding joint's points on a's and b's bodies (−1: a hinge)
   };
 
   TreeBuilder(const System& sys, const Data& data, NodeKind point, NodeKind orientation)
@@ -128,10 +131,15 @@ class TreeBuilder {
       } else if (type.family == ElementFamily::Hinge) {
         if (!static_cast<Derived*>(this)->read_hinge(static_cast<int>(i), se, ids)) return false;
       } else if (!type.automatic) {
-        return refuse(element_name(se) + " is not a " + accepted);
+        if (!static_cast<Derived*>(this)->read_other(static_cast<int>(i), se, ids, accepted)) return false;
       }
     }
     return true;
+  }
+
+  // Another element (Derived may accept some: the spatial tree takes a BEARING as a sliding joint).
+  bool read_other(int, const SystemElement& se, const std::vector<int>&, const char* accepted) {
+    return refuse(element_name(se) + " is not a " + accepted);
   }
 
   bool read_beam(int i, const SystemElement& se, const std::vector<int>& ids) {
@@ -162,6 +170,7 @@ class TreeBuilder {
     if (g_.stray >= 0) return refuse("node " + std::to_string(g_.stray) + " moves with no rigid beam");
     placed_.assign(g_.points.size(), -1);
     pin_.assign(g_.points.size(), -1);
+    own_pin_.assign(g_.points.size(), false);
     for (const auto& [id, n] : nodes_)
       if (n.kind == point_kind_ && n.fixed) owner_[id] = kGround;
     return true;
@@ -205,6 +214,8 @@ class TreeBuilder {
         if (is_placed(child)) return refuse(name + " closes a loop");
         h.used = true;
         Model bd;
+        slide_pin_ = h.pa < 0 ? -1 : (forward ? h.pb : h.pa);  // the child's own point, which slides
+        slide_base_ = h.pa < 0 ? -1 : (forward ? h.pa : h.pb);  // the parent's point it slides from
         if (!self.hinge_joint(h, forward, child, bd) || !self.place(child, parent, bd, name)) return false;
         queue.push_back(child);
       }
@@ -224,18 +235,45 @@ class TreeBuilder {
   // its pin's reference position.
   bool attach(int body, int parent_body, Model& bd, const std::string& joint, int index, Point& p0) {
     const int parent = parent_body == kGround ? kGround : placed_[parent_body];
-    const int pin = pin_of(body);
-    if (pin < 0 || owner_.at(pin) != parent)
+    const bool sliding = slide_pin_ >= 0;
+    // A hinge's pin is the point the body shares with its parent; a sliding joint's is the
+    // body's own point of the joint, whose other point is on the parent, and the two share none.
+    const int pin = sliding ? slide_pin_ : pin_of(body);
+    if (!sliding && g_.points[body].empty() && parent_body != kGround) {
+      // A body of no point (a rotor's LAMBDA node): it turns about its parent's pin, as good as
+      // any point of the axis for a body whose mass is all rotational inertia.
+      placed_[body] = index;
+      p0 = pin0_[parent];
+      bd.parent = parent;
+      bd.r = Point::Zero();
+      pin0_.push_back(p0);
+      return true;
+    }
+    if (sliding) {
+      if (!g_.points[body].count(pin) || pin_of(body) != -1 || !on_body(slide_base_, parent_body, parent))
+        return refuse(joint + " slides a body that is not joined to its parent by that joint alone");
+    } else if (pin < 0 || !on_body(pin, parent_body, parent)) {
       return refuse(joint + " turns a body with no point, or more than one, on its parent");
+    }
     placed_[body] = index;
     pin_[body] = pin;
+    own_pin_[body] = sliding;
     p0 = point(pin);
     bd.parent = parent;
     bd.r = parent == kGround ? p0 : Point(p0 - pin0_[parent]);
     for (int id : g_.points[body])
-      if (id != pin) owner_[id] = index;
+      if (id != pin || sliding) owner_[id] = index;
     pin0_.push_back(p0);
     return true;
+  }
+
+  // Whether point node id is on the placed body parent_body (index parent in the tree) or the
+  // ground. Joints at one origin (two URDF joints at the same point, a spherical wrist) share it
+  // with the parent's own parent, which placed it first.
+  bool on_body(int id, int parent_body, int parent) const {
+    if (!owner_.count(id)) return false;
+    return owner_.at(id) == parent ||
+           (parent_body != kGround && (g_.points[parent_body].count(id) > 0 || pin_[parent_body] == id));
   }
 
   const System& sys_;
@@ -248,6 +286,8 @@ class TreeBuilder {
   BeamBodies g_;                 // the bodies' nodes and beams
   std::vector<int> placed_;      // body → index in the tree, −1: not yet
   std::vector<int> pin_;         // body → its pin node, −1: not placed
+  std::vector<bool> own_pin_;    // body → its pin moves with it (a sliding joint's), not with the parent
+  int slide_pin_ = -1, slide_base_ = -1;  // the sliding joint being placed: its points (−1: a hinge)
   std::map<int, int> owner_;     // point node → body (index in the tree) it moves with, kGround
   std::vector<Point> pin0_;      // reference pin of each placed body
 };

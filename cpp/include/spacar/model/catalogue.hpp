@@ -26,7 +26,7 @@ struct ElementSetup;
 // alike: the recursive planar path (beams are bodies, hinges joints, cpp/src/tree.cpp) and the
 // drawings (python/spacar/geometry.py). Other: no special treatment; drawn as a line through its
 // position nodes (a point if it has one).
-enum class ElementFamily : int { Other = 0, Beam, Truss, Hinge, Belt, Wheel };
+enum class ElementFamily : int { Other = 0, Beam, Truss, Hinge, Belt, Wheel, Bearing };
 
 // Reference geometry from the initial positions (orientation nodes at their reference value):
 // fills the reference length l0 (if the type has one) and the LGEOMY values.

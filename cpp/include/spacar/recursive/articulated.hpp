@@ -38,6 +38,7 @@ struct BodyModel {
   int parent = -1;              // index into the bodies (parents first), −1: the ground
   int dof = 0;                  // position of the joint's coordinate in q
   bool absolute = false;        // q is the body's rotation (a planar DYNX), else a hinge's
+  bool prismatic = false;       // the joint slides along its axis (spatial), else it turns
   double sign = 1.0;            // hinge: joint angle u = sign · q + offset (the hinge may point to the parent)
   double offset = 0.0;          // absolute: the body's rotation is q − offset
   double stiffness = 0.0, damping = 0.0;  // hinge σ = S e + D ė, joint torque −σ

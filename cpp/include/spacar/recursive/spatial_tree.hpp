@@ -2,11 +2,14 @@
 // counterpart of planar_tree.hpp).
 //
 // A spatial model of rigid BEAMs (every deformation fixed) connected as an open tree is a
-// kinematic tree of rigid bodies with revolute joints: beams sharing a LAMBDA node are one body,
-// a body hangs from its parent at a shared (or fixed) XYZ node, its pin, and turns about it by
-// the rotation e1 of a HINGE to the parent (DYNE, e2 and e3 fixed). MASS (point masses, inertia
-// tensors on LAMBDA nodes), EMASS, FORCE on points, TORQUEL, GRAVITY and the hinges' ESTIFF and
-// EDAMPP load it. The equations of motion are solved in O(N) by the articulated-body algorithm
+// kinematic tree of rigid bodies with revolute and prismatic joints: beams sharing a LAMBDA node
+// are one body (a joint's LAMBDA node on no beam is a body of its own, with the joint's point on
+// its side), a body hangs from its parent at a shared (or fixed) XYZ node, its pin, and turns
+// about it by the rotation e1 of a HINGE to the parent (DYNE, e2 and e3 fixed); the pin may be
+// its grandparent's too (joints at one origin). A BEARING with DYNE e1 and e2 … e6 rigid slides
+// the body's own point (its pin) from a point of the parent along the axis, without turning.
+// MASS (point masses, inertia tensors on LAMBDA nodes), EMASS, FORCE on points, TORQUEL, GRAVITY
+// and the joints' ESTIFF and EDAMPP load it. The equations of motion are solved in O(N) by the articulated-body algorithm
 // (articulated.hpp) in spatial algebra, with explicit positions instead of Newton's method: the same equations as
 // the constraint formulation (each body's spatial inertia is the element and nodal mass matrices
 // projected on its rigid motions).
@@ -14,9 +17,10 @@
 // Refused (the general path runs, and detect() says why): planar models (planar_tree.hpp), DYNX
 // rotations (free Euler parameters), spherical joints (a shared XYZ node without a DOF hinge),
 // HINGEs with released or rigid e1, or released e2, e3 (unless all three are released, without
-// stiffness: a measuring hinge), flexible or partly fixed beams, elements other than BEAM,
-// BEAMNL, HINGE and L2MIN1, closed loops, prescribed motions, FORCE on LAMBDA nodes, partly
-// fixed nodes, and mass models that do not move as a rigid body.
+// stiffness: a measuring hinge), flexible or partly fixed beams, elements other than BEAM, BEAMNL,
+// HINGE, BEARING and L2MIN1, BEARINGs other than prismatic joints, closed loops, prescribed
+// motions, FORCE on LAMBDA nodes, partly fixed nodes, and mass models that do not move as a rigid
+// body.
 #pragma once
 
 #include <Eigen/Dense>
@@ -54,6 +58,7 @@ struct SpatialAlgebra {
     Eigen::Matrix3d E;       // parent coordinates → body coordinates
     Eigen::Matrix3d R;       // body coordinates → world
     Eigen::Vector4d lambda;  // Euler parameters (λ0, λ1, λ2, λ3) of R
+    Eigen::Vector3d r;       // the pin from the parent's, in the parent's coordinates (a sliding joint's moves)
   };
   using Model = BodyModel<SpatialAlgebra>;
   using Work = BodyData<SpatialAlgebra>;
@@ -63,12 +68,21 @@ struct SpatialAlgebra {
   }
 
   static void place(const Model& m, const Work* p, double theta, Work& d) {
+    Frame& f = d.frame;
+    if (m.prismatic) {  // no rotation: the pin moves by θ along the axis
+      f.E.setIdentity();
+      f.r = m.r + theta * m.axis;
+      f.R = p ? p->frame.R : Eigen::Matrix3d::Identity();
+      f.lambda = p ? p->frame.lambda : Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
+      d.pin = p ? Eigen::Vector3d(p->pin + p->frame.R * f.r) : f.r;
+      return;
+    }
     const double ch = std::cos(0.5 * theta), sh = std::sin(0.5 * theta);  // of the half angle, for λ too
     const double c = 1.0 - 2.0 * sh * sh, s = 2.0 * sh * ch;
     const Eigen::Vector3d& k = m.axis;
     const Eigen::Matrix3d rel = c * Eigen::Matrix3d::Identity() + s * skew(k) + (1.0 - c) * k * k.transpose();  // body → parent
-    Frame& f = d.frame;
     f.E = rel.transpose();
+    f.r = m.r;
     Eigen::Vector4d q_rel;
     q_rel << ch, sh * k;
     if (!p) {
@@ -82,36 +96,37 @@ struct SpatialAlgebra {
     }
   }
 
+  // S u̇: an angular rate about the axis, or (prismatic) a linear one along it.
   static Vector joint_motion(const Model& m, double ud) {
     Vector v = Vector::Zero();
-    v.head<3>() = ud * m.axis;
+    v.segment<3>(m.prismatic ? 3 : 0) = ud * m.axis;
     return v;
   }
 
-  static Vector to_child(const Model& m, const Frame& f, const Vector& v) {
+  static Vector to_child(const Model&, const Frame& f, const Vector& v) {
     Vector out;
     out.head<3>() = f.E * v.head<3>();
-    out.tail<3>() = f.E * (v.tail<3>() + v.head<3>().cross(m.r));
+    out.tail<3>() = f.E * (v.tail<3>() + v.head<3>().cross(f.r));
     return out;
   }
 
   // The transpose of to_child.
-  static Vector to_parent(const Model& m, const Frame& f, const Vector& g) {
+  static Vector to_parent(const Model&, const Frame& f, const Vector& g) {
     Vector out;
     out.tail<3>() = f.E.transpose() * g.tail<3>();
-    out.head<3>() = f.E.transpose() * g.head<3>() + m.r.cross(out.tail<3>());
+    out.head<3>() = f.E.transpose() * g.head<3>() + f.r.cross(out.tail<3>());
     return out;
   }
 
   // Xᵀ I X with X = [E 0; −E r̃ E] (parent → body, motion vectors), by blocks: rotated,
   // I' = [A B; Bᵀ C] in the parent's axes, then moved to its origin,
   // [A + r̃Bᵀ + (r̃Bᵀ)ᵀ − r̃Cr̃, B + r̃C; (B + r̃C)ᵀ, C] — a third of the full 6×6 products.
-  static void add_inertia_to_parent(const Model& m, const Frame& f, const Inertia& I, Inertia& parent) {
+  static void add_inertia_to_parent(const Model&, const Frame& f, const Inertia& I, Inertia& parent) {
     using Mat3 = Eigen::Matrix3d;
     const Mat3& E = f.E;
     const Mat3 Ib = I.topLeftCorner<3, 3>(), Bb = I.topRightCorner<3, 3>(), Cb = I.bottomRightCorner<3, 3>();
     const Mat3 A = E.transpose() * Ib * E, B = E.transpose() * Bb * E, C = E.transpose() * Cb * E;
-    const Mat3 rx = skew(m.r);
+    const Mat3 rx = skew(f.r);
     const Mat3 rC = rx * C, rBt = rx * B.transpose();
     parent.topLeftCorner<3, 3>() += A + rBt + rBt.transpose() - rC * rx;
     const Mat3 coupling = B + rC;
@@ -120,10 +135,12 @@ struct SpatialAlgebra {
     parent.bottomRightCorner<3, 3>() += C;
   }
 
+  // v ×ₘ S u̇ = (ω × s_ω; ω × s_v + v × s_ω).
   static Vector bias(const Model& m, const Vector& v, double ud) {
-    const Eigen::Vector3d s_w = ud * m.axis;
+    const Eigen::Vector3d s = ud * m.axis;
     Vector b;
-    b << v.head<3>().cross(s_w), v.tail<3>().cross(s_w);
+    if (m.prismatic) b << Eigen::Vector3d::Zero(), v.head<3>().cross(s);
+    else b << v.head<3>().cross(s), v.tail<3>().cross(s);
     return b;
   }
 
@@ -134,9 +151,15 @@ struct SpatialAlgebra {
     return out;
   }
 
-  static Vector joint_column(const Model& m, const Inertia& I) { return I.leftCols<3>() * m.axis; }
-  static double joint_component(const Model& m, const Vector& g) { return m.axis.dot(g.head<3>()); }
-  static void add_joint_acceleration(const Model& m, double udd, Vector& a) { a.head<3>() += udd * m.axis; }
+  static Vector joint_column(const Model& m, const Inertia& I) {
+    return m.prismatic ? Vector(I.rightCols<3>() * m.axis) : Vector(I.leftCols<3>() * m.axis);
+  }
+  static double joint_component(const Model& m, const Vector& g) {
+    return m.axis.dot(m.prismatic ? g.tail<3>() : g.head<3>());
+  }
+  static void add_joint_acceleration(const Model& m, double udd, Vector& a) {
+    a.segment<3>(m.prismatic ? 3 : 0) += udd * m.axis;
+  }
   static double dof_acceleration(const Model& m, const Vector&, double udd) { return m.sign * udd; }
   static double joint_acceleration(const Model& m, const Vector&, const double* qdd) { return m.sign * qdd[m.dof]; }
 };
