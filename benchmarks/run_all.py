@@ -1,6 +1,6 @@
 """Run every benchmark and write its section of docs/performance.md (and the plots under
 docs/img/): the manual's slider-crank (spacar alone, benchmarks/slidercrank.py), then spacar
-side by side with the peers — rigid chains (chains.py), the four-bar (fourbar.py), Newton's
+side by side with the peers — rigid chains (chains.py), the UR5 and Panda robots (robots.py), the four-bar (fourbar.py), Newton's
 iterations of the general path with its predictor and chord (newton.py, spacar alone), the flexible
 cantilever (cantilever.py), the manual's slider-crank against exudyn (slidercrank_exudyn.py) and
 the steel cantilever's time to tip accuracy with the stiff integrator (stiff.py) and the
@@ -27,6 +27,7 @@ import chains  # noqa: E402
 import fourbar  # noqa: E402
 import modes  # noqa: E402
 import newton  # noqa: E402
+import robots  # noqa: E402
 import slidercrank  # noqa: E402
 import slidercrank_exudyn  # noqa: E402
 import statics  # noqa: E402
@@ -35,6 +36,7 @@ import stiff  # noqa: E402
 CASES = {
     "slidercrank": slidercrank,
     "chains": chains,
+    "robots": robots,
     "fourbar": fourbar,
     "newton": newton,
     "cantilever": cantilever,
