@@ -382,7 +382,13 @@ class Results:
         return [f"{prefix}({a},{b})" for a, b in table]
 
     def time_index(self, t: float) -> int:
-        """Index of the output time nearest to t."""
+        """Index of the output time nearest to t (a finite number)."""
+        try:
+            t = float(t)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError(f"time_index: t must be a number, got {show(t)}") from None
+        if not math.isfinite(t):
+            raise InputError(f"time_index: t must be a finite number, got {show(t)}")
         return int(np.argmin(np.abs(self.t - t)))
 
     # --- conversions --------------------------------------------------------------------------

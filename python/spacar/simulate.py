@@ -2,7 +2,9 @@
 from __future__ import annotations
 
 import re
+import threading
 import time
+import weakref
 
 import numpy as np
 
@@ -141,6 +143,22 @@ def _dead_position_hint(err, res, system, model) -> str:
             "other two (Grashof). Check the link lengths, or keep the input within its range.")
 
 
+# Runs on one model, one at a time (issue 38): a run starts from the model's state and leaves its
+# end state in it, so two threads simulating the same model both started at its time and one
+# block was lost (6 threads × 5 s ended at t = 30, not 150). The second run now waits for the
+# first and continues from its end, as two runs one after the other do.
+_RUN_LOCKS_GUARD = threading.Lock()
+_RUN_LOCKS: "weakref.WeakKeyDictionary[Model, threading.RLock]" = weakref.WeakKeyDictionary()
+
+
+def _run_lock(model: Model) -> threading.RLock:
+    with _RUN_LOCKS_GUARD:
+        lock = _RUN_LOCKS.get(model)
+        if lock is None:
+            lock = _RUN_LOCKS[model] = threading.RLock()
+        return lock
+
+
 def simulate(model, *, method: str = "auto", on_output=None, progress=None, output_stem=None,
              time_limit=None, recursive: bool = True, forces=None, inputs=None, controller=None,
              energy: bool = False, rho_inf=None, fixed_step=None) -> Results:
@@ -232,68 +250,69 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         raise InputError(f"energy must be True or False, got {show(energy)}")
     if controller is not None and not isinstance(controller, Controller):
         raise InputError(f"controller must be a spacar.Controller or None, got {show(controller)}")
-    started = time.monotonic()   # the time limit covers the set-up too
-    sim = _core.Simulation(model.core, time_limit=limit)  # prepares the model (the first END) and compiles it
-    system = sim.system
-    if forces or inputs:
-        _time_loads(sim, system, forces or {}, inputs or {})
-    on_sample, finish_sampling = (None, None) if controller is None else controller._bind(system.coord_label)
-    settings = model.core.settings
-    callbacks = []
-    writer = None
-    if settings.matasc == 1:
-        stem = output_stem if output_stem is not None else default_stem(model)
-        writer = MatascWriter(stem, source=model.source, jobid=settings.jobid, version=__version__,
-                              coordinate_labels=system.coord_label, deformation_labels=system.def_label,
-                              coordinate_classes=[c.name for c in system.coord_class],
-                              forcemode=settings.forcemode, created=model._matasc_files)
-        def write(k, state, writer=writer, mode=settings.linear):
-            writer.write(k, state)
-            if "linearization" in state:
-                writer.write_linearization(Linearization(state["linearization"], system.coord_label,
-                                                         system.def_label), mode)
-        callbacks.append(write)
-    bar = _progress.make(progress, model.current_time, settings.timestep_tp)
-    if bar is not None:
-        callbacks.append(bar)
-    if on_output is not None:
-        callbacks.append(on_output)
-    if not callbacks:
-        callback = None
-    elif len(callbacks) == 1:
-        callback = callbacks[0]
-    else:
-        def callback(k, state):
-            for c in callbacks:
-                c(k, state)
-
-    restart = settings.restart == 1
-    step = 0.0 if restart else model._continue_step
-    try:
-        arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit,
-                         recursive=bool(recursive),  # numpy booleans too
-                         sample_period=0.0 if controller is None else 1.0 / controller.rate,
-                         on_sample=on_sample, energy=bool(energy), rho_inf=_core.run_defaults["rho_inf"] if rho_inf is None else float(rho_inf),
-                         fixed_step=step_size, time_spent=time.monotonic() - started)
-    except SpacarError as err:
-        partial = getattr(err, "results", None)
-        if isinstance(partial, dict):
-            model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
-            err.results = _results(partial, sim.system, model, method)
-        hint = _dead_position_hint(err, getattr(err, "results", None), sim.system, model) \
-            if isinstance(err, KinematicsError) and not inputs else ""
-        if hint:
-            explained = KinematicsError(f"{err}{hint}")
-            explained.results = err.results
-            raise explained from err
-        raise
-    finally:
-        if finish_sampling is not None:
-            finish_sampling()
-        if writer is not None:
-            writer.close()
+    with _run_lock(model):  # one run at a time on a model: each starts where the last ended
+        started = time.monotonic()   # the time limit covers the set-up too
+        sim = _core.Simulation(model.core, time_limit=limit)  # prepares the model (the first END) and compiles it
+        system = sim.system
+        if forces or inputs:
+            _time_loads(sim, system, forces or {}, inputs or {})
+        on_sample, finish_sampling = (None, None) if controller is None else controller._bind(system.coord_label)
+        settings = model.core.settings
+        callbacks = []
+        writer = None
+        if settings.matasc == 1:
+            stem = output_stem if output_stem is not None else default_stem(model)
+            writer = MatascWriter(stem, source=model.source, jobid=settings.jobid, version=__version__,
+                                  coordinate_labels=system.coord_label, deformation_labels=system.def_label,
+                                  coordinate_classes=[c.name for c in system.coord_class],
+                                  forcemode=settings.forcemode, created=model._matasc_files)
+            def write(k, state, writer=writer, mode=settings.linear):
+                writer.write(k, state)
+                if "linearization" in state:
+                    writer.write_linearization(Linearization(state["linearization"], system.coord_label,
+                                                             system.def_label), mode)
+            callbacks.append(write)
+        bar = _progress.make(progress, model.current_time, settings.timestep_tp)
         if bar is not None:
-            bar.close()
-    model._continue_step = arrays["last_step"]
-    model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    return _results(arrays, sim.system, model, method)
+            callbacks.append(bar)
+        if on_output is not None:
+            callbacks.append(on_output)
+        if not callbacks:
+            callback = None
+        elif len(callbacks) == 1:
+            callback = callbacks[0]
+        else:
+            def callback(k, state):
+                for c in callbacks:
+                    c(k, state)
+
+        restart = settings.restart == 1
+        step = 0.0 if restart else model._continue_step
+        try:
+            arrays = sim.run(on_output=callback, initial_step=step, method=method, time_limit=limit,
+                             recursive=bool(recursive),  # numpy booleans too
+                             sample_period=0.0 if controller is None else 1.0 / controller.rate,
+                             on_sample=on_sample, energy=bool(energy), rho_inf=_core.run_defaults["rho_inf"] if rho_inf is None else float(rho_inf),
+                             fixed_step=step_size, time_spent=time.monotonic() - started)
+        except SpacarError as err:
+            partial = getattr(err, "results", None)
+            if isinstance(partial, dict):
+                model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
+                err.results = _results(partial, sim.system, model, method)
+            hint = _dead_position_hint(err, getattr(err, "results", None), sim.system, model) \
+                if isinstance(err, KinematicsError) and not inputs else ""
+            if hint:
+                explained = KinematicsError(f"{err}{hint}")
+                explained.results = err.results
+                raise explained from err
+            raise
+        finally:
+            if finish_sampling is not None:
+                finish_sampling()
+            if writer is not None:
+                writer.close()
+            if bar is not None:
+                bar.close()
+        model._continue_step = arrays["last_step"]
+        model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
+        return _results(arrays, sim.system, model, method)

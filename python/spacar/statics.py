@@ -105,6 +105,8 @@ def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int =
     set-up included (None: no limit); beyond it :class:`spacar.TimeLimitError`, also with the
     converged steps.
     """
+    if not isinstance(model, Model):
+        raise InputError(f"static: model must be a spacar.Model, got {show(model)}")
     steps = _count(steps, "steps", 1, 10**7)
     max_iterations = _count(max_iterations, "max_iterations", 1, 1000)
     max_cuts = _count(max_cuts, "max_cuts", 0, 50)

@@ -328,11 +328,11 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81)) -> Model:
     anything that is not a tree of links raise :class:`spacar.InputError` naming the file; so
     does a file that is not well-formed XML.
     """
-    if not isinstance(path, (str, os.PathLike)):
+    if not isinstance(path, (str, os.PathLike)) or "\x00" in os.fspath(path):
         raise InputError(f"from_urdf needs the path of a URDF file, got {show(path)}")
     try:
         g = np.array([float(v) for v in gravity])
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer beyond double
         g = np.array([])
     if g.shape != (3,) or not np.isfinite(g).all():
         raise InputError(f"gravity must be three finite numbers (gx, gy, gz), got {show(gravity)}")
