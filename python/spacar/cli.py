@@ -231,7 +231,8 @@ def main(argv=None) -> int:
     run.add_argument("--dump-digits", type=_digits, default=4, metavar="N",
                      help="significant digits of the dump (default 4 as the manual; 17 for a lossless restart)")
     run.add_argument("--method", choices=_core.integration_methods, default="auto",
-                     help="integration method (default auto: dop853, radau5 where it detects stiffness; "
+                     help="integration method (default auto: dop853, then radau5 where it detects stiffness or "
+                          "generalized_alpha for an undamped structure; "
                           "radau5: implicit, for stiff flexible systems; generalized_alpha: implicit, second order)")
     run.add_argument("--rho-inf", type=float, default=None, metavar="RHO",
                      help="generalized_alpha: spectral radius at infinite frequency, 0..1 (default 0.9; 1: no "
@@ -277,6 +278,13 @@ def main(argv=None) -> int:
     except SpacarError as err:
         sys.stdout.flush()
         print(f"spacar: {type(err).__name__}: {err}", file=sys.stderr)
+        return 1
+    except OSError as err:
+        # The dump could not be written (standard output on a full disk, a closed pipe): one line,
+        # status 1, and standard output pointed at /dev/null so that the exit's flush is quiet.
+        print(f"spacar: cannot write the output: {err.strerror or err}", file=sys.stderr)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
         return 1
     except KeyboardInterrupt:
         # Ctrl-C: one line, no traceback, the shell's status for SIGINT (128 + 2). The analysis

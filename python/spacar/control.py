@@ -16,6 +16,15 @@ from .errors import InputError
 _SENSED = ("x", "xd", "xdd")
 
 
+def _whole(v) -> bool:
+    """A node or coordinate number: an integer, or a float that is one (2.0, not 2.7, NaN or 'a')."""
+    if isinstance(v, (bool, np.bool_)):
+        return False
+    if isinstance(v, (int, np.integer)):
+        return True
+    return isinstance(v, (float, np.floating)) and bool(np.isfinite(v)) and float(v).is_integer()
+
+
 class Controller:
     """``fn(t, sensors) -> actuator loads``, called at ``t0, t0 + 1/rate, ...`` with the sensor
     values (an array in the order of ``sensors``) at that time; it returns one load per actuator,
@@ -33,6 +42,9 @@ class Controller:
                 or not np.isfinite(rate) or rate <= 0:
             raise InputError(f"Controller: rate must be a positive number of samples per second, got {show(rate)}")
         self.fn, self.rate = fn, float(rate)
+        for name, items in (("sensors", sensors), ("actuators", actuators)):
+            if not isinstance(items, (list, tuple)):
+                raise InputError(f"Controller: {name} must be a list of tuples, got {show(items)}")
         self.sensors = [self._sensor(s) for s in sensors]
         self.actuators = [self._actuator(a) for a in actuators]
         if not self.actuators:
@@ -41,14 +53,15 @@ class Controller:
 
     @staticmethod
     def _sensor(s):
-        if not (isinstance(s, tuple) and len(s) == 3 and s[0] in _SENSED):
-            raise InputError(f"Controller: a sensor is ('x' | 'xd' | 'xdd', node, coordinate), got {show(s)}")
+        if not (isinstance(s, tuple) and len(s) == 3 and s[0] in _SENSED and _whole(s[1]) and _whole(s[2])):
+            raise InputError(f"Controller: a sensor is ('x' | 'xd' | 'xdd', node, coordinate) with whole numbers, "
+                             f"got {show(s)}")
         return (s[0], int(s[1]), int(s[2]))
 
     @staticmethod
     def _actuator(a):
-        if not (isinstance(a, tuple) and len(a) == 2):
-            raise InputError(f"Controller: an actuator is (node, coordinate), got {show(a)}")
+        if not (isinstance(a, tuple) and len(a) == 2 and _whole(a[0]) and _whole(a[1])):
+            raise InputError(f"Controller: an actuator is (node, coordinate) with whole numbers, got {show(a)}")
         return (int(a[0]), int(a[1]))
 
     def _bind(self, coordinate_labels):

@@ -23,6 +23,7 @@ import json
 import math
 import os
 import re
+import shutil
 import stat
 import tempfile
 import zipfile
@@ -157,6 +158,16 @@ class ElementResults:
     edd: np.ndarray
     sigma: np.ndarray
 
+
+
+def _stat_value(key, value):
+    """A statistic as JSON stores it: None, a number, a string or a list as they are, a NumPy
+    number as a float; anything else is refused by name (a raw TypeError before, issue 38)."""
+    if value is None or isinstance(value, (bool, int, float, str, list)):
+        return value
+    if isinstance(value, np.generic) and np.issubdtype(type(value), np.number):
+        return float(value)
+    raise InputError(f"Results.save: the statistic {key!r} is not a number, string or list: {show(value)}")
 
 class Results:
     """Arrays over the output times of one block (or of several, see :meth:`concatenate`).
@@ -425,7 +436,8 @@ class Results:
         linearizations); read back with :meth:`Results.load`. ``.npz`` is appended to a name
         without it (as NumPy does). An existing file is replaced (written to a temporary file
         next to it, then renamed: a failed save leaves the old file); a symbolic link or a
-        non-regular file in its place is refused."""
+        non-regular file in its place is refused; the file keeps its mode, and a file with hard
+        links is rewritten in place, so that the links keep sharing it."""
         path = _path_argument(path, "Results.save")
         if not path.endswith(".npz"):
             path += ".npz"
@@ -445,8 +457,7 @@ class Results:
         meta = {
             "format": "spacar.Results",
             "version": 2,  # 2: with the kinematic coordinates of the linearizations
-            "stats": {k: (v if v is None or isinstance(v, (int, float, str, list)) else float(v))
-                      for k, v in self.stats.items()},
+            "stats": {k: _stat_value(k, v) for k, v in self.stats.items()},
             "settings_linear": self.settings_linear,
             "dof_labels": self.dof_labels,
             "geometry": None if self.geometry is None else self.geometry.to_dict(),
@@ -456,18 +467,30 @@ class Results:
         data["meta"] = np.array(json.dumps(meta))
         from .io.files import open_output, reason
 
-        os.close(open_output(path, append=True))  # refuses a link or a non-regular file (appending: not emptied)
+        existing = open_output(path, append=True)  # refuses a link or a non-regular file (appending: not emptied)
+        info = os.fstat(existing)
+        os.close(existing)
         directory, name = os.path.split(os.path.abspath(path))
         fd, temporary = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
         try:
+            os.fchmod(fd, stat.S_IMODE(info.st_mode))  # the file's mode, not mkstemp's 0600 (issue 38)
             with os.fdopen(fd, "wb") as fh:
                 np.savez_compressed(fh, **data)
-            os.replace(temporary, path)
+            if info.st_nlink > 1:  # hard links keep sharing the file: its bytes are replaced in place
+                with open(temporary, "rb") as src:
+                    out = open_output(path)
+                    with os.fdopen(out, "wb") as dst:
+                        shutil.copyfileobj(src, dst)
+                os.unlink(temporary)
+            else:
+                os.replace(temporary, path)
         except OSError as err:
-            os.unlink(temporary)
+            if os.path.exists(temporary):
+                os.unlink(temporary)
             raise SpacarError(f"{path}: cannot save the results ({reason(err)})") from None
         except BaseException:
-            os.unlink(temporary)
+            if os.path.exists(temporary):
+                os.unlink(temporary)
             raise
 
     @classmethod

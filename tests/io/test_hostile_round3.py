@@ -75,3 +75,77 @@ def test_time_index_of_no_time_is_an_input_error(bad, match):
     with pytest.raises(spacar.InputError, match=match):
         res.time_index(bad)  # NaN gave row 0
     assert res.time_index(2.51) == 50
+
+
+@pytest.mark.parametrize("bad, match", [("x", "a number"), ((1.0, 1.0), "a number"), (10**400, "a number"),
+                                        (float("nan"), "finite")])
+def test_a_table_at_no_time_is_an_input_error(bad, match):
+    table = spacar.Table(np.linspace(0.0, 1.0, 5), np.sin(np.linspace(0.0, 1.0, 5)))
+    with pytest.raises(spacar.InputError, match=match):
+        table(bad)  # raw ValueError, TypeError, OverflowError; NaN returned NaN
+
+
+@pytest.mark.parametrize("spacing", [1e-300, 1e-160])
+def test_a_cubic_table_of_samples_too_close_is_refused(spacing):
+    """Times 1e-300 apart gave −inf, NaN and inf from a successful call; the linear table's slopes
+    stay finite there and it is kept."""
+    t, y = np.arange(4) * spacing, np.array([0.0, 1.0, 4.0, 2.0])
+    with pytest.raises(spacar.InputError, match="too close for the cubic interpolation"):
+        spacar.Table(t, y, kind="cubic")
+    linear = spacar.Table(t, y, kind="linear")
+    assert all(np.isfinite(linear(0.5 * spacing, d)) for d in (0, 1, 2))
+
+
+@pytest.mark.parametrize("sensors, actuators, match", [
+    (None, [(2, 1)], "sensors must be a list"),
+    ([("x", "a", 1)], [(2, 1)], "a sensor is"),
+    ([("x", 2, 1)], [(2, float("nan"))], "an actuator is"),
+    ([("x", 2.7, 1)], [(2, 1)], "a sensor is"),  # was node 2, silently
+])
+def test_controller_sensors_and_actuators_are_checked(sensors, actuators, match):
+    with pytest.raises(spacar.InputError, match=match):
+        spacar.Controller(lambda t, s: np.zeros(1), rate=100.0, sensors=sensors, actuators=actuators)
+    whole = spacar.Controller(lambda t, s: np.zeros(1), rate=100.0, sensors=[("x", 2.0, 1)], actuators=[(2, 1)])
+    assert whole.sensors == [("x", 2, 1)]
+
+
+def test_input_without_end_is_said_at_once():
+    """Finding 12: read_string of a text with no END gave an empty model silently."""
+    with pytest.warns(UserWarning, match="lines 1..3: input without a closing END is ignored"):
+        model = spacar.read_string("PLBEAM 1 1 2 3 4\nX 3 1 0\nFIX 1\n")
+    assert model.blocks == [] and any("closing END" in w for w in model.warnings)
+
+
+def test_results_save_keeps_the_file_s_mode_and_hard_links(tmp_path):
+    """Finding 16: a save replaced the file by mkstemp's (mode 0600) and broke its hard links; a
+    statistic that JSON cannot hold gave a raw TypeError."""
+    import os
+
+    res = spacar.simulate(spacar.read(EXAMPLES / "slidercrank.dat"), progress=False)
+    path = tmp_path / "run.npz"
+    res.save(path)
+    os.chmod(path, 0o640)
+    res.save(path)
+    assert os.stat(path).st_mode & 0o777 == 0o640
+    link = tmp_path / "link.npz"
+    os.link(path, link)
+    res.save(path)
+    assert os.path.samefile(path, link) and os.stat(path).st_nlink == 2
+    np.testing.assert_array_equal(spacar.Results.load(link).x, res.x)
+    res.stats["extra"] = {"not": "a number"}
+    with pytest.raises(spacar.InputError, match="the statistic 'extra' is not a number"):
+        res.save(path)
+    np.testing.assert_array_equal(spacar.Results.load(path).x, res.x)  # the file is as it was
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/dev/full"), reason="needs /dev/full")
+def test_cli_into_a_full_disk_says_so_in_one_line():
+    """Finding 16: `spacar run x.dat > /dev/full` printed a raw OSError traceback."""
+    import subprocess
+    import sys
+
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "spacar", "run", str(EXAMPLES / "slidercrank.dat")],
+                              stdout=full, stderr=subprocess.PIPE, text=True, timeout=120)
+    assert done.returncode == 1
+    assert done.stderr.strip() == "spacar: cannot write the output: No space left on device"

@@ -3,6 +3,7 @@
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "spacar/errors.hpp"
@@ -71,6 +72,21 @@ Table::Table(std::vector<double> times, Eigen::MatrixXd values, Kind kind)
   if (!values_.allFinite()) throw InputError("Table: the values must be finite");
   second_ = kind_ == Kind::CUBIC ? not_a_knot_second_derivatives(t_, values_)
                                  : Eigen::MatrixXd::Zero(values_.rows(), values_.cols());
+  // Samples so close that the slopes or the spline's second derivatives overflow (times 1e-300
+  // apart) would give infinite or NaN values, rates and accelerations: refused here.
+  double closest = t_[1] - t_[0];
+  bool finite = second_.allFinite();
+  for (size_t i = 0; i + 1 < t_.size(); ++i) {
+    const double h = t_[i + 1] - t_[i];
+    closest = std::min(closest, h);
+    finite = finite && ((values_.row(i + 1) - values_.row(i)) / h).allFinite();
+  }
+  if (!finite) {
+    std::ostringstream os;
+    os << "Table: samples " << closest << " s apart are too close for the " << (kind_ == Kind::CUBIC ? "cubic" : "linear")
+       << " interpolation of these values: its slopes or second derivatives overflow";
+    throw InputError(os.str());
+  }
 }
 
 size_t Table::interval(double t) const {

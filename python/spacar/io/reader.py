@@ -24,6 +24,7 @@ import io
 import os
 import re
 import stat
+import warnings
 from dataclasses import dataclass, field
 
 from .._util import show
@@ -180,8 +181,10 @@ def _model(blocks: list, file: str) -> Model:
     for b in blocks:
         if not b.ended:
             first, last = b.commands[0], b.commands[-1]
-            model.warnings.append(
-                f"{file}, lines {first.line}..{last.line}: input without a closing END is ignored")
+            message = f"{file}, lines {first.line}..{last.line}: input without a closing END is ignored"
+            model.warnings.append(message)
+            # Said at once too: a text with no END at all gives a model without elements (issue 38).
+            warnings.warn(message, stacklevel=3)
     model.blocks = [b for b in blocks if b.ended]
     if model.blocks:
         apply_block(model, model.blocks[0])
