@@ -37,6 +37,17 @@ def test_a_chain_of_20000_massless_beams_is_refused_at_once_naming_the_missing_m
     assert "memory" not in str(info.value)
 
 
+def test_a_large_model_without_mass_is_refused_before_the_assembly():
+    """Issue 38, finding 11: under time_limit=1 the same chain ended in "the time limit of 1 s was
+    exceeded at t = 0" after 2.7 s (the assembly and a sparse factorization first); the cheap
+    cause is now checked before any work."""
+    model = beam_chain(20000)
+    start = time.perf_counter()
+    with pytest.raises(SingularMassError, match="no element or node carries mass"):
+        spacar.simulate(model, time_limit=1.0)
+    assert time.perf_counter() - start < 5.0  # about 0.4 s (a bound, not a benchmark)
+
+
 def test_a_small_massless_chain_names_its_degrees_of_freedom_as_before():
     with pytest.raises(SingularMassError, match=r"\[DYNE element 1 \(PLBEAM\) deformation 1\].* move no mass"):
         spacar.simulate(beam_chain(2))

@@ -149,3 +149,4 @@ def test_cli_into_a_full_disk_says_so_in_one_line():
                               stdout=full, stderr=subprocess.PIPE, text=True, timeout=120)
     assert done.returncode == 1
     assert done.stderr.strip() == "spacar: cannot write the output: No space left on device"
+

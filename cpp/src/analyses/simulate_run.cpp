@@ -155,6 +155,7 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
     throw InputError("the controller's sample period " + format_number(options.sample_period, 12) + " needs more than " +
                      std::to_string(options.max_steps) + " samples in the block");
   if (plan.integrate) {
+    refuse_large_massless(*sys_, t0);  // before the assembly, which can take seconds at that size
     const double h_min = Stepper::min_step(t_end);
     if (st.timestep_tp < h_min)
       throw InputError("TIMESTEP: the period Tp = " + format_number(st.timestep_tp, 12) +

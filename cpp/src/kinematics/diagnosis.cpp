@@ -222,27 +222,44 @@ std::string weakest_constraint(const System& sys, Data& data) {
   throw SingularMassError(os.str());
 }
 
+namespace {
+// Naming the degrees of freedom without inertia takes dense matrices and an eigen-solver (cubic
+// in their number): beyond this, the cause is said without the names.
+bool too_large_to_name(const System& sys) {
+  return sys.n_dof() > kMaxDiagnosisSize || Data::estimate_dense_bytes(sys) > static_cast<double>(memory_limit());
+}
+
+bool carries_mass(const System& sys) {
+  return std::any_of(sys.elements.begin(), sys.elements.end(), [](const SystemElement& se) { return se.has_mass; }) ||
+         (sys.point_mass.array() != 0.0).any() || !sys.bodies.empty();
+}
+
+void say_no_mass(std::ostream& os, const System& sys) {
+  os << "no element or node carries mass (no EMASS, MASS or body inertia in the model): all its " << sys.n_dof()
+     << " degrees of freedom (DYNX, DYNE) move no mass; add MASS or EMASS to the nodes or elements they move, "
+        "or make them kinematic (INPUTX/INPUTE) for a kinematic analysis";
+}
+}  // namespace
+
+void refuse_large_massless(const System& sys, double t) {
+  if (sys.n_dof() == 0 || carries_mass(sys) || !too_large_to_name(sys)) return;
+  std::ostringstream os;
+  os << "the equations of motion are singular at t = " << t << ": ";
+  say_no_mass(os, sys);
+  throw SingularMassError(os.str());
+}
+
 void explain_singular_equations(const System& sys, Data& data) {
-  // Naming the degrees of freedom without inertia takes dense matrices and an eigen-solver
-  // (cubic in their number). Too large for them: the cause without the names, and never a
+  // Too large to name the degrees of freedom: the cause without the names, and never a
   // complaint about the memory that naming them would need.
   const int nd = sys.n_dof();
-  if (nd > kMaxDiagnosisSize || Data::estimate_dense_bytes(sys) > static_cast<double>(memory_limit())) {
-    const bool any_mass = std::any_of(sys.elements.begin(), sys.elements.end(),
-                                      [](const SystemElement& se) { return se.has_mass; }) ||
-                          (sys.point_mass.array() != 0.0).any() || !sys.bodies.empty();
+  if (too_large_to_name(sys)) {
+    refuse_large_massless(sys, data.t);
     std::ostringstream os;
-    os << "the equations of motion are singular at t = " << data.t << ": ";
-    if (!any_mass)
-      os << "no element or node carries mass (no EMASS, MASS or body inertia in the model): all its " << nd
-         << " degrees of freedom (DYNX, DYNE) move no mass; add MASS or EMASS to the nodes or elements they move, "
-            "or make them kinematic (INPUTX/INPUTE) for a kinematic analysis";
-    else
-      os << "degrees of freedom (of " << nd
-         << ") that move no mass, or dependent constraints; too large to name them (the dense diagnosis is done up "
-            "to "
-         << kMaxDiagnosisSize << " degrees of freedom within the memory limit); check the masses (MASS, EMASS) and "
-                                 "spacar.check(model)";
+    os << "the equations of motion are singular at t = " << data.t << ": degrees of freedom (of " << nd
+       << ") that move no mass, or dependent constraints; too large to name them (the dense diagnosis is done up to "
+       << kMaxDiagnosisSize << " degrees of freedom within the memory limit); check the masses (MASS, EMASS) and "
+                               "spacar.check(model)";
     throw SingularMassError(os.str());
   }
   solve_transfer(sys, data);

@@ -43,5 +43,9 @@ std::string weakest_constraint(const System& sys, Data& data);
 // The sparse equations of motion could not be factorized: name the degrees of freedom without
 // inertia through the reduced equations (transfer functions, M̄), else SingularMassError.
 [[noreturn]] void explain_singular_equations(const System& sys, Data& data);
+// SingularMassError at once if the system has degrees of freedom, no mass anywhere and is too
+// large for the dense diagnosis that names them (a run checks it before any work: a 20 000-beam
+// chain without mass ran into its time limit in the assembly before, issue 38).
+void refuse_large_massless(const System& sys, double t);
 
 }  // namespace spacar
