@@ -34,3 +34,15 @@ def seconds_or_none(value, what: str):
     if not ok:
         raise InputError(f"{what} must be a positive number of seconds or None, got {show(value)}")
     return float(value)
+
+
+def finite_time(value, what: str) -> float:
+    """A time as a finite float; InputError naming ``what`` for anything else (a string, a tuple,
+    an integer beyond double, NaN, infinity)."""
+    try:
+        t = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{what} must be a number, got {show(value)}") from None
+    if not math.isfinite(t):
+        raise InputError(f"{what} must be a finite number, got {show(value)}")
+    return t

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from ._util import show
+from ._util import finite_time, show
 from .energy import KEYS as ENERGY_KEYS, Energy
 from .errors import InputError, SpacarError
 from .geometry import Geometry, euler_e
@@ -394,13 +394,7 @@ class Results:
 
     def time_index(self, t: float) -> int:
         """Index of the output time nearest to t (a finite number)."""
-        try:
-            t = float(t)
-        except (TypeError, ValueError, OverflowError):
-            raise InputError(f"time_index: t must be a number, got {show(t)}") from None
-        if not math.isfinite(t):
-            raise InputError(f"time_index: t must be a finite number, got {show(t)}")
-        return int(np.argmin(np.abs(self.t - t)))
+        return int(np.argmin(np.abs(self.t - finite_time(t, "time_index: t"))))
 
     # --- conversions --------------------------------------------------------------------------
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._util import show
+from ._util import finite_time, show
 from .errors import InputError
 
 
@@ -49,12 +49,7 @@ class Table:
     def __call__(self, t, derivative: int = 0):
         if derivative not in (0, 1, 2):
             raise InputError(f"Table: derivative must be 0, 1 or 2, got {show(derivative)}")
-        try:
-            t = float(t)
-        except (TypeError, ValueError, OverflowError):
-            raise InputError(f"Table: the time must be a number, got {show(t)}") from None
-        if not np.isfinite(t):
-            raise InputError(f"Table: the time must be a finite number, got {show(t)}")
+        t = finite_time(t, "Table: the time")
         out = np.array([self.core(t, c, derivative) for c in range(self.components)])
         return float(out[0]) if self.scalar else out
 
