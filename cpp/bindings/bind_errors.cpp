@@ -35,6 +35,9 @@ py::handle python_type(const std::exception_ptr& p, std::string& message) {
   } catch (const SingularMassError& x) {
     message = x.what();
     return e.mass;
+  } catch (const Interrupted& x) {  // Ctrl-C: Python's own KeyboardInterrupt, with the results so far
+    message = x.what();
+    return py::handle(PyExc_KeyboardInterrupt);
   } catch (const StaticError& x) {
     message = x.what();
     return e.statics;

@@ -14,6 +14,16 @@ namespace spacar::bindings {
 
 namespace {
 
+// Whether Python has a Ctrl-C pending for the main thread (InterruptScope's poll, called by a run
+// without the GIL): Python's signal handler runs here; its KeyboardInterrupt is dropped, as the
+// run raises its own with the results computed so far.
+bool python_interrupt_pending() {
+  py::gil_scoped_acquire gil;
+  if (PyErr_CheckSignals() == 0) return false;
+  PyErr_Clear();
+  return true;
+}
+
 py::dict block_results_to_dict(BlockResults&& r) {
   py::dict d;
   d["t"] = std::move(r.t);
@@ -329,6 +339,8 @@ void bind_run(py::class_<Simulation>& sim) {
             opt.time_limit = time_limit;
             opt.time_spent = time_spent;
             BlockResults r;
+            // Ctrl-C reaches the run (without the GIL) through the deadline's checks.
+            const InterruptScope interrupt(python_interrupt_pending);
             return run_released(r, [&] { s.run(r, opt); }, block_results_to_dict,
                                 [](const std::exception_ptr&) { return true; });
           },

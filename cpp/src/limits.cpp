@@ -13,7 +13,25 @@ namespace spacar {
 namespace {
 std::atomic<std::size_t> g_memory_limit{std::size_t(4) << 30};
 thread_local ThreadDeadline t_deadline;
+thread_local InterruptScope::Poll t_interrupt = nullptr;
+thread_local std::chrono::steady_clock::time_point t_last_poll;
 }  // namespace
+
+InterruptScope::InterruptScope(Poll poll) : outer_(t_interrupt) {
+  t_interrupt = poll;
+  t_last_poll = std::chrono::steady_clock::now();
+}
+
+InterruptScope::~InterruptScope() { t_interrupt = outer_; }
+
+void check_thread_interrupt() {
+  if (!t_interrupt) return;
+  constexpr auto kPollInterval = std::chrono::milliseconds(20);  // the poll takes the GIL
+  const auto now = std::chrono::steady_clock::now();
+  if (now - t_last_poll < kPollInterval) return;
+  t_last_poll = now;
+  if (t_interrupt()) throw Interrupted("the analysis was interrupted (KeyboardInterrupt)");
+}
 
 bool thread_deadline_passed() { return t_deadline.active && std::chrono::steady_clock::now() > t_deadline.at; }
 
@@ -25,6 +43,7 @@ void throw_time_limit(const std::string& where) {
 
 void check_thread_deadline(const char* where) {
   if (thread_deadline_passed()) throw_time_limit(where);
+  check_thread_interrupt();
 }
 
 DeadlineScope::DeadlineScope(double limit, double spent) : outer_(t_deadline) {

@@ -222,7 +222,8 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     midway, the :class:`spacar.SpacarError` raised carries the results up to the failure as
     ``err.results`` (a :class:`spacar.Results` with the output times recorded before the failure,
     possibly none; the MATASC files hold the same times); the model's state is then left as it
-    was before the block.
+    was before the block. Ctrl-C (from the main thread) interrupts the run within about 20 ms:
+    ``KeyboardInterrupt`` carries the results so far as ``err.results`` in the same way.
     """
     from . import __version__, progress as _progress
 
@@ -294,6 +295,10 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
                              sample_period=0.0 if controller is None else 1.0 / controller.rate,
                              on_sample=on_sample, energy=bool(energy), rho_inf=_core.run_defaults["rho_inf"] if rho_inf is None else float(rho_inf),
                              fixed_step=step_size, time_spent=time.monotonic() - started)
+        except KeyboardInterrupt as err:  # Ctrl-C inside the run: the rows done, as after a failure
+            if isinstance(getattr(err, "results", None), dict):
+                err.results = _results(err.results, sim.system, model, method)
+            raise
         except SpacarError as err:
             partial = getattr(err, "results", None)
             if isinstance(partial, dict):

@@ -43,6 +43,12 @@ struct TimeLimitError : Error {
   using Error::Error;
 };
 
+// The user interrupted the analysis (Ctrl-C in Python: InterruptScope, limits.hpp); the results
+// up to that moment are kept, as after a failure.
+struct Interrupted : Error {
+  using Error::Error;
+};
+
 // No static equilibrium was found (statics.hpp): the load factor reached, the worst residual and
 // its degree of freedom are in the message; the bindings attach the converged load steps.
 struct StaticError : Error {

@@ -37,6 +37,22 @@ bool thread_deadline_passed();
 // throw_time_limit(where) if the deadline has passed.
 void check_thread_deadline(const char* where);
 
+// An interruption of the analysis running on this thread: `poll` (the bindings': Python's
+// pending Ctrl-C) is asked, at most every 20 ms, wherever the deadline is checked, for the
+// lifetime of the scope; when it answers true, check_thread_interrupt throws Interrupted.
+class InterruptScope {
+ public:
+  using Poll = bool (*)();
+  explicit InterruptScope(Poll poll);
+  ~InterruptScope();
+  InterruptScope(const InterruptScope&) = delete;
+  InterruptScope& operator=(const InterruptScope&) = delete;
+
+ private:
+  Poll outer_;
+};
+void check_thread_interrupt();
+
 // The deadline of `limit` seconds (0 or beyond 10⁹ s: none) from `spent` seconds ago, for the
 // lifetime of the scope (a run, a set-up, a diagnosis). Nested scopes (an analysis started from
 // a callback of another) keep the earlier deadline and restore the outer one when they end.

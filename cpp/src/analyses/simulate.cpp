@@ -529,6 +529,7 @@ void Simulation::require_finite_state(double t) const {
 }
 
 void Simulation::check_time(double t) {
+  check_thread_interrupt();
   if (!thread_deadline_passed()) return;
   std::ostringstream os;
   os << "at t = " << t;
