@@ -27,7 +27,7 @@ def inverse_dynamics(model: Model, q, qd, qdd) -> np.ndarray:
     for name, value in (("q", q), ("qd", qd), ("qdd", qdd)):
         try:
             a = np.array(value, dtype=float)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise InputError(f"inverse_dynamics: {name} must be an array of numbers, got {show(value)}") from None
         if a.ndim not in (1, 2) or not np.isfinite(a).all():
             raise InputError(f"inverse_dynamics: {name} must be a finite vector or a matrix of states (one per row)")

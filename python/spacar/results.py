@@ -159,7 +159,6 @@ class ElementResults:
     sigma: np.ndarray
 
 
-
 def _stat_value(key, value):
     """A statistic as JSON stores it: None, a number, a string or a list as they are, a NumPy
     number as a float; anything else is refused by name (a raw TypeError before, issue 38)."""
@@ -168,6 +167,7 @@ def _stat_value(key, value):
     if isinstance(value, np.generic) and np.issubdtype(type(value), np.number):
         return float(value)
     raise InputError(f"Results.save: the statistic {key!r} is not a number, string or list: {show(value)}")
+
 
 class Results:
     """Arrays over the output times of one block (or of several, see :meth:`concatenate`).

@@ -144,9 +144,9 @@ def _dead_position_hint(err, res, system, model) -> str:
 
 
 # Runs on one model, one at a time (issue 38): a run starts from the model's state and leaves its
-# end state in it, so two threads simulating the same model both started at its time and one
-# block was lost (6 threads × 5 s ended at t = 30, not 150). The second run now waits for the
-# first and continues from its end, as two runs one after the other do.
+# end state in it, so threads simulating the same model started at the same time and blocks were
+# lost (six threads of one 5 s run each left the manual's slider-crank at t = 10, not 30). A run
+# now waits for the one before and continues from its end, as runs one after the other do.
 _RUN_LOCKS_GUARD = threading.Lock()
 _RUN_LOCKS: "weakref.WeakKeyDictionary[Model, threading.RLock]" = weakref.WeakKeyDictionary()
 

@@ -1,7 +1,7 @@
 """Issue 38, the third adversarial round (docs/robustness.md, "Third round"). Finding 1: runs on
 one model from several threads. A run starts from the model's
 state and leaves its end state there; threads simulating the same model all started at its time
-and their blocks overwrote each other (six 5 s runs left the model at t = 5, not 30). Now the runs
+and their blocks overwrote each other (six 5 s runs left the model at t = 10, not 30). Now the runs
 on one model take turns: the model ends where the same runs one after the other end, and each
 run's rows continue the last one's. Findings 12, 14 and 15 (in part): raw errors at entry points
 and a NaN time index."""

@@ -109,7 +109,7 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
         bd.absolute = true;
         bd.dof = dof_of_coord_.at(coord);
         bd.offset = x_[coord];
-        if (!place(child, parent, bd, "DYNX " + sys_.coord_name(coord))) return false;
+        if (!place(child, parent, bd, "DYNX " + sys_.coord_name(coord), Slide{})) return false;
         queue.push_back(child);
       }
     return true;
@@ -140,10 +140,10 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
 
   // Adds the body to the tree under the placed body `parent_body` (or kGround) with its joint
   // `bd`: the pin, the inertia about it, the coordinates and loads moving with it.
-  bool place(int body, int parent_body, Model bd, const std::string& joint) {
+  bool place(int body, int parent_body, Model bd, const std::string& joint, const Slide& slide) {
     const int index = tree_.n_bodies();
     Eigen::Vector2d p0;
-    if (!attach(body, parent_body, bd, joint, index, p0)) return false;
+    if (!attach(body, parent_body, bd, joint, index, p0, slide)) return false;
     Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
     for (int i : g_.beams[body]) I += element_inertia(sys_.elements[i], p0);
     for (int id : g_.points[body])

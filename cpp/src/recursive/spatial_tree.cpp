@@ -170,16 +170,16 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
 
   // Adds the body to the tree under the placed body `parent_body` (or kGround) with its joint
   // `bd`: the pin, the inertia about it, the coordinates moving with it.
-  bool place(int body, int parent_body, Model bd, const std::string& joint) {
+  bool place(int body, int parent_body, Model bd, const std::string& joint, const Slide& slide) {
     const int index = tree_.n_bodies();
     Vec3 p0;
-    if (!attach(body, parent_body, bd, joint, index, p0)) return false;
+    if (!attach(body, parent_body, bd, joint, index, p0, slide)) return false;
     Inertia I = Inertia::Zero();
     auto row = [&](int g) { return rigid_row_of(g, p0); };
     for (int i : g_.beams[body])
       if (i >= 0) I += tree_detail::element_inertia<6>(sys_.elements[i], x_, row);
     for (int id : g_.points[body]) {
-      if (id == pin_[body] && !own_pin_[body]) continue;  // a hinge's pin: its mass and loads move with the parent
+      if (id == pin_[body] && !owns_pin(body)) continue;  // a hinge's pin: its mass and loads move with the parent
       for (int c = 0; c < 3; ++c) {
         const int g = nodes_[id].coord + c;
         I += sys_.point_mass[g] * row(g).transpose() * row(g);

@@ -99,6 +99,12 @@ class TreeBuilder {
     int pa = -1, pb = -1;  // a sliding joint's points on a's and b's bodies (−1: a hinge)
   };
 
+  // The points of the sliding joint that places a body: its own point (its pin, which slides)
+  // and the parent's point it slides from; −1: a hinge.
+  struct Slide {
+    int pin = -1, base = -1;
+  };
+
   TreeBuilder(const System& sys, const Data& data, NodeKind point, NodeKind orientation)
       : sys_(sys), x_(data.x), point_kind_(point), orientation_kind_(orientation) {}
 
@@ -170,7 +176,6 @@ class TreeBuilder {
     if (g_.stray >= 0) return refuse("node " + std::to_string(g_.stray) + " moves with no rigid beam");
     placed_.assign(g_.points.size(), -1);
     pin_.assign(g_.points.size(), -1);
-    own_pin_.assign(g_.points.size(), false);
     for (const auto& [id, n] : nodes_)
       if (n.kind == point_kind_ && n.fixed) owner_[id] = kGround;
     return true;
@@ -214,9 +219,8 @@ class TreeBuilder {
         if (is_placed(child)) return refuse(name + " closes a loop");
         h.used = true;
         Model bd;
-        slide_pin_ = h.pa < 0 ? -1 : (forward ? h.pb : h.pa);  // the child's own point, which slides
-        slide_base_ = h.pa < 0 ? -1 : (forward ? h.pa : h.pb);  // the parent's point it slides from
-        if (!self.hinge_joint(h, forward, child, bd) || !self.place(child, parent, bd, name)) return false;
+        const Slide slide = h.pa < 0 ? Slide{} : forward ? Slide{h.pb, h.pa} : Slide{h.pa, h.pb};
+        if (!self.hinge_joint(h, forward, child, bd) || !self.place(child, parent, bd, name, slide)) return false;
         queue.push_back(child);
       }
       if (!self.place_rotated(parent, queue)) return false;
@@ -233,12 +237,13 @@ class TreeBuilder {
   // The first step of placing a body under the placed body `parent_body` (or kGround) with its
   // joint `bd`: its pin, its parent and its points; index and p0 are its place in the tree and
   // its pin's reference position.
-  bool attach(int body, int parent_body, Model& bd, const std::string& joint, int index, Point& p0) {
+  bool attach(int body, int parent_body, Model& bd, const std::string& joint, int index, Point& p0,
+              const Slide& slide) {
     const int parent = parent_body == kGround ? kGround : placed_[parent_body];
-    const bool sliding = slide_pin_ >= 0;
+    const bool sliding = slide.pin >= 0;
     // A hinge's pin is the point the body shares with its parent; a sliding joint's is the
     // body's own point of the joint, whose other point is on the parent, and the two share none.
-    const int pin = sliding ? slide_pin_ : pin_of(body);
+    const int pin = sliding ? slide.pin : pin_of(body);
     if (!sliding && g_.points[body].empty() && parent_body != kGround) {
       // A body of no point (a rotor's LAMBDA node): it turns about its parent's pin, as good as
       // any point of the axis for a body whose mass is all rotational inertia.
@@ -250,14 +255,13 @@ class TreeBuilder {
       return true;
     }
     if (sliding) {
-      if (!g_.points[body].count(pin) || pin_of(body) != -1 || !on_body(slide_base_, parent_body, parent))
+      if (!g_.points[body].count(pin) || pin_of(body) != -1 || !on_body(slide.base, parent_body, parent))
         return refuse(joint + " slides a body that is not joined to its parent by that joint alone");
     } else if (pin < 0 || !on_body(pin, parent_body, parent)) {
       return refuse(joint + " turns a body with no point, or more than one, on its parent");
     }
     placed_[body] = index;
     pin_[body] = pin;
-    own_pin_[body] = sliding;
     p0 = point(pin);
     bd.parent = parent;
     bd.r = parent == kGround ? p0 : Point(p0 - pin0_[parent]);
@@ -266,6 +270,9 @@ class TreeBuilder {
     pin0_.push_back(p0);
     return true;
   }
+
+  // Whether a placed body's pin moves with it (a sliding joint's), not with its parent (a hinge's).
+  bool owns_pin(int body) const { return pin_[body] >= 0 && owner_.at(pin_[body]) == placed_[body]; }
 
   // Whether point node id is on the placed body parent_body (index parent in the tree) or the
   // ground. Joints at one origin (two URDF joints at the same point, a spherical wrist) share it
@@ -286,8 +293,6 @@ class TreeBuilder {
   BeamBodies g_;                 // the bodies' nodes and beams
   std::vector<int> placed_;      // body → index in the tree, −1: not yet
   std::vector<int> pin_;         // body → its pin node, −1: not placed
-  std::vector<bool> own_pin_;    // body → its pin moves with it (a sliding joint's), not with the parent
-  int slide_pin_ = -1, slide_base_ = -1;  // the sliding joint being placed: its points (−1: a hinge)
   std::map<int, int> owner_;     // point node → body (index in the tree) it moves with, kGround
   std::vector<Point> pin0_;      // reference pin of each placed body
 };

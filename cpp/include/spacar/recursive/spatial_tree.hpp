@@ -9,10 +9,10 @@
 // its grandparent's too (joints at one origin). A BEARING with DYNE e1 and e2 … e6 rigid slides
 // the body's own point (its pin) from a point of the parent along the axis, without turning.
 // MASS (point masses, inertia tensors on LAMBDA nodes), EMASS, FORCE on points, TORQUEL, GRAVITY
-// and the joints' ESTIFF and EDAMPP load it. The equations of motion are solved in O(N) by the articulated-body algorithm
-// (articulated.hpp) in spatial algebra, with explicit positions instead of Newton's method: the same equations as
-// the constraint formulation (each body's spatial inertia is the element and nodal mass matrices
-// projected on its rigid motions).
+// and the joints' ESTIFF and EDAMPP load it. The equations of motion are solved in O(N) by the
+// articulated-body algorithm (articulated.hpp) in spatial algebra, with explicit positions instead
+// of Newton's method: the same equations as the constraint formulation (each body's spatial
+// inertia is the element and nodal mass matrices projected on its rigid motions).
 //
 // Refused (the general path runs, and detect() says why): planar models (planar_tree.hpp), DYNX
 // rotations (free Euler parameters), spherical joints (a shared XYZ node without a DOF hinge),
@@ -67,32 +67,31 @@ struct SpatialAlgebra {
     return hinge_angle(m, q, qd, d);
   }
 
+  // The body's rotation relative to its parent and its pin: a hinge turns by θ about its axis, a
+  // sliding joint moves the pin by θ along its axis without turning.
   static void place(const Model& m, const Work* p, double theta, Work& d) {
     Frame& f = d.frame;
-    if (m.prismatic) {  // no rotation: the pin moves by θ along the axis
-      f.E.setIdentity();
-      f.r = m.r + theta * m.axis;
-      f.R = p ? p->frame.R : Eigen::Matrix3d::Identity();
-      f.lambda = p ? p->frame.lambda : Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
-      d.pin = p ? Eigen::Vector3d(p->pin + p->frame.R * f.r) : f.r;
-      return;
-    }
-    const double ch = std::cos(0.5 * theta), sh = std::sin(0.5 * theta);  // of the half angle, for λ too
-    const double c = 1.0 - 2.0 * sh * sh, s = 2.0 * sh * ch;
-    const Eigen::Vector3d& k = m.axis;
-    const Eigen::Matrix3d rel = c * Eigen::Matrix3d::Identity() + s * skew(k) + (1.0 - c) * k * k.transpose();  // body → parent
-    f.E = rel.transpose();
+    Eigen::Matrix3d rel = Eigen::Matrix3d::Identity();  // body → parent
+    Eigen::Vector4d q_rel(1.0, 0.0, 0.0, 0.0);
     f.r = m.r;
-    Eigen::Vector4d q_rel;
-    q_rel << ch, sh * k;
+    if (m.prismatic) {
+      f.r += theta * m.axis;
+    } else {
+      const double ch = std::cos(0.5 * theta), sh = std::sin(0.5 * theta);  // of the half angle, for λ too
+      const double c = 1.0 - 2.0 * sh * sh, s = 2.0 * sh * ch;
+      const Eigen::Vector3d& k = m.axis;
+      rel = c * Eigen::Matrix3d::Identity() + s * skew(k) + (1.0 - c) * k * k.transpose();
+      q_rel << ch, sh * k;
+    }
+    f.E = rel.transpose();
     if (!p) {
       f.R = rel;
       f.lambda = q_rel;
-      d.pin = m.r;
+      d.pin = f.r;
     } else {
       f.R = p->frame.R * rel;
       f.lambda = tree_detail::compose(p->frame.lambda, q_rel);
-      d.pin = p->pin + p->frame.R * m.r;
+      d.pin = p->pin + p->frame.R * f.r;
     }
   }
 
