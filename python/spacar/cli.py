@@ -23,8 +23,10 @@ Everything that is not the dump is printed as ``*`` comment lines, so the output
 from __future__ import annotations
 
 import argparse
+import contextlib
 import itertools
 import os
+import signal
 import sys
 import threading
 from pathlib import Path
@@ -274,7 +276,8 @@ def main(argv=None) -> int:
     check.set_defaults(func=_check)
     args = parser.parse_args(argv)
     try:
-        return _interruptible(args.func, args)
+        with _terminations_as_interrupts():
+            return _interruptible(args.func, args)
     except SpacarError as err:
         sys.stdout.flush()
         print(f"spacar: {type(err).__name__}: {err}", file=sys.stderr)
@@ -286,14 +289,43 @@ def main(argv=None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 1
-    except KeyboardInterrupt:
-        # Ctrl-C: one line, no traceback, the shell's status for SIGINT (128 + 2). The analysis
-        # thread cannot be stopped inside C++: the process ends here, once an output time being
-        # written is complete (the MATASC files hold whole output times).
+    except KeyboardInterrupt as err:
+        # Ctrl-C, SIGTERM or SIGHUP: one line, no traceback, the shell's status for the signal
+        # (128 + its number). The analysis thread cannot be stopped inside C++: the process ends
+        # here, once an output time being written is complete (the MATASC files hold whole output
+        # times).
+        signum = getattr(err, "signum", signal.SIGINT)
         with WRITING:
             sys.stdout.flush()
-            print("spacar: interrupted", file=sys.stderr, flush=True)
-            os._exit(130)
+            what = "interrupted" if signum == signal.SIGINT else f"terminated ({signal.Signals(signum).name})"
+            print(f"spacar: {what}", file=sys.stderr, flush=True)
+            os._exit(128 + signum)
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, raised in the main thread as Ctrl-C is."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def _terminations_as_interrupts():
+    """SIGTERM and SIGHUP end a run as Ctrl-C does (complete output files, one line), instead of
+    killing the process between the rows of an output time; the handlers are restored after."""
+    def handler(signum, frame):
+        raise _Terminated(signum)
+
+    wanted = [getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name)]
+    if threading.current_thread() is not threading.main_thread():
+        wanted = []  # signal handlers can only be set in the main thread
+    previous = {sig: signal.signal(sig, handler) for sig in wanted}
+    try:
+        yield
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
 
 
 def _interruptible(func, args):

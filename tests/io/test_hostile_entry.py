@@ -72,20 +72,28 @@ def _start_long_run(tmp_path, extra=""):
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
-@pytest.mark.parametrize("extra", ["", "MATASC 1", "MATASC 1\nLINEAR 1"])
-def test_ctrl_c_in_spacar_run_prints_one_line_and_exits_130(tmp_path, extra):
+@pytest.mark.parametrize("extra, sig, message", [
+    ("", "SIGINT", "interrupted"), ("MATASC 1", "SIGINT", "interrupted"),
+    ("MATASC 1\nLINEAR 1", "SIGINT", "interrupted"),
+    # Issue 38, finding 7: SIGTERM and SIGHUP killed the process between the rows of an output
+    # time (MATASC files of 2451 and 2450 rows), status 143/129, no message.
+    ("MATASC 1", "SIGTERM", "terminated (SIGTERM)"), ("MATASC 1\nLINEAR 1", "SIGHUP", "terminated (SIGHUP)")])
+def test_ctrl_c_in_spacar_run_prints_one_line_and_exits_130(tmp_path, extra, sig, message):
+    """Ctrl-C (and SIGTERM, SIGHUP) during `spacar run`: one line, the shell's status 128 + the
+    signal's number, the MATASC files complete and of equal length."""
     proc = _start_long_run(tmp_path, extra)
     time.sleep(2.5)  # inside the C++ integration by now
     assert proc.poll() is None
-    proc.send_signal(signal.SIGINT)
+    signum = getattr(signal, sig)
+    proc.send_signal(signum)
     start = time.perf_counter()
     try:
         out, err = proc.communicate(timeout=20)
     finally:
         proc.kill()
     assert time.perf_counter() - start < 5
-    assert proc.returncode == 130
-    assert err == "spacar: interrupted\n"
+    assert proc.returncode == 128 + signum
+    assert err == f"spacar: {message}\n"
     if extra:
         counts = {p.name: sum(not line.startswith("%") for line in p.read_text().splitlines())
                   for p in tmp_path.glob("long_*.asc")}
