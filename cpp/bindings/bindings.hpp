@@ -14,6 +14,7 @@ namespace py = pybind11;
 namespace spacar::bindings {
 
 void bind_errors(py::module_& m);
+void bind_limits(py::module_& m);
 void bind_catalogue(py::module_& m);
 void bind_model(py::module_& m);
 void bind_simulation(py::module_& m);

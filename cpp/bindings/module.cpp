@@ -1,15 +1,13 @@
 // spacar._core: thin pybind11 bindings of the C++ core, one unit per subject (bindings.hpp). No
 // logic here: the Python package (python/spacar) builds the user-facing API on top.
 #include "bindings.hpp"
-#include "spacar/limits.hpp"
 
 using namespace spacar::bindings;
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "spacar C++ core";
   bind_errors(m);
-  m.def("memory_limit", &spacar::memory_limit, "Bytes one analysis may allocate for its work and result arrays.");
-  m.def("set_memory_limit", &spacar::set_memory_limit, py::arg("bytes"));
+  bind_limits(m);
   bind_catalogue(m);
   bind_model(m);
   bind_simulation(m);

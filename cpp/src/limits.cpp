@@ -15,6 +15,7 @@ std::atomic<std::size_t> g_memory_limit{std::size_t(4) << 30};
 thread_local ThreadDeadline t_deadline;
 thread_local InterruptScope::Poll t_interrupt = nullptr;
 thread_local std::chrono::steady_clock::time_point t_last_poll;
+thread_local const std::atomic<bool>* t_cancel = nullptr;
 }  // namespace
 
 InterruptScope::InterruptScope(Poll poll) : outer_(t_interrupt) {
@@ -24,7 +25,12 @@ InterruptScope::InterruptScope(Poll poll) : outer_(t_interrupt) {
 
 InterruptScope::~InterruptScope() { t_interrupt = outer_; }
 
+CancelScope::CancelScope(const std::atomic<bool>* flag) : outer_(t_cancel) { t_cancel = flag; }
+
+CancelScope::~CancelScope() { t_cancel = outer_; }
+
 void check_thread_interrupt() {
+  if (t_cancel && t_cancel->load(std::memory_order_relaxed)) throw Interrupted("the analysis was cancelled");
   if (!t_interrupt) return;
   constexpr auto kPollInterval = std::chrono::milliseconds(20);  // the poll takes the GIL
   const auto now = std::chrono::steady_clock::now();

@@ -13,10 +13,12 @@ convective terms), G0 geometric stiffness (stresses incl. reaction stresses, loa
 """
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 
 from . import _core
-from ._util import show
+from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError
 from .model import Model
 
@@ -150,7 +152,9 @@ class Linearization:
         """(ω², vectors) of all undamped modes, sorted by |ω²|: in the modal basis of a symmetric
         pencil (the inverse pencil when the stiffness is positive definite: the lowest modes to
         full relative precision, see _modal_basis), SciPy's QZ otherwise."""
-        basis = _modal_basis(self.M0, self.stiffness)
+        M, K = self.M0, self.stiffness
+        _core.check_deadline("(in the eigen-analysis)")  # a sweep's time_limit, between the dense steps
+        basis = _modal_basis(M, K)
         if basis is None:
             import scipy.linalg  # lazily: `import spacar` stays light
 
@@ -373,7 +377,7 @@ class NodalMatrices:
             info = sim.nodal_factorize(1.0, 1.0, -sigma, 0.0)
         if not info["ok"] or info["singular"]:
             raise SpacarError("the stiffness matrix K0 + G0 - σ M0 of the eigen-analysis is singular or not finite")
-        op = sla.LinearOperator(M.shape, matvec=lambda b: sim.nodal_solve(np.asarray(b, dtype=float).ravel()),
+        op = sla.LinearOperator(M.shape, matvec=lambda b: _bounded_solve(sim, np.asarray(b, dtype=float).ravel()),
                                 dtype=float)
         v0 = sim.nodal_solve(np.ones(M.shape[0]))
         if info["symmetric"]:
@@ -402,7 +406,7 @@ class NodalMatrices:
         if not info["ok"] or info["singular"]:
             raise SpacarError("the structural stiffness K0 is singular (a degree of freedom without stiffness): "
                               "the sparse buckling analysis needs a regular K0; use method='dense'")
-        op = sla.LinearOperator(G.shape, matvec=lambda b: sim.nodal_solve(-(G @ np.asarray(b, dtype=float).ravel())),
+        op = sla.LinearOperator(G.shape, matvec=lambda b: _bounded_solve(sim, -(G @ np.asarray(b, dtype=float).ravel())),
                                 dtype=float)
         nu, vf = sla.eigs(op, k=k, which="LM", v0=sim.nodal_solve(np.ones(G.shape[0])))
         keep = np.abs(nu) > 0
@@ -417,13 +421,34 @@ class NodalMatrices:
 
 
 
-def linearize(model, state=None) -> Linearization:
+def _bounded_solve(sim, b):
+    """One solve of ARPACK's shift-invert iteration, within the thread's deadline (a sweep's
+    time_limit) and stopped by its cancellation."""
+    _core.check_deadline("(in the eigen-analysis)")
+    return sim.nodal_solve(b)
+
+
+def linearize(model, state=None, *, time_limit=None) -> Linearization:
     """Linearized equations of ``model`` at ``state``: None for the model's current state, or
     ``(t, q, qd)`` with the degrees of freedom in their order (DYNX coordinates ascending, then
     DYNE deformations ascending). The mechanism is assembled at the model's current state first
     and then moved continuously to ``state`` (the inputs at time t), so that the calculable
-    coordinates stay on the branch of the assembled mechanism."""
-    return linearized_simulation(model, state)[0]
+    coordinates stay on the branch of the assembled mechanism. ``time_limit``: wall-clock seconds
+    the linearization may take (:class:`spacar.TimeLimitError` beyond; the eigen-analyses of the
+    result are later calls, bounded by :func:`spacar.sweep`'s time_limit when it makes them)."""
+    with time_limited(time_limit, "in the linearization"):
+        return linearized_simulation(model, state)[0]
+
+
+@contextlib.contextmanager
+def time_limited(time_limit, where: str):
+    """The calls into the core made by this thread inside the block share a deadline of
+    ``time_limit`` seconds (None: none), checked where the core checks a run's; a block that
+    ends past it raises TimeLimitError naming ``where``."""
+    limit = seconds_or_none(time_limit, "time_limit") or 0.0
+    with _core.Deadline(limit):
+        yield
+        _core.check_deadline(f"({where})")
 
 
 def linearized_simulation(model, state=None):
@@ -434,6 +459,7 @@ def linearized_simulation(model, state=None):
         raise InputError(f"linearize: model must be a spacar.Model, got {show(model)}")
     sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
     sim.assemble()
+    _core.check_deadline("(in the assembly)")
     system = sim.system
     if state is None:
         t, q, qd = model.current_time, system.q0, system.qd0

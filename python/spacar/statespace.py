@@ -18,7 +18,7 @@ import numpy as np
 from . import _core
 from ._util import show
 from .errors import InputError
-from .linearize import Linearization, _count, linearized_simulation, second_order_eigenvalues
+from .linearize import Linearization, _count, linearized_simulation, second_order_eigenvalues, time_limited
 from .model import Model, Signal
 
 INPUT_KEYWORDS = ("INPUTF", "INPUTS")
@@ -150,7 +150,7 @@ class StateSpace:
                 f"{len(self.input_labels)} inputs, {len(self.output_labels)} outputs>")
 
 
-def state_space(source, at=None, inputs=None, outputs=None, *, modes=None) -> StateSpace:
+def state_space(source, at=None, inputs=None, outputs=None, *, modes=None, time_limit=None) -> StateSpace:
     """The state-space model of ``source`` linearized about a state.
 
     ``source``: a :class:`spacar.Model`; a :class:`spacar.Linearization`; or a
@@ -173,7 +173,15 @@ def state_space(source, at=None, inputs=None, outputs=None, *, modes=None) -> St
     states are the modal coordinates and their rates (Φᵀ M Φ = I), A = [[0, I], [−Ω², −Φᵀ D Φ]],
     and the static response of the truncated modes, C (K⁻¹ − Φ Ω⁻² Φᵀ) F, is kept as the direct
     feedthrough D, so that the static gain stays exact (the residual flexibility of the modal
-    truncation). For models of thousands of degrees of freedom; damping from EDAMPP."""
+    truncation). For models of thousands of degrees of freedom; damping from EDAMPP.
+
+    ``time_limit``: wall-clock seconds the whole construction may take (linearization, the
+    differences of the velocities, the modes), as for :func:`spacar.linearize`."""
+    with time_limited(time_limit, "in state_space"):
+        return _state_space(source, at, inputs, outputs, modes)
+
+
+def _state_space(source, at, inputs, outputs, modes) -> StateSpace:
     if hasattr(source, "linearizations") and hasattr(source, "time_index"):  # a spacar.Results
         if not source.linearizations:
             raise InputError("state_space: these results have no linearizations (run with LINE or LINEAR 1), "

@@ -19,6 +19,7 @@ See docs/sweep.md.
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import itertools
 import math
 import multiprocessing
@@ -136,6 +137,24 @@ def _check_value(key, lines, value):
             raise InputError(f"sweep parameter {show(_name(key))} = {show(value)}: {err}") from None
 
 
+# Bytes a case holds at least while a sweep runs, before its outputs: its parameters' dict, its
+# index and chunk entries, its outcome (its outputs come on top: 6.6 kB per case in all for the
+# slider-crank's final state, measured with tracemalloc).
+_CASE_BYTES = 500
+_PARAMETER_BYTES = 100
+
+
+def _check_size(n_cases: int, n_parameters: int):
+    """Refuse a grid whose cases alone would exceed the memory limit, before building it."""
+    from . import memory_limit
+
+    need = n_cases * (_CASE_BYTES + _PARAMETER_BYTES * n_parameters)
+    if need > memory_limit():
+        raise InputError(f"sweep: a grid of {n_cases:,} cases would need at least {need / 1e9:.3g} GB to hold its "
+                         f"cases and outcomes, more than the memory limit of {memory_limit() / 1e9:.3g} GB "
+                         "(spacar.set_memory_limit); sweep fewer values, a sample (a list of dicts), or in parts")
+
+
 def _cases(parameters, by_lines: bool):
     """(names, cases as dicts name → value, grid axes or None)."""
     if isinstance(parameters, dict):
@@ -151,6 +170,7 @@ def _cases(parameters, by_lines: bool):
             names.append(_name(key))
             axes.append(values)
         keys = list(parameters)
+        _check_size(math.prod(len(a) for a in axes), len(names))
         cases = [dict(zip(names, combo)) for combo in itertools.product(*axes)]
         grid = dict(zip(names, axes))
     elif isinstance(parameters, (list, tuple)):
@@ -297,32 +317,46 @@ def _run_case(task: _Task, params: dict, index: int = 0):
     if model.core.settings.matasc == 1:
         model.output_stem = _case_stem(model, index, task.n_cases)
     n_warnings = len(model.warnings)
-    if task.analysis == "simulate":
-        from .simulate import simulate
+    from .linearize import time_limited
 
-        result = simulate(model, method=task.method, time_limit=task.time_limit)
-    elif task.analysis == "linearize":
-        from .linearize import linearize
+    # The time limit bounds the whole case: the analysis and the outputs computed from its result
+    # (a linearization's eigen-analysis).
+    with time_limited(task.time_limit, "in this case of the sweep"):
+        if task.analysis == "simulate":
+            from .simulate import simulate
 
-        result = linearize(model)
-    else:
-        result = task.analysis(model)
-    values = {name: np.asarray(v) for name, v in task.outputs.extract(result).items()}
+            result = simulate(model, method=task.method, time_limit=task.time_limit)
+        elif task.analysis == "linearize":
+            from .linearize import linearize
+
+            result = linearize(model)
+        else:
+            result = task.analysis(model)
+        values = {name: np.asarray(v) for name, v in task.outputs.extract(result).items()}
     labels = None
     if task.analysis == "simulate":
         labels = (result.coordinate_labels, result.deformation_labels)
     return values, labels, model.warnings[n_warnings:]
 
 
-def _run_cases(task: _Task, cases: list) -> list:
+def _run_cases(task: _Task, cases: list, cancel=None) -> list:
     """Run the cases [(index, params)]; returns [(index, ok, payload, seconds)] with payload
-    (values, labels, warnings) or, for a failed case, (exception type name, message)."""
+    (values, labels, warnings) or, for a failed case, (exception type name, message). Once
+    ``cancel`` (a _core.Cancellation) is cancelled, the running analysis stops and no case starts."""
     out = []
     for index, params in cases:
         start = time.perf_counter()
+        if cancel is not None and cancel.cancelled:
+            out.append((index, False, ("KeyboardInterrupt", "not run: the sweep was interrupted"), math.nan))
+            continue
         try:
-            payload = _run_case(task, params, index)
+            with cancel.watch() if cancel is not None else contextlib.nullcontext():
+                payload = _run_case(task, params, index)
             ok = True
+        except KeyboardInterrupt:
+            if cancel is None or not cancel.cancelled:
+                raise
+            ok, payload = False, ("KeyboardInterrupt", "interrupted: the sweep was interrupted while this case ran")
         except Exception as err:  # noqa: BLE001 - every failure is reported with its case
             ok = False
             payload = (_type_name(err), str(err))
@@ -577,7 +611,8 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     the result returns a number, an array or a dict of them; a dict ``{name: function or name}``
     names each output.
 
-    ``time_limit``: seconds per simulation (:class:`spacar.TimeLimitError` beyond).
+    ``time_limit``: seconds per case, the analysis and its outputs (:class:`spacar.TimeLimitError`
+    beyond; checked inside the core's work, so a case stops at its limit).
 
     Where the cases run: ``client`` (a ``dask.distributed.Client``) runs them on that cluster;
     ``executor`` (any ``concurrent.futures.Executor``) on it; otherwise ``workers`` local
@@ -643,38 +678,28 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
             failed += not ok
         bar.update(len(chunk), failed)
 
-    def lost(chunk, err):
-        collect(chunk, [(i, False, (_type_name(err), f"the worker failed: {err}"), math.nan) for i, _ in chunk])
-
+    cancel = _core.Cancellation()
     try:
         if client is None and executor is None and n_workers == 1:
             for chunk in chunks:
                 collect(chunk, _run_cases(task, chunk))
         elif client is None and executor is None and workers is None:
-            # Threads share the task: nothing to pickle, nothing to start.
-            with concurrent.futures.ThreadPoolExecutor(max_workers=n_workers) as pool:
-                futures = {pool.submit(_run_cases, task, chunk): chunk for chunk in chunks}
-                for future in concurrent.futures.as_completed(futures):
-                    collect(futures[future], future.result())
+            _run_threads(task, chunks, n_workers, collect, cancel)
+        elif client is not None:
+            _run_dask(client, _dumps(task), chunks, collect)
+        elif executor is not None:
+            _run_executor(executor, _dumps(task), chunks, collect)
         else:
-            payload = _dumps(task)
-            if client is not None:
-                _run_dask(client, payload, chunks, collect, lost)
-            else:
-                own = executor is None
-                pool = executor or concurrent.futures.ProcessPoolExecutor(
-                    max_workers=n_workers, mp_context=multiprocessing.get_context("spawn"))
-                try:
-                    futures = {pool.submit(_run_chunk, payload, chunk): chunk for chunk in chunks}
-                    for future in concurrent.futures.as_completed(futures):
-                        chunk = futures[future]
-                        try:
-                            collect(chunk, future.result())
-                        except Exception as err:  # noqa: BLE001 - a worker that died
-                            lost(chunk, err)
-                finally:
-                    if own:
-                        pool.shutdown(wait=True, cancel_futures=True)
+            _run_processes(_dumps(task), chunks, n_workers, collect)
+    except KeyboardInterrupt as err:
+        # Ctrl-C: what is pending is cancelled (the threads' running cases stop within
+        # milliseconds), what is done is kept, as err.results.
+        cancel.cancel()
+        for i in range(n):
+            outcomes.setdefault(i, (False, ("KeyboardInterrupt", "not run: the sweep was interrupted"), math.nan))
+        err.results = _gather(task, names, cases, grid, outcomes, time.perf_counter() - start)
+        err.results.workers = n_workers
+        raise
     finally:
         bar.close()
 
@@ -690,18 +715,142 @@ def _client_workers(client) -> int:
         return os.cpu_count() or 1
 
 
-def _run_dask(client, payload, chunks, collect, lost):
+def _lost(chunk, message: str, err: BaseException | None = None) -> list:
+    """The outcome of the cases of ``chunk`` that no worker could run."""
+    kind = _type_name(err) if err is not None else "spacar.SpacarError"
+    return [(i, False, (kind, message), math.nan) for i, _ in chunk]
+
+
+def _run_threads(task, chunks, n_workers, collect, cancel):
+    """Threads share the task: nothing to pickle, nothing to start. On Ctrl-C (which reaches only
+    this, the main thread) the pending chunks are dropped and the running analyses cancelled."""
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=n_workers)
+    futures, collected = {}, set()
+    try:
+        futures = {pool.submit(_run_cases, task, chunk, cancel): chunk for chunk in chunks}
+        for future in concurrent.futures.as_completed(futures):
+            collect(futures[future], future.result())
+            collected.add(future)
+    except KeyboardInterrupt:
+        cancel.cancel()
+        pool.shutdown(wait=True, cancel_futures=True)
+        for future, chunk in futures.items():  # the chunks that ended meanwhile, stopped or not
+            if future not in collected and future.done() and not future.cancelled() and future.exception() is None:
+                collect(chunk, future.result())
+        raise
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _run_executor(executor, payload, chunks, collect):
+    """On a user's executor, which spacar cannot restart: a chunk whose worker died is reported
+    as such."""
+    futures = {executor.submit(_run_chunk, payload, chunk): chunk for chunk in chunks}
+    for future in concurrent.futures.as_completed(futures):
+        chunk = futures[future]
+        try:
+            collect(chunk, future.result())
+        except Exception as err:  # noqa: BLE001 - a worker that died
+            collect(chunk, _lost(chunk, f"the worker running this case failed or died: {err}", err))
+
+
+def _run_processes(payload, chunks, n_workers, collect):
+    """Spawned worker processes. A case that kills its process (a crash, a signal, the memory
+    of the machine) breaks the whole pool: the chunks it took with it are run again in a new
+    pool, one case per task, until every case has either run or, run alone in a process of its
+    own, killed that process too; only such a case fails, its error naming how its process
+    ended."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    context = multiprocessing.get_context("spawn")
+    pending = chunks
+    while pending:
+        pool = concurrent.futures.ProcessPoolExecutor(max_workers=min(n_workers, len(pending)), mp_context=context)
+        broken, done = [], 0
+        try:
+            futures = {pool.submit(_run_chunk, payload, chunk): chunk for chunk in pending}
+            for future in concurrent.futures.as_completed(futures):
+                chunk = futures[future]
+                try:
+                    collect(chunk, future.result())
+                    done += len(chunk)
+                except BrokenProcessPool:
+                    broken.append(chunk)
+                except Exception as err:  # noqa: BLE001 - e.g. a result that cannot be pickled back
+                    collect(chunk, _lost(chunk, f"the worker could not return this case: {err}", err))
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+        suspects = [case for chunk in broken for case in chunk]
+        if suspects and not done:
+            # No case got through: run the first suspect alone, in a process of its own.
+            collect([suspects[0]], _run_alone(payload, suspects[0], context))
+            suspects = suspects[1:]
+        pending = [[case] for case in suspects]
+
+
+def _run_alone(payload, case, context) -> list:
+    """Run one case in a process of its own: its outcome, or the way that process ended."""
+    receive, send = context.Pipe(duplex=False)
+    process = context.Process(target=_run_piped, args=(payload, [case], send), daemon=True)
+    process.start()
+    send.close()
+    try:
+        return receive.recv()
+    except EOFError:  # the process ended without an answer
+        process.join()
+        return _lost([case], f"the worker process running this case {_ending(process.exitcode)} (run alone, it "
+                             "did so again): a crash in the analysis or a callable, a kill, or the machine's "
+                             "memory")
+    finally:
+        receive.close()
+        process.join()
+
+
+def _run_piped(payload, cases, send):
+    send.send(_run_chunk(payload, cases))
+    send.close()
+
+
+def _ending(code) -> str:
+    """How a process with this exit code ended, in words."""
+    if code is not None and code < 0:
+        import signal
+
+        try:
+            return f"was killed by signal {signal.Signals(-code).name}"
+        except ValueError:
+            return f"was killed by signal {-code}"
+    return f"exited with status {code}"
+
+
+def _run_dask(client, payload, chunks, collect):
+    """On a Dask cluster. The task is sent with each chunk (not scattered once: a scattered copy
+    dies with the workers that hold it, and the chunks could not be rerun on their successors), so
+    that Dask reruns the chunks of a dead worker on the others. A chunk that killed every worker
+    that ran it (KilledWorker) is split into single cases, and only the case that does it again
+    fails, with Dask's account of it."""
     from distributed import as_completed
 
-    data = client.scatter(payload, broadcast=True)
-    futures = [client.submit(_run_chunk, data, chunk, pure=False) for chunk in chunks]
-    owner = {f.key: chunk for f, chunk in zip(futures, chunks)}
-    for future in as_completed(futures):
-        chunk = owner[future.key]
+    def submit(chunk):
+        return client.submit(_run_chunk, payload, chunk, pure=False)
+
+    futures = [submit(chunk) for chunk in chunks]
+    owner = {future.key: chunk for future, chunk in zip(futures, chunks)}
+    running = as_completed(futures)
+    for future in running:
+        chunk = owner.pop(future.key)
         try:
             collect(chunk, future.result())
         except Exception as err:  # noqa: BLE001 - a worker that died, a lost connection
-            lost(chunk, err)
+            if len(chunk) > 1 and type(err).__name__ == "KilledWorker":
+                for case in chunk:
+                    again = submit([case])
+                    owner[again.key] = [case]
+                    running.add(again)
+            else:
+                why = ("killed every Dask worker that ran it" if type(err).__name__ == "KilledWorker"
+                       else "could not be run by the cluster")
+                collect(chunk, _lost(chunk, f"this case {why}: {err}", err))
 
 
 def _gather(task, names, cases, grid, outcomes, wall_time) -> SweepResult:

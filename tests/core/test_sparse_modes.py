@@ -14,28 +14,10 @@ import pytest
 import spacar
 from support.paths import EXAMPLES
 from support.planar_models import compressed_cantilever
+from support.planar_models import tip_loaded_beam as beam
 from support.spatial_models import cantilever as beam_cantilever
 
 BETA = np.array([1.8751040687119611, 4.694091132974175, 7.854757438237613, 10.995540734875467, 14.13716839104647])
-
-
-def beam(n, L=1.2, EI=2.0, rhoA=3.0, EA=1e4):
-    """n PLBEAMs along x clamped at nodes 1/2, all deformations DYNE (elongation stiff), tip node
-    2n+1 with a force input and position and rate outputs."""
-    m = spacar.Model()
-    for k in range(1, n + 1):
-        m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
-        m.x(2 * k + 1, k * L / n, 0.0)
-        m.estiff(k, EA, EI)
-        m.emass(k, rhoA)
-        m.dyne(k, 1, 2, 3)
-    m.fix(1)
-    m.fix(2)
-    tip = 2 * n + 1
-    m.inputf(1, tip, 2)
-    m.outx(1, tip, 2)
-    m.outxp(2, tip, 2)
-    return m
 
 
 def euler_bernoulli(L=1.2, EI=2.0, rhoA=3.0):

@@ -20,3 +20,22 @@ def compressed_cantilever(n):
     m.force(2 * n + 1, -1.0, 0.0)
     m.linear(2)
     return m
+
+
+def tip_loaded_beam(n, L=1.2, EI=2.0, rhoA=3.0, EA=1e4):
+    """n PLBEAMs along x clamped at nodes 1/2, all deformations DYNE (elongation stiff), tip node
+    2n+1 with a force input and position and rate outputs."""
+    m = spacar.Model()
+    for k in range(1, n + 1):
+        m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
+        m.x(2 * k + 1, k * L / n, 0.0)
+        m.estiff(k, EA, EI)
+        m.emass(k, rhoA)
+        m.dyne(k, 1, 2, 3)
+    m.fix(1)
+    m.fix(2)
+    tip = 2 * n + 1
+    m.inputf(1, tip, 2)
+    m.outx(1, tip, 2)
+    m.outxp(2, tip, 2)
+    return m

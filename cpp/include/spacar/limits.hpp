@@ -5,6 +5,7 @@
 // refused with an InputError that says what needs the memory and how to reduce it.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <string>
@@ -52,6 +53,21 @@ class InterruptScope {
   Poll outer_;
 };
 void check_thread_interrupt();
+
+// A cancellation of the analyses running on the threads that watch `flag` (a sweep's threads,
+// which Python's Ctrl-C does not reach): once the flag is set, check_thread_interrupt throws
+// Interrupted on each of them, without waiting for the poll's interval. Nested scopes restore
+// the outer flag.
+class CancelScope {
+ public:
+  explicit CancelScope(const std::atomic<bool>* flag);
+  ~CancelScope();
+  CancelScope(const CancelScope&) = delete;
+  CancelScope& operator=(const CancelScope&) = delete;
+
+ private:
+  const std::atomic<bool>* outer_;
+};
 
 // The deadline of `limit` seconds (0 or beyond 10⁹ s: none) from `spent` seconds ago, for the
 // lifetime of the scope (a run, a set-up, a diagnosis). Nested scopes (an analysis started from

@@ -11,6 +11,7 @@
 #include "spacar/recursive/chain.hpp"
 #include "spacar/kinematics/dynamics.hpp"
 #include "spacar/errors.hpp"
+#include "spacar/limits.hpp"
 #include "spacar/kinematics/kinematics.hpp"
 #include "spacar/analyses/nodal.hpp"
 #include "spacar/analyses/statics.hpp"
@@ -213,9 +214,15 @@ Linearizer::Nominal Linearizer::nominal_matrices(const System& sys, const Data& 
     lin.DFez.col(i) = ld_->DFe.col(L.dof_cols[order_[i]]);
   }
   compute_inertia_and_loads(L, *ld_);
+  // Dense products of the model's size: the deadline of a time_limit is checked between them.
+  const char* where = "(in the linearization)";
+  check_thread_deadline(where);
   lin.M0 = lin.DFz.transpose() * (nodal_part(L, *ld_, data.sigma, kMass) * lin.DFz);
+  check_thread_deadline(where);
   lin.G0 = lin.DFz.transpose() * (nodal_part(L, *ld_, data.sigma, kGeometric) * lin.DFz);
+  check_thread_deadline(where);
   lin.K0 = lin.DFez.transpose() * (nodal_constitutive(L, false) * lin.DFez);
+  check_thread_deadline(where);
   lin.D0 = lin.DFez.transpose() * (nodal_constitutive(L, true) * lin.DFez);
   const int nk = static_cast<int>(sys.e_kinematic.size());
   lin.AK0.resize(nk, nz);
@@ -233,6 +240,7 @@ void Linearizer::differenced_matrices(const System& sys, const ZState& zs, const
   const Eigen::VectorXd &z = zs.z, &zd = zs.zd, &zdd = zs.zdd, &scale = zs.scale;
   const Eigen::VectorXd &x_nominal = at.x, &angles_nominal = at.angles;
   auto response = [&](const Eigen::VectorXd& zz, const Eigen::VectorXd& zzd, const Eigen::VectorXd& yy) {
+    check_thread_deadline("(in the linearization)");  // a time_limit of linearize or state_space
     ld_->x = x_nominal;
     ld_->angle_ref = angles_nominal;
     for (int j = 0; j < nk; ++j) ld_->e_integrated[sys.e_kinematic[j]] = yy[j];
@@ -295,6 +303,7 @@ Linearization Linearizer::compute(const System& sys, const Data& data, Differenc
     lin.y_label.push_back({1, sys.def_label[k][0], sys.def_label[k][1]});
   }
   const Nominal nominal = nominal_matrices(sys, data, zs, lin);
+  check_thread_deadline("(in the linearization)");
   if (differences == Differences::None) {  // at rest in static equilibrium (compute_nodal)
     if (y.size() > 0) throw Error("linearize: a state with kinematic coordinates needs the differences");
     lin.C0 = lin.N0 = Eigen::MatrixXd::Zero(nz, nz);
