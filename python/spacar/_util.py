@@ -1,6 +1,7 @@
 """Small helpers shared by the modules: safe texts of user values for messages, argument checks."""
 from __future__ import annotations
 
+import contextlib
 import math
 import numbers
 
@@ -46,3 +47,16 @@ def finite_time(value, what: str) -> float:
     if not math.isfinite(t):
         raise InputError(f"{what} must be a finite number, got {show(value)}")
     return t
+
+
+@contextlib.contextmanager
+def time_limited(time_limit, where: str):
+    """The calls into the core made by this thread inside the block share a deadline of
+    ``time_limit`` seconds (None: none), checked where the core checks a run's; a block that
+    ends past it raises TimeLimitError naming ``where``."""
+    from . import _core
+
+    limit = seconds_or_none(time_limit, "time_limit") or 0.0
+    with _core.Deadline(limit):
+        yield
+        _core.check_deadline(f"({where})")

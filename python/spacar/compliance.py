@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._util import show
+from ._util import show, time_limited
 from .errors import InputError
 
 # The node kinds whose displacements the compliance gives (a LAMBDA node: its rotation vector).
@@ -36,7 +36,7 @@ def _node(nodes: dict, n, what: str) -> int:
     return int(n)
 
 
-def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.ndarray:
+def compliance(model, node, rotation=None, *, results=None, k: int = -1, time_limit=None) -> np.ndarray:
     """The static compliance at ``node`` at the model's current state (an equilibrium: after
     :func:`spacar.static`, which leaves the model there, or an unloaded model), or at row ``k``
     of ``results`` of :func:`spacar.static` of this model (its load factor λ = ``results.t[k]``
@@ -54,7 +54,8 @@ def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.n
     support) has zero compliance.
 
     Raises :class:`spacar.StaticError` when the tangent stiffness is singular (a mechanism: a
-    degree of freedom without stiffness), naming the direction."""
+    degree of freedom without stiffness), naming the direction. ``time_limit``: wall-clock
+    seconds it may take (:class:`spacar.TimeLimitError` beyond)."""
     from .model import Model
     from .results import Results
 
@@ -76,16 +77,18 @@ def compliance(model, node, rotation=None, *, results=None, k: int = -1) -> np.n
             raise InputError(f"rotation {show(rotation)} must be a BETA or LAMBDA node of the model")
         chosen.append(int(rotation))
     if results is None:
-        return np.asarray(_core.static_compliance(model.core, chosen))
+        with time_limited(time_limit, "in the compliance"):
+            return np.asarray(_core.static_compliance(model.core, chosen))
     if getattr(results, "stats", {}).get("analysis") != "static":
         raise InputError("results must come from spacar.static (the rows are equilibria at load factors)")
     k = range(len(results.t))[k]
-    return np.asarray(_core.static_compliance(model.core, chosen, float(results.t[k]),
-                                              np.asarray(results.x[k], dtype=float),
-                                              np.asarray(results.e[k], dtype=float)))
+    with time_limited(time_limit, "in the compliance"):
+        return np.asarray(_core.static_compliance(model.core, chosen, float(results.t[k]),
+                                                  np.asarray(results.x[k], dtype=float),
+                                                  np.asarray(results.e[k], dtype=float)))
 
 
-def support_stiffness(model, node, components=None) -> np.ndarray:
+def support_stiffness(model, node, components=None, *, time_limit=None) -> np.ndarray:
     """The stiffness of a support or drive: the response of the reactions on the prescribed
     (FIX or INPUTX) coordinates ``components`` of ``node`` (1-based; default: all of its
     prescribed ones) to a unit prescribed displacement of each, the rest of the model in
@@ -96,7 +99,7 @@ def support_stiffness(model, node, components=None) -> np.ndarray:
     coordinates become degrees of freedom (DYNX), the DYNE deformations that this makes
     redundant (named by the constraint diagnosis) become RLSE (their stiffness stays), and
     K_s = C_pp⁻¹ with C_pp their compliance (:func:`compliance`). Position (XY, XYZ) and BETA
-    nodes."""
+    nodes. ``time_limit``: wall-clock seconds it may take (:class:`spacar.TimeLimitError` beyond)."""
     from .model import Model
 
     if not isinstance(model, Model):
@@ -115,6 +118,11 @@ def support_stiffness(model, node, components=None) -> np.ndarray:
     if not components or any(i not in prescribed for i in components):
         raise InputError(f"components {show(components)} must be prescribed (FIX, INPUTX) components of node {n}; "
                          f"its prescribed ones: {prescribed}")
+    with time_limited(time_limit, "in the support stiffness"):
+        return _support_stiffness(model, n, components)
+
+
+def _support_stiffness(model, n, components):
     free = model.copy()
     free.dynx(n, *components)
     for e, i in free.check().diagnosis.redundant:

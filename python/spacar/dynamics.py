@@ -4,12 +4,12 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._util import show
+from ._util import show, time_limited
 from .errors import InputError
 from .model import Model
 
 
-def inverse_dynamics(model: Model, q, qd, qdd) -> np.ndarray:
+def inverse_dynamics(model: Model, q, qd, qdd, *, time_limit=None) -> np.ndarray:
     """The generalized forces on the degrees of freedom, beyond the model's own loads, gravity,
     springs and dampers, under which it has the accelerations ``qdd`` at the state (``q``,
     ``qd``): M̄(q) q̈ + h(q, q̇) − (its loads), as ``pinocchio.rnea`` for a robot read by
@@ -20,7 +20,8 @@ def inverse_dynamics(model: Model, q, qd, qdd) -> np.ndarray:
     recursive Newton–Euler algorithm, O(N) per state, in C++ over the whole batch. Any other
     system is solved by its reduced equations, M̄ (q̈ − q̈₀) with q̈₀ its accelerations under its
     own loads; there each state's positions are found by Newton from the previous state's (the
-    first from the assembled one), so a batch should move in small steps along a path."""
+    first from the assembled one), so a batch should move in small steps along a path.
+    ``time_limit``: wall-clock seconds it may take (:class:`spacar.TimeLimitError` beyond)."""
     if not isinstance(model, Model):
         raise InputError(f"inverse_dynamics: model must be a spacar.Model, got {show(model)}")
     arrays = []
@@ -36,8 +37,9 @@ def inverse_dynamics(model: Model, q, qd, qdd) -> np.ndarray:
     if any(a.shape != shape for a in arrays):
         raise InputError(f"inverse_dynamics: q, qd and qdd must have the same shape, got "
                          f"{', '.join(str(a.shape) for a in arrays)}")
-    sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
-    sim.assemble()
-    rows = [np.ascontiguousarray(np.atleast_2d(a)) for a in arrays]
-    force, _ = sim.inverse_dynamics(*rows)
+    with time_limited(time_limit, "in inverse_dynamics"):
+        sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
+        sim.assemble()
+        rows = [np.ascontiguousarray(np.atleast_2d(a)) for a in arrays]
+        force, _ = sim.inverse_dynamics(*rows)
     return np.asarray(force).reshape(shape)

@@ -13,12 +13,10 @@ convective terms), G0 geometric stiffness (stresses incl. reaction stresses, loa
 """
 from __future__ import annotations
 
-import contextlib
-
 import numpy as np
 
 from . import _core
-from ._util import seconds_or_none, show
+from ._util import show, time_limited
 from .errors import InputError, SpacarError
 from .model import Model
 
@@ -438,17 +436,6 @@ def linearize(model, state=None, *, time_limit=None) -> Linearization:
     result are later calls, bounded by :func:`spacar.sweep`'s time_limit when it makes them)."""
     with time_limited(time_limit, "in the linearization"):
         return linearized_simulation(model, state)[0]
-
-
-@contextlib.contextmanager
-def time_limited(time_limit, where: str):
-    """The calls into the core made by this thread inside the block share a deadline of
-    ``time_limit`` seconds (None: none), checked where the core checks a run's; a block that
-    ends past it raises TimeLimitError naming ``where``."""
-    limit = seconds_or_none(time_limit, "time_limit") or 0.0
-    with _core.Deadline(limit):
-        yield
-        _core.check_deadline(f"({where})")
 
 
 def linearized_simulation(model, state=None):

@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._util import show
+from ._util import show, time_limited
 from .errors import InputError
-from .linearize import Linearization, _count, linearized_simulation, second_order_eigenvalues, time_limited
+from .linearize import Linearization, _count, linearized_simulation, second_order_eigenvalues
 from .model import Model, Signal
 
 INPUT_KEYWORDS = ("INPUTF", "INPUTS")

@@ -35,7 +35,7 @@ import numpy as np
 
 from . import _core, progress as bars  # named so: sweep()'s argument is `progress`
 from .results import _ARRAYS
-from ._util import seconds_or_none, show
+from ._util import seconds_or_none, show, time_limited
 from .errors import InputError, SpacarError
 from .keywords import INT, LOOKUP, SETTINGS, Keyword
 from .model import Model, check_args
@@ -317,8 +317,6 @@ def _run_case(task: _Task, params: dict, index: int = 0):
     if model.core.settings.matasc == 1:
         model.output_stem = _case_stem(model, index, task.n_cases)
     n_warnings = len(model.warnings)
-    from .linearize import time_limited
-
     # The time limit bounds the whole case: the analysis and the outputs computed from its result
     # (a linearization's eigen-analysis).
     with time_limited(task.time_limit, "in this case of the sweep"):

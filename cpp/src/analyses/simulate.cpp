@@ -453,12 +453,15 @@ RowMatrix Simulation::inverse_dynamics(const RowMatrix& q, const RowMatrix& qd, 
   RowMatrix force(q.rows(), nd);
   if (RecursiveTree* tree = recursive_tree()) {
     path = "tree";
-    for (Eigen::Index k = 0; k < q.rows(); ++k)
+    for (Eigen::Index k = 0; k < q.rows(); ++k) {
+      if ((k & 1023) == 1023) check_thread_deadline("(in inverse_dynamics)");  // a state takes about 1 µs
       tree->inverse_dynamics(q.row(k).data(), qd.row(k).data(), qdd.row(k).data(), force.row(k).data());
+    }
     return force;
   }
   path = "general";
   for (Eigen::Index k = 0; k < q.rows(); ++k) {
+    check_thread_deadline("(in inverse_dynamics)");
     evaluate(data_->t, q.row(k).data(), qd.row(k).data());
     force.row(k) = (data_->Mbar * (qdd.row(k).transpose() - data_->qdd)).transpose();
   }
