@@ -20,6 +20,7 @@ from matplotlib import animation as _mpl_animation
 
 from .errors import InputError
 from .geometry import Geometry
+from .io.files import check_output_path, write_replacing
 from .plotting import Scene, _displaced, snapshot
 from .results import Results, require_results
 
@@ -143,7 +144,13 @@ def _linearized_state(source, at):
 def save_animation(anim, path, *, fps: float | None = None, dpi: int | None = None, **animate_kwargs):
     """Write an animation (an :class:`Animation`, or :class:`spacar.Results` to animate with
     ``animate_kwargs``) to ``path``: ``.gif`` (pillow), ``.mp4`` (ffmpeg), ``.html``
-    (self-contained JavaScript player). Returns the path."""
+    (self-contained JavaScript player). Returns the path. As every file spacar writes: never
+    through a symbolic link, only a regular file, an existing file replaced once the new one is
+    complete (docs/robustness.md, "Files")."""
+    try:
+        check_output_path(os.fspath(path))  # before the frames are drawn
+    except OSError as err:
+        raise InputError(f"{path}: cannot write the animation ({err.strerror or err})") from None
     if isinstance(anim, Results):
         anim = animate(anim, **animate_kwargs)
     elif animate_kwargs:
@@ -159,9 +166,13 @@ def save_animation(anim, path, *, fps: float | None = None, dpi: int | None = No
             raise RuntimeError("writing MP4 needs ffmpeg on the PATH; write a .gif or .html instead")
         writer = _mpl_animation.FFMpegWriter(fps=fps)
     elif suffix in (".html", ".htm"):
-        path.write_text(anim.to_jshtml(fps=fps), encoding="utf-8")
+        html = anim.to_jshtml(fps=fps)
+        write_replacing(os.fspath(path), lambda temporary: Path(temporary).write_text(html, encoding="utf-8"),
+                        "write the animation")
         return path
     else:
         raise InputError(f"cannot write an animation as {suffix or 'a file without suffix'}: use .gif, .mp4 or .html")
-    anim.save(os.fspath(path), writer=writer, dpi=dpi)
+    # Never through a link planted at the path, never into a FIFO; a failed write keeps the old file.
+    write_replacing(os.fspath(path), lambda temporary: anim.save(temporary, writer=writer, dpi=dpi),
+                    "write the animation")
     return path

@@ -23,9 +23,7 @@ import json
 import math
 import os
 import re
-import shutil
 import stat
-import tempfile
 import zipfile
 import zlib
 from dataclasses import dataclass
@@ -459,33 +457,13 @@ class Results:
             "energy": energy is not None,
         }
         data["meta"] = np.array(json.dumps(meta))
-        from .io.files import open_output, reason
+        from .io.files import write_replacing
 
-        existing = open_output(path, append=True)  # refuses a link or a non-regular file (appending: not emptied)
-        info = os.fstat(existing)
-        os.close(existing)
-        directory, name = os.path.split(os.path.abspath(path))
-        fd, temporary = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
-        try:
-            os.fchmod(fd, stat.S_IMODE(info.st_mode))  # the file's mode, not mkstemp's 0600 (issue 38)
-            with os.fdopen(fd, "wb") as fh:
+        def write(temporary):
+            with open(temporary, "wb") as fh:  # through a file object: NumPy appends no .npz
                 np.savez_compressed(fh, **data)
-            if info.st_nlink > 1:  # hard links keep sharing the file: its bytes are replaced in place
-                with open(temporary, "rb") as src:
-                    out = open_output(path)
-                    with os.fdopen(out, "wb") as dst:
-                        shutil.copyfileobj(src, dst)
-                os.unlink(temporary)
-            else:
-                os.replace(temporary, path)
-        except OSError as err:
-            if os.path.exists(temporary):
-                os.unlink(temporary)
-            raise SpacarError(f"{path}: cannot save the results ({reason(err)})") from None
-        except BaseException:
-            if os.path.exists(temporary):
-                os.unlink(temporary)
-            raise
+
+        write_replacing(path, write, "save the results")
 
     @classmethod
     def load(cls, path) -> "Results":

@@ -180,3 +180,79 @@ def test_ctrl_c_interrupts_a_run_and_keeps_its_rows():
     assert len(words) == 4, (done.stdout, done.stderr)
     seconds, kind, rows, model_time = float(words[0]), words[1], int(words[2]), float(words[3])
     assert seconds < 5.0 and kind == "Results" and rows >= 1 and model_time == 0.0
+
+
+# --- finding 8: the file rules for every file spacar reads or writes -------------------------------
+
+posix = pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="POSIX FIFOs and links")
+
+
+@pytest.fixture(scope="module")
+def slider_results():
+    return spacar.simulate(spacar.read(EXAMPLES / "slidercrank.dat"), progress=False)
+
+
+@posix
+@pytest.mark.parametrize("suffix", [".gif", ".html"])
+def test_an_animation_is_never_written_through_a_link_or_into_a_fifo(tmp_path, slider_results, suffix):
+    """Finding 8: ANIMATE output wrote through a planted symbolic link (overwriting its target),
+    and a FIFO given as --animation hung. Both are refused at once, as for MATASC files and
+    Results.save; an existing file is replaced once the new one is complete and keeps its mode."""
+    import os
+
+    target = tmp_path / "precious.txt"
+    target.write_text("precious")
+    link = tmp_path / f"link{suffix}"
+    link.symlink_to(target)
+    with pytest.raises(spacar.InputError, match="refusing to write through a symbolic link"):
+        spacar.save_animation(slider_results, link)
+    assert target.read_text() == "precious"
+    fifo = tmp_path / f"fifo{suffix}"
+    os.mkfifo(fifo)
+    with pytest.raises(spacar.InputError, match="not a regular file"):
+        spacar.save_animation(slider_results, fifo)
+    existing = tmp_path / f"old{suffix}"
+    existing.write_text("old")
+    existing.chmod(0o640)
+    spacar.save_animation(slider_results, existing)
+    assert existing.stat().st_mode & 0o777 == 0o640 and existing.stat().st_size > 1000
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["precious.txt", link.name, fifo.name, existing.name])
+
+
+@posix
+def test_spacar_run_with_a_fifo_as_animation_says_so_and_does_not_hang(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    model = tmp_path / "anim.dat"
+    model.write_text((EXAMPLES / "slidercrank.dat").read_text().replace("END", "ANIMATE 1\nEND", 1))
+    fifo = tmp_path / "out.gif"
+    os.mkfifo(fifo)
+    done = subprocess.run([sys.executable, "-m", "spacar", "run", str(model), "--animation", str(fifo)],
+                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert done.returncode == 1 and "not a regular file" in done.stderr, done.stderr
+
+
+@posix
+def test_from_urdf_refuses_a_fifo_a_directory_and_a_file_beyond_its_limit(tmp_path):
+    """Finding 8: from_urdf on a FIFO blocked forever, and a 20 MB URDF took 454 MB and 11 s. It
+    now follows the reader's rules: regular files only, at most max_bytes (8 MiB by default)."""
+    import os
+    import time
+
+    fifo = tmp_path / "robot.urdf"
+    os.mkfifo(fifo)
+    start = time.perf_counter()
+    for path in (fifo, tmp_path):
+        with pytest.raises(spacar.InputError, match="not a regular file"):
+            spacar.from_urdf(path)
+    big = tmp_path / "big.urdf"
+    big.write_text('<robot name="r">' + " " * (9 * 2**20) + "</robot>")
+    with pytest.raises(spacar.InputError, match=r"big.urdf: the URDF file has 9437\d+ bytes, more than the limit"):
+        spacar.from_urdf(big)
+    assert time.perf_counter() - start < 1.0
+    small = DATA / "wrist.urdf"
+    with pytest.raises(spacar.InputError, match="more than the limit of 100 bytes"):
+        spacar.from_urdf(small, max_bytes=100)
+    assert len(spacar.from_urdf(small).elements) > 0
