@@ -60,3 +60,19 @@ def time_limited(time_limit, where: str):
     with _core.Deadline(limit):
         yield
         _core.check_deadline(f"({where})")
+
+
+def returned_loads(value, n: int, what: str, t: float):
+    """The ``n`` finite numbers a user's function returned at time ``t`` as a float array, or an
+    InputError naming ``what`` ("forces: the function of node 3") and the value (a string, a
+    dict, a complex number, the wrong count, NaN)."""
+    import numpy as np
+
+    try:
+        loads = np.asarray(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError, OverflowError):
+        loads = None
+    if loads is None or loads.shape != (n,) or not np.isfinite(loads).all():
+        raise InputError(f"{what} must return {n} finite number{'s' if n != 1 else ''}, got {show(value)} "
+                         f"at t = {t:g}")
+    return loads

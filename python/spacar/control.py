@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._util import show
+from ._util import returned_loads, show
 from .errors import InputError
 
 _SENSED = ("x", "xd", "xdd")
@@ -81,10 +81,7 @@ class Controller:
         def on_sample(t, x, xd, xdd):
             state = (x, xd, xdd)
             y = np.array([state[k][g] for k, g in sensed])
-            u = np.asarray(self.fn(t, y.copy()), dtype=float).reshape(-1)
-            if u.shape != (len(acting),) or not np.all(np.isfinite(u)):
-                raise InputError(f"Controller: fn must return {len(acting)} finite loads (one per actuator), "
-                                 f"got {show(u)} at t = {t:g}")
+            u = returned_loads(self.fn(t, y.copy()), len(acting), "Controller: fn (one load per actuator)", t)
             log_t.append(t)
             log_y.append(y)
             log_u.append(u)

@@ -9,7 +9,7 @@ import weakref
 import numpy as np
 
 from . import _core
-from ._util import seconds_or_none, show
+from ._util import returned_loads, seconds_or_none, show
 from .errors import InputError, KinematicsError, SpacarError
 from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
@@ -106,11 +106,8 @@ def _time_loads(sim, system, forces, inputs):
         def load_function(t):
             load = np.zeros(nx)
             for coords, f, node in functions:
-                value = np.asarray(f(t), dtype=float).reshape(-1)
-                if value.shape != (len(coords),):
-                    raise InputError(f"forces: the function of node {node} must return {len(coords)} values "
-                                     f"(one per FORCE value), got {show(value)} at t = {t:g}")
-                load[coords] += value
+                load[coords] += returned_loads(f(t), len(coords),
+                                               f"forces: the function of node {node} (one value per FORCE value)", t)
             return load
     sim.set_time_loads(tables, motions, load_function)
 
@@ -255,6 +252,10 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         started = time.monotonic()   # the time limit covers the set-up too
         sim = _core.Simulation(model.core, time_limit=limit)  # prepares the model (the first END) and compiles it
         system = sim.system
+        for name, value in (("forces", forces), ("inputs", inputs)):
+            if value is not None and not isinstance(value, dict):  # before its truth value (an array has none)
+                raise InputError(f"{name} must be a dict: forces={{node: Table or f(t)}}, inputs={{(node, i): Table}}, "
+                                 f"got {show(value)}")
         if forces or inputs:
             _time_loads(sim, system, forces or {}, inputs or {})
         on_sample, finish_sampling = (None, None) if controller is None else controller._bind(system.coord_label)

@@ -67,18 +67,24 @@ class StateSpace:
         second_order = self._second_order()
         for j, wj in enumerate(w):
             try:
-                if second_order:
-                    # s = [δz; iω δz] with (K − ω² M + iω Dm) δz = Q u: a system half the size,
-                    # without M⁻¹ (better conditioned for stiff models)
-                    M, Dm, K, Q = second_order
-                    X = np.linalg.solve(K - wj**2 * M + 1j * wj * Dm, Q)
-                    out[j] = self.C @ np.vstack([X, 1j * wj * X]) + self.D
-                else:
-                    out[j] = self.C @ np.linalg.solve(1j * wj * np.eye(self.A.shape[0]) - self.A, self.B) + self.D
+                with np.errstate(over="ignore", invalid="ignore"):  # an overflow is said below
+                    out[j] = self._response(wj, second_order)
             except np.linalg.LinAlgError:
                 raise InputError(f"frequency_response: ω = {wj:g} rad/s is a pole of the model (e.g. ω = 0 "
                                  "with a free rigid-body motion)") from None
+            if not np.isfinite(out[j]).all():  # ω² times the model's matrices beyond double precision
+                raise InputError(f"frequency_response: at ω = {wj:g} rad/s the response overflows double "
+                                 "precision (ω² times the mass matrix); give lower frequencies")
         return out
+
+    def _response(self, w, second_order):
+        if second_order:
+            # s = [δz; iω δz] with (K − ω² M + iω Dm) δz = Q u: a system half the size, without M⁻¹
+            # (better conditioned for stiff models)
+            M, Dm, K, Q = second_order
+            X = np.linalg.solve(K - w**2 * M + 1j * w * Dm, Q)
+            return self.C @ np.vstack([X, 1j * w * X]) + self.D
+        return self.C @ np.linalg.solve(1j * w * np.eye(self.A.shape[0]) - self.A, self.B) + self.D
 
     def _second_order(self):
         """(M, Dm, K, Q) of M δz̈ + Dm δż + K δz = Q u when the model has no kinematic coordinates
@@ -472,8 +478,13 @@ def _frequencies(freqs, unit) -> np.ndarray:
         raise InputError(f"unit must be 'Hz' or 'rad/s', got {show(unit)}")
     try:
         f = np.asarray(freqs, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError(f"freqs must be numbers, got {show(freqs)}") from None
     if not np.isfinite(f).all():
         raise InputError("freqs must be finite numbers")
-    return 2 * np.pi * f if unit == "Hz" else f
+    with np.errstate(over="ignore"):
+        w = 2 * np.pi * f if unit == "Hz" else f
+    if not np.isfinite(w).all():
+        raise InputError(f"freqs: {float(f[~np.isfinite(w)][0]):g} Hz is beyond the angular frequencies double "
+                         "precision holds")
+    return w

@@ -91,5 +91,5 @@ def test_controller_errors_are_clear():
         spacar.simulate(pendulum(0.1, 2), controller=spacar.Controller(pd, 10, [("x", 9, 1)], [(2, 1)]),
                         progress=False)
     bad = spacar.Controller(lambda t, y: [1.0, 2.0], 10, [("x", 2, 1)], [(2, 1)])
-    with pytest.raises(spacar.InputError, match="1 finite loads"):
+    with pytest.raises(spacar.InputError, match="must return 1 finite number"):
         spacar.simulate(pendulum(0.1, 2), controller=bad, progress=False)

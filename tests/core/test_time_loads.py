@@ -139,7 +139,7 @@ def test_bad_time_loads_are_refused():
         spacar.simulate(m, inputs={("e", 1, 1): spacar.Table([0, 1], [1.0, 2.0])}, progress=False)
     with pytest.raises(spacar.InputError, match="increase"):
         spacar.Table([0, 0], [1.0, 2.0])
-    with pytest.raises(spacar.InputError, match="must return 2 values"):
+    with pytest.raises(spacar.InputError, match="must return 2 finite numbers"):
         spacar.simulate(m, forces={2: lambda t: 1.0}, progress=False)
 
 

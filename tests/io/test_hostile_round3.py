@@ -256,3 +256,46 @@ def test_from_urdf_refuses_a_fifo_a_directory_and_a_file_beyond_its_limit(tmp_pa
     with pytest.raises(spacar.InputError, match="more than the limit of 100 bytes"):
         spacar.from_urdf(small, max_bytes=100)
     assert len(spacar.from_urdf(small).elements) > 0
+
+
+# --- findings 13 and 15, the rest: what a user's function returns, arrays for dicts, huge frequencies
+
+RETURNED = ["abc", {"a": 1}, 1j, (1 + 2j, 0.0), [1.0, "x"], None, (float("nan"), 0.0), 10**400, (1.0, 2.0, 3.0)]
+
+
+@pytest.mark.parametrize("value", RETURNED, ids=repr)
+def test_a_force_function_returning_something_else_is_an_input_error(value):
+    """Finding 13: raw ValueError/TypeError from a force callable returning a string, a dict or a
+    complex number. The message names the node, what was returned and the time."""
+    model = spacar.read(EXAMPLES / "slidercrank.dat")
+    with pytest.raises(spacar.InputError, match=r"^forces: the function of node 3 .* must return 2 finite numbers, "
+                                                r"got .* at t = 0$"):
+        spacar.simulate(model, forces={3: lambda t: value}, progress=False)
+
+
+@pytest.mark.parametrize("value", RETURNED, ids=repr)
+def test_a_controller_law_returning_something_else_is_an_input_error(value):
+    model = spacar.read(EXAMPLES / "slidercrank.dat")
+    law = spacar.Controller(lambda t, y: value, rate=100.0, sensors=[("x", 3, 1)], actuators=[(3, 1)])
+    with pytest.raises(spacar.InputError, match=r"^Controller: fn .* must return 1 finite number, got .* at t = 0$"):
+        spacar.simulate(model, controller=law, progress=False)
+
+
+@pytest.mark.parametrize("keyword", ["forces", "inputs"])
+def test_forces_or_inputs_given_as_an_array_are_an_input_error(keyword):
+    """Finding 13: forces=np.array(...) gave the raw 'truth value of an array is ambiguous'."""
+    model = spacar.read(EXAMPLES / "slidercrank.dat")
+    with pytest.raises(spacar.InputError, match=rf"^{keyword} must be a dict: .* got array"):
+        spacar.simulate(model, **{keyword: np.array([1.0, 2.0])}, progress=False)
+
+
+def test_a_frequency_response_beyond_double_precision_is_an_input_error():
+    """Finding 15: StateSpace.frequency_response([1e308]) returned NaN from a successful call."""
+    from support.planar_models import tip_loaded_beam
+
+    ss = spacar.state_space(tip_loaded_beam(4))
+    with pytest.raises(spacar.InputError, match="1e[+]308 Hz is beyond the angular frequencies double precision"):
+        ss.frequency_response([1e308])
+    with pytest.raises(spacar.InputError, match="the response overflows double precision"):
+        ss.frequency_response([1e200])
+    assert np.isfinite(ss.frequency_response([1e150, 1.0])).all()
