@@ -253,3 +253,16 @@ def test_unsupported_models_are_named():
         sp_pinocchio.build(m)
     # an UnsupportedModelError is a spacar.InputError
     assert issubclass(UnsupportedModelError, spacar.InputError)
+
+
+def test_a_diverged_peer_run_reported_as_success_is_refused():
+    """Issue 38, finding 2: exudyn returned a diverged state (q ≈ 1e19 on a 20-link chain) while
+    reporting success, and the comparison used it. A peer's state that is not finite or has run
+    away from the start now raises PeerResultError; a converged run of the same model passes."""
+    from spacar.compare import PeerResultError
+
+    peer = sp_exudyn.build(models.spatial_chain(20, t_end=1.0, n_out=1), formulation="tree")
+    for step in (0.5, 0.1):  # RK44 far beyond its stability: angles of 1e12 rad, then NaN
+        with pytest.raises(PeerResultError, match=r"exudyn's rk44 reported success but returned a diverged state"):
+            peer.solve(solver="rk44", step=step, n_out=1)
+    assert np.isfinite(peer.solve(solver="rk44", step=0.01, n_out=1).q).all()

@@ -12,8 +12,10 @@ a spacar model, run it, and return side-by-side arrays.
 Both need the optional extra ``compare`` (``pip install "spacar[compare]"``: exudyn and pin);
 the submodules import their peer on first use, so ``import spacar.compare`` always works.
 What each converter supports is listed in its module docstring and in docs/comparison.md; a
-model outside that raises :class:`UnsupportedModelError` naming the node or element concerned.
+model outside that raises :class:`UnsupportedModelError` naming the node or element concerned;
+a peer run that reports success with a non-finite or diverged state raises
+:class:`PeerResultError`.
 """
-from ._topology import Topology, UnsupportedModelError, analyse
+from ._topology import PeerResultError, Topology, UnsupportedModelError, analyse
 
-__all__ = ["UnsupportedModelError", "Topology", "analyse"]
+__all__ = ["PeerResultError", "UnsupportedModelError", "Topology", "analyse"]

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _core
-from ..errors import InputError
+from ..errors import InputError, SpacarError
 from ..geometry import euler_e, rotation  # E(λ) of ω = 2 E(λ) λ̇; R(λ), body → global
 
 PLANAR_BEAMS = ("PLBEAM", "PLBEAMNL")
@@ -46,6 +46,12 @@ CC = _core.CoordClass
 DC = _core.DefClass
 ORIENTATION_KINDS = (NK.BETA, NK.LAMBDA)
 POSITION_KINDS = (NK.XY, NK.XYZ)
+
+
+class PeerResultError(SpacarError):
+    """A peer engine reported success but returned a state that is not a solution (not finite,
+    or run away from the start): its numbers are not to be trusted (issue 38, finding 2: exudyn's
+    DOPRI5 returned q ≈ 1e19 as a success)."""
 
 
 class UnsupportedModelError(InputError):

@@ -77,6 +77,7 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
 
 from .. import _core
 from ._topology import (
+    PeerResultError,
     UnsupportedModelError,
     analyse,
     lambda_of_rotation,
@@ -608,6 +609,9 @@ class ExudynModel:
                 stats["steps"] += it.currentStepIndex
                 stats["rejected"] += getattr(it, "rejectedAutomaticStepSizeSteps", 0)
                 x, q = self.current_x(prev)
+                _check_peer_state(x, xs[0], solver, times[k])
+                if qs is not None:  # the tree's joint coordinates: positions stay bounded when these run away
+                    _check_peer_state(np.asarray(q, dtype=float), np.asarray(qs[0], dtype=float), solver, times[k])
                 xs[k] = x
                 if qs is not None:
                     qs.append(q)
@@ -629,6 +633,21 @@ class ExudynModel:
             return self.current_x()
         finally:
             sd.SetSystemState(cur, exu.ConfigurationType.Current)
+
+
+# A state whose coordinates grew beyond this many times the initial state's size (plus one
+# model length) has diverged: no mechanism of the comparisons moves that far.
+_DIVERGED = 1e6
+
+
+def _check_peer_state(x, x0, solver, t):
+    """Raise PeerResultError if exudyn's state at t is not finite or has run away from the start."""
+    size = 1.0 + float(np.max(np.abs(x0))) if x0.size else 1.0
+    if not np.isfinite(x).all() or (x.size and float(np.max(np.abs(x))) > _DIVERGED * size):
+        worst = float(np.max(np.abs(x))) if np.isfinite(x).all() else float("nan")
+        raise PeerResultError(f"exudyn's {solver} reported success but returned a diverged state at t = {t:g} "
+                              f"(largest coordinate {worst:.3g}, initially {size - 1.0:.3g}): its result is not "
+                              "to be trusted; try a smaller step, a tighter tolerance or another solver")
 
 
 def build(spacar_model, formulation: str = "redundant", axial_stiffness=None) -> ExudynModel:
