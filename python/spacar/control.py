@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._util import returned_loads, show
+from ._util import finite_time, returned_loads, show
 from .errors import InputError
 
 _SENSED = ("x", "xd", "xdd")
@@ -39,7 +39,7 @@ class Controller:
         if not callable(fn):
             raise InputError(f"Controller: fn must be a function fn(t, sensors), got {show(fn)}")
         if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)) \
-                or not np.isfinite(rate) or rate <= 0:
+                or finite_time(rate, "Controller: rate") <= 0:
             raise InputError(f"Controller: rate must be a positive number of samples per second, got {show(rate)}")
         self.fn, self.rate = fn, float(rate)
         for name, items in (("sensors", sensors), ("actuators", actuators)):

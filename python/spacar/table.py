@@ -25,12 +25,12 @@ class Table:
     """
 
     def __init__(self, t, values, kind: str = "cubic"):
-        if kind not in ("linear", "cubic"):
+        if not isinstance(kind, str) or kind not in ("linear", "cubic"):
             raise InputError(f"Table: kind must be 'linear' or 'cubic', got {show(kind)}")
         try:
             times = np.asarray(t, dtype=float)
             vals = np.asarray(values, dtype=float)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):  # OverflowError: an integer beyond double
             raise InputError("Table: t and values must be arrays of numbers") from None
         if times.ndim != 1:
             raise InputError(f"Table: t must be one-dimensional, got shape {times.shape}")
