@@ -443,9 +443,10 @@ class Model:
         other.output_stem = self.output_stem
         other.state_space_inputs = dict(self.state_space_inputs)
         other.state_space_outputs = dict(self.state_space_outputs)
-        for name in ("urdf_joints", "urdf_links"):   # set by spacar.from_urdf
+        copies = {"urdf_joints": list, "urdf_links": dict, "urdf_base": lambda base: base}  # set by spacar.from_urdf
+        for name, copy in copies.items():
             if hasattr(self, name):
-                setattr(other, name, list(getattr(self, name)) if name == "urdf_joints" else dict(getattr(self, name)))
+                setattr(other, name, copy(getattr(self, name)))
         return other
 
     def summary(self):

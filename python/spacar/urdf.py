@@ -164,8 +164,9 @@ class _Reader:
         kind = elem.get("type")
         where = f"joint {name!r}"
         if kind in ("floating", "planar"):
-            self.fail(f"{where} is {kind}: spacar.from_urdf builds fixed-base robots of revolute, continuous, "
-                      "prismatic and fixed joints (a floating base is not supported)")
+            self.fail(f"{where} is {kind}: spacar.from_urdf builds robots of revolute, continuous, prismatic and "
+                      "fixed joints (for a floating base, leave the root link without a joint and call "
+                      "from_urdf(path, floating=True))")
         if kind not in MOVING + ("fixed",):
             self.fail(f"{where} has type {kind!r}: use revolute, continuous, prismatic or fixed")
         ends = []
@@ -313,7 +314,7 @@ def _perpendicular(d) -> np.ndarray:
 MAX_URDF_BYTES = 8 * 2**20
 
 
-def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, max_bytes: int | None = None) -> Model:
+def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, max_bytes: int | None = None) -> Model:
     """A spacar :class:`Model` of the fixed-base robot described by the URDF file ``path``: its
     revolute, continuous, prismatic and fixed joints, branches, link inertias (mass, centre of
     mass, inertia tensor with the origin's rpy), joint origins (xyz, rpy) and axes, in the URDF's
@@ -330,7 +331,20 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, max_bytes: int | None = None) 
     geometry (meshes), transmissions, joint limits, damping and friction, mimic relations (the
     mimic joint becomes an independent DOF). Floating and planar joints (a floating base) and
     anything that is not a tree of links raise :class:`spacar.InputError` naming the file; so
-    does a file that is not well-formed XML. The file must be a regular file (a FIFO or a device
+    does a file that is not well-formed XML.
+
+    ``floating=True``: the root link is a free body instead of the ground, as Pinocchio's
+    ``buildModelFromUrdf(path, JointModelFreeFlyer())``: its origin (XYZ node 1) and its
+    orientation (LAMBDA node 2, Euler parameters with the L2MIN1 constraint) are degrees of
+    freedom, DYNX 1 1 2 3 and DYNX 2 2 3 4 (λ0 calculable: orientations up to, not through, a half
+    turn from the URDF's frame), the first six DOFs: ``res.q`` is (x, y, z, λ1, λ2, λ3, the joints).
+    ``model.urdf_base`` is (1, 2), None for a fixed base. The model is returned prepared (its
+    reference geometry the URDF's zero configuration), so that ``model.x(1, x, y, z)`` and
+    ``model.x(2, λ0, λ1, λ2, λ3)`` place the robot and ``model.xd`` set the base's velocity
+    (``λ̇ = ½ E(λ)ᵀ ω``); no elements can be added to it. Such a model takes the general path (an
+    open chain's where it is one), not the recursive path.
+
+    The file must be a regular file (a FIFO or a device
     is refused at once) of at most ``max_bytes`` bytes (default :data:`MAX_URDF_BYTES`, 8 MiB).
     """
     if not isinstance(path, (str, os.PathLike)) or "\x00" in os.fspath(path):
@@ -360,12 +374,28 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, max_bytes: int | None = None) 
     moving = [j for j in order if j.type in MOVING]
     element_of = {j.name: k for k, j in enumerate(moving, start=1)}
     next_element = len(moving) + 1  # elements 1..n are the joints: the DOFs in their order
-    ground = _Body(np.zeros(3))
-    ground.lam = b.lambda_node(fixed=True)
-    body_of = {root: ground}
-    bodies = [ground]
-    n_origin, next_element = b.point(ground, np.zeros(3), True, next_element)
-    link_nodes = {root: (n_origin, ground.lam)}  # (the ground's inertia does not matter)
+    if not isinstance(floating, bool):
+        raise InputError(f"from_urdf: floating must be True or False, got {show(floating)}")
+    if floating:  # the root link a free body: its origin and orientation the first six DOFs
+        ground = None
+        base = _Body(np.zeros(3))
+        n_origin = b.node()
+        m.xyz(n_origin, 0.0, 0.0, 0.0)
+        base.points.append((np.zeros(3), n_origin))
+        base.lam = b.lambda_node()
+        m.dynx(n_origin, 1, 2, 3)
+        m.dynx(base.lam, 2, 3, 4)  # λ1..λ3; λ0 calculable (the L2MIN1 constraint)
+        base.add(links[root], np.eye(3), np.zeros(3))
+        body_of = {root: base}
+        bodies = [base]
+        link_nodes = {root: (n_origin, base.lam)}
+    else:
+        ground = _Body(np.zeros(3))
+        ground.lam = b.lambda_node(fixed=True)
+        body_of = {root: ground}
+        bodies = []
+        n_origin, next_element = b.point(ground, np.zeros(3), True, next_element)
+        link_nodes = {root: (n_origin, ground.lam)}  # (the ground's inertia does not matter)
     for j in order:
         parent = body_of[j.parent]
         R, o = frame[j.child]
@@ -394,7 +424,7 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, max_bytes: int | None = None) 
         if body_of[j.child] is not ground:
             body_of[j.child].add(links[j.child], R, o)
 
-    for body in bodies[1:]:
+    for body in bodies:
         c, J = body.centre_and_inertia()
         if c is not None:
             n, next_element = b.point(body, c, False, next_element)
@@ -407,6 +437,11 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, max_bytes: int | None = None) 
         m.gravity(*g)
 
     m.urdf_joints = [j.name for j in moving]
+    m.urdf_base = (n_origin, base.lam) if floating else None
+    if floating:
+        # The reference geometry is the URDF's zero configuration: X 1 and X 2 then place the
+        # robot (before the first END they would change its geometry instead).
+        m.prepare()
     m.urdf_links = link_nodes
     for w in reader.warnings:
         m.warnings.append(f"{reader.path}: {w}")

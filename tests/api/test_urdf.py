@@ -22,12 +22,12 @@ from support.paths import DATA
 SMALL = ["two_link_arm", "branched_tree", "prismatic", "fixed_joints"]
 
 
-def robot_file(package: str, name: str) -> Path:
+def robot_file(package: str, name: str, folder: str = "urdf") -> Path:
     try:
         dist = importlib.metadata.distribution("example-robot-data")
     except importlib.metadata.PackageNotFoundError:
         pytest.skip("example-robot-data is not installed (pip install 'spacar[robots]')")
-    return Path(dist.locate_file(f"cmeel.prefix/share/example-robot-data/robots/{package}/urdf/{name}"))
+    return Path(dist.locate_file(f"cmeel.prefix/share/example-robot-data/robots/{package}/{folder}/{name}"))
 
 
 def urdf_path(name: str) -> Path:
@@ -104,7 +104,7 @@ def test_what_is_left_out_is_reported(tmp_path):
     ("<robot><link name='a'/><link name='b'/>", "not a well-formed"),
     ("<model/>", "not <robot>"),
     ("<robot><link name='a'/><link name='b'/><joint name='j' type='floating'><parent link='a'/>"
-     "<child link='b'/></joint></robot>", "floating base is not supported"),
+     "<child link='b'/></joint></robot>", "floating=True"),
     ("<robot><link name='a'/><link name='b'/><joint name='j' type='planar'><parent link='a'/>"
      "<child link='b'/></joint></robot>", "is planar"),
     ("<robot><link name='a'/><link name='b'/><joint name='j' type='screw'><parent link='a'/>"
@@ -298,6 +298,134 @@ def test_initial_joint_values_place_the_links_as_pinocchio_does():
     np.testing.assert_allclose(res.qd[0], np.linspace(0.1, 0.9, 9), rtol=0, atol=1e-14)
     peer.column = {lbl: i for i, lbl in enumerate(res.coordinate_labels)}
     assert peer.link_position_error(res.x[0], q0) < 1e-12
+
+
+# --- floating base (issue 37) -------------------------------------------------------------------------
+
+def base_velocity_map(lam):
+    """T(λ) of (v, ω) of the base in its own axes, Pinocchio's free-flyer velocity, from the rates of
+    spacar's base DOFs (ẋ, λ̇1, λ̇2, λ̇3) in global axes: v = Rᵀ ẋ, ω = Rᵀ 2 E(λ) λ̇, λ̇0 following
+    from the L2MIN1 constraint λ · λ̇ = 0."""
+    from spacar.geometry import euler_e, rotation
+
+    R = rotation(lam)
+    dlam = np.vstack([-lam[1:] / lam[0], np.eye(3)])
+    T = np.zeros((6, 6))
+    T[:3, :3] = R.T
+    T[3:, 3:] = R.T @ (2.0 * euler_e(lam)) @ dlam
+    return T
+
+
+@pytest.mark.parametrize("name", ["solo12", "ur5"])
+def test_floating_base_matches_pinocchio_s_free_flyer(name):
+    """from_urdf(floating=True): the root link a free body (its origin and Euler parameters the
+    first six DOFs, L2MIN1 holding λ0). At random states (base pose and twist, joints and rates):
+    the reduced mass matrix is Pinocchio's crba with JointModelFreeFlyer in spacar's coordinates
+    (Tᵀ M T), and the accelerations, the bias forces with them, are its aba's: the classical
+    acceleration of the base origin, the base's angular acceleration and the joints' q̈."""
+    from spacar.geometry import euler_e, rotation
+
+    path = robot_file("solo_description", "solo12.urdf", "robots") if name == "solo12" else urdf_path(name)
+    model = spacar.from_urdf(path, floating=True)
+    model.epskin(1e-14)  # the positions to round-off: the comparison is at 1e-10
+    assert model.urdf_base == (1, 2)
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = pm.createData()
+    sim = _core.Simulation(model.core)
+    sim.assemble()
+    column = {tuple(lbl): i for i, lbl in enumerate(sim.system.coord_label)}
+    nv, rng, now = pm.nv, np.random.default_rng(7), np.zeros(pm.nv)
+    assert sim.system.n_dof == nv and model.urdf_joints == list(pm.names)[2:]
+    for _ in range(3):
+        axis = rng.normal(size=3)
+        lam = np.r_[np.cos(0.35), np.sin(0.35) * axis / np.linalg.norm(axis)]
+        q = np.r_[rng.uniform(-0.5, 0.5, 3), lam[1:], rng.uniform(-1.0, 1.0, nv - 6)]
+        qd = rng.uniform(-1.5, 1.5, nv)
+        for s in np.linspace(0.0, 1.0, 9)[1:]:  # by continuation, on the assembled branch
+            sim.evaluate(0.0, now + s * (q - now), qd)
+        now = q
+        d = sim.data
+        T = np.eye(nv)
+        T[:6, :6] = base_velocity_map(lam)
+        q_pin = np.r_[q[:3], lam[1:], lam[0], q[6:]]
+        v_pin = T @ qd
+        M = pin.crba(pm, data, q_pin)
+        M = np.triu(M) + np.triu(M, 1).T
+        assert np.abs(np.array(d.Mbar) - T.T @ M @ T).max() <= 1e-10 * np.abs(M).max()
+        a = pin.aba(pm, data, q_pin, v_pin, np.zeros(nv))
+        R = rotation(lam)
+        xdd = np.array(d.xdd)
+        origin = xdd[[column[(1, c)] for c in (1, 2, 3)]]
+        lam_dd = xdd[[column[(2, c)] for c in (1, 2, 3, 4)]]
+        scale = max(1.0, np.abs(a).max())
+        assert np.abs(origin - R @ (a[:3] + np.cross(v_pin[3:6], v_pin[:3]))).max() <= 1e-10 * scale
+        assert np.abs(2.0 * euler_e(lam) @ lam_dd - R @ a[3:6]).max() <= 1e-10 * scale
+        assert np.abs(np.array(d.qdd)[6:] - a[6:]).max() <= 1e-10 * scale
+
+
+def test_floating_base_free_fall_matches_pinocchio_integrated_by_scipy():
+    """Solo12 thrown with its joint torques off: 1 s of spacar against Pinocchio's aba with the
+    free flyer's quaternion integrated by SciPy's DOP853 at 1e-12. The base is placed with X 1 and
+    X 2 after from_urdf (the model comes prepared, its geometry the URDF's)."""
+    from scipy.integrate import solve_ivp
+
+    from spacar.geometry import euler_e, rotation
+
+    path = robot_file("solo_description", "solo12.urdf", "robots")
+    model = spacar.from_urdf(path, floating=True)
+    nj = len(model.urdf_joints)
+    rng = np.random.default_rng(2)
+    axis = rng.normal(size=3)
+    lam = np.r_[np.cos(0.2), np.sin(0.2) * axis / np.linalg.norm(axis)]
+    p, qj = np.array([0.0, 0.0, 0.5]), rng.normal(size=nj) * 0.3
+    v, w, qdj = rng.normal(size=3) * 0.5, rng.normal(size=3), rng.normal(size=nj)
+    model.x(1, *p)
+    model.x(2, *lam)
+    lam_d = 0.5 * euler_e(lam).T @ w
+    for i in range(3):
+        model.xd(1, i + 1, v[i])
+    for i in range(4):
+        model.xd(2, i + 1, lam_d[i])
+    for k in range(nj):
+        model.e(k + 1, 1, qj[k])
+        model.ed(k + 1, 1, qdj[k])
+    model.timestep(10, 1.0)
+    for eps in (model.epsint, model.epsind):
+        eps(1e-10)
+    res = spacar.simulate(model)
+
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = pm.createData()
+    R = rotation(lam)
+
+    def f(t, y):
+        q, vv = y[:pm.nq].copy(), y[pm.nq:]
+        q[3:7] /= np.linalg.norm(q[3:7])
+        x, y_, z, s = q[3:7]
+        wx, wy, wz = vv[3:6]
+        quat_d = 0.5 * np.array([s * wx + y_ * wz - z * wy, s * wy + z * wx - x * wz, s * wz + x * wy - y_ * wx,
+                                 -x * wx - y_ * wy - z * wz])
+        Rq = pin.Quaternion(s, x, y_, z).matrix()
+        return np.r_[Rq @ vv[:3], quat_d, vv[6:], pin.aba(pm, data, q, vv, np.zeros(pm.nv))]
+
+    y0 = np.r_[p, lam[1:], lam[0], qj, R.T @ v, R.T @ w, qdj]
+    ref = solve_ivp(f, (0.0, 1.0), y0, method="DOP853", rtol=1e-12, atol=1e-12)
+    assert ref.success
+    qT = ref.y[:pm.nq, -1]
+    quat = qT[3:7] / np.linalg.norm(qT[3:7])
+    assert res.node(1).x[-1][2] < 0.0  # it fell
+    np.testing.assert_allclose(res.node(1).x[-1], qT[:3], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(res.node(2).x[-1], np.r_[quat[3], quat[:3]], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(res.q[-1][6:], qT[7:], rtol=0, atol=1e-8)
+
+
+def test_a_floating_base_that_moves_no_mass_is_said():
+    """A massless root link whose only joint turns about an axis through its origin: turning the
+    base one way and the joint the other moves nothing (singular mass), named as such."""
+    model = spacar.from_urdf(DATA / "wrist.urdf", floating=True)
+    model.timestep(1, 0.01)
+    with pytest.raises(spacar.SingularMassError, match="singular"):
+        spacar.simulate(model)
 
 
 # Of the URDFs of example-robot-data that from_urdf reads, those not on the recursive path, and why.
