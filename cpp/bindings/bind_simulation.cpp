@@ -172,6 +172,13 @@ void bind_linearization(py::class_<Simulation>& sim) {
            py::arg("differences") = true,
            "The linearized equations at the state of the last evaluate(); differences=False at a state "
            "linearize_nodal accepted (at rest in static equilibrium: C0 = N0 = 0, no finite differences).")
+      .def(
+          "linearize_at_rest",
+          [](Simulation& s, double t, const Eigen::VectorXd& q) { return linearization_to_dict(s.linearize_at_rest(t, q)); },
+          py::arg("t"), py::arg("q"),
+          "The dense linearized equations at the state of linearize_nodal (DOFs q at time t, at rest in static "
+          "equilibrium) without the equations of motion: q̈ = 0 and the static stresses (a model without mass "
+          "has K0, G0 and DF; M0 = 0).")
       .def("linearize_nodal",
            [](Simulation& s) -> py::object {
              NodalLinearization n;

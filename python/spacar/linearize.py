@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _core
 from ._util import show, time_limited
-from .errors import InputError, SpacarError
+from .errors import InputError, SingularMassError, SpacarError
 from .model import Model
 
 
@@ -103,9 +103,10 @@ class Linearization:
     def _densify(self):
         """The dense reduced matrices (formulation.md §7) at the nodal linearization's state."""
         sim = self._sim
-        t, q, qd = self._state
-        sim.move_to(t, q, qd)
-        d = sim.linearize(differences=False)  # at rest in static equilibrium: C0 = N0 = 0
+        t, q, _ = self._state
+        # At rest in static equilibrium: C0 = N0 = 0, q̈ = 0 and the static stresses, no equations
+        # of motion (a model without mass has its K0, G0 and DF; M0 = 0).
+        d = sim.linearize_at_rest(t, q)
         nz = len(self.z_labels)
         for name in MATRICES:
             if name != "r0":
@@ -163,8 +164,22 @@ class Linearization:
         order = np.argsort(np.abs(w2))
         return np.real(w2[order]), v[:, order]
 
+    def _require_mass(self, what: str):
+        """A SingularMassError for an analysis that needs masses when no node or element carries
+        any (a flexure model built for its stiffness: its K0, G0, buckling factors, compliance
+        and support stiffness need none)."""
+        if not self.z_labels:
+            return  # nothing moves: every result is empty
+        nodal = self.__dict__.get("nodal")
+        massless = nodal.M.count_nonzero() == 0 if nodal is not None else not np.any(self.M0)
+        if massless:
+            raise SingularMassError(f"{what} needs masses: no node or element of the model carries mass (add MASS "
+                                    "or EMASS, e.g. spacar.section's emass); its stiffness K0, G0, the buckling "
+                                    "factors, the compliance and the support stiffness need none")
+
     def _modes(self, k, method):
         """(ω², shapes in z, shapes in x) of the k lowest |ω²| (all if k is None)."""
+        self._require_mass("the eigen-analysis")
         if self._sparse(k, method):
             w2, vx = self.nodal.modes(self._sim, _count(k, len(self.z_labels)))
             return w2, self.nodal.E @ vx, vx
@@ -206,6 +221,7 @@ class Linearization:
     def state_matrix(self) -> np.ndarray:
         """A of d/dt [δz; δy^k; δż] = A [δz; δy^k; δż] (formulation.md §7.3); without
         nonholonomic constraints just d/dt [δz; δż]."""
+        self._require_mass("the state matrix")
         n, k = self.M0.shape[0], len(self.y_labels)
         Minv = np.linalg.inv(self.M0)
         return np.block([
@@ -217,6 +233,7 @@ class Linearization:
     def eigenvalues(self) -> np.ndarray:
         """Eigenvalues of the first-order system (damping, gyroscopic terms included), sorted by
         |Im| and then Re."""
+        self._require_mass("the eigen-analysis")
         lam = None if len(self.y_labels) else second_order_eigenvalues(self.M0, self.damping, self.stiffness)
         if lam is None:
             lam = np.linalg.eigvals(self.state_matrix())
@@ -467,5 +484,12 @@ def linearized_simulation(model, state=None):
         if nodal is not None:
             return (Linearization._from_nodal(nodal, sim, (t, q, qd), system.coord_label, system.def_label), sim,
                     (t, q, qd))
-    sim.move_to(t, q, qd)
+    try:
+        sim.move_to(t, q, qd)
+    except SingularMassError as err:
+        if state is None:  # a structure without masses, for its stiffness: at its static equilibrium
+            raise SingularMassError(f"{err}; a model without masses is linearized at a static equilibrium (at rest, "
+                                    "its loads balanced): call spacar.static(model) first, which leaves it there") \
+                from None
+        raise
     return Linearization(sim.linearize(), system.coord_label, system.def_label), sim, (t, q, qd)

@@ -312,6 +312,7 @@ def _build_modal(lin: Linearization, inputs, outputs, modes) -> StateSpace:
                          "this one is not (the dense model, without modes=, is)")
     if lin.n_line:
         raise InputError("state_space: modes= is for models without LINE parameters")
+    lin._require_mass("state_space's modes")
     sim = lin._sim
     k = _count(modes, len(lin.z_labels))
     w2, vx = nodal.modes(sim, k)

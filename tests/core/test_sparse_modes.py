@@ -78,9 +78,10 @@ def test_buckling_loads_sparse_dense_and_analytic():
 
 
 def test_buckling_needs_no_mass():
-    """The flexure guide of examples/ has no masses (its dense linearization cannot be reduced:
-    SingularMassError): its buckling factors on the sparse path equal those of the same guide
-    with masses."""
+    """The flexure guide of examples/ has no masses: at its static equilibrium its buckling factors,
+    on the sparse path and on the dense one (issue 39: the dense matrices at rest come without the
+    equations of motion, M0 = 0), equal those of the same guide with masses; the modes ask for
+    masses."""
     def guide(mass):
         m = spacar.read(EXAMPLES / "parallel_leaf_guide.dat")
         m.force(9, 0.0, -100.0)  # a compressive load on the stage
@@ -94,8 +95,18 @@ def test_buckling_needs_no_mass():
     with_mass = spacar.linearize(guide(True))
     np.testing.assert_allclose(free, with_mass.buckling_factors(k=2, method="sparse"), rtol=1e-12)
     np.testing.assert_allclose(free, with_mass.buckling_factors(k=2, method="dense"), rtol=1e-8)
-    with pytest.raises(spacar.SingularMassError):
-        spacar.linearize(guide(False)).M0
+    massless = spacar.linearize(guide(False))
+    assert not massless.M0.any()
+    np.testing.assert_allclose(massless.K0, with_mass.K0, rtol=0, atol=1e-9 * np.abs(with_mass.K0).max())
+    np.testing.assert_allclose(massless.G0, with_mass.G0, rtol=0, atol=1e-9 * np.abs(with_mass.G0).max())
+    np.testing.assert_allclose(free, massless.buckling_factors(k=2, method="dense"), rtol=1e-8)
+    for modes in (lambda: massless.eigenfrequencies(2), lambda: massless.eigenfrequencies(2, method="dense"),
+                  lambda: massless.state_matrix()):
+        with pytest.raises(spacar.SingularMassError, match="needs masses: no node or element"):
+            modes()
+    with pytest.raises(spacar.SingularMassError, match="call spacar.static"):  # away from its equilibrium
+        unloaded = spacar.read(EXAMPLES / "parallel_leaf_guide.dat")
+        spacar.linearize(unloaded)
 
 
 def test_state_space_poles_keep_their_digits():

@@ -288,6 +288,14 @@ void Linearizer::differenced_matrices(const System& sys, const ZState& zs, const
   lin.BK0 << dz.bottomRows(nk), dy.bottomRows(nk);
 }
 
+Linearization Linearizer::compute_at_rest(const System& sys, const Data& data) {
+  if (!reduced_) throw Error("linearize: no state at rest in static equilibrium was linearized (compute_nodal)");
+  Data at = data;
+  at.sigma = nodal_sigma_;  // the static equilibrium's
+  at.qhat_dd.setZero();     // at rest: compute_nodal refused moving inputs
+  return compute(sys, at, Differences::None);
+}
+
 Linearization Linearizer::compute(const System& sys, const Data& data, Differences differences) {
   const System& L = *lin_;
   const int nz = L.n_dof();

@@ -284,6 +284,14 @@ Linearization Simulation::linearize(Linearizer::Differences differences) {
 
 bool Simulation::linearize_nodal(NodalLinearization& out) { return linearizer().compute_nodal(*sys_, *data_, out); }
 
+Linearization Simulation::linearize_at_rest(double t, const Eigen::VectorXd& q) {
+  const Eigen::VectorXd at_rest = Eigen::VectorXd::Zero(sys_->n_dof());
+  require_dof_sizes("linearize_at_rest", q, at_rest);
+  solve_motion(t, q.data(), at_rest.data(), Start::Transfer);  // positions and rates only
+  have_transfer_ = false;
+  return linearizer().compute_at_rest(*sys_, *data_);
+}
+
 void Simulation::evaluate_state(double t, const Eigen::VectorXd& Y) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   if (Y.size() != 2 * nd + ny + run_.n_energy)

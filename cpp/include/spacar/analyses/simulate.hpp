@@ -232,6 +232,10 @@ class Simulation {
   // assemble() or evaluate() (Linearizer::compute_nodal); false if that state is not at rest in
   // static equilibrium. Then the saddle-point solves of the eigen-analyses (linearizer()).
   bool linearize_nodal(NodalLinearization& out);
+  // The dense reduced matrices at the state of linearize_nodal (at rest in static equilibrium,
+  // DOFs q at time t): the positions solved there again (the simulation may have moved since),
+  // no equations of motion (q̈ = 0, the static stresses), so a model without mass has them too.
+  Linearization linearize_at_rest(double t, const Eigen::VectorXd& q);
   Linearizer& linearizer();
   // Complete state at (t, Y), Y = (q, y, q̇): DOFs, integrated deformations, DOF rates.
   void evaluate_state(double t, const Eigen::VectorXd& Y);
