@@ -278,6 +278,18 @@ void bind_states(py::class_<Simulation>& sim) {
       .def("recursive_refusal", &Simulation::recursive_refusal,
            "Why the system takes the general path rather than the recursive one ('' if it is a rigid tree).")
       .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))
+      .def("kinematic_state", &Simulation::kinematic_state, py::arg("t"), py::arg("q"),
+           "The positions at (t, q), the rates zero, with DF and DFe: the kinematic analysis alone (no equations "
+           "of motion), predicted from the last solved state by its DF (spacar.transfer).")
+      .def(
+          "second_order_transfer",
+          [](Simulation& s) {
+            Eigen::MatrixXd d2f, d2fe;
+            s.second_order_transfer(d2f, d2fe);
+            return py::make_tuple(d2f, d2fe);
+          },
+          "(D2F, D2Fe) at the state of the last evaluate(): column i·n + j holds ∂²x/∂q̂_i∂q̂_j, ∂²e/∂q̂_i∂q̂_j "
+          "(q̂: the inputs and DOFs, DF's columns; spacar.transfer).")
       .def(
           "evaluate_state",
           [](Simulation& s, double t, const Eigen::VectorXd& Y) { s.evaluate_state(t, Y); },

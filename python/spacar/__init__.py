@@ -43,6 +43,7 @@ from .simulate import simulate
 from .statics import StaticError, static
 from .statespace import StateSpace, state_space
 from .sweep import SweepError, SweepResult, sweep
+from .transfer import Transfer, TransferPath, transfer, transfer_path
 from .urdf import from_urdf
 
 __version__ = "0.1.0"
@@ -129,6 +130,10 @@ __all__ = [
     "Linearization",
     "state_space",
     "StateSpace",
+    "transfer",
+    "transfer_path",
+    "Transfer",
+    "TransferPath",
     "summary",
     "check",
     "Check",

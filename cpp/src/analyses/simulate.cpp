@@ -214,6 +214,63 @@ void Simulation::evaluate(double t, const double* q, const double* qd) {
   have_transfer_ = true;
 }
 
+void Simulation::kinematic_state(double t, const Eigen::VectorXd& q) {
+  const Eigen::VectorXd at_rest = Eigen::VectorXd::Zero(sys_->n_dof());
+  require_dof_sizes("kinematic_state", q, at_rest);
+  solve_motion(t, q.data(), at_rest.data(), Start::Transfer);
+  solve_transfer(*sys_, *data_);
+  solve_velocities(*sys_, *data_);
+  remember(run_.base);
+  qhat_transfer_ = data_->qhat;
+  have_transfer_ = true;
+}
+
+void Simulation::second_order_transfer(Eigen::MatrixXd& d2f, Eigen::MatrixXd& d2fe) {
+  if (!have_transfer_) throw InputError("second_order_transfer: evaluate() or kinematic_state() a state first");
+  const System& sys = *sys_;
+  Data& d = *data_;
+  const int n = static_cast<int>(d.DF.cols());
+  require_memory(8.0 * (sys.nx + sys.ne) * double(n) * n, "the second-order transfer functions",
+                 "ask for them on a model with fewer inputs and degrees of freedom");
+  const Eigen::VectorXd rates = d.qhat_d, xdd = d.xdd, edd = d.edd;
+  // ẍ and ë at q̂̈ = 0 for the rates v: vᵀ D2F v, vᵀ D2Fe v.
+  Eigen::VectorXd ax(sys.nx), ae(sys.ne);
+  auto quadratic = [&](const Eigen::VectorXd& v) {
+    check_thread_deadline("(in the second-order transfer functions)");
+    d.qhat_d = v;
+    solve_velocities(sys, d);
+    d.xdd = d.acc0;
+    deformation_accelerations(sys, d);
+    ax = d.acc0;
+    ae = d.edd;
+  };
+  d2f.resize(sys.nx, n * n);
+  d2fe.resize(sys.ne, n * n);
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    v[i] = 1.0;
+    quadratic(v);
+    d2f.col(i * n + i) = ax;
+    d2fe.col(i * n + i) = ae;
+    v[i] = 0.0;
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      v[i] = v[j] = 1.0;
+      quadratic(v);
+      v[i] = v[j] = 0.0;
+      d2f.col(i * n + j) = 0.5 * (ax - d2f.col(i * n + i) - d2f.col(j * n + j));
+      d2fe.col(i * n + j) = 0.5 * (ae - d2fe.col(i * n + i) - d2fe.col(j * n + j));
+      d2f.col(j * n + i) = d2f.col(i * n + j);
+      d2fe.col(j * n + i) = d2fe.col(i * n + j);
+    }
+  }
+  d.qhat_d = rates;  // the state as it was
+  solve_velocities(sys, d);
+  d.xdd = xdd;
+  d.edd = edd;
+}
+
 void Simulation::move_to(double t, const double* q, const double* qd) {
   const System& sys = *sys_;
   const int nd = sys.n_dof();

@@ -219,6 +219,16 @@ class Simulation {
   // Complete state at (t, q, q̇): solve_state plus the transfer functions DF, DFe and the
   // reduced mass matrix M̄ (for users, tests and teaching).
   void evaluate(double t, const double* q, const double* qd);
+  // The positions at (t, q) with the first-order transfer functions DF, DFe, the rates zero: the
+  // kinematic analysis alone (no equations of motion: a mechanism without masses too), from the
+  // last solved state predicted by its DF as in move_to's steps.
+  void kinematic_state(double t, const Eigen::VectorXd& q);
+  // The second-order transfer functions at the state of the last evaluate() or kinematic_state(): column i·n + j of
+  // d2f (d2fe) is ∂²x/∂q̂_i∂q̂_j (∂²e/∂q̂_i∂q̂_j) over the n independent coordinates q̂ (the
+  // inputs and the DOFs: DF's columns). By polarization of the velocity-product accelerations
+  // ẍ(q̂̈ = 0) = q̂̇ᵀ D2F q̂̇, exact as they are quadratic in q̂̇: one velocity solve per pair.
+  // The state's rates are left as they were.
+  void second_order_transfer(Eigen::MatrixXd& d2f, Eigen::MatrixXd& d2fe);
   // Complete state at (t, q, q̇) reached from the last evaluated (or assembled) state along the
   // straight path in (t, q, q̇), in steps small enough that the first-order predictor keeps the
   // kinematic solution on its branch: one Newton solve from a distant state may converge to
