@@ -13,11 +13,13 @@ elements' own stresses: σ > 0 is tension).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import _core
 from ._util import show, time_limited
-from .errors import InputError
+from .errors import InputError, SingularMassError
 from .linearize import Linearization, _count, linearized_simulation, second_order_eigenvalues
 from .model import Model, Signal
 
@@ -156,7 +158,8 @@ class StateSpace:
                 f"{len(self.input_labels)} inputs, {len(self.output_labels)} outputs>")
 
 
-def state_space(source, at=None, inputs=None, outputs=None, *, modes=None, time_limit=None) -> StateSpace:
+def state_space(source, at=None, inputs=None, outputs=None, *, modes=None, damping=None, rayleigh=None,
+                time_limit=None) -> StateSpace:
     """The state-space model of ``source`` linearized about a state.
 
     ``source``: a :class:`spacar.Model`; a :class:`spacar.Linearization`; or a
@@ -181,10 +184,88 @@ def state_space(source, at=None, inputs=None, outputs=None, *, modes=None, time_
     feedthrough D, so that the static gain stays exact (the residual flexibility of the modal
     truncation). For models of thousands of degrees of freedom; damping from EDAMPP.
 
+    ``damping``: modal damping ratios ζ added to the element damping (EDAMPP), as SPACAR Light's
+    relative damping: one value for every mode, or a sequence for the lowest modes in order
+    (the others keep only the element damping). Mode i then gets the damping 2 ζ_i ω_i in its
+    modal coordinate: C += M Φ diag(2 ζ ω) Φᵀ M with the undamped modes Φᵀ M Φ = I of
+    (K0 + N0 + G0, M0). ``rayleigh=(α, β)``: C += α M0 + β (K0 + N0 + G0), a mode's ratio
+    α/(2ω) + βω/2. Both need masses; they add to each other and to EDAMPP.
+
     ``time_limit``: wall-clock seconds the whole construction may take (linearization, the
     differences of the velocities, the modes), as for :func:`spacar.linearize`."""
+    ratios = _damping_ratios(damping)
+    alpha, beta = _rayleigh(rayleigh)
     with time_limited(time_limit, "in state_space"):
-        return _state_space(source, at, inputs, outputs, modes)
+        ss = _state_space(source, at, inputs, outputs, modes)
+    if ratios is not None or alpha or beta:
+        ss = _add_damping(ss, ratios, alpha, beta)
+    return ss
+
+
+def _damping_ratios(damping):
+    """None, or the modal damping ratios as an array (a scalar: every mode)."""
+    if damping is None:
+        return None
+    try:
+        ratios = np.array(damping, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        ratios = None
+    if ratios is None or ratios.ndim > 1 or not np.isfinite(ratios).all() or (ratios < 0).any():
+        raise InputError(f"state_space: damping must be a modal damping ratio ζ ≥ 0 or a sequence of them (lowest "
+                         f"mode first), got {show(damping)}")
+    return ratios
+
+
+def _rayleigh(rayleigh):
+    if rayleigh is None:
+        return 0.0, 0.0
+    try:
+        alpha, beta = (float(v) for v in rayleigh)
+    except (TypeError, ValueError, OverflowError):
+        alpha = beta = math.nan
+    if not (math.isfinite(alpha) and math.isfinite(beta) and alpha >= 0 and beta >= 0):
+        raise InputError(f"state_space: rayleigh must be (α, β), two finite numbers ≥ 0, got {show(rayleigh)}")
+    return alpha, beta
+
+
+def _add_damping(ss: StateSpace, ratios, alpha: float, beta: float) -> StateSpace:
+    """ss with the modal and Rayleigh damping in its second-order equations M δz̈ + C δż + K δz = Q u
+    (the states [δz; δż] of the dense model, or the modal coordinates of modes=)."""
+    second_order = ss._second_order()
+    if second_order is None:
+        raise InputError("state_space: damping= and rayleigh= need the second-order equations M δz̈ + C δż + K δz: "
+                         "not a model with nonholonomic constraints")
+    M, C, K, Q = second_order
+    if not np.any(M):
+        raise SingularMassError("state_space: damping= and rayleigh= need masses: no node or element of the model "
+                                "carries mass")
+    n = M.shape[0]
+    extra = alpha * M + beta * K
+    if ratios is not None:
+        w2, phi = _mass_normalized_modes(M, K)
+        zeta = np.zeros(n)
+        if ratios.ndim == 0:
+            zeta[:] = ratios
+        else:
+            if len(ratios) > n:
+                raise InputError(f"state_space: damping gives {len(ratios)} modal ratios for {n} modes")
+            zeta[:len(ratios)] = ratios
+        Mphi = M @ phi
+        extra = extra + Mphi @ np.diag(2.0 * zeta * np.sqrt(np.abs(w2))) @ Mphi.T
+    C = C + extra
+    A = ss.A.copy()
+    A[n:, n:] = -np.linalg.solve(M, C)
+    return StateSpace(A, ss.B, ss.C, ss.D, ss.state_labels, ss.input_labels, ss.output_labels, ss.t,
+                      ss.linearization, (M, C, K, Q))
+
+
+def _mass_normalized_modes(M, K):
+    """(ω², Φ) of K φ = ω² M φ, sorted by |ω²|, with Φᵀ M Φ = I."""
+    import scipy.linalg
+
+    w2, phi = scipy.linalg.eigh(K, M)
+    order = np.argsort(np.abs(w2))
+    return w2[order], phi[:, order]
 
 
 def _state_space(source, at, inputs, outputs, modes) -> StateSpace:
