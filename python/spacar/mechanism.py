@@ -1,0 +1,311 @@
+"""Mechanism analysis in the vocabulary of a mechanisms course: the Grashof classification, limit
+(toggle) and dead positions and the transmission angle of four-bars, Freudenstein's three-point
+synthesis, and, for any single-input mechanism in a model, its limit positions along the input
+and the instant centres of its bodies (docs/mechanisms.md).
+
+    fb = spacar.mechanism.FourBar(a=0.1, b=0.35, c=0.3, d=0.4)   # crank, coupler, rocker, ground
+    fb.grashof()                       # Grashof(kind='crank-rocker', ...)
+    fb.limit_positions()               # crank angles where the rocker reverses
+    model = fb.model()                 # the spacar model, crank driven at 1 rad/s
+    spacar.mechanism.limit_positions(model, output=(9, 1))   # found along the input, refined
+    spacar.mechanism.instant_centres(model, [1, 2, 3])       # Aronhold–Kennedy, from the velocities
+
+The four-bar's ground pivots are A = (0, 0) and D = (d, 0); the crank AB turns by θ from the x
+axis, the rocker DC by ψ; Freudenstein's equation K1 cos ψ − K2 cos θ + K3 = cos(θ − ψ) with
+K1 = d/a, K2 = d/c, K3 = (a² − b² + c² + d²)/(2ac) ties them. The general helpers work on any
+model from its kinematic analysis (:func:`spacar.transfer`), no masses needed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._util import show
+from .errors import InputError
+from .model import Model
+
+__all__ = ["Grashof", "FourBar", "synthesize", "limit_positions", "instant_centres", "transmission_angle"]
+
+
+def _length(value, name) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        v = math.nan
+    if not (math.isfinite(v) and v > 0):
+        raise InputError(f"{name} must be a positive length, got {show(value)}")
+    return v
+
+
+@dataclass(frozen=True)
+class Grashof:
+    """The Grashof classification of a four-bar: ``kind`` is "crank-rocker" (the crank, the
+    shortest link next to the ground, turns fully), "double-crank" (the ground is the shortest:
+    a drag link), "double-rocker" (the coupler is the shortest), "change point" (s + l = p + q:
+    the links can fold into a line) or "triple-rocker" (s + l > p + q: no link turns fully);
+    ``grashof``: s + l ≤ p + q; ``s``, ``l``, ``p``, ``q``: the shortest, longest and other two
+    lengths."""
+
+    kind: str
+    grashof: bool
+    s: float
+    l: float
+    p: float
+    q: float
+
+
+class FourBar:
+    """A planar four-bar: crank ``a`` (A–B), coupler ``b`` (B–C), rocker ``c`` (D–C), ground ``d``
+    (A–D along x). ``branch`` +1: C on the left of the diagonal B→D (the open assembly for
+    θ = 0 when C is above the ground line), −1 the other (crossed) assembly."""
+
+    def __init__(self, a, b, c, d, branch: int = 1):
+        self.a, self.b, self.c, self.d = (_length(v, n) for v, n in ((a, "a"), (b, "b"), (c, "c"), (d, "d")))
+        if branch not in (1, -1):
+            raise InputError(f"branch must be 1 or -1, got {show(branch)}")
+        self.branch = branch
+
+    def __repr__(self):
+        return f"FourBar(a={self.a:g}, b={self.b:g}, c={self.c:g}, d={self.d:g}, branch={self.branch})"
+
+    def grashof(self) -> Grashof:
+        """The Grashof classification (:class:`Grashof`)."""
+        links = sorted([(self.a, "crank"), (self.b, "coupler"), (self.c, "rocker"), (self.d, "ground")])
+        s, p, q, l = (v for v, _ in links)
+        shortest = links[0][1]
+        excess = (s + l) - (p + q)
+        tol = 1e-12 * l
+        if abs(excess) <= tol:
+            kind = "change point"
+        elif excess > 0:
+            kind = "triple-rocker"
+        elif shortest == "ground":
+            kind = "double-crank"
+        elif shortest == "coupler":
+            kind = "double-rocker"
+        else:
+            kind = "crank-rocker"  # the shortest is the crank (or the rocker, which then is the crank)
+        return Grashof(kind, excess <= tol, s, l, p, q)
+
+    # --- the closed forms ------------------------------------------------------------------------
+
+    def points(self, theta):
+        """(B, C) for the crank angle θ (arrays of shape (2,) or (n, 2)); NaN where the loop cannot
+        close."""
+        theta = np.asarray(theta, dtype=float)
+        B = np.stack([self.a * np.cos(theta), self.a * np.sin(theta)], axis=-1)
+        u = np.array([self.d, 0.0]) - B
+        f = np.linalg.norm(u, axis=-1)
+        along = (self.b**2 - self.c**2 + f**2) / (2 * f)
+        with np.errstate(invalid="ignore"):
+            across = np.sqrt(self.b**2 - along**2)
+        normal = np.stack([-u[..., 1], u[..., 0]], axis=-1) / f[..., None]
+        C = B + (along / f)[..., None] * u + (self.branch * across)[..., None] * normal
+        return B, C
+
+    def rocker_angle(self, theta):
+        """ψ, the rocker's angle at D from the x axis, for the crank angle θ."""
+        _, C = self.points(theta)
+        return np.arctan2(C[..., 1], C[..., 0] - self.d)
+
+    def coupler_angle(self, theta):
+        B, C = self.points(theta)
+        return np.arctan2(C[..., 1] - B[..., 1], C[..., 0] - B[..., 0])
+
+    def transmission_angle(self, theta):
+        """μ, the angle between the coupler and the rocker at C (0 … π; best near π/2), from
+        cos μ = (b² + c² − BD²)/(2bc), BD² = a² + d² − 2ad cos θ."""
+        bd2 = self.a**2 + self.d**2 - 2 * self.a * self.d * np.cos(np.asarray(theta, dtype=float))
+        with np.errstate(invalid="ignore"):
+            return np.arccos((self.b**2 + self.c**2 - bd2) / (2 * self.b * self.c))
+
+    def limit_positions(self) -> list:
+        """The crank angles θ (in [−π, π)) at which the rocker reverses, the crank and the
+        coupler in line (extended, AC = a + b, and folded, AC = b − a), with the rocker angles ψ
+        there: [(θ, ψ), ...]; empty where the triangle ACD cannot close. With the rocker driving,
+        these are the dead-centre positions: it cannot turn the crank on."""
+        out = []
+        for length, sign in ((self.b + self.a, 1.0), (self.b - self.a, -1.0)):
+            if length <= 0:
+                continue
+            cos_at_a = (self.d**2 + length**2 - self.c**2) / (2 * self.d * length)
+            if abs(cos_at_a) > 1:
+                continue
+            phi = math.acos(cos_at_a) * self.branch  # direction of AC
+            theta = phi if sign > 0 else phi + math.pi
+            theta = (theta + math.pi) % (2 * math.pi) - math.pi
+            out.append((theta, float(self.rocker_angle(theta))))
+        return out
+
+    def toggle_positions(self) -> list:
+        """The crank angles θ at which the coupler and the rocker are in line (transmission angle
+        0 or π): the crank, driving, cannot move the rocker on, and its range of motion ends
+        there (a linkage whose crank does not turn fully). [θ, ...], both signs."""
+        out = []
+        for bd in (self.b + self.c, abs(self.b - self.c)):
+            cos_theta = (self.a**2 + self.d**2 - bd**2) / (2 * self.a * self.d)
+            if abs(cos_theta) <= 1:
+                out.extend([math.acos(cos_theta), -math.acos(cos_theta)])
+        return out
+
+    def freudenstein(self, theta, psi):
+        """F(θ, ψ) = K1 cos ψ − K2 cos θ + K3 − cos(θ − ψ), zero on the mechanism's positions."""
+        K1, K2, K3 = self.d / self.a, self.d / self.c, (self.a**2 - self.b**2 + self.c**2 + self.d**2) / (2 * self.a * self.c)
+        return K1 * np.cos(psi) - K2 * np.cos(theta) + K3 - np.cos(np.asarray(theta) - psi)
+
+    def model(self, theta0: float = 0.0, rate: float = 1.0, steps: int = 360, coupler_point=None) -> Model:
+        """The spacar model: PLBEAM 1 the crank (nodes 1 A, 3 B; its BETA node 2 the input, turning
+        at ``rate`` from θ0), PLBEAM 2 the coupler (3 → 6 C), PLBEAM 3 the rocker (8 D → 6, BETA node 9
+        at D: ψ − ψ0); ``coupler_point`` (u, v) in the coupler's frame (along B→C, across) adds node
+        11 rigidly on the coupler (PLBEAM 4). One crank revolution in ``steps`` output times."""
+        B, C = self.points(theta0)
+        if not np.isfinite(C).all():
+            raise InputError(f"{self}: the loop cannot close at θ0 = {theta0:g}")
+        m = Model()
+        m.plbeam(1, 1, 2, 3, 4)
+        m.plbeam(2, 3, 5, 6, 7)
+        m.plbeam(3, 8, 9, 6, 10)
+        m.x(3, *B)
+        m.x(6, *C)
+        m.x(8, self.d, 0.0)
+        if coupler_point is not None:
+            u, v = (float(w) for w in coupler_point)
+            along = (C - B) / self.b
+            m.plbeam(4, 3, 5, 11, 12)
+            m.x(11, *(B + u * along + v * np.array([-along[1], along[0]])))
+        m.fix(1)
+        m.fix(8)
+        m.apply("INPUTX", 2, 1)
+        m.xd(2, 1, float(rate))
+        m.epskin(1e-12)
+        m.timestep(int(steps), 2 * math.pi / abs(rate) if rate else 1.0)
+        return m
+
+
+def synthesize(pairs, d: float = 1.0) -> FourBar:
+    """Function generation by Freudenstein's three-point method: the four-bar with ground ``d``
+    whose crank and rocker angles pass the three precision points ``pairs`` = [(θ1, ψ1), (θ2, ψ2),
+    (θ3, ψ3)] (rad), from K1 cos ψ_i − K2 cos θ_i + K3 = cos(θ_i − ψ_i), i = 1, 2, 3:
+    a = d/K1, c = d/K2, b² = a² + c² + d² − 2 a c K3, assembled on the branch that takes the first
+    point. InputError if the points give no real linkage (a negative length, or a singular
+    system)."""
+    try:
+        pts = np.array(pairs, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        pts = np.zeros((0,))
+    if pts.shape != (3, 2) or not np.isfinite(pts).all():
+        raise InputError(f"synthesize: three (θ, ψ) pairs of finite angles, got {show(pairs)}")
+    d = _length(d, "d")
+    theta, psi = pts[:, 0], pts[:, 1]
+    A = np.stack([np.cos(psi), -np.cos(theta), np.ones(3)], axis=1)
+    if abs(np.linalg.det(A)) < 1e-12:
+        raise InputError("synthesize: the three precision points do not determine a four-bar (singular system)")
+    K1, K2, K3 = np.linalg.solve(A, np.cos(theta - psi))
+    a, c = d / K1, d / K2
+    b2 = a**2 + c**2 + d**2 - 2 * a * c * K3
+    if not (a > 0 and c > 0 and b2 > 0):
+        raise InputError(f"synthesize: these precision points give no real four-bar (a = {a:.4g}, c = {c:.4g}, "
+                         f"b² = {b2:.4g})")
+    # The assembly (branch) on which the rocker takes the first precision point's angle.
+    candidates = [FourBar(a, math.sqrt(b2), c, d, branch) for branch in (1, -1)]
+    miss = [abs(math.remainder(float(fb.rocker_angle(theta[0])) - psi[0], 2 * math.pi)) for fb in candidates]
+    return candidates[int(np.nanargmin(miss))]
+
+
+# --- any single-input mechanism in a model ---------------------------------------------------------
+
+def _single_input(tf) -> tuple:
+    inputs = [label for label, is_input in zip(tf.q_labels, tf.is_input) if is_input]
+    if len(inputs) != 1 or len(tf.q_labels) != 1:
+        raise InputError(f"a single-input mechanism (one input, no degrees of freedom) is needed; q̂ is {tf.q_labels}")
+    return inputs[0]
+
+
+def limit_positions(model, output, steps: int = 360, *, t_end=None, tol: float = 1e-10) -> list:
+    """The limit positions of a single-input mechanism along its input's motion (the current
+    block, or to ``t_end``): where the output (node, component) or ("e", element, deformation)
+    reverses, its velocity ratio changing sign between the ``steps`` samples of
+    :func:`spacar.transfer_path`, each refined by the bisection of the velocity ratio to ``tol``
+    in the input. Returns [(t, input value, output value), ...]."""
+    from scipy.optimize import brentq
+
+    from .transfer import transfer, transfer_path
+
+    path = transfer_path(model, steps, t_end=t_end)
+    wrt = _single_input(path.at(0))
+    ratio = path.ratio(output, wrt)
+    q0 = np.zeros(0)
+    found = []
+    column = path.at(0).column(wrt)
+    rate = (path.q[-1, column] - path.q[0, column]) / (path.t[-1] - path.t[0]) if len(path.t) > 1 else 1.0
+    for k in np.nonzero(np.sign(ratio[:-1]) * np.sign(ratio[1:]) < 0)[0]:
+        t = brentq(lambda s: transfer(model, at=(s, q0)).ratio(output, wrt), path.t[k], path.t[k + 1],
+                   xtol=tol / max(abs(rate), 1e-300), rtol=4 * np.finfo(float).eps)
+        tf = transfer(model, at=(t, q0))
+        first, _, row = tf._row(output)
+        found.append((float(t), float(tf.q[column]), float((tf.x if first is tf.DF else tf.e)[row])))
+    return found
+
+
+def instant_centres(model, bodies, at=None) -> dict:
+    """The instant centres (Aronhold–Kennedy) of pairs of the planar ``bodies`` (element numbers
+    of rigid PLBEAMs, 0 for the ground) of a single-input or single-DOF mechanism at its current
+    configuration (``at``: as for :func:`spacar.transfer`): {(i, j): (x, y)} for i < j, the point
+    where the two bodies have the same velocity; (inf, inf) for a pair that translates relative to
+    each other. From the velocities of a unit input rate, ẋ = DF."""
+    from .transfer import transfer
+
+    tf = transfer(model, at=at)
+    if len(tf.q_labels) != 1:
+        raise InputError(f"instant_centres: a mechanism with one input or degree of freedom; q̂ is {tf.q_labels}")
+    rows = {label: i for i, label in enumerate(tf.coordinate_labels)}
+    elements = model.elements
+    motion = {0: (np.zeros(2), np.zeros(2), 0.0)}  # body: (a point, its velocity, ω)
+    for e in bodies:
+        if e == 0:
+            continue
+        if e not in elements or elements[e].type_name not in ("PLBEAM", "PLBEAMNL"):
+            raise InputError(f"instant_centres: body {show(e)} must be 0 (the ground) or a PLBEAM of the model")
+        p, o = elements[e].nodes[0], elements[e].nodes[1]
+        point = np.array([tf.x[rows[(p, 1)]], tf.x[rows[(p, 2)]]])
+        velocity = np.array([tf.DF[rows[(p, 1)], 0], tf.DF[rows[(p, 2)], 0]])
+        motion[e] = (point, velocity, float(tf.DF[rows[(o, 1)], 0]))
+    J = np.array([[0.0, -1.0], [1.0, 0.0]])  # k ×
+    out = {}
+    ids = sorted(set(bodies))
+    for n, i in enumerate(ids):
+        for j in ids[n + 1:]:
+            (pi, vi, wi), (pj, vj, wj) = motion[i], motion[j]
+            scale = max(abs(wi), abs(wj), 1e-300)
+            if abs(wi - wj) <= 1e-12 * scale:
+                out[(i, j)] = (math.inf, math.inf)
+                continue
+            rhs = vj - wj * (J @ pj) - vi + wi * (J @ pi)
+            P = -J @ rhs / (wi - wj)
+            out[(i, j)] = (float(P[0]), float(P[1]))
+    return out
+
+
+def transmission_angle(path_or_transfer, coupler: int, follower: int, model=None):
+    """The angle μ (0 … π) between two elements (the coupler and the follower of a four-bar or a
+    slider-crank's rod and guide direction), from their end nodes' positions in a
+    :class:`spacar.Transfer` or along a :class:`spacar.TransferPath`; ``model`` gives the
+    elements' nodes (a Transfer does not keep them)."""
+    if model is None:
+        raise InputError("transmission_angle: pass model= (the elements' nodes)")
+    rows = {label: i for i, label in enumerate(path_or_transfer.coordinate_labels)}
+    x = np.atleast_2d(path_or_transfer.x)
+
+    def direction(e):
+        if e not in model.elements:
+            raise InputError(f"transmission_angle: element {show(e)} is not defined")
+        nodes = model.elements[e].nodes
+        p1, p2 = nodes[0], nodes[2]
+        return np.stack([x[:, rows[(p2, 1)]] - x[:, rows[(p1, 1)]], x[:, rows[(p2, 2)]] - x[:, rows[(p1, 2)]]], axis=1)
+
+    u, v = direction(coupler), direction(follower)
+    cos = np.einsum("ij,ij->i", u, v) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+    mu = np.arccos(np.clip(cos, -1.0, 1.0))
+    return mu if np.ndim(path_or_transfer.x) > 1 else float(mu[0])

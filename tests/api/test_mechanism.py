@@ -1,0 +1,127 @@
+"""spacar.mechanism (issue 41): the vocabulary of a mechanisms course, each helper against its
+closed form: the Grashof classes, the limit and toggle positions and the transmission angle of
+four-bars (examples/fourbar_coupler.dat among them) found along the input by the kinematic
+analysis, the instant centres of a slider-crank against the Aronhold–Kennedy construction, and a
+four-bar synthesized by Freudenstein's three-point method passing its precision points."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import spacar
+from spacar.mechanism import FourBar, instant_centres, limit_positions, synthesize, transmission_angle
+from support.paths import EXAMPLES
+
+
+@pytest.mark.parametrize("lengths, kind", [
+    ((0.1, 0.35, 0.30, 0.40), "crank-rocker"),
+    ((0.35, 0.30, 0.40, 0.1), "double-crank"),      # the ground the shortest: a drag link
+    ((0.35, 0.1, 0.30, 0.40), "double-rocker"),     # the coupler the shortest
+    ((0.3, 0.35, 0.30, 0.40), "triple-rocker"),     # s + l > p + q
+    ((0.2, 0.4, 0.3, 0.3), "change point"),         # s + l = p + q
+])
+def test_grashof_classes(lengths, kind):
+    g = FourBar(*lengths).grashof()
+    assert g.kind == kind and g.grashof == (kind != "triple-rocker")
+    assert (g.s, g.l) == (min(lengths), max(lengths))
+
+
+def coupler_example():
+    """examples/fourbar_coupler.dat: A (0, 0), B (0, 1), C (3, 3), D (4, 0); the crank starts at 90°."""
+    return spacar.read(EXAMPLES / "fourbar_coupler.dat"), FourBar(1.0, math.sqrt(13.0), math.sqrt(10.0), 4.0)
+
+
+def test_the_example_four_bar_s_limit_positions_are_the_closed_form():
+    model, fb = coupler_example()
+    assert fb.grashof().kind == "crank-rocker"
+    B, C = fb.points(math.pi / 2)
+    np.testing.assert_allclose(C, [3.0, 3.0], atol=1e-14)  # the assembly of the example
+    found = limit_positions(model, (9, 1), steps=36)        # the rocker's rotation (BETA 9 at D)
+    expected = sorted(fb.limit_positions(), key=lambda p: (p[0] - math.pi / 2) % (2 * math.pi))
+    assert len(found) == 2
+    psi0 = float(fb.rocker_angle(math.pi / 2))
+    for (t, crank, rocker), (theta, psi) in zip(found, expected):
+        assert math.remainder(math.pi / 2 + crank - theta, 2 * math.pi) == pytest.approx(0.0, abs=1e-10)
+        assert math.remainder(psi0 + rocker - psi, 2 * math.pi) == pytest.approx(0.0, abs=1e-10)
+        assert fb.freudenstein(theta, psi) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_transmission_angle_along_a_turn_is_the_closed_form():
+    fb = FourBar(0.10, 0.35, 0.30, 0.40)
+    model = fb.model(steps=72)
+    path = spacar.transfer_path(model, steps=72)
+    mu = transmission_angle(path, 2, 3, model=model)        # coupler B→C, rocker D→C
+    np.testing.assert_allclose(mu, fb.transmission_angle(path.q[:, 0]), rtol=0, atol=1e-12)
+    psi = fb.rocker_angle(path.q[:, 0])
+    np.testing.assert_allclose(fb.freudenstein(path.q[:, 0], psi), 0.0, atol=1e-12)
+    with pytest.raises(spacar.InputError, match="pass model="):
+        transmission_angle(path, 2, 3)
+
+
+def test_a_non_grashof_linkage_s_toggle_positions_end_its_crank_s_range():
+    """A triple-rocker: its crank cannot turn fully; at the toggle positions the coupler and the
+    rocker are in line (transmission angle 0 or π) and the loop closes there and nowhere beyond."""
+    fb = FourBar(0.3, 0.35, 0.30, 0.40)
+    assert fb.grashof().kind == "triple-rocker"
+    toggles = fb.toggle_positions()
+    assert len(toggles) >= 2
+    for theta in toggles:
+        mu = fb.transmission_angle(theta)
+        assert min(mu, math.pi - mu) == pytest.approx(0.0, abs=1e-7)  # arccos near ±1: √ε
+        B, C = fb.points(theta)
+        u, v = C - B, C - np.array([fb.d, 0.0])
+        cross = u[0] * v[1] - u[1] * v[0]
+        assert cross == pytest.approx(0.0, abs=1e-7)
+        beyond = theta + 1e-3 * np.sign(theta)
+        assert not np.isfinite(fb.points(beyond)[1]).all()  # past the toggle the loop cannot close
+
+
+def rigid_slider_crank():
+    m = spacar.Model()
+    m.plbeam(1, 1, 11, 2, 12)        # crank A → B
+    m.plbeam(2, 2, 21, 3, 22)        # rod B → C, C sliding along x
+    m.x(1, 0.0, 0.0)
+    m.x(2, 0.15 * math.cos(0.7), 0.15 * math.sin(0.7))
+    m.x(3, 0.15 * math.cos(0.7) + math.sqrt(0.3**2 - (0.15 * math.sin(0.7)) ** 2), 0.0)
+    m.fix(1)
+    m.fix(3, 2)
+    m.apply("INPUTX", 11, 1)
+    m.xd(11, 1, 1.0)
+    m.timestep(10, 1.0)
+    return m
+
+
+def test_slider_crank_instant_centres_are_kennedy_s_construction():
+    """Crank 1 about A, rod 2; the ground 0. I01 = A, I12 = B, I02 on the line A–B extended and on
+    the perpendicular to the slide through C (the slider translates along x)."""
+    model = rigid_slider_crank()
+    ic = instant_centres(model, [0, 1, 2])
+    A, B = np.zeros(2), 0.15 * np.array([math.cos(0.7), math.sin(0.7)])
+    xc = B[0] + math.sqrt(0.3**2 - B[1] ** 2)
+    np.testing.assert_allclose(ic[(0, 1)], A, atol=1e-14)
+    np.testing.assert_allclose(ic[(1, 2)], B, atol=1e-14)
+    np.testing.assert_allclose(ic[(0, 2)], [xc, xc * B[1] / B[0]], rtol=1e-12)
+    with pytest.raises(spacar.InputError, match="must be 0 .the ground. or a PLBEAM"):
+        instant_centres(model, [0, 7])
+
+
+def test_three_point_synthesis_passes_its_precision_points():
+    """Freudenstein's three-point function generation: the synthesized four-bar's rocker takes the
+    prescribed angles at the three crank angles, by its closed form and by spacar's kinematic
+    analysis of its model (the crank driven from the first point), to 1e-10."""
+    pairs = [(math.radians(40), math.radians(70)), (math.radians(60), math.radians(85)),
+             (math.radians(80), math.radians(95))]
+    fb = synthesize(pairs, d=1.0)
+    for theta, psi in pairs:
+        assert fb.freudenstein(theta, psi) == pytest.approx(0.0, abs=1e-12)
+        assert math.remainder(float(fb.rocker_angle(theta)) - psi, 2 * math.pi) == pytest.approx(0.0, abs=1e-10)
+    model = fb.model(theta0=pairs[0][0])
+    psi0 = float(fb.rocker_angle(pairs[0][0]))
+    for theta, psi in pairs[1:]:
+        tf = spacar.transfer(model, at=(theta - pairs[0][0], []))  # the crank turns at 1 rad/s
+        rocker = tf.x[tf.coordinate_labels.index((9, 1))]
+        assert math.remainder(psi0 + rocker - psi, 2 * math.pi) == pytest.approx(0.0, abs=1e-10)
+    with pytest.raises(spacar.InputError, match="three .θ, ψ. pairs"):
+        synthesize([(0.1, 0.2)])
