@@ -181,3 +181,14 @@ LOOKUP: dict[str, Keyword] = {}
 for _k in KEYWORDS.values():
     for _name in (_k.name, *_k.aliases):
         LOOKUP[_name[:8]] = _k
+
+
+def did_you_mean(word) -> str:
+    """" (did you mean TIMESTEP?)" for a misspelt keyword (the closest names of the catalogue),
+    or ""."""
+    import difflib
+
+    if not isinstance(word, str):
+        return ""
+    close = difflib.get_close_matches(word.upper(), list(KEYWORDS), n=3, cutoff=0.6)
+    return f" (did you mean {' or '.join(close)}?)" if close else ""

@@ -14,7 +14,7 @@ import numpy as np
 from . import _core
 from ._util import show
 from .errors import InputError
-from .keywords import INT, KEYWORDS, Keyword
+from .keywords import INT, KEYWORDS, Keyword, did_you_mean
 
 _INT_LIMIT = 2**31 - 1
 
@@ -118,7 +118,7 @@ class Model:
         first END (e.g. an element of zero length)."""
         kw = KEYWORDS.get(keyword.upper()) if isinstance(keyword, str) else None
         if kw is None or kw.name in ("END", "EOF"):
-            raise InputError(f"unknown keyword {show(keyword)}")
+            raise InputError(f"unknown keyword {show(keyword)}{did_you_mean(keyword)}")
         self._origin = origin
         try:
             return getattr(self, kw.builder)(*args)

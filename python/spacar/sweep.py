@@ -37,7 +37,7 @@ from . import _core, progress as bars  # named so: sweep()'s argument is `progre
 from .results import _ARRAYS
 from ._util import seconds_or_none, show, time_limited
 from .errors import InputError, SpacarError
-from .keywords import INT, LOOKUP, SETTINGS, Keyword
+from .keywords import INT, LOOKUP, SETTINGS, Keyword, did_you_mean
 from .model import Model, check_args
 
 __all__ = ["sweep", "SweepResult", "SweepError"]
@@ -94,7 +94,7 @@ def _parse_line_key(key: str) -> _Line:
         raise InputError(f"sweep parameter {show(key)}: empty")
     kw = LOOKUP.get(words[0].upper()[:8])
     if kw is None:
-        raise InputError(f"sweep parameter {show(key)}: unknown keyword {show(words[0])}")
+        raise InputError(f"sweep parameter {show(key)}: unknown keyword {show(words[0])}{did_you_mean(words[0])}")
     if kw.group not in _SWEEPABLE_GROUPS:
         raise InputError(f"sweep parameter {show(key)}: {kw.name} lines define the model's structure and cannot "
                          "be replaced by value; use a factory function (sweep(make_model, ...))")

@@ -40,18 +40,10 @@ def _q_labels(system) -> tuple:
 
 
 @dataclass
-class Transfer:
-    """The transfer functions at one configuration (:func:`transfer`).
+class _Arrays:
+    """The fields of Transfer and TransferPath (of one configuration, or stacked over a path)."""
 
-    ``DF`` (nx × n), ``DFe`` (ne × n): ∂x/∂q̂ and ∂e/∂q̂; ``D2F`` (nx × n × n), ``D2Fe``
-    (ne × n × n): the second derivatives, symmetric in their last two indices. q̂: the inputs
-    (INPUTX, INPUTE) and then the degrees of freedom, labelled by ``q_labels`` ("x", node,
-    component) or ("e", element, deformation), ``is_input`` telling which; ``q`` their values.
-    ``x``, ``e``: the coordinates and deformations there, rows labelled by
-    ``coordinate_labels`` (node, component) and ``deformation_labels`` (element, deformation),
-    as in :class:`spacar.Results`."""
-
-    t: float
+    t: float | np.ndarray
     q: np.ndarray
     q_labels: list
     is_input: list
@@ -63,6 +55,19 @@ class Transfer:
     D2Fe: np.ndarray
     coordinate_labels: list
     deformation_labels: list
+
+
+@dataclass
+class Transfer(_Arrays):
+    """The transfer functions at one configuration (:func:`transfer`).
+
+    ``DF`` (nx × n), ``DFe`` (ne × n): ∂x/∂q̂ and ∂e/∂q̂; ``D2F`` (nx × n × n), ``D2Fe``
+    (ne × n × n): the second derivatives, symmetric in their last two indices. q̂: the inputs
+    (INPUTX, INPUTE) and then the degrees of freedom, labelled by ``q_labels`` ("x", node,
+    component) or ("e", element, deformation), ``is_input`` telling which; ``q`` their values.
+    ``x``, ``e``: the coordinates and deformations there, rows labelled by
+    ``coordinate_labels`` (node, component) and ``deformation_labels`` (element, deformation),
+    as in :class:`spacar.Results`."""
 
     def column(self, label) -> int:
         """The index in q̂ of ("x", node, component) or ("e", element, deformation)."""
@@ -163,24 +168,11 @@ def _time_step(model) -> float:
 
 
 @dataclass
-class TransferPath:
+class TransferPath(_Arrays):
     """The transfer functions along a path (:func:`transfer_path`): ``t`` (m,), and per time the
     arrays of :class:`Transfer` stacked: ``q`` (m, n), ``x`` (m, nx), ``e`` (m, ne), ``DF`` (m, nx,
     n), ``DFe``, ``D2F`` (m, nx, n, n), ``D2Fe``; labels as in Transfer. ``at(k)`` is the
     Transfer of time k."""
-
-    t: np.ndarray
-    q: np.ndarray
-    x: np.ndarray
-    e: np.ndarray
-    DF: np.ndarray
-    DFe: np.ndarray
-    D2F: np.ndarray
-    D2Fe: np.ndarray
-    q_labels: list
-    is_input: list
-    coordinate_labels: list
-    deformation_labels: list
 
     def at(self, k: int) -> Transfer:
         return Transfer(float(self.t[k]), self.q[k], self.q_labels, self.is_input, self.x[k], self.e[k], self.DF[k],

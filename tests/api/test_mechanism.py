@@ -125,3 +125,21 @@ def test_three_point_synthesis_passes_its_precision_points():
         assert math.remainder(psi0 + rocker - psi, 2 * math.pi) == pytest.approx(0.0, abs=1e-10)
     with pytest.raises(spacar.InputError, match="three .θ, ψ. pairs"):
         synthesize([(0.1, 0.2)])
+
+
+# --- errors that point at the cause (issue 41) ---------------------------------------------------
+
+@pytest.mark.parametrize("line, suggestion", [("TIMSTEP 100 5.0", "TIMESTEP"), ("ESTIF 2 1 2", "ESTIFF"),
+                                              ("EPSINTT 1e-6", "EPSINT")])
+def test_a_misspelt_keyword_gets_a_suggestion(line, suggestion):
+    text = (EXAMPLES / "slidercrank.dat").read_text().replace("Timestep 100 5.0", line)
+    with pytest.raises(spacar.InputError, match=rf"unknown keyword .*\(did you mean {suggestion}\b"):
+        spacar.read_string(text)
+
+
+def test_a_model_without_mass_is_pointed_to_the_static_analysis():
+    model = spacar.read(EXAMPLES / "parallel_leaf_guide.dat")
+    model.timestep(10, 1.0)
+    with pytest.raises(spacar.SingularMassError, match="no node or element of the model carries mass: for its "
+                                                       "stiffness alone.* spacar static or spacar.static"):
+        spacar.simulate(model)

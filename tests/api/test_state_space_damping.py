@@ -8,27 +8,15 @@ import numpy as np
 import pytest
 
 import spacar
-from support.planar_models import tip_loaded_beam
+from support.planar_models import spring_mass, tip_loaded_beam
 
 K, MASS = 400.0, 4.0
 OMEGA = np.sqrt(K / MASS)  # 10 rad/s
 
 
 def oscillator(mass=MASS):
-    """A mass on a spring: PLTRUSS 1 (released, EA/L = K) to node 2, which moves along x only."""
-    m = spacar.Model()
-    m.pltruss(1, 1, 2)
-    m.x(2, 1.0, 0.0)
-    m.fix(1)
-    m.fix(2, 2)
-    m.dynx(2, 1)
-    m.rlse(1)
-    m.estiff(1, K)
-    if mass:
-        m.mass(2, mass)
-    m.inputf(1, 2, 1)
-    m.outx(1, 2, 1)
-    return m
+    """A mass on a spring (PLTRUSS 1, released, EA/L = K), without element damping."""
+    return spring_mass(mass=mass, k=K, c=0.0)
 
 
 def pole(zeta):

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import spacar
+from support.planar_models import spring_mass as oscillator
 
 BETA = [1.8751040687119611, 4.6940911329741745, 7.8547574382376126]  # cos β cosh β = −1
 
@@ -29,28 +30,6 @@ def cantilever(n, L=1.2, EI=2.0, rhoA=3.0):
     m.inputf(1, tip, 2)
     m.outx(1, tip, 2)
     m.outxp(2, tip, 2)
-    return m
-
-
-def oscillator(mass=2.0, k=50.0, c=0.7):
-    """A mass on a PLTRUSS spring-damper of unit length along x: x of node 2 the DOF."""
-    m = spacar.Model()
-    m.pltruss(1, 1, 2)
-    m.x(1, 0.0, 0.0)
-    m.x(2, 1.0, 0.0)
-    m.fix(1)
-    m.fix(2, 2)
-    m.dynx(2, 1)
-    m.rlse(1)
-    m.estiff(1, k)
-    m.edampp(1, c)
-    m.mass(2, mass)
-    m.inputf(1, 2, 1)
-    m.inputs(2, 1, 1)
-    m.outx(1, 2, 1)
-    m.outxp(2, 2, 1)
-    m.oute(3, 1, 1)
-    m.outep(4, 1, 1)
     return m
 
 

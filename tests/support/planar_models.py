@@ -39,3 +39,25 @@ def tip_loaded_beam(n, L=1.2, EI=2.0, rhoA=3.0, EA=1e4):
     m.outx(1, tip, 2)
     m.outxp(2, tip, 2)
     return m
+
+
+def spring_mass(mass=2.0, k=50.0, c=0.7):
+    """A mass on a PLTRUSS spring-damper of unit length along x: x of node 2 the DOF."""
+    m = spacar.Model()
+    m.pltruss(1, 1, 2)
+    m.x(1, 0.0, 0.0)
+    m.x(2, 1.0, 0.0)
+    m.fix(1)
+    m.fix(2, 2)
+    m.dynx(2, 1)
+    m.rlse(1)
+    m.estiff(1, k)
+    m.edampp(1, c)
+    m.mass(2, mass)
+    m.inputf(1, 2, 1)
+    m.inputs(2, 1, 1)
+    m.outx(1, 2, 1)
+    m.outxp(2, 2, 1)
+    m.oute(3, 1, 1)
+    m.outep(4, 1, 1)
+    return m

@@ -190,6 +190,25 @@ std::string weakest_constraint(const System& sys, Data& data) {
   return os.str();
 }
 
+namespace {
+// Naming the degrees of freedom without inertia takes dense matrices and an eigen-solver (cubic
+// in their number): beyond this, the cause is said without the names.
+bool too_large_to_name(const System& sys) {
+  return sys.n_dof() > kMaxDiagnosisSize || Data::estimate_dense_bytes(sys) > static_cast<double>(memory_limit());
+}
+
+bool carries_mass(const System& sys) {
+  return std::any_of(sys.elements.begin(), sys.elements.end(), [](const SystemElement& se) { return se.has_mass; }) ||
+         (sys.point_mass.array() != 0.0).any() || !sys.bodies.empty();
+}
+
+void say_no_mass(std::ostream& os, const System& sys) {
+  os << "no element or node carries mass (no EMASS, MASS or body inertia in the model): all its " << sys.n_dof()
+     << " degrees of freedom (DYNX, DYNE) move no mass; add MASS or EMASS to the nodes or elements they move, "
+        "or make them kinematic (INPUTX/INPUTE) for a kinematic analysis";
+}
+}  // namespace
+
 [[noreturn]] void throw_singular_mass(const System& sys, const Data& data, const Eigen::MatrixXd& Mbar) {
   const int nd = sys.n_dof();
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Mbar);
@@ -219,27 +238,13 @@ std::string weakest_constraint(const System& sys, Data& data) {
   }
   if (total > 8) os << " and " << total - 8 << " more";
   os << " move no mass; add MASS or EMASS to the nodes or elements they move";
+  // A structure modelled for its stiffness alone (a flexure): its question is a static one.
+  if (!carries_mass(sys))
+    os << " (no node or element of the model carries mass: for its stiffness alone, its static equilibrium, "
+          "compliance and buckling, use the static analysis, spacar static or spacar.static, which needs none)";
   throw SingularMassError(os.str());
 }
 
-namespace {
-// Naming the degrees of freedom without inertia takes dense matrices and an eigen-solver (cubic
-// in their number): beyond this, the cause is said without the names.
-bool too_large_to_name(const System& sys) {
-  return sys.n_dof() > kMaxDiagnosisSize || Data::estimate_dense_bytes(sys) > static_cast<double>(memory_limit());
-}
-
-bool carries_mass(const System& sys) {
-  return std::any_of(sys.elements.begin(), sys.elements.end(), [](const SystemElement& se) { return se.has_mass; }) ||
-         (sys.point_mass.array() != 0.0).any() || !sys.bodies.empty();
-}
-
-void say_no_mass(std::ostream& os, const System& sys) {
-  os << "no element or node carries mass (no EMASS, MASS or body inertia in the model): all its " << sys.n_dof()
-     << " degrees of freedom (DYNX, DYNE) move no mass; add MASS or EMASS to the nodes or elements they move, "
-        "or make them kinematic (INPUTX/INPUTE) for a kinematic analysis";
-}
-}  // namespace
 
 void refuse_large_massless(const System& sys, double t) {
   if (sys.n_dof() == 0 || carries_mass(sys) || !too_large_to_name(sys)) return;

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 from .._util import show
 from ..errors import InputError, SpacarError
-from ..keywords import INT, LOOKUP, Keyword
+from ..keywords import INT, LOOKUP, Keyword, did_you_mean
 from ..model import Model, check_args
 
 _INT_RE = re.compile(r"^[+-]?\d+$", re.ASCII)
@@ -140,7 +140,7 @@ def _parse_lines(lines, file: str) -> list[Block]:
                          f"a line must start with a keyword (a letter first), not {show(head)}")
         kw = LOOKUP.get(head.upper()[:8])
         if kw is None:
-            raise _error(file, lineno, _keyword_echo(head), f"unknown keyword {show(head)}")
+            raise _error(file, lineno, _keyword_echo(head), f"unknown keyword {show(head)}{did_you_mean(head)}")
         try:
             values = _parse_line(kw, tokens[1:])
             check_args(kw, values)
