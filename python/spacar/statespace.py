@@ -153,9 +153,88 @@ class StateSpace:
         return control.ss(self.A, self.B, self.C, self.D, states=self.state_labels,
                           inputs=self.input_labels, outputs=self.output_labels)
 
+    def reduce(self, k: int, method: str = "modal") -> "StateSpace":
+        """A model of ``k`` states (modal: ``k`` modes, 2k states) approximating this one.
+
+        ``method="modal"``: the ``k`` lowest undamped modes of the second-order equations (no
+        kinematic coordinates), their damping projected (Φᵀ C Φ), and the static response of the
+        modes left out as the feedthrough, C_x (K⁻¹ − Φ Ω⁻² Φᵀ) Q: the static gain stays exact
+        (as ``state_space(modes=k)`` on the nodal matrices, here from the dense model).
+
+        ``method="balanced"``: balanced truncation (square-root method) to ``k`` states, for a
+        stable model (every pole in the left half-plane: damping from EDAMPP, ``damping=`` or
+        ``rayleigh=``); ``hankel_singular_values`` holds all of them and ``error_bound`` the
+        H∞ bound 2 Σ_{i>k} σ_i of the error of the reduced model."""
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k:
+            raise InputError(f"reduce: k must be a positive whole number, got {show(k)}")
+        if method == "modal":
+            return _modal_reduction(self, int(k))
+        if method == "balanced":
+            return _balanced_reduction(self, int(k))
+        raise InputError(f"reduce: method must be 'modal' or 'balanced', got {show(method)}")
+
     def __repr__(self):
         return (f"<spacar.StateSpace at t = {self.t:g}: {len(self.state_labels)} states, "
                 f"{len(self.input_labels)} inputs, {len(self.output_labels)} outputs>")
+
+
+def _modal_reduction(ss: StateSpace, k: int) -> StateSpace:
+    second_order = ss._second_order()
+    if second_order is None:
+        raise InputError("reduce(method='modal') needs the second-order equations (a model without kinematic "
+                         "coordinates, A and B as built)")
+    M, C, K, Q = second_order
+    n = M.shape[0]
+    if k > n:
+        raise InputError(f"reduce: k = {k} modes of a model of {n} degrees of freedom")
+    if not np.any(M):
+        raise SingularMassError("reduce: the modes need masses: no node or element of the model carries mass")
+    w2, phi = _mass_normalized_modes(M, K)
+    w2, phi = w2[:k], phi[:, :k]
+    if not np.all(w2 > 0):
+        raise InputError("reduce(method='modal'): a kept mode has no stiffness (a rigid-body motion); the static "
+                         "correction needs a supported model")
+    Cz, Cv = ss.C[:, :n], ss.C[:, n:]
+    Qm = phi.T @ Q
+    damping = phi.T @ C @ phi
+    A = np.block([[np.zeros((k, k)), np.eye(k)], [-np.diag(w2), -damping]])
+    B = np.vstack([np.zeros((k, Q.shape[1])), Qm])
+    static = np.linalg.solve(K, Q)
+    D = ss.D + Cz @ (static - phi @ (Qm / w2[:, None]))
+    states = [f"mode({i + 1})" for i in range(k)] + [f"moded({i + 1})" for i in range(k)]
+    return StateSpace(A, B, np.hstack([Cz @ phi, Cv @ phi]), D, states, ss.input_labels, ss.output_labels, ss.t,
+                      ss.linearization, (np.eye(k), damping, np.diag(w2), Qm))
+
+
+def _balanced_reduction(ss: StateSpace, k: int) -> StateSpace:
+    import scipy.linalg
+
+    A, B, C = ss.A, ss.B, ss.C
+    n = A.shape[0]
+    if k > n:
+        raise InputError(f"reduce: k = {k} states of a model of {n}")
+    if not np.all(np.linalg.eigvals(A).real < 0):
+        raise InputError("reduce(method='balanced') needs a stable model (every pole in the left half-plane): give "
+                         "it damping (EDAMPP, state_space(damping=...) or rayleigh=...) and no rigid-body motion")
+    Wc = scipy.linalg.solve_continuous_lyapunov(A, -B @ B.T)
+    Wo = scipy.linalg.solve_continuous_lyapunov(A.T, -C.T @ C)
+    Lc, Lo = _square_root(Wc), _square_root(Wo)          # W = L Lᵀ
+    U, hsv, Vt = scipy.linalg.svd(Lo.T @ Lc)
+    scale = 1.0 / np.sqrt(hsv[:k])
+    T = Lc @ Vt[:k].T * scale                               # n × k
+    Ti = (U[:, :k] * scale).T @ Lo.T                        # k × n, Ti T = I
+    reduced = StateSpace(Ti @ A @ T, Ti @ B, C @ T, ss.D, [f"balanced({i + 1})" for i in range(k)], ss.input_labels,
+                         ss.output_labels, ss.t, ss.linearization)
+    reduced.hankel_singular_values = hsv
+    reduced.error_bound = 2.0 * float(np.sum(hsv[k:]))
+    return reduced
+
+
+def _square_root(W):
+    """L with W = L Lᵀ for a symmetric positive semidefinite Gramian (the eigenvalues rounded
+    below zero clipped)."""
+    w, V = np.linalg.eigh(0.5 * (W + W.T))
+    return V * np.sqrt(np.clip(w, 0.0, None))
 
 
 def state_space(source, at=None, inputs=None, outputs=None, *, modes=None, damping=None, rayleigh=None,

@@ -78,3 +78,61 @@ def test_damping_of_a_model_without_mass_asks_for_masses():
     spacar.static(model)
     with pytest.raises(spacar.SingularMassError, match="needs masses"):
         spacar.state_space(model, damping=0.02)
+
+
+# --- model reduction (issue 40) -----------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def damped_beam():
+    return spacar.state_space(tip_loaded_beam(30), damping=0.02)  # 90 DOFs, 180 states
+
+
+def upper_poles(ss, k=None):
+    p = ss.poles()
+    p = p[p.imag > 0]
+    return p[np.argsort(p.imag)][:k]
+
+
+def test_modal_reduction_keeps_the_static_gain_and_the_lowest_poles(damped_beam):
+    """Five modes with the static correction of the other 85: the static gain exact, the five
+    poles the full model's, the tip's response below half the first resonance within 1e-6."""
+    reduced = damped_beam.reduce(5)
+    assert reduced.A.shape == (10, 10) and reduced.state_labels[0] == "mode(1)"
+    np.testing.assert_allclose(reduced.static_gain(), damped_beam.static_gain(), rtol=1e-12)
+    np.testing.assert_allclose(upper_poles(reduced), upper_poles(damped_beam, 5), rtol=1e-8)
+    first = upper_poles(damped_beam, 1)[0].imag
+    f = np.linspace(0.0, 0.5 * first, 200) / (2 * np.pi)
+    full, small = damped_beam.frequency_response(f)[:, 0, 0], reduced.frequency_response(f)[:, 0, 0]
+    assert np.max(np.abs(small - full) / np.abs(full)) < 1e-6
+
+
+def test_balanced_truncation_stays_within_its_error_bound(damped_beam):
+    """Balanced truncation to 8 states: the reduced model is balanced (both Gramians the diagonal of
+    its Hankel singular values) and its error over 6 decades of frequency is within the H∞ bound
+    2 Σ_{i>8} σ_i; keeping every state reproduces the model."""
+    import scipy.linalg
+
+    reduced = damped_beam.reduce(8, method="balanced")
+    hsv = reduced.hankel_singular_values
+    assert np.all(np.diff(hsv) <= 0) and reduced.error_bound == pytest.approx(2 * hsv[8:].sum())
+    Wc = scipy.linalg.solve_continuous_lyapunov(reduced.A, -reduced.B @ reduced.B.T)
+    Wo = scipy.linalg.solve_continuous_lyapunov(reduced.A.T, -reduced.C.T @ reduced.C)
+    np.testing.assert_allclose(Wc, np.diag(hsv[:8]), atol=1e-6 * hsv[0])
+    np.testing.assert_allclose(Wo, np.diag(hsv[:8]), atol=1e-6 * hsv[0])
+    f = np.logspace(-2, 4, 3000)
+    error = np.abs(damped_beam.frequency_response(f) - reduced.frequency_response(f)).max()
+    assert 0 < error <= reduced.error_bound
+    every = damped_beam.reduce(180, method="balanced")
+    np.testing.assert_allclose(every.frequency_response(f[::100]), damped_beam.frequency_response(f[::100]),
+                               rtol=1e-6, atol=1e-9 * np.abs(damped_beam.static_gain()).max())
+
+
+def test_bad_reductions_are_input_errors(damped_beam):
+    with pytest.raises(spacar.InputError, match="needs a stable model"):
+        spacar.state_space(tip_loaded_beam(4)).reduce(2, method="balanced")  # undamped: poles on the axis
+    with pytest.raises(spacar.InputError, match="method must be 'modal' or 'balanced'"):
+        damped_beam.reduce(2, method="pod")
+    with pytest.raises(spacar.InputError, match="k must be a positive whole number"):
+        damped_beam.reduce(0)
+    with pytest.raises(spacar.InputError, match="k = 91 modes of a model of 90"):
+        damped_beam.reduce(91)
