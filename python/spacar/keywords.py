@@ -92,6 +92,9 @@ def _element_keywords():
     return out
 
 
+# The most ESTIFF (and EDAMPP) values any element type takes (the spatial beam's six with shear).
+_MOST_ESTIFF = max(t.n_estiff for t in _core.element_catalogue())
+
 _OTHER = [
     Keyword("X", NODES, (_p("n"), _p("x", REAL, 1, 4)), "any node n with coordinates x1..x4"),
     Keyword("XY", NODES, (_p("n"), _p("x", REAL, 2, 2)), "2D position node n with coordinates x y"),
@@ -128,9 +131,9 @@ _OTHER = [
             "concentrated mass m (XY, XYZ), Izz (BETA) or inertia tensor Ixx Ixy Ixz Iyy Iyz Izz (LAMBDA) at node n"),
     Keyword("EMASS", PROPERTIES, (_p("e"), _p("rhoA", REAL, 1, 4)),
             "distributed mass rhoA per length of element e (PLBELT: rhoA a1 a2)"),
-    Keyword("ESTIFF", PROPERTIES, (_p("e"), _p("x", REAL, 1, 4)),
+    Keyword("ESTIFF", PROPERTIES, (_p("e"), _p("x", REAL, 1, _MOST_ESTIFF)),
             "stiffness parameters of element e (meaning per element type)"),
-    Keyword("EDAMPP", PROPERTIES, (_p("e"), _p("x", REAL, 1, 4)),
+    Keyword("EDAMPP", PROPERTIES, (_p("e"), _p("x", REAL, 1, _MOST_ESTIFF)),
             "damping values of element e, in the form of ESTIFF"),
     Keyword("FORCE", PROPERTIES, (_p("n"), _p("f", REAL, 1, 4)), "prescribed constant force x1..x4 at node n"),
     Keyword("TORQUEL", PROPERTIES, (_p("n"), _p("T", REAL, 1, 3)),

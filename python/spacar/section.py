@@ -87,16 +87,33 @@ class Section:
         """ESTIFF of PLTRUSS/TRUSS: (EA,)."""
         return (self._mat().E * self.A,)
 
-    def plbeam_estiff(self) -> tuple:
-        """ESTIFF of PLBEAM/PLBEAMNL: (EA, EI) with I = Iz (bending in the plane)."""
-        m = self._mat()
-        return (m.E * self.A, m.E * self.Iz)
+    def shear_coefficient(self) -> float:
+        """Timoshenko's shear coefficient k of the section (the shear stiffness is k G A), Cowper's
+        (1966) values for the material's Poisson ratio ν: rectangle 10(1 + ν)/(12 + 11ν), circle
+        6(1 + ν)/(7 + 6ν), thin-walled tube 2(1 + ν)/(4 + 3ν) (the same for both axes)."""
+        nu = self._mat().nu
+        if self.shape == "rectangle":
+            return 10 * (1 + nu) / (12 + 11 * nu)
+        if self.shape == "circle":
+            return 6 * (1 + nu) / (7 + 6 * nu)
+        return 2 * (1 + nu) / (4 + 3 * nu)
 
-    def beam_estiff(self) -> tuple:
-        """ESTIFF of BEAM/BEAMNL: (EA, GIp, EIy, EIz), the torsional stiffness being G J (the
-        catalogue's "GIp"; J = Ip only for round sections)."""
+    def plbeam_estiff(self, shear: bool = False) -> tuple:
+        """ESTIFF of PLBEAM/PLBEAMNL: (EA, EI) with I = Iz (bending in the plane); with ``shear``
+        (EA, EI, kGA): the shear-flexible (Timoshenko) beam, for short and deep beams."""
         m = self._mat()
-        return (m.E * self.A, m.G * self.J, m.E * self.Iy, m.E * self.Iz)
+        values = (m.E * self.A, m.E * self.Iz)
+        return values + (self.shear_coefficient() * m.G * self.A,) if shear else values
+
+    def beam_estiff(self, shear: bool = False) -> tuple:
+        """ESTIFF of BEAM/BEAMNL: (EA, GIp, EIy, EIz), the torsional stiffness being G J (the
+        catalogue's "GIp"; J = Ip only for round sections); with ``shear`` also (kGAy, kGAz)."""
+        m = self._mat()
+        values = (m.E * self.A, m.G * self.J, m.E * self.Iy, m.E * self.Iz)
+        if shear:
+            kGA = self.shear_coefficient() * m.G * self.A
+            values += (kGA, kGA)
+        return values
 
     def emass(self, rotary: bool = False) -> tuple:
         """EMASS: (ρA,), or for BEAM with ``rotary=True`` (ρA, ρIp, ρIy, ρIz), the rotary inertia
@@ -106,10 +123,11 @@ class Section:
             return (rho * self.A, rho * self.Ip, rho * self.Iy, rho * self.Iz)
         return (rho * self.A,)
 
-    def apply(self, model, *elements, rotary: bool = False):
+    def apply(self, model, *elements, rotary: bool = False, shear: bool = False):
         """Give the elements (numbers; none: every beam and truss of the model) the ESTIFF of
         this section and, if the material has a density, its EMASS (BEAM with ``rotary=True``:
-        with the rotary inertia). Returns ``model``."""
+        with the rotary inertia); ``shear``: the beams' shear stiffness too (Timoshenko).
+        Returns ``model``."""
         table = model.elements
         if not elements:
             elements = [e for e, el in table.items() if el.type_name in _ESTIFF]
@@ -119,7 +137,8 @@ class Section:
             kind = table[e].type_name
             if kind not in _ESTIFF:
                 raise InputError(f"a cross-section gives the data of beams and trusses, not of element {e} ({kind})")
-            model.estiff(e, *getattr(self, _ESTIFF[kind])())
+            estiff = getattr(self, _ESTIFF[kind])
+            model.estiff(e, *(estiff(shear=True) if shear and kind != "PLTRUSS" and kind != "TRUSS" else estiff()))
             if self._mat().rho > 0.0:
                 model.emass(e, *self.emass(rotary and kind in ("BEAM", "BEAMNL")))
         return model

@@ -184,19 +184,20 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
     return T;
   }
 
-  // σ1 = (EA/l0) e1, σ2 = (GIp/l0³) e2, bending pairs (EI/l0³)[[4, −2], [−2, 4]].
+  // σ1 = (EA/l0) e1, σ2 = (GIp/l0³) e2, bending pairs (EI/l0³)[[4, −2], [−2, 4]]; with the shear
+  // stiffnesses kGAy, kGAz (values 5 and 6; 0 or absent: shear-rigid) Timoshenko's pairs
+  // (bending_pair): bending about y (EIy) shears along z (kGAz), about z (EIz) along y (kGAy).
   void constitutive(const std::vector<double>& v, double* S) const override {
     auto val = [&](size_t i) { return i < v.size() ? v[i] : 0.0; };
     Eigen::Map<Eigen::Matrix<double, 6, 6>> Sm(S);
     Sm.setZero();
-    const double l3 = l0_ * l0_ * l0_;
     Sm(0, 0) = val(0) / l0_;
-    Sm(1, 1) = val(1) / l3;
+    Sm(1, 1) = val(1) / (l0_ * l0_ * l0_);
     for (int pair = 0; pair < 2; ++pair) {
-      const double k = val(2 + pair) / l3;
+      const BendingPair b = bending_pair(val(2 + pair), val(pair == 0 ? 5 : 4), l0_);
       const int a = 2 + 2 * pair;
-      Sm(a, a) = Sm(a + 1, a + 1) = 4.0 * k;
-      Sm(a, a + 1) = Sm(a + 1, a) = -2.0 * k;
+      Sm(a, a) = Sm(a + 1, a + 1) = b.diagonal;
+      Sm(a, a + 1) = Sm(a + 1, a) = b.coupling;
     }
   }
 
@@ -267,7 +268,7 @@ ElementType beam_type() {
        "bending about local y at p2", "bending about local z at p1", "bending about local z at p2"},
       Nonlinear ? "spatial beam with bending-corrected elongation" : "spatial beam");
   set_params(t, 3, 3, "x y z: initial direction of the principal y-axis of the cross-section");
-  set_stiffness(t, 4, "EA GIp EIy EIz");
+  set_stiffness(t, 6, "EA GIp EIy EIz kGAy kGAz");
   set_emass(t, 4, "rhoA [rhoIp rhoIy rhoIz] (rotary inertia: extension)");
   t.has_length = true;
   t.n_lgeomy = 9;

@@ -196,16 +196,15 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
     inertia(x, v, g, M, h, f);
   }
 
-  // σ1 = (EA/l0) e1, [σ2; σ3] = (EI/l0³) [[4, −2], [−2, 4]] [e2; e3].
+  // σ1 = (EA/l0) e1, [σ2; σ3] = (EI/l0³) [[4, −2], [−2, 4]] [e2; e3]; with a shear stiffness
+  // kGA (the third value, 0 or absent: shear-rigid) Timoshenko's bending pair (bending_pair).
   void constitutive(const std::vector<double>& v, double* S) const override {
-    const double EA = v.size() > 0 ? v[0] : 0.0, EI = v.size() > 1 ? v[1] : 0.0;
-    const double k = EI / (l0_ * l0_ * l0_);
+    auto val = [&](size_t i) { return i < v.size() ? v[i] : 0.0; };
     for (int i = 0; i < 9; ++i) S[i] = 0.0;
-    S[0] = EA / l0_;
-    S[4] = 4.0 * k;
-    S[5] = -2.0 * k;
-    S[7] = -2.0 * k;
-    S[8] = 4.0 * k;
+    S[0] = val(0) / l0_;
+    const BendingPair b = bending_pair(val(1), val(2), l0_);
+    S[4] = S[8] = b.diagonal;
+    S[5] = S[7] = b.coupling;
   }
 
  private:
@@ -280,7 +279,7 @@ ElementType plbeam_type() {
       Nonlinear ? "PLBEAMNL" : "PLBEAM", {p, o, p, o}, {"p1", "o1", "p2", "o2"},
       {Nonlinear ? "bending-corrected elongation" : "elongation", "bending at p1", "bending at p2"},
       Nonlinear ? "planar beam with bending-corrected elongation" : "planar beam");
-  set_stiffness(t, 2, "EA EI");
+  set_stiffness(t, 3, "EA EI kGA");
   set_emass(t, 1, "rhoA");
   t.has_length = true;
   t.n_lgeomy = 1;

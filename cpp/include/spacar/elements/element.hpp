@@ -128,6 +128,21 @@ MassPoints<4, DIM> hermite_mass(double rhoA, double l0) {
   return m;
 }
 
+// A beam's bending pair [σa; σb] = [[diagonal, coupling], [coupling, diagonal]] [ea; eb] for the
+// two bending deformations of one plane (the end rotations from the chord, times l0, formulation.md
+// §4): Euler–Bernoulli's (EI/l0³)[[4, −2], [−2, 4]], or with a shear stiffness kGA > 0
+// Timoshenko's, (EI/(l0³ (1 + Φ)))[[4 + Φ, Φ − 2], [Φ − 2, 4 + Φ]], Φ = 12 EI/(kGA l0²): the
+// beam whose shear force is constant along it, so that a cantilever's tip deflection under a tip
+// force, P L³/(3 EI) + P L/(kGA), is exact with one element.
+struct BendingPair {
+  double diagonal, coupling;
+};
+inline BendingPair bending_pair(double EI, double kGA, double l0) {
+  const double k = EI / (l0 * l0 * l0);
+  const double phi = kGA > 0.0 ? 12.0 * EI / (kGA * l0 * l0) : 0.0;
+  return {k * (4.0 + phi) / (1.0 + phi), k * (phi - 2.0) / (1.0 + phi)};
+}
+
 namespace detail {
 template <class T, class = void>
 struct velocity_rows : std::integral_constant<unsigned, 0> {};
