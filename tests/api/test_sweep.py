@@ -80,7 +80,7 @@ def test_failed_cases_are_reported_with_their_parameters():
     base = spacar.read(EXAMPLE)
     sample = [{"ESTIFF 2": (0.0, 1e-3), "TIMESTEP": (4, 0.2)},
               {"ESTIFF 2": (0.0, 1e308), "TIMESTEP": (4, 0.2)},        # overflows
-              {"ESTIFF 2": (0.0, 1e-3, 2.0), "TIMESTEP": (4, 0.2)},    # PLBEAM takes 2 stiffnesses
+              {"ESTIFF 2": (0.0, 1e-3, 2.0, 3.0), "TIMESTEP": (4, 0.2)},    # PLBEAM takes 3 stiffnesses
               {"ESTIFF 2": (0.0, 2e-3), "TIMESTEP": (4, 0.2)}]
     result = spacar.sweep(base, sample, workers=1, time_limit=30)
     assert result.ok.tolist() == [True, False, False, True]
@@ -89,7 +89,7 @@ def test_failed_cases_are_reported_with_their_parameters():
     assert e1.parameters == {"ESTIFF 2": (0.0, 1e308), "TIMESTEP": (4, 0.2)}
     assert e1.type == "spacar.SpacarError" and "the accelerations at t = 0 are not finite" in e1.message
     assert e2.type == "spacar.InputError"
-    assert e2.message.startswith("sweep parameter 'ESTIFF 2' = (0.0, 0.001, 2.0): ESTIFF of PLBEAM takes 1 to 2")
+    assert e2.message.startswith("sweep parameter 'ESTIFF 2' = (0.0, 0.001, 2.0, 3.0): ESTIFF of PLBEAM takes 1 to 3")
     assert np.isnan(result.values["x"][1:3]).all() and np.isfinite(result.values["x"][[0, 3]]).all()
     assert result.values["t"].tolist()[0] == 0.2
     with pytest.raises(spacar.SpacarError, match=r"2 of 4 cases failed:\ncase 1 .*SpacarError: the accelerations"):
