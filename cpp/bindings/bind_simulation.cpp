@@ -275,6 +275,16 @@ void bind_states(py::class_<Simulation>& sim) {
           py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "Inverse dynamics at the states in the rows of q, qd, qdd: (the generalized forces on the DOFs beyond "
           "the model's own loads, 'tree' or 'general'), spacar.inverse_dynamics.")
+      .def(
+          "dynamics_derivatives",
+          [](Simulation& s, const RowMatrix& q, const RowMatrix& qd, const RowMatrix& tau) {
+            RowMatrix qdd, dq, dqd, dtau;
+            s.dynamics_derivatives(q, qd, tau, qdd, dq, dqd, dtau);
+            return py::make_tuple(qdd, dq, dqd, dtau);
+          },
+          py::arg("q"), py::arg("qd"), py::arg("tau"),
+          "(qdd, dqdd/dq, dqdd/dqd, dqdd/dtau) at the states in the rows of q, qd, tau, each derivative a row of "
+          "n·n values (row-major): spacar.dynamics_derivatives.")
       .def("recursive_refusal", &Simulation::recursive_refusal,
            "Why the system takes the general path rather than the recursive one ('' if it is a rigid tree).")
       .def("move_to", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::move_to))

@@ -21,7 +21,7 @@ from . import mechanism, section
 from .check import Check, Diagnosis, Summary, check, summary
 from .compliance import compliance, support_stiffness
 from .control import Controller
-from .dynamics import inverse_dynamics
+from .dynamics import dynamics_derivatives, inverse_dynamics
 from .energy import Energy
 from .table import Table
 from .errors import (
@@ -118,6 +118,7 @@ __all__ = [
     "dump",
     "simulate",
     "inverse_dynamics",
+    "dynamics_derivatives",
     "static",
     "StaticError",
     "compliance",

@@ -17,7 +17,7 @@ import pytest
 
 import spacar
 from spacar import _core
-from support.paths import DATA
+from support.paths import DATA, EXAMPLES
 
 SMALL = ["two_link_arm", "branched_tree", "prismatic", "fixed_joints"]
 
@@ -257,6 +257,40 @@ def test_inverse_dynamics_matches_rnea(name):
     # the public function: one state, the same numbers
     one = spacar.inverse_dynamics(peer.model, q[3], qd[3], qdd[3])
     assert one.shape == (nv,) and np.abs(one - ref[3]).max() <= 1e-10 * max(1.0, np.abs(ref).max())
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_dynamics_derivatives_match_compute_aba_derivatives(name):
+    """spacar.dynamics_derivatives against pinocchio.computeABADerivatives at random states and
+    torques, over a batch in one call: q̈, ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ to 1e-10 (relative to
+    each matrix's largest entry). Exact derivatives: the recursive Newton–Euler algorithm on dual
+    numbers (issue 37)."""
+    rng = np.random.default_rng(sum(map(ord, name)) + 2)
+    peer = Peer(name)
+    nv = peer.pin.nv
+    end = rng.uniform(-1.5, 1.5, nv)
+    q = np.outer(np.linspace(0.2, 1.0, 5), end)
+    qd, tau = rng.uniform(-2.0, 2.0, (5, nv)), rng.uniform(-3.0, 3.0, (5, nv))
+    qdd, dq, dqd, dtau = spacar.dynamics_derivatives(peer.model, q, qd, tau)
+    assert qdd.shape == (5, nv) and dq.shape == dqd.shape == dtau.shape == (5, nv, nv)
+    for k in range(5):
+        ref = pin.computeABADerivatives(peer.pin, peer.data, peer.pin_q(q[k]), qd[k], tau[k])
+        expected_qdd = pin.aba(peer.pin, peer.data, peer.pin_q(q[k]), qd[k], tau[k])
+        assert np.abs(qdd[k] - expected_qdd).max() <= 1e-10 * max(1.0, np.abs(expected_qdd).max())
+        minv = np.triu(ref[2]) + np.triu(ref[2], 1).T
+        for ours, theirs in zip((dq[k], dqd[k], dtau[k]), (ref[0], ref[1], minv)):
+            assert np.abs(ours - theirs).max() <= 1e-10 * max(1.0, np.abs(theirs).max())
+    one = spacar.dynamics_derivatives(peer.model, q[0], qd[0], tau[0])
+    assert one[1].shape == (nv, nv) and np.abs(one[1] - dq[0]).max() == 0.0
+
+
+def test_dynamics_derivatives_need_a_spatial_tree():
+    model = spacar.read(EXAMPLES / "slidercrank.dat")  # a closed loop: the general path
+    with pytest.raises(spacar.InputError, match="not a tree of rigid bodies of the recursive path"):
+        spacar.dynamics_derivatives(model, [0.0] * 5, [0.0] * 5, [0.0] * 5)
+    peer = Peer("ur5")
+    with pytest.raises(spacar.InputError, match="q, qd and tau must have the same shape"):
+        spacar.dynamics_derivatives(peer.model, np.zeros(6), np.zeros(6), np.zeros(5))
 
 
 def test_ur5_gravity_swing_matches_aba_integrated_by_scipy():

@@ -533,6 +533,40 @@ RowMatrix Simulation::inverse_dynamics(const RowMatrix& q, const RowMatrix& qd, 
   return force;
 }
 
+void Simulation::dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, const RowMatrix& tau, RowMatrix& qdd,
+                                      RowMatrix& dq, RowMatrix& dqd, RowMatrix& dtau) {
+  RecursiveTree* tree = recursive_tree();
+  if (!tree) {
+    throw InputError("dynamics_derivatives: the model is not a tree of rigid bodies of the recursive path (" +
+                     recursive_refusal() + "); the derivatives are computed on spatial trees (URDF robots)");
+  }
+  const int nd = sys_->n_dof();
+  if (q.cols() != nd || qd.cols() != nd || tau.cols() != nd || qd.rows() != q.rows() || tau.rows() != q.rows())
+    throw InputError("dynamics_derivatives(): q, qd and tau must have the same number of states (rows) and one "
+                     "column per degree of freedom (" + std::to_string(nd) + ")");
+  require_memory(8.0 * double(q.rows()) * (3.0 * nd * nd + nd), "the dynamics derivatives",
+                 "ask for fewer states at a time");
+  qdd.resize(q.rows(), nd);
+  dq.resize(q.rows(), nd * nd);
+  dqd.resize(q.rows(), nd * nd);
+  dtau.resize(q.rows(), nd * nd);
+  Eigen::MatrixXd a(nd, nd), b(nd, nd), c(nd, nd);  // column major, transposed into the rows
+  for (Eigen::Index k = 0; k < q.rows(); ++k) {
+    check_thread_deadline("(in dynamics_derivatives)");
+    if (!tree->dynamics_derivatives(nd, q.row(k).data(), qd.row(k).data(), tau.row(k).data(), qdd.row(k).data(),
+                                    a.data(), b.data(), c.data())) {
+      throw InputError("dynamics_derivatives: the derivatives are computed on spatial trees (URDF robots), not on "
+                       "this (planar) tree, or its mass matrix is not positive definite at state " + std::to_string(k));
+    }
+    for (int i = 0; i < nd; ++i)
+      for (int j = 0; j < nd; ++j) {
+        dq(k, i * nd + j) = a(i, j);
+        dqd(k, i * nd + j) = b(i, j);
+        dtau(k, i * nd + j) = c(i, j);
+      }
+  }
+}
+
 std::string Simulation::recursive_refusal() const {
   std::string why;
   return RecursiveTree::detect(*sys_, *data_, &why) ? std::string() : why;

@@ -170,6 +170,11 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   // constraints (a solved state).
   static std::unique_ptr<SpatialTree> detect(const System& sys, const Data& data, std::string* why = nullptr);
 
+  // Exact: the recursive Newton–Euler algorithm on dual numbers (spatial_rnea.hpp) gives ∂τ/∂q and
+  // ∂τ/∂q̇ at (q, q̇, q̈), and ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇), M from the inverse dynamics' columns.
+  bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
+                            double* dqd, double* dtau) override;
+
  private:
   using Vec3 = Eigen::Vector3d;
   using Quat = Eigen::Vector4d;
@@ -189,6 +194,10 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   class Builder;
 
   void applied_loads() override;
+  // ∂τ/∂q and ∂τ/∂q̇ (n × n) at (q, q̇, q̈) by the inverse dynamics on dual numbers of N parts.
+  template <int N>
+  void directional_derivatives(int n, const double* q, const double* qd, const double* qdd, Eigen::MatrixXd& dtau_dq,
+                               Eigen::MatrixXd& dtau_dqd) const;
   void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
 
   std::vector<Follower> followers_;
