@@ -10,8 +10,8 @@ from collections import Counter
 from dataclasses import dataclass
 
 from . import _core
-from ._util import seconds_or_none, show
-from .errors import InputError
+from ._util import seconds_or_none, show, time_limited
+from .errors import InputError, KinematicsError
 from .model import Model
 
 COORD_CLASSES = ("fixed", "input", "dynamic", "calculable")
@@ -79,19 +79,21 @@ class Diagnosis:
 class Check:
     summary: Summary
     diagnosis: Diagnosis
+    assembly: str = ""  # why the model cannot be assembled (lengths that cannot close a loop), or ""
 
     @property
     def ok(self) -> bool:
         """Nothing to report: a model with elements whose constraints determine its calculable
-        coordinates (``spacar check`` exits 1 otherwise)."""
-        return self.diagnosis.ok and sum(self.summary.elements.values()) > 0
+        coordinates and can be met (``spacar check`` exits 1 otherwise)."""
+        return self.diagnosis.ok and sum(self.summary.elements.values()) > 0 and not self.assembly
 
     def __str__(self):
         if self.ok:
             verdict = "the constraints determine the calculable coordinates"
         else:
             verdict = "problems:" if self.diagnosis.detailed else "not diagnosed:"
-        return f"{self.summary}\nconstraints: {verdict}\n{self.diagnosis.text}"
+        text = f"{self.summary}\nconstraints: {verdict}\n{self.diagnosis.text}"
+        return text + (f"\nassembly: {self.assembly}" if self.assembly else "")
 
 
 def check(model, time_limit=None) -> Check:
@@ -112,7 +114,14 @@ def check(model, time_limit=None) -> Check:
     d = sim.diagnose(time_limit=limit, time_spent=time.monotonic() - started)
     diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
                           list(d["undetermined"]), d["text"])
-    return Check(summary(model), diagnosis)
+    assembly = ""
+    if diagnosis.ok:  # the constraints are independent: can they be met? (lengths that close no loop)
+        try:
+            with time_limited(time_limit, "in the assembly"):
+                sim.assemble()
+        except KinematicsError as err:
+            assembly = str(err)
+    return Check(summary(model), diagnosis, assembly)
 
 
 def release_overconstraints(model, time_limit=None) -> list:

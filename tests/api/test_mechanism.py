@@ -143,3 +143,17 @@ def test_a_model_without_mass_is_pointed_to_the_static_analysis():
     with pytest.raises(spacar.SingularMassError, match="no node or element of the model carries mass: for its "
                                                        "stiffness alone.* spacar static or spacar.static"):
         spacar.simulate(model)
+
+
+def test_a_loop_that_cannot_close_is_said_by_run_and_check():
+    """Issue 41: a rocker shortened by LENGTHO 3 0.5 (of 3.16) cannot close the example four-bar's
+    loop: 'Newton iteration ... did not converge' with 50 residuals before; now the least-squares
+    configuration shows that no configuration meets the constraints and names the lengths that miss,
+    in spacar.simulate and in spacar.check (which called the file OK)."""
+    text = (EXAMPLES / "fourbar_coupler.dat").read_text().replace("FIX 1", "LENGTHO 3 0.5\nFIX 1", 1)
+    message = r"the constraints cannot all be met at t = 0: .* largest residuals are .*element [23] \(PLBEAM\)"
+    with pytest.raises(spacar.KinematicsError, match=message):
+        spacar.simulate(spacar.read_string(text), progress=False)
+    check = spacar.check(spacar.read_string(text))
+    assert not check.ok and "cannot all be met" in check.assembly and "assembly: the constraints" in str(check)
+    assert spacar.check(spacar.read(EXAMPLES / "fourbar_coupler.dat")).ok

@@ -8,6 +8,7 @@
 
 #include "spacar/kinematics/diagnosis.hpp"
 #include "spacar/errors.hpp"
+#include "spacar/limits.hpp"
 
 namespace spacar {
 
@@ -153,6 +154,69 @@ void check_constraint_counts(const System& sys, Data& data) {
   }
 }
 
+namespace {
+// After an assembly's Newton iteration failed: whether the constraints can be met at all. The
+// Levenberg–Marquardt iteration on the residuals of the position constraints finds the
+// configuration closest to meeting them (least squares); where that still leaves residuals, no
+// configuration meets them — the lengths (LENGTHO, the geometry of X) cannot close a loop, or a
+// prescribed position is out of reach — and the message names the deformations that miss most
+// there. Empty if the least-squares residual vanishes (then Newton failed for another reason: a
+// poor start or a singular configuration) or the system is too large for the dense iteration.
+std::string unclosable_constraints(const System& sys, Data& data, double tol) {
+  constexpr int kMaxDense = 2000;  // calculable coordinates
+  const int nc = static_cast<int>(sys.x_calc.size());
+  if (nc == 0 || nc > kMaxDense) return "";
+  const Eigen::VectorXd start = data.x;
+  auto residual = [&]() {
+    evaluate_elements(sys, data);
+    compute_residual(sys, data);
+    return data.residual.allFinite() ? data.residual.squaredNorm() : std::numeric_limits<double>::infinity();
+  };
+  double cost = residual(), mu = 1e-3;
+  for (int it = 0; it < 200 && std::isfinite(cost); ++it) {
+    check_thread_deadline("(in the assembly's diagnosis)");
+    assemble_block(sys, data, data.AP, data.AP_block);
+    const Eigen::MatrixXd J = data.AP.matrix();
+    const Eigen::VectorXd r = data.residual, g = J.transpose() * r;
+    const Eigen::MatrixXd H = J.transpose() * J;
+    if (g.norm() <= 1e-12 * std::max(1.0, H.diagonal().maxCoeff()) * std::max(1.0, std::sqrt(cost))) break;
+    bool improved = false;
+    for (int tries = 0; tries < 30 && !improved; ++tries) {
+      Eigen::MatrixXd A = H;
+      A.diagonal() += mu * (H.diagonal().array() + 1e-12).matrix();
+      const Eigen::VectorXd dx = A.ldlt().solve(g);
+      for (int j = 0; j < nc; ++j) data.x[sys.x_calc[j]] -= dx[j];
+      const double trial = residual();
+      if (trial < cost) {
+        improved = true;
+        cost = trial;
+        mu = std::max(mu / 3.0, 1e-12);
+      } else {
+        for (int j = 0; j < nc; ++j) data.x[sys.x_calc[j]] += dx[j];
+        mu *= 4.0;
+      }
+    }
+    if (!improved) break;
+  }
+  residual();
+  const double worst = max_abs(data.residual);
+  const double allowed = std::max(1e3 * tol, 1e-6 * std::max(1.0, sys.length_scale));
+  std::string message;
+  if (std::isfinite(worst) && worst > allowed) {
+    std::ostringstream os;
+    os << "the constraints cannot all be met at t = " << data.t << ": in the configuration closest to meeting them "
+       << "(least squares) the largest residuals are " << worst_rows(sys, data, 3)
+       << ". No configuration closes these elements' loop with their lengths and geometry: check their LENGTHO and "
+          "LGEOMY, the positions given by X, and the inputs' values";
+    message = os.str();
+  }
+  data.x = start;
+  evaluate_elements(sys, data);
+  compute_residual(sys, data);
+  return message;
+}
+}  // namespace
+
 void solve_positions(const System& sys, Data& data, int max_iter, double tol, bool assembly, bool exact_start) {
   const int nc = static_cast<int>(sys.x_calc.size());
   set_targets(sys, data);
@@ -225,6 +289,9 @@ void solve_positions(const System& sys, Data& data, int max_iter, double tol, bo
   data.total_newton_iterations += data.newton_iterations;
   if (!converged && nc > 0) {
     std::ostringstream os;
+    // An assembly that fails may be asked for the impossible: lengths that cannot close a loop.
+    const std::string impossible = assembly ? unclosable_constraints(sys, data, tol) : std::string();
+    if (!impossible.empty()) throw KinematicsError(impossible);
     os << "Newton iteration on the positions did not converge in " << limit << " iterations at t = " << data.t
        << " (EPSKIN " << tol << "); max residual per iteration:";
     for (int i = 0; i < n_history; ++i) os << (i ? ", " : " ") << number(history[i]);
