@@ -116,8 +116,9 @@ def check(model, time_limit=None) -> Check:
                           list(d["undetermined"]), d["text"])
     assembly = ""
     if diagnosis.ok:  # the constraints are independent: can they be met? (lengths that close no loop)
+        left = None if not limit else max(limit - (time.monotonic() - started), 1e-9)  # one limit for all of check
         try:
-            with time_limited(time_limit, "in the assembly"):
+            with time_limited(left, "in the assembly"):
                 sim.assemble()
         except KinematicsError as err:
             assembly = str(err)

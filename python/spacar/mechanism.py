@@ -123,20 +123,23 @@ class FourBar:
 
     def limit_positions(self) -> list:
         """The crank angles θ (in [−π, π)) at which the rocker reverses, the crank and the
-        coupler in line (extended, AC = a + b, and folded, AC = b − a), with the rocker angles ψ
+        coupler in line (extended, AC = a + b, and folded, AC = |b − a|), with the rocker angles ψ
         there: [(θ, ψ), ...]; empty where the triangle ACD cannot close. With the rocker driving,
         these are the dead-centre positions: it cannot turn the crank on."""
         out = []
-        for length, sign in ((self.b + self.a, 1.0), (self.b - self.a, -1.0)):
+        for length, extended in ((self.b + self.a, True), (abs(self.b - self.a), False)):
             if length <= 0:
                 continue
             cos_at_a = (self.d**2 + length**2 - self.c**2) / (2 * self.d * length)
             if abs(cos_at_a) > 1:
                 continue
-            phi = math.acos(cos_at_a) * self.branch  # direction of AC
-            theta = phi if sign > 0 else phi + math.pi
-            theta = (theta + math.pi) % (2 * math.pi) - math.pi
-            out.append((theta, float(self.rocker_angle(theta))))
+            for phi in (math.acos(cos_at_a), -math.acos(cos_at_a)):  # the direction of AC
+                # The crank points along AC, except folded with the coupler the longer (B behind A).
+                theta = phi if extended or self.a > self.b else phi + math.pi
+                theta = (theta + math.pi) % (2 * math.pi) - math.pi
+                C = length * np.array([math.cos(phi), math.sin(phi)])
+                if np.abs(self.points(theta)[1] - C).max() <= 1e-9 * max(self.d, length):  # on this assembly
+                    out.append((theta, float(self.rocker_angle(theta))))
         return out
 
     def toggle_positions(self) -> list:
@@ -208,10 +211,15 @@ def synthesize(pairs, d: float = 1.0) -> FourBar:
     if not (a > 0 and c > 0 and b2 > 0):
         raise InputError(f"synthesize: these precision points give no real four-bar (a = {a:.4g}, c = {c:.4g}, "
                          f"b² = {b2:.4g})")
-    # The assembly (branch) on which the rocker takes the first precision point's angle.
-    candidates = [FourBar(a, math.sqrt(b2), c, d, branch) for branch in (1, -1)]
-    miss = [abs(math.remainder(float(fb.rocker_angle(theta[0])) - psi[0], 2 * math.pi)) for fb in candidates]
-    return candidates[int(np.nanargmin(miss))]
+    # The assembly (branch) on which the rocker takes the precision points' angles: Freudenstein's
+    # equation holds on both, and the points may fall on different ones (a branch defect).
+    for branch in (1, -1):
+        fb = FourBar(a, math.sqrt(b2), c, d, branch)
+        miss = [abs(math.remainder(float(fb.rocker_angle(t)) - p, 2 * math.pi)) for t, p in zip(theta, psi)]
+        if max(miss) <= 1e-8:
+            return fb
+    raise InputError("synthesize: the three precision points lie on different assemblies of the synthesized four-bar "
+                     "(a branch defect): no one linkage passes all three; choose other points")
 
 
 # --- any single-input mechanism in a model ---------------------------------------------------------
@@ -301,8 +309,11 @@ def transmission_angle(path_or_transfer, coupler: int, follower: int, model=None
     def direction(e):
         if e not in model.elements:
             raise InputError(f"transmission_angle: element {show(e)} is not defined")
-        nodes = model.elements[e].nodes
-        p1, p2 = nodes[0], nodes[2]
+        points = [n for n in model.elements[e].nodes if (n, 1) in rows and (n, 2) in rows
+                  and model.nodes[n].kind.name in ("XY", "XYZ")]
+        if len(points) < 2:
+            raise InputError(f"transmission_angle: element {e} has no two position nodes to give it a direction")
+        p1, p2 = points[0], points[-1]
         return np.stack([x[:, rows[(p2, 1)]] - x[:, rows[(p1, 1)]], x[:, rows[(p2, 2)]] - x[:, rows[(p1, 2)]]], axis=1)
 
     u, v = direction(coupler), direction(follower)

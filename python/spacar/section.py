@@ -90,13 +90,15 @@ class Section:
     def shear_coefficient(self) -> float:
         """Timoshenko's shear coefficient k of the section (the shear stiffness is k G A), Cowper's
         (1966) values for the material's Poisson ratio ν: rectangle 10(1 + ν)/(12 + 11ν), circle
-        6(1 + ν)/(7 + 6ν), thin-walled tube 2(1 + ν)/(4 + 3ν) (the same for both axes)."""
+        6(1 + ν)/(7 + 6ν), tube of inner to outer diameter m
+        6(1 + ν)(1 + m²)² / ((7 + 6ν)(1 + m²)² + (20 + 12ν) m²) (the same for both axes)."""
         nu = self._mat().nu
         if self.shape == "rectangle":
             return 10 * (1 + nu) / (12 + 11 * nu)
         if self.shape == "circle":
             return 6 * (1 + nu) / (7 + 6 * nu)
-        return 2 * (1 + nu) / (4 + 3 * nu)
+        m2 = ((self.dims["d"] - 2 * self.dims["t"]) / self.dims["d"]) ** 2
+        return 6 * (1 + nu) * (1 + m2) ** 2 / ((7 + 6 * nu) * (1 + m2) ** 2 + (20 + 12 * nu) * m2)
 
     def plbeam_estiff(self, shear: bool = False) -> tuple:
         """ESTIFF of PLBEAM/PLBEAMNL: (EA, EI) with I = Iz (bending in the plane); with ``shear``

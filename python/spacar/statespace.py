@@ -220,6 +220,11 @@ def _balanced_reduction(ss: StateSpace, k: int) -> StateSpace:
     Wo = scipy.linalg.solve_continuous_lyapunov(A.T, -C.T @ C)
     Lc, Lo = _square_root(Wc), _square_root(Wo)          # W = L Lᵀ
     U, hsv, Vt = scipy.linalg.svd(Lo.T @ Lc)
+    significant = int(np.sum(hsv > np.finfo(float).eps * hsv[0])) if hsv.size and hsv[0] > 0 else 0
+    if k > significant:
+        raise InputError(f"reduce(method='balanced'): only {significant} of the model's Hankel singular values are "
+                         f"above ε σ1 (the others are states no input reaches or no output sees); reduce to at most "
+                         f"{significant} states")
     scale = 1.0 / np.sqrt(hsv[:k])
     T = Lc @ Vt[:k].T * scale                               # n × k
     Ti = (U[:, :k] * scale).T @ Lo.T                        # k × n, Ti T = I
@@ -339,9 +344,15 @@ def _add_damping(ss: StateSpace, ratios, alpha: float, beta: float) -> StateSpac
 
 
 def _mass_normalized_modes(M, K):
-    """(ω², Φ) of K φ = ω² M φ, sorted by |ω²|, with Φᵀ M Φ = I."""
+    """(ω², Φ) of K φ = ω² M φ, sorted by |ω²|, with Φᵀ M Φ = I. The modes of a symmetric problem
+    only: a stiffness made unsymmetric by a moving state (N0) or follower loads has no such basis."""
     import scipy.linalg
 
+    scale = max(float(np.abs(K).max()), 1e-300)
+    if np.abs(K - K.T).max() > 1e-10 * scale or np.abs(M - M.T).max() > 1e-10 * max(float(np.abs(M).max()), 1e-300):
+        raise InputError("state_space: modal damping and the modal reduction need the symmetric undamped problem "
+                         "(K0 + N0 + G0 symmetric, as at rest without follower loads); this stiffness is not "
+                         "symmetric: use rayleigh= or EDAMPP, and reduce(method='balanced')")
     w2, phi = scipy.linalg.eigh(K, M)
     order = np.argsort(np.abs(w2))
     return w2[order], phi[:, order]

@@ -27,6 +27,7 @@ import numbers
 import os
 import pickle
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
@@ -669,18 +670,27 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
     bar = _Progress(progress, n)
     failed = 0
 
+    collecting = threading.Lock()  # _isolate collects from several threads
+
     def collect(chunk, results):
         nonlocal failed
-        for index, ok, payload, seconds in results:
-            outcomes[index] = (ok, payload, seconds)
-            failed += not ok
-        bar.update(len(chunk), failed)
+        with collecting:
+            for index, ok, payload, seconds in results:
+                outcomes[index] = (ok, payload, seconds)
+                failed += not ok
+            bar.update(len(chunk), failed)
 
     cancel = _core.Cancellation()
     try:
         if client is None and executor is None and n_workers == 1:
             for chunk in chunks:
-                collect(chunk, _run_cases(task, chunk))
+                done = []
+                try:  # case by case, so that a Ctrl-C keeps every case done
+                    for case in chunk:
+                        done.extend(_run_cases(task, [case]))
+                finally:
+                    if done:
+                        collect(chunk[:len(done)], done)
         elif client is None and executor is None and workers is None:
             _run_threads(task, chunks, n_workers, collect, cancel)
         elif client is not None:
@@ -754,58 +764,68 @@ def _run_executor(executor, payload, chunks, collect):
 
 def _run_processes(payload, chunks, n_workers, collect):
     """Spawned worker processes. A case that kills its process (a crash, a signal, the memory
-    of the machine) breaks the whole pool: the chunks it took with it are run again in a new
-    pool, one case per task, until every case has either run or, run alone in a process of its
-    own, killed that process too; only such a case fails, its error naming how its process
-    ended."""
+    of the machine) breaks the whole pool: the cases it took with it are then run by processes
+    that report case by case (_isolate), so that a process that dies names the case it was
+    running, which alone fails, its error saying how its process ended; the others complete."""
     from concurrent.futures.process import BrokenProcessPool
 
     context = multiprocessing.get_context("spawn")
-    pending = chunks
-    while pending:
-        pool = concurrent.futures.ProcessPoolExecutor(max_workers=min(n_workers, len(pending)), mp_context=context)
-        broken, done = [], 0
-        try:
-            futures = {pool.submit(_run_chunk, payload, chunk): chunk for chunk in pending}
-            for future in concurrent.futures.as_completed(futures):
-                chunk = futures[future]
-                try:
-                    collect(chunk, future.result())
-                    done += len(chunk)
-                except BrokenProcessPool:
-                    broken.append(chunk)
-                except Exception as err:  # noqa: BLE001 - e.g. a result that cannot be pickled back
-                    collect(chunk, _lost(chunk, f"the worker could not return this case: {err}", err))
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
-        suspects = [case for chunk in broken for case in chunk]
-        if suspects and not done:
-            # No case got through: run the first suspect alone, in a process of its own.
-            collect([suspects[0]], _run_alone(payload, suspects[0], context))
-            suspects = suspects[1:]
-        pending = [[case] for case in suspects]
-
-
-def _run_alone(payload, case, context) -> list:
-    """Run one case in a process of its own: its outcome, or the way that process ended."""
-    receive, send = context.Pipe(duplex=False)
-    process = context.Process(target=_run_piped, args=(payload, [case], send), daemon=True)
-    process.start()
-    send.close()
+    pool = concurrent.futures.ProcessPoolExecutor(max_workers=min(n_workers, len(chunks)), mp_context=context)
+    suspects = []
     try:
-        return receive.recv()
-    except EOFError:  # the process ended without an answer
-        process.join()
-        return _lost([case], f"the worker process running this case {_ending(process.exitcode)} (run alone, it "
-                             "did so again): a crash in the analysis or a callable, a kill, or the machine's "
-                             "memory")
+        futures = {pool.submit(_run_chunk, payload, chunk): chunk for chunk in chunks}
+        for future in concurrent.futures.as_completed(futures):
+            chunk = futures[future]
+            try:
+                collect(chunk, future.result())
+            except BrokenProcessPool:
+                suspects.extend(chunk)
+            except Exception as err:  # noqa: BLE001 - e.g. a result that cannot be pickled back
+                collect(chunk, _lost(chunk, f"the worker could not return this case: {err}", err))
     finally:
-        receive.close()
-        process.join()
+        pool.shutdown(wait=True, cancel_futures=True)
+    if suspects:
+        _isolate(payload, suspects, context, n_workers, collect)
 
 
-def _run_piped(payload, cases, send):
-    send.send(_run_chunk(payload, cases))
+def _isolate(payload, cases, context, n_workers, collect):
+    """Run ``cases`` in ``n_workers`` processes side by side, each reporting every case as it ends:
+    a process that dies is blamed for the case it had not reported, which fails naming how the
+    process ended, and a new process takes the rest of its share. Each crash costs one process
+    start; the innocent cases run on."""
+    shares = [cases[i::n_workers] for i in range(n_workers) if cases[i::n_workers]]
+
+    def run_share(share):
+        while share:
+            receive, send = context.Pipe(duplex=False)
+            process = context.Process(target=_run_reporting, args=(payload, share, send), daemon=True)
+            process.start()
+            send.close()
+            done = 0
+            try:
+                while done < len(share):
+                    collect([share[done]], receive.recv())
+                    done += 1
+            except EOFError:  # the process died while running share[done]
+                process.join()
+                collect([share[done]], _lost([share[done]], f"the worker process running this case "
+                                                            f"{_ending(process.exitcode)}: a crash in the analysis "
+                                                            "or a callable, a kill, or the machine's memory"))
+                done += 1
+            finally:
+                receive.close()
+                process.join()
+            share = share[done:]
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=len(shares)) as threads:
+        for future in [threads.submit(run_share, share) for share in shares]:
+            future.result()
+
+
+def _run_reporting(payload, cases, send):
+    """Worker process of _isolate: the cases one by one, each outcome sent when it ends."""
+    for case in cases:
+        send.send(_run_chunk(payload, [case]))
     send.close()
 
 

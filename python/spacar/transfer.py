@@ -2,17 +2,20 @@
 degrees of freedom, to first and second order (SPACAR's DF and D2F, docs/formulation.md §6).
 
     tf = spacar.transfer(model)              # at the model's current configuration
-    tf.DF                                    # ∂x/∂q̂ (coordinates × q̂), q̂ = the inputs, then the DOFs
+    tf.DF                                    # ∂x/∂q̂ (coordinates × q̂), q̂ = the inputs and DOFs
     tf.D2F                                   # ∂²x/∂q̂∂q̂ (coordinates × q̂ × q̂)
     tf.ratio((8, 1), ("x", 2, 1))            # velocity ratio ∂x(8, 1)/∂q̂ of the crank's input
     path = spacar.transfer_path(model, steps=72)   # the same along the block's input motion
 
-ẋ = DF q̂̇ and ẍ = DF q̂̈ + q̂̇ᵀ D2F q̂̇ (likewise ė, ë with DFe, D2Fe): the velocity and acceleration
+q̂ holds the independent coordinates in SPACAR's order: the input coordinates, the coordinate DOFs
+(DYNX), the input deformations, the deformation DOFs (DYNE); ``q_labels`` and ``is_input`` name
+them. ẋ = DF q̂̇ and ẍ = DF q̂̈ + q̂̇ᵀ D2F q̂̇ (likewise ė, ë with DFe, D2Fe): the velocity and acceleration
 ratios of a driven mechanism are the columns of DF and D2F of its input. The kinematic analysis
 alone: no masses are needed.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,8 +66,9 @@ class Transfer(_Arrays):
 
     ``DF`` (nx × n), ``DFe`` (ne × n): ∂x/∂q̂ and ∂e/∂q̂; ``D2F`` (nx × n × n), ``D2Fe``
     (ne × n × n): the second derivatives, symmetric in their last two indices. q̂: the inputs
-    (INPUTX, INPUTE) and then the degrees of freedom, labelled by ``q_labels`` ("x", node,
-    component) or ("e", element, deformation), ``is_input`` telling which; ``q`` their values.
+    (INPUTX, INPUTE) and the degrees of freedom in SPACAR's order (input coordinates, DYNX, input
+    deformations, DYNE), labelled by ``q_labels`` ("x", node, component) or ("e", element,
+    deformation), ``is_input`` telling which; ``q`` their values.
     ``x``, ``e``: the coordinates and deformations there, rows labelled by
     ``coordinate_labels`` (node, component) and ``deformation_labels`` (element, deformation),
     as in :class:`spacar.Results`."""
@@ -115,9 +119,10 @@ def _transfer_here(sim, t, q, labels, is_input, coordinate_labels, deformation_l
     d = sim.data
     n = len(labels)
     d2f, d2fe = sim.second_order_transfer()
-    return Transfer(t=float(t), q=np.array(d.qhat), q_labels=labels, is_input=is_input, x=np.array(d.x),
-                    e=np.array(d.e), DF=np.array(d.DF), DFe=np.array(d.DFe),
-                    D2F=np.asarray(d2f).reshape(-1, n, n), D2Fe=np.asarray(d2fe).reshape(-1, n, n),
+    x, e = np.array(d.x), np.array(d.e)
+    return Transfer(t=float(t), q=np.array(d.qhat), q_labels=labels, is_input=is_input, x=x, e=e,
+                    DF=np.array(d.DF).reshape(len(x), n), DFe=np.array(d.DFe).reshape(len(e), n),
+                    D2F=np.asarray(d2f).reshape(len(x), n, n), D2Fe=np.asarray(d2fe).reshape(len(e), n, n),
                     coordinate_labels=coordinate_labels, deformation_labels=deformation_labels)
 
 
@@ -155,10 +160,17 @@ def transfer(model, at=None, *, time_limit=None) -> Transfer:
         labels, is_input = _q_labels(system)
         coordinate_labels, deformation_labels = _labels(system)
         t0, q0 = model.current_time, np.array(system.q0, dtype=float)
-        steps = max(1, int(np.ceil(np.abs(q - q0).max(initial=0.0) / 0.1)), int(np.ceil(abs(t - t0) / _time_step(model))))
+        need = max(1.0, np.abs(q - q0).max(initial=0.0) / 0.1, abs(t - t0) / _time_step(model))
+        if not need <= _MAX_STEPS:
+            raise InputError(f"transfer: at=(t, q) is {need:.3g} continuation steps from the model's configuration, "
+                             f"more than {_MAX_STEPS}; move the model nearer first (or give a TIMESTEP that spans t)")
+        steps = int(math.ceil(need))
         for s in np.linspace(0.0, 1.0, steps + 1)[1:-1]:  # continuation: the first-order predictor's steps
             sim.kinematic_state(t0 + s * (t - t0), q0 + s * (q - q0))
         return _transfer_here(sim, t, q, labels, is_input, coordinate_labels, deformation_labels)
+
+
+_MAX_STEPS = 100_000  # continuation steps from the assembled configuration to at=(t, q)
 
 
 def _time_step(model) -> float:

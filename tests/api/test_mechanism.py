@@ -60,6 +60,21 @@ def test_transmission_angle_along_a_turn_is_the_closed_form():
         transmission_angle(path, 2, 3)
 
 
+@pytest.mark.parametrize("lengths", [(0.1, 0.35, 0.30, 0.40), (0.3, 0.1, 0.35, 0.4)], ids=["a < b", "a > b"])
+@pytest.mark.parametrize("branch", [1, -1])
+def test_limit_positions_are_where_the_rocker_reverses(lengths, branch):
+    """Both limit positions (crank and coupler extended and folded; folded with AC = |b − a|, also
+    when the crank is the longer) against the extremes of ψ(θ) sampled finely."""
+    fb = FourBar(*lengths, branch=branch)
+    found = fb.limit_positions()
+    assert len(found) == 2
+    for theta, psi in found:
+        h = 1e-4
+        before, at, after = fb.rocker_angle(np.array([theta - h, theta, theta + h]))
+        assert (at - before) * (after - at) <= 0  # ψ reverses there
+        assert at == pytest.approx(psi, abs=1e-12) and fb.freudenstein(theta, psi) == pytest.approx(0.0, abs=1e-12)
+
+
 def test_a_non_grashof_linkage_s_toggle_positions_end_its_crank_s_range():
     """A triple-rocker: its crank cannot turn fully; at the toggle positions the coupler and the
     rocker are in line (transmission angle 0 or π) and the loop closes there and nowhere beyond."""
@@ -125,6 +140,9 @@ def test_three_point_synthesis_passes_its_precision_points():
         assert math.remainder(psi0 + rocker - psi, 2 * math.pi) == pytest.approx(0.0, abs=1e-10)
     with pytest.raises(spacar.InputError, match="three .θ, ψ. pairs"):
         synthesize([(0.1, 0.2)])
+    with pytest.raises(spacar.InputError, match="branch defect"):  # the points on both assemblies
+        synthesize([(math.radians(46), math.radians(67)), (math.radians(58), math.radians(68)),
+                    (math.radians(63), math.radians(86))])
 
 
 # --- errors that point at the cause (issue 41) ---------------------------------------------------
@@ -151,9 +169,9 @@ def test_a_loop_that_cannot_close_is_said_by_run_and_check():
     configuration shows that no configuration meets the constraints and names the lengths that miss,
     in spacar.simulate and in spacar.check (which called the file OK)."""
     text = (EXAMPLES / "fourbar_coupler.dat").read_text().replace("FIX 1", "LENGTHO 3 0.5\nFIX 1", 1)
-    message = r"the constraints cannot all be met at t = 0: .* largest residuals are .*element [23] \(PLBEAM\)"
+    message = r"found no configuration that meets the constraints at t = 0: .* largest residuals .*element [23] \(PLBEAM\)"
     with pytest.raises(spacar.KinematicsError, match=message):
         spacar.simulate(spacar.read_string(text), progress=False)
     check = spacar.check(spacar.read_string(text))
-    assert not check.ok and "cannot all be met" in check.assembly and "assembly: the constraints" in str(check)
+    assert not check.ok and "meets the constraints" in check.assembly and "assembly: the assembly found" in str(check)
     assert spacar.check(spacar.read(EXAMPLES / "fourbar_coupler.dat")).ok

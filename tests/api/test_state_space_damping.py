@@ -122,7 +122,10 @@ def test_balanced_truncation_stays_within_its_error_bound(damped_beam):
     f = np.logspace(-2, 4, 3000)
     error = np.abs(damped_beam.frequency_response(f) - reduced.frequency_response(f)).max()
     assert 0 < error <= reduced.error_bound
-    every = damped_beam.reduce(180, method="balanced")
+    significant = int(np.sum(hsv > np.finfo(float).eps * hsv[0]))  # the states an input reaches and an output sees
+    with pytest.raises(spacar.InputError, match=f"only {significant} of the model's Hankel singular values"):
+        damped_beam.reduce(significant + 1, method="balanced")
+    every = damped_beam.reduce(significant, method="balanced")
     np.testing.assert_allclose(every.frequency_response(f[::100]), damped_beam.frequency_response(f[::100]),
                                rtol=1e-6, atol=1e-9 * np.abs(damped_beam.static_gain()).max())
 

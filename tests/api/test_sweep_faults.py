@@ -84,8 +84,8 @@ def make(params):  # two quick cases, then runs of minutes
 threading.Timer(1.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
 start = time.perf_counter()
 try:
-    spacar.sweep(make, {"T": [1e-4, 1e-4, 20.0, 20.0, 20.0, 20.0]}, method="dop853", workers=None, chunksize=1,
-                 progress=False)
+    spacar.sweep(make, {"T": [1e-4, 1e-4, 20.0, 20.0, 20.0, 20.0]}, method="dop853", workers=WORKERS,
+                 chunksize=CHUNK, progress=False)
     print("finished")
 except KeyboardInterrupt as err:
     r = err.results
@@ -95,12 +95,15 @@ except KeyboardInterrupt as err:
 
 
 @posix
-def test_ctrl_c_stops_a_threaded_sweep_and_keeps_the_cases_done():
+@pytest.mark.parametrize("workers, chunk", [("None", 1), ("1", 6)], ids=["threads", "serial"])
+def test_ctrl_c_stops_a_threaded_sweep_and_keeps_the_cases_done(workers, chunk):
     """Finding 5: Ctrl-C during the default (threaded) sweep surfaced only after every case had
     run (sent at 2 s, seen at 11 s), and every result was lost. Now the pending cases are
     cancelled, the running analyses stop (a cancellation the sweep's threads watch), and the
-    KeyboardInterrupt carries the cases done as err.results."""
-    done = subprocess.run([sys.executable, "-c", INTERRUPTED_SWEEP], capture_output=True, text=True, timeout=120)
+    KeyboardInterrupt carries the cases done as err.results. In this process (workers=1) too, the
+    cases done in the running chunk included."""
+    program = f"WORKERS, CHUNK = {workers}, {chunk}\n" + INTERRUPTED_SWEEP
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True, timeout=120)
     words = done.stdout.split()
     assert len(words) == 4, (done.stdout, done.stderr)
     assert float(words[0]) < 5.0  # 1.5 s to the signal; the cases of minutes stopped at once

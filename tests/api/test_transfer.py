@@ -127,6 +127,15 @@ def test_bad_requests_are_input_errors():
         spacar.transfer(model, at=(0.0, [1.0]))
     with pytest.raises(spacar.InputError, match="steps must be a whole number"):
         spacar.transfer_path(model, steps=0)
+    with pytest.raises(spacar.InputError, match="continuation steps from the model's configuration"):
+        spacar.transfer(model, at=(1e300, []))
+    rigid = spacar.Model()  # nothing moves: empty transfer functions
+    rigid.plbeam(1, 1, 2, 3, 4)
+    rigid.x(3, 1.0, 0.0)
+    rigid.fix(1)
+    rigid.fix(2)
+    empty = spacar.transfer(rigid)
+    assert empty.DF.shape == (6, 0) and empty.D2F.shape == (6, 0, 0) and empty.q_labels == []
     tf = spacar.transfer(model)
     with pytest.raises(spacar.InputError, match="is not an input or degree of freedom"):
         tf.ratio((3, 1), ("x", 3, 1))

@@ -204,10 +204,13 @@ std::string unclosable_constraints(const System& sys, Data& data, double tol) {
   std::string message;
   if (std::isfinite(worst) && worst > allowed) {
     std::ostringstream os;
-    os << "the constraints cannot all be met at t = " << data.t << ": in the configuration closest to meeting them "
-       << "(least squares) the largest residuals are " << worst_rows(sys, data, 3)
-       << ". No configuration closes these elements' loop with their lengths and geometry: check their LENGTHO and "
-          "LGEOMY, the positions given by X, and the inputs' values";
+    // A local minimum of the residuals (or a slow one near a singular assembly) looks the same:
+    // the message says what was found, not that no assembly exists anywhere.
+    os << "the assembly found no configuration that meets the constraints at t = " << data.t
+       << ": the closest one (least squares, from the given positions) leaves the largest residuals "
+       << worst_rows(sys, data, 3)
+       << ". The lengths and geometry of these elements cannot close their loop (check their LENGTHO and LGEOMY, the "
+          "positions given by X and the inputs' values), or the given positions are far from an assembly";
     message = os.str();
   }
   data.x = start;

@@ -632,6 +632,9 @@ def _flexible_beams(flexible):
         ei = el.estiff[1] if len(el.estiff) > 1 else 0.0
         if el.edampp and any(v != 0 for v in el.edampp):
             raise UnsupportedModelError(f"element {el.id}: EDAMPP of flexible beams is not converted")
+        if any(v != 0 for v in el.estiff[2:]):
+            raise UnsupportedModelError(f"element {el.id}: the shear stiffness kGA of a Timoshenko beam is not "
+                                        "converted (the peer's beams here are shear-rigid)")
         if ei <= 0:
             raise UnsupportedModelError(f"element {el.id}: a flexible beam needs ESTIFF EI > 0")
         flex.append(FlexibleBeam(el.id, el.type_name, tuple(el.nodes), el.l0,

@@ -68,6 +68,9 @@ def _beam_data(model):
         if any(el.e_given):
             raise UnsupportedModelError(f"element {e}: prescribed initial deformations are not converted")
         elastic = [c.name in ("released", "dynamic") for c in el.cls]
+        if any(v != 0 for v in list(el.estiff)[2:]):
+            raise UnsupportedModelError(f"element {e}: the shear stiffness kGA of a Timoshenko beam is not converted "
+                                        "(the peer's beam here takes its own shear stiffness)")
         stiff = list(el.estiff) + [0.0] * (2 - len(el.estiff))
         EA = stiff[0] if elastic[0] else None
         EI = stiff[1] if elastic[1] or elastic[2] else None

@@ -91,6 +91,7 @@ def write_replacing(path: str, write, what: str) -> None:
     results")."""
     from ..errors import SpacarError
 
+    existed = os.path.lexists(path)
     existing = open_output(path, append=True)  # refuses a link or a non-regular file (appending: not emptied)
     info = os.fstat(existing)
     os.close(existing)
@@ -107,13 +108,13 @@ def write_replacing(path: str, write, what: str) -> None:
             os.unlink(temporary)
         else:
             os.replace(temporary, path)
-    except OSError as err:
+    except BaseException as err:
         if os.path.exists(temporary):
             os.unlink(temporary)
-        raise SpacarError(f"{path}: cannot {what} ({reason(err)})") from None
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
+        if not existed and os.path.isfile(path) and os.path.getsize(path) == 0:
+            os.unlink(path)  # the empty file made to check the path: nothing was there before
+        if isinstance(err, OSError):
+            raise SpacarError(f"{path}: cannot {what} ({reason(err)})") from None
         raise
 
 
