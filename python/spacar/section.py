@@ -125,11 +125,13 @@ class Section:
             return (rho * self.A, rho * self.Ip, rho * self.Iy, rho * self.Iz)
         return (rho * self.A,)
 
-    def apply(self, model, *elements, rotary: bool = False, shear: bool = False):
+    def apply(self, model, *elements, rotary: bool = True, shear: bool = False):
         """Give the elements (numbers; none: every beam and truss of the model) the ESTIFF of
-        this section and, if the material has a density, its EMASS (BEAM with ``rotary=True``:
-        with the rotary inertia); ``shear``: the beams' shear stiffness too (Timoshenko).
-        Returns ``model``."""
+        this section and, if the material has a density, its EMASS: a spatial BEAM's with the
+        rotary inertia of the section (ρIp, ρIy, ρIz; since issue 39 the default, without which
+        the torsion of a leaf has no inertia and a 3-D leaf guide's modes fail), ``rotary=False``
+        for ρA alone as the manual's EMASS; ``shear``: the beams' shear stiffness too
+        (Timoshenko). Returns ``model``."""
         table = model.elements
         if not elements:
             elements = [e for e, el in table.items() if el.type_name in _ESTIFF]

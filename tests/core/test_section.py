@@ -103,8 +103,10 @@ def test_apply_sets_estiff_and_emass_by_element_type():
     section.rectangle(0.02, 0.01, section.Material(1e9, nu=0.3)).apply(spatial, 2)  # no density: no EMASS change
     assert spatial.elements[2].estiff[3] == pytest.approx(1e9 * 0.02 * 1e-6 / 12)
     assert list(spatial.elements[2].emass) == list(spatial.elements[1].emass)
-    s.apply(spatial, 1, rotary=True)
+    s.apply(spatial, 1)  # a BEAM: the rotary inertia by default (issue 39)
     np.testing.assert_allclose(spatial.elements[1].emass, s.emass(rotary=True))
+    s.apply(spatial, 1, rotary=False)
+    np.testing.assert_allclose(spatial.elements[1].emass, s.emass())
     with pytest.raises(InputError, match="not defined"):
         s.apply(m, 9)
 
