@@ -97,8 +97,10 @@ def support_stiffness(model, node, components=None, *, time_limit=None) -> np.nd
 
     Computed exactly as the Schur complement of the tangent stiffness: on a copy of the model the
     coordinates become degrees of freedom (DYNX), the DYNE deformations that this makes
-    redundant (named by the constraint diagnosis) become RLSE (their stiffness stays), and
-    K_s = C_pp⁻¹ with C_pp their compliance (:func:`compliance`). Position (XY, XYZ) and BETA
+    redundant (named by the constraint diagnosis) become RLSE (their stiffness stays), as do rigid
+    deformations it makes redundant (a stage of rigid beams closing a loop of its own: they stay
+    rigid through the others; a warning names them), and K_s = C_pp⁻¹ with C_pp their compliance
+    (:func:`compliance`). Position (XY, XYZ) and BETA
     nodes. ``time_limit``: wall-clock seconds it may take (:class:`spacar.TimeLimitError` beyond)."""
     from .model import Model
 
@@ -125,12 +127,18 @@ def support_stiffness(model, node, components=None, *, time_limit=None) -> np.nd
 def _support_stiffness(model, n, components):
     free = model.copy()
     free.dynx(n, *components)
+    rigid = []
     for e, i in free.check().diagnosis.redundant:
         if free.elements[e].cls[i - 1].name != "dynamic":
-            raise InputError(f"freeing node {n} components {components} makes the rigid deformation {i} of element "
-                             f"{e} redundant; the support stiffness needs a model whose prescribed coordinates "
-                             "are supported by elastic (DYNE) deformations")
+            rigid.append((e, i))  # a rigid body (a stage of rigid beams) closes a loop of its own: redundant
         free.rlse(e, i)
+    if rigid:
+        import warnings
+
+        names = ", ".join(f"deformation {i} of element {e}" for e, i in rigid)
+        warnings.warn(f"support_stiffness: freeing node {n} components {components} made the rigid {names} redundant "
+                      "(a rigid body's own loop); released to compute the stiffness (RLSE), which leaves the body rigid",
+                      stacklevel=2)
     C = compliance(free, n)
     rows = [i - 1 for i in components]
     return np.linalg.inv(C[np.ix_(rows, rows)])

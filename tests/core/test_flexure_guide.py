@@ -116,3 +116,27 @@ def test_support_stiffness_drops_with_the_drive_displacement(drive):
     assert K == pytest.approx(published, rel=1e-12 + 1.5e-2 * (u / (0.1 * L)) ** 2)
     if drive == 40.0:
         assert 0.09 * L < u < 0.1 * L and K < 0.4 * 2 * EA / L
+
+
+def test_support_stiffness_of_a_stage_with_a_rigid_loop_of_its_own():
+    """Issue 39: a stage of two rigid beams between the same ends (a rigid loop of its own) made
+    support_stiffness refuse ("freeing node 9 ... makes the rigid deformation ... redundant"); the
+    redundant rigid deformation is now released with a warning naming it, and the stiffness is that
+    of the stage with one beam."""
+    import warnings
+
+    from support.planar_models import leaf_guide
+
+    def guide(doubled):
+        m = leaf_guide(0.05, 0.03, n=4)
+        for e in range(1, 9):
+            m.estiff(e, 2.1e6, 0.04375)
+        if doubled:
+            m.plbeam(10, 9, 10, 109, 110)  # the same rigid stage again
+        return m
+
+    single = spacar.support_stiffness(guide(False), 9, [1])
+    with pytest.warns(UserWarning, match=r"made the rigid deformation \d of element (9|10)\b.*redundant"):
+        doubled = spacar.support_stiffness(guide(True), 9, [1])
+    np.testing.assert_allclose(doubled, single, rtol=1e-9)
+    assert single[0, 0] == pytest.approx(24 * 0.04375 / 0.05**3, rel=2e-3)  # the guide's 24 EI/L³ (stage tilt)

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import spacar
+from support.planar_models import leaf_guide
 
 
 def planar_cantilever(n, L, EA, EI, kGA=None):
@@ -89,27 +90,3 @@ def test_a_short_leaf_spring_guide_follows_timoshenko():
     m = leaf_guide(L, D, n=4)
     leaf.apply(m, 1, shear=True)
     assert m.elements[1].estiff == pytest.approx([EA, EI, kGA])
-
-
-def leaf_guide(L, D, n):
-    """Two leaves of n PLBEAMs along y (x = 0 and x = D), clamped at the ground, welded to a rigid
-    stage (PLBEAM 2n + 1) whose x at node 2n + 1 is fixed: its support stiffness along x is the
-    drive stiffness of the guide."""
-    m = spacar.Model()
-    e = 0
-    for leaf, x0 in enumerate((0.0, D)):
-        base = 100 * leaf
-        for i in range(n):
-            e += 1
-            m.plbeam(e, base + 2 * i + 1, base + 2 * i + 2, base + 2 * i + 3, base + 2 * i + 4)
-            m.rlse(e)
-        for i in range(n + 1):
-            m.x(base + 2 * i + 1, x0, L * i / n)
-        m.fix(base + 1)
-        m.fix(base + 2)
-        for node in range(base + 3, base + 2 * n + (3 if leaf == 0 else 1)):  # leaf 2's top follows the stage
-            m.dynx(node)
-    top = 2 * n + 1
-    m.plbeam(e + 1, top, top + 1, 100 + top, 100 + top + 1)  # the rigid stage
-    m.fix(top, 1)
-    return m
