@@ -9,7 +9,8 @@ a spacar model, run it, and return side-by-side arrays.
 * :mod:`spacar.compare.exudyn_static` — static equilibria of planar flexure models (beams as
   exudyn's geometrically exact 2D beams, SolveStatic).
 
-Both need the optional extra ``compare`` (``pip install "spacar[compare]"``: exudyn and pin);
+Both need the optional extra ``compare`` (``pip install "spacar[compare]"``, from a clone
+``pip install ".[compare]"``: exudyn and pin);
 the submodules import their peer on first use, so ``import spacar.compare`` always works.
 What each converter supports is listed in its module docstring and in docs/comparison.md; a
 model outside that raises :class:`UnsupportedModelError` naming the node or element concerned;

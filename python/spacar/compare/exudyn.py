@@ -73,7 +73,7 @@ try:
         ObjectRigidBody2D,
     )
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
-    raise ImportError("spacar.compare.exudyn needs exudyn: pip install 'spacar[compare]'") from exc
+    raise ImportError("spacar.compare.exudyn needs exudyn: pip install 'spacar[compare]' (from a clone of spacar: pip install '.[compare]')") from exc
 
 from .. import _core
 from ._topology import (

@@ -40,7 +40,7 @@ try:
         Torque,
     )
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
-    raise ImportError("spacar.compare.exudyn_static needs exudyn: pip install 'spacar[compare]'") from exc
+    raise ImportError("spacar.compare.exudyn_static needs exudyn: pip install 'spacar[compare]' (from a clone of spacar: pip install '.[compare]')") from exc
 
 from ._topology import UnsupportedModelError
 

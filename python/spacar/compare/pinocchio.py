@@ -33,7 +33,7 @@ import numpy as np
 try:
     import pinocchio as pin
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
-    raise ImportError("spacar.compare.pinocchio needs Pinocchio: pip install 'spacar[compare]' (package pin)") from exc
+    raise ImportError("spacar.compare.pinocchio needs Pinocchio: pip install 'spacar[compare]' (from a clone of spacar: pip install '.[compare]') (package pin)") from exc
 
 from .. import _core
 from ._topology import UnsupportedModelError, analyse
