@@ -142,7 +142,7 @@ def test_every_analysis_honours_a_time_limit(large_beam, analysis):
     ARPACK's solves."""
     call = lambda: ANALYSES[analysis](large_beam)  # noqa: E731
     start = time.perf_counter()
-    with pytest.raises(spacar.TimeLimitError, match=r"the time limit of 0.001 s was exceeded \(in the"):
+    with pytest.raises(spacar.TimeLimitError, match=r"the time limit of 0.001 s was exceeded \(in "):  # where the deadline was seen
         call()
     assert time.perf_counter() - start < 3.0
     assert spacar.linearize(large_beam, time_limit=60).eigenfrequencies(3).shape == (3,)  # a fair limit passes
