@@ -229,8 +229,10 @@ def test_spacar_run_with_a_fifo_as_animation_says_so_and_does_not_hang(tmp_path)
     model.write_text((EXAMPLES / "slidercrank.dat").read_text().replace("END", "ANIMATE 1\nEND", 1))
     fifo = tmp_path / "out.gif"
     os.mkfifo(fifo)
+    from support.paths import spacar_env
+
     done = subprocess.run([sys.executable, "-m", "spacar", "run", str(model), "--animation", str(fifo)],
-                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
+                          capture_output=True, text=True, timeout=120, cwd=tmp_path, env=spacar_env())
     assert done.returncode == 1 and "not a regular file" in done.stderr, done.stderr
 
 

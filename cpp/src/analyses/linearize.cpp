@@ -288,12 +288,23 @@ void Linearizer::differenced_matrices(const System& sys, const ZState& zs, const
   lin.BK0 << dz.bottomRows(nk), dy.bottomRows(nk);
 }
 
-Linearization Linearizer::compute_at_rest(const System& sys, const Data& data) {
+Linearization Linearizer::compute_at_rest(const System& sys, Data& data) {
   if (!reduced_) throw Error("linearize: no state at rest in static equilibrium was linearized (compute_nodal)");
-  Data at = data;
-  at.sigma = nodal_sigma_;  // the static equilibrium's
-  at.qhat_dd.setZero();     // at rest: compute_nodal refused moving inputs
-  return compute(sys, at, Differences::None);
+  // The static equilibrium's stresses and q̈ = 0 (at rest: compute_nodal refused moving inputs) in
+  // place of the analysis' for this computation, swapped back whatever happens (data is not
+  // copied: it holds factorizations that were never computed).
+  Eigen::VectorXd sigma = nodal_sigma_, qhat_dd = Eigen::VectorXd::Zero(data.qhat_dd.size());
+  data.sigma.swap(sigma);
+  data.qhat_dd.swap(qhat_dd);
+  struct SwapBack {
+    Data& d;
+    Eigen::VectorXd &sigma, &qhat_dd;
+    ~SwapBack() {
+      d.sigma.swap(sigma);
+      d.qhat_dd.swap(qhat_dd);
+    }
+  } swap_back{data, sigma, qhat_dd};
+  return compute(sys, data, Differences::None);
 }
 
 Linearization Linearizer::compute(const System& sys, const Data& data, Differences differences) {

@@ -83,7 +83,7 @@ class Linearizer {
   // (positions, rates, transfer functions), with q̈ = 0 and the static stresses of compute_nodal
   // in place of the equations of motion, which a model without mass does not have (its M0 is 0;
   // K0, G0, DF are complete).
-  Linearization compute_at_rest(const System& sys, const Data& data);
+  Linearization compute_at_rest(const System& sys, Data& data);
   // After compute_nodal: H = the coefficients' combination of K, G, M, D at that state in the
   // saddle-point system (nodal.hpp), factorized; then solves over the free coordinates,
   // x_f = Z (Zᵀ H Z)⁻¹ Zᵀ b_f (ReducedSystem: refined in z). False if the values are not finite.
