@@ -844,31 +844,43 @@ def _ending(code) -> str:
 def _run_dask(client, payload, chunks, collect):
     """On a Dask cluster. The task is sent with each chunk (not scattered once: a scattered copy
     dies with the workers that hold it, and the chunks could not be rerun on their successors), so
-    that Dask reruns the chunks of a dead worker on the others. A chunk that killed every worker
-    that ran it (KilledWorker) is split into single cases, and only the case that does it again
-    fails, with Dask's account of it."""
+    that Dask reruns the chunks of a dead worker on the others. Dask gives up on a task when the
+    workers running it died several times (KilledWorker), which also befalls tasks that merely
+    shared a worker with the culprit: such chunks are split into single cases, and each single case
+    given up on is run once more alone on the cluster, after the rest, where only a case that kills
+    its workers by itself fails, with Dask's account of it."""
     from distributed import as_completed
 
     def submit(chunk):
         return client.submit(_run_chunk, payload, chunk, pure=False)
 
+    def killed(err):
+        return type(err).__name__ == "KilledWorker"
+
     futures = [submit(chunk) for chunk in chunks]
     owner = {future.key: chunk for future, chunk in zip(futures, chunks)}
     running = as_completed(futures)
+    suspects = []
     for future in running:
         chunk = owner.pop(future.key)
         try:
             collect(chunk, future.result())
         except Exception as err:  # noqa: BLE001 - a worker that died, a lost connection
-            if len(chunk) > 1 and type(err).__name__ == "KilledWorker":
+            if killed(err) and len(chunk) > 1:
                 for case in chunk:
                     again = submit([case])
                     owner[again.key] = [case]
                     running.add(again)
+            elif killed(err):
+                suspects.append(chunk)
             else:
-                why = ("killed every Dask worker that ran it" if type(err).__name__ == "KilledWorker"
-                       else "could not be run by the cluster")
-                collect(chunk, _lost(chunk, f"this case {why}: {err}", err))
+                collect(chunk, _lost(chunk, f"this case could not be run by the cluster: {err}", err))
+    for chunk in suspects:  # one at a time: nothing else runs beside it
+        try:
+            collect(chunk, submit(chunk).result())
+        except Exception as err:  # noqa: BLE001
+            why = "killed every Dask worker that ran it, alone" if killed(err) else "could not be run by the cluster"
+            collect(chunk, _lost(chunk, f"this case {why}: {err}", err))
 
 
 def _gather(task, names, cases, grid, outcomes, wall_time) -> SweepResult:
