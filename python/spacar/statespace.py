@@ -20,7 +20,7 @@ import numpy as np
 from . import _core
 from ._util import show, time_limited
 from .errors import InputError, SingularMassError
-from .linearize import Linearization, _count, linearized_simulation, second_order_eigenvalues
+from .linearize import Linearization, _count, _modal_basis, linearized_simulation, second_order_eigenvalues
 from .model import Model, Signal
 
 INPUT_KEYWORDS = ("INPUTF", "INPUTS")
@@ -344,16 +344,15 @@ def _add_damping(ss: StateSpace, ratios, alpha: float, beta: float) -> StateSpac
 
 
 def _mass_normalized_modes(M, K):
-    """(ω², Φ) of K φ = ω² M φ, sorted by |ω²|, with Φᵀ M Φ = I. The modes of a symmetric problem
-    only: a stiffness made unsymmetric by a moving state (N0) or follower loads has no such basis."""
-    import scipy.linalg
-
-    scale = max(float(np.abs(K).max()), 1e-300)
-    if np.abs(K - K.T).max() > 1e-10 * scale or np.abs(M - M.T).max() > 1e-10 * max(float(np.abs(M).max()), 1e-300):
+    """(ω², Φ) of K φ = ω² M φ, sorted by |ω²|, with Φᵀ M Φ = I (linearize's modal basis). The modes
+    of a symmetric problem only: a stiffness made unsymmetric by a moving state (N0) or follower
+    loads has no such basis."""
+    basis = _modal_basis(M, K)
+    if basis is None:
         raise InputError("state_space: modal damping and the modal reduction need the symmetric undamped problem "
                          "(K0 + N0 + G0 symmetric, as at rest without follower loads); this stiffness is not "
                          "symmetric: use rayleigh= or EDAMPP, and reduce(method='balanced')")
-    w2, phi = scipy.linalg.eigh(K, M)
+    w2, phi = basis
     order = np.argsort(np.abs(w2))
     return w2[order], phi[:, order]
 

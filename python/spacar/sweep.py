@@ -338,6 +338,10 @@ def _run_case(task: _Task, params: dict, index: int = 0):
     return values, labels, model.warnings[n_warnings:]
 
 
+# The outcome's payload of a case that a Ctrl-C kept from running.
+_NOT_RUN = ("KeyboardInterrupt", "not run: the sweep was interrupted")
+
+
 def _run_cases(task: _Task, cases: list, cancel=None) -> list:
     """Run the cases [(index, params)]; returns [(index, ok, payload, seconds)] with payload
     (values, labels, warnings) or, for a failed case, (exception type name, message). Once
@@ -346,7 +350,7 @@ def _run_cases(task: _Task, cases: list, cancel=None) -> list:
     for index, params in cases:
         start = time.perf_counter()
         if cancel is not None and cancel.cancelled:
-            out.append((index, False, ("KeyboardInterrupt", "not run: the sweep was interrupted"), math.nan))
+            out.append((index, False, _NOT_RUN, math.nan))
             continue
         try:
             with cancel.watch() if cancel is not None else contextlib.nullcontext():
@@ -704,7 +708,7 @@ def sweep(model, parameters, *, analysis="simulate", outputs=None, method: str =
         # milliseconds), what is done is kept, as err.results.
         cancel.cancel()
         for i in range(n):
-            outcomes.setdefault(i, (False, ("KeyboardInterrupt", "not run: the sweep was interrupted"), math.nan))
+            outcomes.setdefault(i, (False, _NOT_RUN, math.nan))
         err.results = _gather(task, names, cases, grid, outcomes, time.perf_counter() - start)
         err.results.workers = n_workers
         raise
