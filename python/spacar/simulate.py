@@ -5,6 +5,8 @@ import re
 import threading
 import time
 import weakref
+import functools
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -38,9 +40,11 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     stats["switches"] = [tuple(s) for s in arrays["switches"]]
     coords, defs = system.coord_label, system.def_label  # each a fresh copy of the list: taken once
     lins = [Linearization(d, coords, defs) for d in arrays["linearizations"]]
-    res = Results(arrays, coords, defs, stats, None, lins, model.settings.linear,
-                  dof_labels(system, model.core, coords, defs))
-    res._geometry_source = model.core.copy()  # res.geometry is built from this copy when first used
+    res = Results(arrays, coords, defs, stats, None, lins, model.settings.linear)
+    res._geometry_source = core = model.core.copy()  # res.geometry is built from this copy when first used
+    # The DOF labels, when first asked for, from the compiled system's lists and the copy.
+    dofs = SimpleNamespace(x_dyn=system.x_dyn, e_dyn=system.e_dyn)
+    res._set_dofs(functools.partial(dof_labels, dofs, core, coords, defs))
     if "energy" in arrays:
         res._energy = Energy(res.t, arrays["energy"])
     return res

@@ -16,6 +16,7 @@ limit points::
 from __future__ import annotations
 
 import numbers
+from functools import partial
 from types import SimpleNamespace
 
 import numpy as np
@@ -45,14 +46,15 @@ def _results(arrays: dict, model) -> Results:
         "limit_points": [float(v) for v in arrays["limit_points"]],
         "wall_time": float(arrays["wall_time"]),
     }
-    # The degrees of freedom of the system the solve compiled; its labels converted once.
-    coords, defs = arrays["coord_label"].tolist(), arrays["def_label"].tolist()
-    system = SimpleNamespace(coord_label=coords, def_label=defs, x_dyn=arrays["x_dyn"], e_dyn=arrays["e_dyn"])
-    res = Results(table, coords, defs, stats, dof_labels=dof_labels(system, model.core))
+    res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
     # A copy of the model at the end of the solve: res.geometry is built from it when first used,
     # and spacar.compliance(res, node) takes the loads and elements from it (not pickled).
     res._geometry_source = core = model.core.copy()
     res._static_model = Model._of_core(core)
+    # The degrees of freedom of the system the solve compiled, labelled when first asked for.
+    system = SimpleNamespace(coord_label=arrays["coord_label"], def_label=arrays["def_label"],
+                             x_dyn=arrays["x_dyn"], e_dyn=arrays["e_dyn"])
+    res._set_dofs(partial(dof_labels, system, core))
     return res
 
 
