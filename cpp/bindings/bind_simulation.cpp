@@ -156,7 +156,7 @@ void bind_setup(py::class_<Simulation>& sim) {
            "`time_spent` are spent.")
       .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
-      .def("assemble", &Simulation::assemble)
+      .def("assemble", [](Simulation& s) { s.assemble(); })
       .def("forces", &Simulation::forces)
       .def("reduced_accelerations", &Simulation::reduced_accelerations);
 }

@@ -37,12 +37,18 @@ namespace {
 void add_outer(const Eigen::MatrixXd& B, int a, const double* r, Eigen::Index stride, double scale,
                Eigen::MatrixXd& out) {
   const int n = static_cast<int>(B.cols());
+  // B's row a copied to a contiguous array first: the column updates then vectorize (read
+  // through B's stride, and with `out` possibly aliasing it, they did not).
+  double stack[32];
+  std::vector<double> heap(n > 32 ? n : 0);
+  double* row = n > 32 ? heap.data() : stack;
+  for (int i = 0; i < n; ++i) row[i] = B(a, i);
   double* o = out.data();
   for (int j = 0; j < n; ++j) {
     const double rj = scale * r[j * stride];
     if (rj == 0.0) continue;
     double* column = o + static_cast<Eigen::Index>(j) * n;
-    for (int i = 0; i < n; ++i) column[i] += B(a, i) * rj;
+    for (int i = 0; i < n; ++i) column[i] += row[i] * rj;
   }
 }
 
@@ -306,8 +312,13 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
   for (int k = 0; k < sys.ne; ++k) symmetric_ = symmetric_ && !sys.def_velocity_level[k];
   for (const SystemElement& se : sys.elements) symmetric_ = symmetric_ && symmetric_constitutive(sys, se, layout);
   kkt_.reset(n_, n_);
+  element_scale_start_.push_back(0);
+  std::vector<int> fi, cr;  // an element's free indices and constraint rows (reused)
   for (const SystemElement& se : sys.elements) {
-    std::vector<int> fi(se.coords.size()), cr(se.nd);
+    for (int g : se.coords) element_scale_.push_back(layout.free_of[g] >= 0 ? layout.scale[layout.free_of[g]] : 1.0);
+    element_scale_start_.push_back(static_cast<int>(element_scale_.size()));
+    fi.resize(se.coords.size());
+    cr.resize(se.nd);
     bool any_row = false;
     for (size_t j = 0; j < se.coords.size(); ++j) fi[j] = layout.free_of[se.coords[j]];
     for (int a = 0; a < se.nd; ++a) {
@@ -343,8 +354,12 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
   // that no pivot is structurally zero (nodal.hpp).
   std::vector<int> order(n_);
   if (n_ > 0) {
+    // The pattern is symmetric as registered (each element's block, its rows of A and their
+    // transpose): AMD runs on it directly, without Eigen's A + Aᵀ (a sparse transpose and sum,
+    // a quarter of the set-up's ordering).
     Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
-    Eigen::AMDOrdering<int>()(A, perm);
+    Eigen::SparseMatrix<double> pattern = A;
+    Eigen::internal::minimum_degree_ordering(pattern, perm);
     for (int k = 0; k < n_; ++k) order[k] = perm.indices()[k];  // step → index
   }
   std::vector<double> key(n_);
@@ -374,8 +389,9 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
     add_constitutive(sys, se, data.work[i].B, se.S, c.stiffness, &layout_, local_);
     add_constitutive(sys, se, data.work[i].B, se.D, c.damping, &layout_, local_);
     const int n = static_cast<int>(se.coords.size());
+    const double* sc = element_scale_.data() + element_scale_start_[i];
     for (int b = 0; b < n; ++b)
-      for (int a = 0; a < n; ++a) local_(a, b) *= scale_of(se.coords[a]) * scale_of(se.coords[b]);
+      for (int a = 0; a < n; ++a) local_(a, b) *= sc[a] * sc[b];
     kkt_.add(element_block_[i], local_);
   }
   if (c.mass != 0.0) {

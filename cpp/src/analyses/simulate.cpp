@@ -131,13 +131,24 @@ void Simulation::step_start(double t, const Eigen::VectorXd& Y) {
   run_.anchor.exact = solved_dofs(run_.base, Y);
 }
 
-void Simulation::assemble() {
+void Simulation::assemble(ExplicitChain* chain) {
   const System& sys = *sys_;
   set_inputs(sys, *data_, sys.t0);
   apply_time_loads(sys.t0);
   set_dofs(sys, *data_, sys.q0.data(), sys.qd0.data());
   check_constraint_counts(sys, *data_);
-  solve_positions(sys, *data_, sys.settings.maxiterat, simulation_kinematic_tolerance(sys), true);
+  const double tol = simulation_kinematic_tolerance(sys);
+  bool solved = false;
+  if (chain) {
+    const Eigen::VectorXd start = data_->x;
+    try {
+      chain->solve_positions(sys, *data_, std::max(sys.settings.maxiterat, 50), tol);
+      solved = true;
+    } catch (const KinematicsError&) {
+      data_->x = start;  // the general iteration from the given positions, with its diagnosis
+    }
+  }
+  if (!solved) solve_positions(sys, *data_, sys.settings.maxiterat, tol, true);
   run_.base = run_.anchor = Solved();
   run_.base.x = data_->x;  // positions only: no velocities yet for the predictor
   run_.base.angle_ref = data_->angle_ref;

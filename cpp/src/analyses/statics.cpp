@@ -28,9 +28,11 @@ namespace {
 // represented on the coordinates and the solution read back in q.
 class EquilibriumPath {
  public:
-  EquilibriumPath(const System& sys, Data& data, const StaticOptions& opt, StaticResults& res)
+  // `chain`: the system's open chain (ExplicitChain::detect), or nullptr.
+  EquilibriumPath(const System& sys, Data& data, const StaticOptions& opt, StaticResults& res,
+                  std::unique_ptr<ExplicitChain> chain)
       : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()), reduced_(sys, data), tangent_(reduced_.saddle()),
-        chain_(ExplicitChain::detect(sys)), scale_(dof_scale(sys)) {
+        chain_(std::move(chain)), scale_(dof_scale(sys)) {
     // Inputs at the block start (λ = 0) and end (λ = 1), ordered as input_cols.
     const double tp = sys.settings.timestep_tp;
     p0_ = sys.p0;
@@ -63,7 +65,7 @@ class EquilibriumPath {
     Eigen::VectorXd qhat = with_inputs(data_.qhat, lambda);
     Eigen::VectorXd R, dq, dx;
     double last_correction = std::numeric_limits<double>::infinity();
-    int start_sign = 0;
+    int start_sign = 0, last_sign = 0;
     bool crossed = false;
     for (int it = 0;; ++it) {
       check_thread_deadline("(in the static analysis)");
@@ -73,9 +75,29 @@ class EquilibriumPath {
         a.why = std::string("the kinematics has no solution there (") + err.what() + ")";
         return a;
       }
-      const double force = evaluate_here(lambda, R);
+      const double force = forces_here(lambda, R);
       const Eigen::VectorXd Rs = scale_.cwiseProduct(R);
-      if (!Rs.allFinite() || !factorized_) {
+      if (!Rs.allFinite()) {
+        a.why = "the forces or the stiffness are not finite";
+        return a;
+      }
+      // Converged on the residual after an iteration: the tangent of the last iterate, one
+      // Newton correction away (about √tolerance relative), stands for this state's in the
+      // checks of its determinant's sign and of stability (indefinite()), and the factorization
+      // at the solution (a sixth of the work of a solve in five iterations) is not made.
+      if (it > 0 && nd_ > 0 && factorized_) {
+        const double r = Rs.cwiseAbs().maxCoeff();
+        if (r <= opt_.tolerance * force || (last_correction <= 1e-12 && r <= 1e-6 * force)) {
+          if (crossed && last_sign == start_sign) {
+            a.why = "past a limit point: the only equilibrium found lies on a distant branch (a snap-through)";
+            return a;
+          }
+          a.converged = true;
+          return a;
+        }
+      }
+      factorize_here(lambda);
+      if (!factorized_) {
         a.why = "the forces or the stiffness are not finite";
         return a;
       }
@@ -83,6 +105,7 @@ class EquilibriumPath {
       const int sign = singular || nd_ == 0 ? 0 : tangent_.sign_determinant();
       if (it == 0) start_sign = sign;
       else if (sign != start_sign) crossed = true;
+      last_sign = sign;
       if (crossed && !last_chance) {
         a.why = "the tangent stiffness changes the sign of its determinant within the step (a limit or "
                 "bifurcation point)";
@@ -206,13 +229,20 @@ class EquilibriumPath {
   // The state at the current positions for load factor λ: R − (1 − λ) R0 and the tangent
   // factorized.
   double evaluate_here(double lambda, Eigen::VectorXd& R, Eigen::VectorXd* full_load = nullptr) {
+    const double force = forces_here(lambda, R, full_load);
+    factorize_here(lambda);
+    return force;
+  }
+  double forces_here(double lambda, Eigen::VectorXd& R, Eigen::VectorXd* full_load = nullptr) {
     const double force = static_forces(sys_, data_, lambda, R, nullptr, full_load, chain_.get());
     R -= (1.0 - lambda) * R0_;
+    return force;
+  }
+  void factorize_here(double lambda) {
     NodalCoefficients c;
     c.load_factor = lambda;
     check_thread_deadline("(in the static analysis)");
     factorized_ = reduced_.factorize(data_.sigma, c);
-    return force;
   }
 
   // dq = K⁻¹ v and dx = DF_q dq for a vector v of generalized forces of the DOFs (ReducedSystem),
@@ -687,9 +717,10 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
                  "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
                      std::to_string(sys.ne) + " deformations in " + std::to_string(n) + " load steps",
                  opt.arc_length ? "allow fewer steps (max_steps)" : "use fewer load steps");
-  sim.assemble();
+  std::unique_ptr<ExplicitChain> chain = ExplicitChain::detect(sys);
+  sim.assemble(chain.get());
   data.t = sys.t0;
-  EquilibriumPath path(sys, data, opt, res);
+  EquilibriumPath path(sys, data, opt, res, std::move(chain));
   path.start();
   Rows rows(sys, data, path, res, n);
   try {

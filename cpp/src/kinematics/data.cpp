@@ -37,8 +37,15 @@ Data::Data(const System& sys) {
   rhs = qdd = Eigen::VectorXd::Zero(nd);
   body_M.assign(sys.bodies.size(), Eigen::Matrix4d::Zero());
   body_h.assign(sys.bodies.size(), Eigen::Vector4d::Zero());
-  build_constraint_blocks(sys);
   number_equations_of_motion(sys);
+}
+
+void Data::ensure_constraint_blocks(const System& sys) {
+  if (constraint_blocks_ready) return;
+  AP_block.clear();
+  AV_block.clear();
+  build_constraint_blocks(sys);
+  constraint_blocks_ready = true;
 }
 
 void Data::build_constraint_blocks(const System& sys) {

@@ -102,6 +102,7 @@ void factorize_velocity_block(const System& sys, Data& data) {
 }  // namespace
 
 void assemble_block(const System& sys, Data& data, BlockMatrix& A, const std::vector<int>& block) {
+  data.ensure_constraint_blocks(sys);  // (A and block are members of data: built in place)
   A.set_zero();
   for (size_t i = 0; i < sys.elements.size(); ++i) A.add(block[i], data.work[i].B);
 }

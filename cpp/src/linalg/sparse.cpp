@@ -7,13 +7,23 @@
 namespace spacar {
 
 void BlockMatrix::reset(int rows, int cols) {
-  blocks_.clear();
+  rows_.clear();
+  cols_.clear();
+  row_start_.assign(1, 0);
+  col_start_.assign(1, 0);
+  entry_start_.assign(1, 0);
+  value_.clear();
+  local_.clear();
+  local_transposed_.clear();
   A_.resize(rows, cols);
 }
 
 int BlockMatrix::add_block(const std::vector<int>& rows, const std::vector<int>& cols) {
-  blocks_.push_back({rows, cols, {}, {}, {}});
-  return static_cast<int>(blocks_.size()) - 1;
+  rows_.insert(rows_.end(), rows.begin(), rows.end());
+  cols_.insert(cols_.end(), cols.begin(), cols.end());
+  row_start_.push_back(static_cast<int>(rows_.size()));
+  col_start_.push_back(static_cast<int>(cols_.size()));
+  return static_cast<int>(row_start_.size()) - 2;
 }
 
 // The pattern and every block entry's value position in O(entries), column by column, from a
@@ -23,24 +33,29 @@ int BlockMatrix::add_block(const std::vector<int>& rows, const std::vector<int>&
 // [slot(j) · stored rows + place of i among the stored rows].
 void BlockMatrix::finalize() {
   const int n_rows = rows(), n_cols = cols();
-  const int n_blocks = static_cast<int>(blocks_.size());
+  const int n_blocks = static_cast<int>(row_start_.size()) - 1;
   struct Ref {
     int block, slot;  // the block, and the place of its local column among its stored columns
   };
   // Each block's stored local rows (stored[stored_start[k] ...]), and per column the count of
-  // rows and of (block, slot) pairs.
+  // rows and of (block, slot) pairs; each block's first entry.
   std::vector<int> stored, stored_start(n_blocks + 1, 0);
   std::vector<int> row_start(n_cols + 1, 0), ref_start(n_cols + 1, 0);
+  stored.reserve(rows_.size());
+  entry_start_.assign(n_blocks + 1, 0);
   for (int k = 0; k < n_blocks; ++k) {
-    const Block& b = blocks_[k];
-    for (int i = 0; i < static_cast<int>(b.rows.size()); ++i)
-      if (b.rows[i] >= 0) stored.push_back(i);
+    for (int i = 0; i < n_local_rows(k); ++i)
+      if (rows_[row_start_[k] + i] >= 0) stored.push_back(i);
     stored_start[k + 1] = static_cast<int>(stored.size());
-    for (int c : b.cols)
-      if (c >= 0) {
-        row_start[c + 1] += stored_start[k + 1] - stored_start[k];
+    const int n_own = stored_start[k + 1] - stored_start[k];
+    int n_cols_stored = 0;
+    for (int j = col_start_[k]; j < col_start_[k + 1]; ++j)
+      if (const int c = cols_[j]; c >= 0) {
+        row_start[c + 1] += n_own;
         ++ref_start[c + 1];
+        ++n_cols_stored;
       }
+    entry_start_[k + 1] = entry_start_[k] + n_own * n_cols_stored;
   }
   // Counts (in [c + 1]) to offsets.
   std::partial_sum(row_start.begin(), row_start.end(), row_start.begin());
@@ -48,24 +63,23 @@ void BlockMatrix::finalize() {
   std::vector<int> rows_in(row_start.back());
   std::vector<Ref> refs(ref_start.back());
   std::vector<int> row_fill(row_start.begin(), row_start.end() - 1), ref_fill(ref_start.begin(), ref_start.end() - 1);
+  value_.assign(entry_start_.back(), 0);
+  local_.assign(entry_start_.back(), 0);
+  local_transposed_.assign(entry_start_.back(), 0);
   for (int k = 0; k < n_blocks; ++k) {
-    Block& b = blocks_[k];
-    const int nr = static_cast<int>(b.rows.size()), nc = static_cast<int>(b.cols.size());
+    const int* rows = rows_.data() + row_start_[k];
+    const int nr = n_local_rows(k), nc = col_start_[k + 1] - col_start_[k];
     const int* own = stored.data() + stored_start[k];
     const int n_own = stored_start[k + 1] - stored_start[k];
-    const auto n_cols_stored = std::count_if(b.cols.begin(), b.cols.end(), [](int c) { return c >= 0; });
-    b.local.resize(static_cast<size_t>(n_own) * n_cols_stored);
-    b.local_transposed.resize(b.local.size());
-    b.value.resize(b.local.size());
     int slot = 0;
     for (int j = 0; j < nc; ++j) {
-      const int c = b.cols[j];
+      const int c = cols_[col_start_[k] + j];
       if (c < 0) continue;
       for (int a = 0; a < n_own; ++a) {
-        const int i = own[a], e = slot * n_own + a;
-        rows_in[row_fill[c]++] = b.rows[i];
-        b.local[e] = i + j * nr;
-        b.local_transposed[e] = j + i * nc;
+        const int i = own[a], e = entry_start_[k] + slot * n_own + a;
+        rows_in[row_fill[c]++] = rows[i];
+        local_[e] = i + j * nr;
+        local_transposed_[e] = j + i * nc;
       }
       refs[ref_fill[c]++] = {k, slot++};
     }
@@ -90,11 +104,12 @@ void BlockMatrix::finalize() {
   for (int c = 0; c < n_cols; ++c) {
     for (int p = outer[c]; p < outer[c + 1]; ++p) position[inner[p]] = p;
     for (int q = ref_start[c]; q < ref_start[c + 1]; ++q) {
-      Block& b = blocks_[refs[q].block];
-      const int* own = stored.data() + stored_start[refs[q].block];
-      const int n_own = stored_start[refs[q].block + 1] - stored_start[refs[q].block];
-      int* value = b.value.data() + static_cast<size_t>(refs[q].slot) * n_own;
-      for (int a = 0; a < n_own; ++a) value[a] = position[b.rows[own[a]]];
+      const int k = refs[q].block;
+      const int* rows = rows_.data() + row_start_[k];
+      const int* own = stored.data() + stored_start[k];
+      const int n_own = stored_start[k + 1] - stored_start[k];
+      int* value = value_.data() + entry_start_[k] + refs[q].slot * n_own;
+      for (int a = 0; a < n_own; ++a) value[a] = position[rows[own[a]]];
     }
   }
 }
@@ -102,24 +117,21 @@ void BlockMatrix::finalize() {
 void BlockMatrix::set_zero() { std::fill(A_.valuePtr(), A_.valuePtr() + A_.nonZeros(), 0.0); }
 
 void BlockMatrix::add(int id, const Eigen::MatrixXd& local) {
-  const Block& b = blocks_[id];
   double* v = A_.valuePtr();
   const double* l = local.data();
-  for (size_t t = 0; t < b.value.size(); ++t) v[b.value[t]] += l[b.local[t]];
+  for (int t = entry_start_[id]; t < entry_start_[id + 1]; ++t) v[value_[t]] += l[local_[t]];
 }
 
 void BlockMatrix::add_value(int id, int a, int b, double v) {
-  const Block& k = blocks_[id];
-  const int entry = a + b * static_cast<int>(k.rows.size());
-  for (size_t t = 0; t < k.local.size(); ++t)
-    if (k.local[t] == entry) A_.valuePtr()[k.value[t]] += v;
+  const int entry = a + b * n_local_rows(id);
+  for (int t = entry_start_[id]; t < entry_start_[id + 1]; ++t)
+    if (local_[t] == entry) A_.valuePtr()[value_[t]] += v;
 }
 
 void BlockMatrix::add_transposed(int id, const Eigen::MatrixXd& local) {
-  const Block& b = blocks_[id];
   double* v = A_.valuePtr();
   const double* l = local.data();
-  for (size_t t = 0; t < b.value.size(); ++t) v[b.value[t]] += l[b.local_transposed[t]];
+  for (int t = entry_start_[id]; t < entry_start_[id + 1]; ++t) v[value_[t]] += l[local_transposed_[t]];
 }
 
 void LinearSolver::analyze(const Eigen::SparseMatrix<double>& A) {

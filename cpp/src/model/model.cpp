@@ -549,6 +549,7 @@ void Model::add_automatic_constraints() {
   std::map<int, bool> has_constraint;
   for (const auto& [id, n] : nodes)
     if (n.kind == NodeKind::Lambda) has_constraint[id] = false;
+  if (has_constraint.empty()) return;  // a planar or point model: no walk over the elements
   const int l2 = automatic_element_type();
   for (const auto& [id, el] : elements)
     if (el.type == l2) has_constraint[el.nodes[0]] = true;
@@ -570,10 +571,11 @@ void Model::add_automatic_constraints() {
 }
 
 void Model::compute_reference_geometry() {
+  std::vector<double> xref;  // one buffer for all elements
   for (auto& [id, el] : elements) {
     const ElementType& t = type_of(el);
     if (!t.reference) continue;
-    std::vector<double> xref;
+    xref.clear();
     for (int nid : el.nodes) {
       const Node& n = nodes.at(nid);
       if (n.kind == NodeKind::Beta) xref.push_back(0.0);

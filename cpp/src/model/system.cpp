@@ -1,5 +1,6 @@
 #include "spacar/model/system.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -41,10 +42,25 @@ int free_rotation_dependent(const Node& n, const std::map<int, int>& dependent) 
   return n_dyn == 4 || std::abs(n.x[calc]) < 0.5 ? best : calc;
 }
 
-void number_coordinates(const Model& model, System& sys, std::map<int, int>& node_offset,
+// The first coordinate of each node: node ids ascending (the order of model.nodes) beside
+// their offsets, searched by bisection (a std::map's nodes cost a cache miss each, and the
+// compilation of a large model looked up every element's nodes in one).
+struct NodeOffsets {
+  std::vector<int> ids, offsets;
+  int at(int id) const {
+    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
+    if (it == ids.end() || *it != id) throw Error("compile(): node " + std::to_string(id) + " is not defined");
+    return offsets[it - ids.begin()];
+  }
+};
+
+void number_coordinates(const Model& model, System& sys, NodeOffsets& node_offset,
                         const std::map<int, int>& dependent) {
+  node_offset.ids.reserve(model.nodes.size());
+  node_offset.offsets.reserve(model.nodes.size());
   for (const auto& [id, n] : model.nodes) {
-    node_offset[id] = sys.nx;
+    node_offset.ids.push_back(id);
+    node_offset.offsets.push_back(sys.nx);
     const int dep = free_rotation_dependent(n, dependent);
     if (dep >= 0) sys.free_rotations.push_back({id, sys.nx, dep, {}});
     for (int i = 0; i < node_size(n.kind); ++i) {
@@ -59,7 +75,7 @@ void number_coordinates(const Model& model, System& sys, std::map<int, int>& nod
   }
 }
 
-void build_elements(const Model& model, System& sys, const std::map<int, int>& node_offset, bool line_as_dof) {
+void build_elements(const Model& model, System& sys, const NodeOffsets& node_offset, bool line_as_dof) {
   for (const auto& [id, el] : model.elements) {
     const ElementType& t = element_catalogue()[el.type];
     ElementSetup setup;
@@ -181,11 +197,13 @@ void initial_values(const Model& model, System& sys) {
     for (double v : n.x) x0[g++] = v;
   Eigen::VectorXd e_geom(sys.ne), e_given(sys.ne), ed(sys.ne), edd(sys.ne);
   std::vector<bool> given(sys.ne, false);
+  std::vector<double> xl;
+  auto model_element = model.elements.begin();  // sys.elements are in the order of model.elements
   for (const SystemElement& se : sys.elements) {
-    Eigen::VectorXd xl(se.coords.size());
+    xl.resize(se.coords.size());
     for (size_t i = 0; i < se.coords.size(); ++i) xl[i] = x0[se.coords[i]];
     se.kernel->deformations(xl.data(), e_geom.data() + se.def_offset);
-    const Element& el = model.elements.at(se.id);
+    const Element& el = (model_element++)->second;
     for (int i = 0; i < se.nd; ++i) {
       e_given[se.def_offset + i] = el.e[i];
       given[se.def_offset + i] = el.e_given[i];
@@ -246,7 +264,7 @@ void initial_values(const Model& model, System& sys) {
   for (size_t i = 0; i < sys.y_defs.size(); ++i) sys.y0[i] = sys.e_target[sys.y_defs[i]];
 }
 
-void masses_and_loads(const Model& model, System& sys, const std::map<int, int>& node_offset) {
+void masses_and_loads(const Model& model, System& sys, const NodeOffsets& node_offset) {
   sys.point_mass = Eigen::VectorXd::Zero(sys.nx);
   sys.force = Eigen::VectorXd::Zero(sys.nx);
   for (const auto& [id, n] : model.nodes) {
@@ -288,7 +306,7 @@ std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& de
   if (!model.frozen()) throw Error("compile(): the model has not been prepared (call Model::prepare())");
   auto sys = std::make_unique<System>();
   sys->settings = model.settings;
-  std::map<int, int> node_offset;
+  NodeOffsets node_offset;
   number_coordinates(model, *sys, node_offset, dependent);
   build_elements(model, *sys, node_offset, line_as_dof);
   partition(*sys);

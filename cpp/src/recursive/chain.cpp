@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <sstream>
 
 #include "spacar/errors.hpp"
@@ -100,6 +101,15 @@ ExplicitChain::Block ExplicitChain::make_block(const System& sys, const std::vec
   Block b;
   b.elements = group;
   b.coords = U;
+  size_t n_rows = 0, n_terms = 0;  // reserved: a long chain makes thousands of blocks
+  for (int i : group) {
+    const size_t rows = position_rows(sys, i);
+    n_rows += rows;
+    n_terms += rows * sys.elements[i].coords.size();
+  }
+  b.rows.reserve(n_rows);
+  b.unknown_terms.reserve(n_terms);
+  b.known_terms.reserve(n_terms);
   for (size_t s = 0; s < group.size(); ++s) {
     const SystemElement& se = sys.elements[group[s]];
     for (int a = 0; a < se.nd; ++a) {
@@ -140,7 +150,6 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
   auto chain = std::unique_ptr<ExplicitChain>(new ExplicitChain());
   std::vector<int> pending;
   std::vector<char> is_pending(sys.elements.size(), 0);
-  std::vector<std::vector<int>> touching(sys.nx);  // the pending elements on each coordinate
   for (int i = 0; i < static_cast<int>(sys.elements.size()); ++i) {
     if (position_rows(sys, i) == 0) {
       chain->rest_.push_back(i);
@@ -148,7 +157,18 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
     }
     pending.push_back(i);
     is_pending[i] = 1;
-    for (int g : sys.elements[i].coords) touching[g].push_back(i);
+  }
+  // The pending elements on each coordinate g: touching[touching_start[g] ...] (one array, not
+  // a vector per coordinate).
+  std::vector<int> touching_start(sys.nx + 1, 0), touching;
+  for (int i : pending)
+    for (int g : sys.elements[i].coords) ++touching_start[g + 1];
+  std::partial_sum(touching_start.begin(), touching_start.end(), touching_start.begin());
+  touching.resize(touching_start.back());
+  {
+    std::vector<int> fill(touching_start.begin(), touching_start.end() - 1);
+    for (int i : pending)
+      for (int g : sys.elements[i].coords) touching[fill[g]++] = i;
   }
   // Greedy: an element whose rows, with those of the pending elements whose unknowns lie within
   // its own (the L2MIN1 of a rotation it reaches), are as many as its unknowns determines them.
@@ -159,7 +179,8 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
     std::vector<int> group{i};
     int rows = position_rows(sys, i);
     for (int g : U)
-      for (int j : touching[g]) {
+      for (int t = touching_start[g]; t < touching_start[g + 1]; ++t) {
+        const int j = touching[t];
         if (alone || j == i || !is_pending[j] || std::find(group.begin(), group.end(), j) != group.end()) continue;
         const std::vector<int> Uj = unknown_coords(sys, known, j);
         const bool inside = !Uj.empty() && std::all_of(Uj.begin(), Uj.end(), [&](int c) {

@@ -128,6 +128,10 @@ class SaddlePoint {
   BlockMatrix kkt_;
   std::vector<int> element_block_, row_block_, column_block_, point_block_, body_block_, torque_block_;
   std::vector<int> diagonal_;    // value position of each diagonal entry (free part)
+  // The scale of each element's coordinates (layout.scale; 1 where not free), element i's from
+  // element_scale_[element_scale_start_[i]].
+  std::vector<double> element_scale_;
+  std::vector<int> element_scale_start_;
   SparseLDLT ldlt_;
   LinearSolver lu_;
   bool singular_ = false;

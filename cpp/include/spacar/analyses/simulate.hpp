@@ -202,8 +202,10 @@ class Simulation {
   Data& data() { return *data_; }
 
   // Assemble at the block start: inputs at t0, DOFs at their initial values, Newton on the
-  // calculable coordinates (with the relaxed limits of an initial assembly).
-  void assemble();
+  // calculable coordinates (with the relaxed limits of an initial assembly). `chain`: the
+  // system's open chain (ExplicitChain::detect), solved element by element instead (the
+  // general Newton's iteration if it fails there).
+  void assemble(ExplicitChain* chain = nullptr);
   // Where Newton's iterations on the positions start (the predictor).
   enum class Start {
     Taylor,    // the last solved state advanced by a second-order Taylor step in time

@@ -30,6 +30,10 @@ struct Data {
   // ordering) on first use: the recursive path's runs never solve them.
   void ensure_equations_of_motion(const System& sys);
   bool equations_ready = false;
+  // Build the constraint blocks AP, AV (pattern and ordering) on first use (assemble_block):
+  // the open chains' kinematics and statics never assemble them.
+  void ensure_constraint_blocks(const System& sys);
+  bool constraint_blocks_ready = false;
   // Bytes an analysis of `sys` allocates on the sparse path (vectors, element work arrays, the
   // constraint blocks and the equations of motion with room for the fill of their factors), and
   // in addition for the dense matrices of ensure_dense (transfer functions, mass matrices, the
@@ -55,7 +59,7 @@ struct Data {
   Eigen::VectorXd e_integrated; // current values of the integrated deformations y (ne; others unused)
   Eigen::VectorXd angle_ref;    // last value of each angle-type deformation (unwrapping), NaN: none
   Eigen::VectorXd residual;     // D^P(x) − target (|P|)
-  BlockMatrix AP, AV;           // constraint blocks ∂D^P/∂x^c and ∂D^V/∂x^c (sparse, fixed pattern)
+  BlockMatrix AP, AV;           // constraint blocks ∂D^P/∂x^c and ∂D^V/∂x^c (sparse, fixed pattern; see ensure_constraint_blocks)
   std::vector<int> AP_block, AV_block;  // block id of each element in AP / AV
   LinearSolver luP, luV;        // their factorizations
   bool jacobian_reusable = false;  // luV holds the position block at the last solved positions

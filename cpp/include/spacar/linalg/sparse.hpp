@@ -35,13 +35,14 @@ class BlockMatrix {
   int cols() const { return static_cast<int>(A_.cols()); }
 
  private:
-  struct Block {
-    std::vector<int> rows, cols;
-    // The entries that are stored, as lists: value position, local entry (column-major) and
-    // local entry of the transpose; add() runs down them without tests.
-    std::vector<int> value, local, local_transposed;
-  };
-  std::vector<Block> blocks_;
+  // The blocks in flat arrays (one allocation per array, not five per block: a large model's
+  // set-up registers thousands of blocks): block k's global rows are rows_[row_start_[k] ...],
+  // its columns cols_[col_start_[k] ...], and its stored entries (rows and columns ≥ 0) the
+  // lists value_, local_, local_transposed_ from entry_start_[k]: the value position, the local
+  // entry (column-major) and the local entry of the transpose; add() runs down them without tests.
+  int n_local_rows(int k) const { return row_start_[k + 1] - row_start_[k]; }
+  std::vector<int> rows_, cols_, row_start_{0}, col_start_{0};
+  std::vector<int> value_, local_, local_transposed_, entry_start_{0};
   Eigen::SparseMatrix<double> A_;
 };
 
