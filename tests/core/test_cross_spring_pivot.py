@@ -36,37 +36,7 @@ import pytest
 import spacar
 from spacar import section
 
-N, L, B, T = 8, 0.05, 0.02, 0.0005   # 8 elements per leaf, 50 mm long, 20 x 0.5 mm
-DIRECTIONS = (np.array([1.0, 1.0]) / np.sqrt(2), np.array([-1.0, 1.0]) / np.sqrt(2))
-BODY, BETA = 2 * N + 1, 2 * N + 2    # the body's node at leaf 1's upper end, its rotation
-
-
-def pivot(element="plbeam", alpha=0.5):
-    """The leaves (nodes 1.. and 101..) along DIRECTIONS, crossing at the origin at a = αL from
-    their upper ends, clamped at their lower ends; the rigid body (element 2N + 1, no RLSE, no
-    DYNE) joins the upper ends and shares their BETA nodes. Leaf 2's upper end follows the body."""
-    m = spacar.Model()
-    leaf = section.rectangle(B, T, section.STEEL)
-    for side, (d, base) in enumerate(zip(DIRECTIONS, (0, 100))):
-        start = -(1 - alpha) * L * d
-        for k in range(1, N + 1):
-            e = side * N + k
-            getattr(m, element)(e, base + 2 * k - 1, base + 2 * k, base + 2 * k + 1, base + 2 * k + 2)
-            m.x(base + 2 * k + 1, *(start + k * L / N * d))
-            m.rlse(e)
-        m.x(base + 1, *start)
-        m.fix(base + 1)
-        m.fix(base + 2)
-        for k in range(1, (N if side == 0 else N - 1) + 1):
-            m.dynx(base + 2 * k + 1)
-            m.dynx(base + 2 * k + 2)
-    leaf.apply(m)
-    m.plbeam(2 * N + 1, 2 * N + 1, 2 * N + 2, 2 * N + 101, 2 * N + 102)
-    return m, leaf.plbeam_estiff()[1]
-
-
-def stiffness(m):
-    return 1.0 / spacar.compliance(m, BETA)[0, 0]
+from support.flexures import BETA, BODY, DIRECTIONS, L, pivot, stiffness
 
 
 def load(m, P):

@@ -19,34 +19,7 @@ import pytest
 import spacar
 from spacar import section
 
-N, L, D, B, T = 8, 0.05, 0.03, 0.02, 0.0005   # 8 elements per leaf, 50 mm long, 30 mm apart, 20 x 0.5 mm
-
-
-def leaf_guide(element="plbeam"):
-    """Two steel leaves along y at x = 0 and x = D (nodes 1.. and 101..), clamped at y = 0, their
-    tops joined by a rigid stage (element 2N + 1: nodes 2N+1, 2N+2 — 2N+101, 2N+102). The leaves'
-    deformations RLSE with the section's stiffness; their free nodes DYNX (leaf 2's top follows
-    the stage)."""
-    m = spacar.Model()
-    leaf = section.rectangle(B, T, section.STEEL)
-    for side, (x0, base) in enumerate([(0.0, 0), (D, 100)]):
-        for k in range(1, N + 1):
-            e = side * N + k
-            getattr(m, element)(e, base + 2 * k - 1, base + 2 * k, base + 2 * k + 1, base + 2 * k + 2)
-            m.x(base + 2 * k + 1, x0, k * L / N)
-            m.rlse(e)
-        m.x(base + 1, x0, 0.0)
-        m.fix(base + 1)
-        m.fix(base + 2)
-        for k in range(1, (N if side == 0 else N - 1) + 1):
-            m.dynx(base + 2 * k + 1)
-            m.dynx(base + 2 * k + 2)
-    leaf.apply(m)
-    m.plbeam(2 * N + 1, 2 * N + 1, 2 * N + 2, 2 * N + 101, 2 * N + 102)  # rigid: no RLSE, no DYNE
-    return m, leaf
-
-
-STAGE = 2 * N + 1
+from support.flexures import D, L, N, STAGE, T, leaf_guide
 
 
 def test_drive_stiffness_and_stress():

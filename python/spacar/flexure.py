@@ -1,0 +1,291 @@
+"""Flexure mechanisms built from their parts (docs/flexures.md): rigid bodies joined by leaf
+springs and wire flexures, each meshed into beams with its cross-section, in the plane (PLBEAM) or
+in space (BEAM)::
+
+    from spacar import flexure, section
+
+    leaf = section.rectangle(b=0.02, h=0.0005, material=section.STEEL)
+    fx = flexure.Flexure()                                   # planar; Flexure(spatial=True): 3-D
+    stage = fx.body(at=(0.015, 0.05))
+    fx.leaf_spring(fx.ground, stage, (0.0, 0.0), (0.0, 0.05), leaf, n=8)
+    fx.leaf_spring(fx.ground, stage, (0.03, 0.0), (0.03, 0.05), leaf, n=8)
+    model = fx.model()                                       # a spacar.Model
+    C = spacar.compliance(model, stage.node, rotation=stage.rotation_node)
+
+The model is the one a SPACAR user writes by hand for a flexure (and SPACAR Light writes for its
+users): each flexure a chain of beams whose deformations are released (RLSE) with the section's
+stiffness (ESTIFF, and EMASS when the material has a density); every node of a flexure and the
+reference node of every body dynamic (DYNX), so that the whole structure finds its equilibrium;
+a flexure's end that is not a body's reference point joined to the body by a rigid beam (all its
+deformations fixed), whose far nodes are then calculable; the ground's points fixed.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+
+import numpy as np
+
+from ._util import show
+from .errors import InputError
+from .model import Model
+from .section import Section
+
+__all__ = ["Body", "Flexure", "Beam"]
+
+_CLOSE = 1e-12  # relative: points closer than this (to the model's size) are the same point
+
+
+class Body:
+    """A rigid body of a :class:`Flexure`: its reference point ``at``, the node of that point
+    (``node``: its coordinates) and of the body's rotation (``rotation_node``: BETA in the plane,
+    the Euler parameters of LAMBDA in space), the nodes to load, drive or ask the compliance of.
+    The ground is a body too (``Flexure.ground``), with its nodes fixed."""
+
+    def __init__(self, flexure, name: str, at, node: int, rotation_node: int, mass: float, inertia, fixed: bool):
+        self.flexure, self.name, self.at = flexure, name, at
+        self.node, self.rotation_node = node, rotation_node
+        self.mass, self.inertia, self.fixed = mass, inertia, fixed
+
+    def __repr__(self):
+        where = ", ".join(f"{v:g}" for v in self.at)
+        return f"<spacar.flexure.Body {self.name!r} at ({where}): node {self.node}, rotation node {self.rotation_node}>"
+
+
+class Beam:
+    """A flexure of a :class:`Flexure` (a leaf spring, a wire, a beam): its ``elements`` from
+    ``a`` to ``b``, the nodes along it (``nodes``: position nodes, ``rotation_nodes``), its
+    ``section``."""
+
+    def __init__(self, kind: str, a, b, section: Section, elements: list, nodes: list, rotation_nodes: list):
+        self.kind, self.a, self.b, self.section = kind, a, b, section
+        self.elements, self.nodes, self.rotation_nodes = elements, nodes, rotation_nodes
+
+    def __repr__(self):
+        return (f"<spacar.flexure.Beam {self.kind} of {len(self.elements)} elements "
+                f"{self.elements[0]}–{self.elements[-1]}>")
+
+
+class Flexure:
+    """A flexure mechanism in the plane (PLBEAM, the default) or in space (``spatial=True``:
+    BEAM). ``nonlinear=True`` meshes the flexures with PLBEAMNL/BEAMNL, whose elongation includes
+    the shortening by bending: the stiffness of a loaded flexure along its stroke (support
+    stiffness, buckling) needs it. ``ground``: the fixed body. Bodies, flexures, then
+    :meth:`model` builds the spacar.Model (each call a new one)."""
+
+    def __init__(self, spatial: bool = False, nonlinear: bool = False):
+        if not isinstance(spatial, bool) or not isinstance(nonlinear, bool):
+            raise InputError("Flexure: spatial and nonlinear must be True or False")
+        self.spatial, self.nonlinear = spatial, nonlinear
+        self.dim = 3 if spatial else 2
+        self._element_type = ("BEAM" if spatial else "PLBEAM") + ("NL" if nonlinear else "")
+        self._next_node = 1
+        self._next_element = 1
+        self._positions: dict = {}      # node → coordinates
+        self._dynamic: set = set()      # nodes whose coordinates are DYNX
+        self._fixed: set = set()        # nodes fixed
+        self._elements: list = []       # (number, nodes, vector or None, section or None, flexible)
+        self._ground_points: dict = {}  # point (rounded) → (node, rotation node)
+        self.bodies: list = []
+        self.flexures: list = []
+        self.ground = self._new_body("ground", (0.0,) * self.dim, 0.0, None, fixed=True)
+
+    # --- parts ---------------------------------------------------------------------------------
+
+    def body(self, at, *, mass: float = 0.0, inertia=None, name: str | None = None) -> Body:
+        """A rigid body with its reference point ``at`` (its node's position), free to move;
+        ``mass`` at that point and the rotational ``inertia`` about it (the plane: Izz; space:
+        (Ixx, Ixy, Ixz, Iyy, Iyz, Izz) in the body's axes, which are the global axes at the
+        start), both optional (a static analysis needs none)."""
+        at = self._point(at, "at")
+        mass = _non_negative(mass, "mass")
+        if inertia is not None:
+            size = 6 if self.spatial else 1
+            values = np.atleast_1d(np.asarray(inertia, dtype=float)) if _numbers(inertia) else None
+            if values is None or values.size != size or not np.isfinite(values).all():
+                raise InputError(f"inertia must be {'(Ixx, Ixy, Ixz, Iyy, Iyz, Izz)' if self.spatial else 'Izz'}, "
+                                 f"got {show(inertia)}")
+            inertia = tuple(float(v) for v in values.ravel())
+        return self._new_body(name or f"body {len(self.bodies)}", at, mass, inertia, fixed=False)
+
+    def beam(self, body_a: Body, body_b: Body, a, b, section: Section, *, n: int = 8, y=None,
+             kind: str = "beam") -> Beam:
+        """A flexible beam from point ``a`` of ``body_a`` to point ``b`` of ``body_b``, meshed
+        into ``n`` elements of the cross-section ``section`` (its ESTIFF, and its EMASS when the
+        material has a density). In space, ``y`` is the direction of the section's y axis (the
+        axis of its ``h``: a leaf's thickness), not along the beam; None: a direction
+        perpendicular to the beam (for round sections)."""
+        self._check_body(body_a, "body_a")
+        self._check_body(body_b, "body_b")
+        if body_a is body_b:
+            raise InputError(f"a {kind} joins two different bodies, got {body_a.name!r} twice")
+        if not isinstance(section, Section):
+            raise InputError(f"section must be a spacar.section Section (rectangle, circle, tube), got {show(section)}")
+        section._mat()  # a material, for E, G and rho
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or not 1 <= n <= 100_000:
+            raise InputError(f"n must be a number of elements from 1 to 100000, got {show(n)}")
+        a, b = self._point(a, "a"), self._point(b, "b")
+        axis = np.subtract(b, a)
+        length = float(np.linalg.norm(axis))
+        if not length > _CLOSE * self._size(a, b):
+            raise InputError(f"the {kind} from {a} to {b} has no length")
+        vector = self._y_axis(axis, y) if self.spatial else None
+        arms: list = []  # rigid beams to the bodies, numbered after the flexure's elements
+        ends = [self._attach(body_a, a, arms), self._attach(body_b, b, arms)]
+        nodes, rotations = [ends[0][0]], [ends[0][1]]
+        for k in range(1, n):
+            node, rotation = self._new_point(tuple(float(v) for v in np.add(a, axis * (k / n))))
+            self._dynamic.update((node, rotation))
+            nodes.append(node)
+            rotations.append(rotation)
+        nodes.append(ends[1][0])
+        rotations.append(ends[1][1])
+        elements = []
+        for k in range(n):
+            elements.append(self._add_element((nodes[k], rotations[k], nodes[k + 1], rotations[k + 1]), vector,
+                                              section))
+        for arm_nodes, arm_vector in arms:
+            self._add_element(arm_nodes, arm_vector, None)
+        flexure = Beam(kind, a, b, section, elements, nodes, rotations)
+        self.flexures.append(flexure)
+        return flexure
+
+    def leaf_spring(self, body_a: Body, body_b: Body, a, b, section: Section, *, n: int = 8, thickness=None) -> Beam:
+        """A leaf spring from ``a`` on ``body_a`` to ``b`` on ``body_b``: a beam of the
+        rectangular ``section`` (``section.rectangle(b=width, h=thickness)``), bending in the plane
+        (planar) or, in space, thin along ``thickness`` (the direction of the leaf's normal)."""
+        if self.spatial and thickness is None:
+            raise InputError("a leaf spring in space needs the direction of its thickness: thickness=(x, y, z)")
+        return self.beam(body_a, body_b, a, b, section, n=n, y=thickness, kind="leaf spring")
+
+    def wire(self, body_a: Body, body_b: Body, a, b, section: Section, *, n: int = 8) -> Beam:
+        """A wire flexure (a slender rod of a round section) from ``a`` on ``body_a`` to ``b`` on
+        ``body_b``."""
+        return self.beam(body_a, body_b, a, b, section, n=n, kind="wire")
+
+    # --- the model -----------------------------------------------------------------------------
+
+    def model(self) -> Model:
+        """The spacar.Model of the mechanism (a new one at every call): loads, drives (INPUTX on a
+        body's node) and analyses are added to it as to any model."""
+        if not self.flexures:
+            raise InputError("the flexure mechanism has no flexures: add leaf springs, wires or beams first")
+        used = {node for _, nodes, _, _, _ in self._elements for node in nodes}
+        for body in self.bodies:
+            if not body.fixed and body.node not in used:
+                raise InputError(f"the body {body.name!r} is joined to nothing: attach a flexure to it")
+        m = Model()
+        element = getattr(m, self._element_type.lower())
+        rigid = getattr(m, "beam" if self.spatial else "plbeam")
+        for number, nodes, vector, section, _ in self._elements:
+            (element if section is not None else rigid)(number, *nodes, *(vector if self.spatial else ()))
+        for node, x in self._positions.items():
+            if node in used:
+                m.x(node, *x)
+        for number, _, _, section, _ in self._elements:
+            if section is not None:
+                m.rlse(number)
+                section.apply(m, number)
+        for node in sorted(self._fixed & used):
+            m.fix(node)
+        for node in sorted((self._dynamic - self._fixed) & used):
+            m.dynx(node)
+        for body in self.bodies:
+            if body.mass > 0.0:
+                m.mass(body.node, body.mass)
+            if body.inertia is not None:
+                m.mass(body.rotation_node, *body.inertia)
+        return m
+
+    # --- inside ------------------------------------------------------------------------------
+
+    def _new_body(self, name, at, mass, inertia, fixed) -> Body:
+        if any(b.name == name for b in self.bodies):
+            raise InputError(f"there is a body named {name!r} already")
+        node, rotation = self._new_point(at)
+        (self._fixed if fixed else self._dynamic).update((node, rotation))
+        body = Body(self, name, at, node, rotation, mass, inertia, fixed)
+        self.bodies.append(body)
+        if fixed:
+            self._ground_points[self._key(at)] = (node, rotation)
+        return body
+
+    def _new_point(self, at):
+        node, rotation = self._next_node, self._next_node + 1
+        self._next_node += 2
+        self._positions[node] = tuple(at)
+        return node, rotation
+
+    def _add_element(self, nodes, vector, section) -> int:
+        number = self._next_element
+        self._next_element += 1
+        self._elements.append((number, nodes, vector, section, section is not None))
+        return number
+
+    def _attach(self, body: Body, point, arms: list):
+        """The nodes of a flexure's end at ``point`` of ``body``: the body's own at its reference
+        point; on the ground fixed nodes there; elsewhere new nodes held to the body by a rigid
+        beam from its reference point (its nodes and y axis appended to ``arms``)."""
+        if self._same(point, body.at):
+            return body.node, body.rotation_node
+        if body.fixed:
+            key = self._key(point)
+            if key not in self._ground_points:
+                nodes = self._new_point(point)
+                self._fixed.update(nodes)
+                self._ground_points[key] = nodes
+            return self._ground_points[key]
+        node, rotation = self._new_point(point)
+        arm = np.subtract(point, body.at)
+        arms.append(((body.node, body.rotation_node, node, rotation), self._y_axis(arm, None) if self.spatial else None))
+        return node, rotation
+
+    def _y_axis(self, axis, y):
+        """A unit vector for the section's y axis: ``y`` less its component along the beam, or
+        (None) the global axis least aligned with the beam, made perpendicular."""
+        axis = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+        if y is None:
+            y = np.eye(3)[int(np.argmin(np.abs(axis)))]
+        else:
+            y = self._point(y, "the y axis")
+        y = np.asarray(y, dtype=float) - np.dot(y, axis) * axis
+        norm = np.linalg.norm(y)
+        if not norm > 1e-9 * max(1.0, float(np.linalg.norm(y))):
+            raise InputError(f"the direction {tuple(float(v) for v in y)} lies along the beam: give one across it")
+        return tuple(float(v) for v in y / norm)
+
+    def _point(self, value, name):
+        if not _numbers(value):
+            raise InputError(f"{name} must be a point of {self.dim} coordinates, got {show(value)}")
+        p = np.asarray(value, dtype=float).ravel()
+        if p.size != self.dim or not np.isfinite(p).all():
+            raise InputError(f"{name} must be a point of {self.dim} finite coordinates, got {show(value)}")
+        return tuple(float(v) for v in p)
+
+    def _size(self, *points) -> float:
+        every = [p for p in self._positions.values()] + list(points)
+        return max(1.0, max(max(abs(v) for v in p) for p in every))
+
+    def _same(self, p, q) -> bool:
+        return math.dist(p, q) <= _CLOSE * self._size(p, q)
+
+    def _key(self, point):
+        return tuple(round(v / self._size(point), 9) for v in point)
+
+    def _check_body(self, body, name):
+        if not isinstance(body, Body) or body.flexure is not self:
+            raise InputError(f"{name} must be a body of this flexure mechanism (Flexure.body or .ground), got {show(body)}")
+
+
+def _numbers(value) -> bool:
+    try:
+        np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return not isinstance(value, (str, bytes, bool))
+
+
+def _non_negative(value, name) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) or value < 0:
+        raise InputError(f"{name} must be a non-negative number, got {show(value)}")
+    return float(value)

@@ -1,0 +1,145 @@
+"""spacar.flexure (issue 39): flexure mechanisms built from bodies, leaf springs and wires give
+the closed forms of flexure design and the same answers as the models written by hand in
+tests/core/test_flexure_guide.py and test_cross_spring_pivot.py (whose formulas are derived
+there): the parallel leaf-spring guide's drive stiffness 24 EI/L³ and support stiffness 2EA/L,
+the same guide in 3-D (BEAMs; sideways 24 EI_wide/L³), the cross-spring pivot's rotational
+stiffness (2EI/L)(12α² − 12α + 4), a wire's tip compliance L³/3EI, and masses on the bodies."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import spacar
+from spacar import flexure, section
+
+from support.flexures import B, D, L, N, STAGE, T, leaf_guide, pivot, stiffness
+LEAF = section.rectangle(b=B, h=T, material=section.STEEL)
+EA, EI = LEAF.plbeam_estiff()
+EI_WIDE = section.STEEL.E * LEAF.Iy
+
+
+def guide(spatial=False, nonlinear=False, stage_mass=0.0, inertia=None, leaf=LEAF):
+    fx = flexure.Flexure(spatial=spatial, nonlinear=nonlinear)
+    at = (D / 2, L, 0.0) if spatial else (D / 2, L)
+    stage = fx.body(at=at, mass=stage_mass, inertia=inertia, name="stage")
+    for x0 in (0.0, D):
+        a, b = ((x0, 0.0, 0.0), (x0, L, 0.0)) if spatial else ((x0, 0.0), (x0, L))
+        fx.leaf_spring(fx.ground, stage, a, b, leaf, n=N, **({"thickness": (1.0, 0.0, 0.0)} if spatial else {}))
+    return fx, stage
+
+
+def test_planar_guide_drive_and_support_stiffness():
+    fx, stage = guide()
+    m = fx.model()
+    C = spacar.compliance(m, stage.node, rotation=stage.rotation_node)
+    assert 1 / C[0, 0] == pytest.approx(24 * EI / L**3, rel=5e-4)   # (the leaves' axial compliance: 3e-4)
+    assert 1 / C[1, 1] == pytest.approx(2 * EA / L, rel=1e-9)       # at the middle: the leaves as bars
+    # The same guide written by hand (the stage a rigid beam between the leaves' tops).
+    hand, _ = leaf_guide()
+    assert 1 / C[0, 0] == pytest.approx(1 / spacar.compliance(hand, STAGE)[0, 0], rel=1e-10)
+    # Each leaf: n elements, RLSE with the section's ESTIFF; its inner nodes DYNX.
+    leaf1 = fx.flexures[0]
+    assert len(leaf1.elements) == N and len(leaf1.nodes) == N + 1
+    el = m.elements[leaf1.elements[0]]
+    assert el.type_name == "PLBEAM" and tuple(el.estiff) == pytest.approx(LEAF.plbeam_estiff())
+
+
+def test_spatial_guide_equals_the_planar_one_and_bends_sideways_on_the_wide_axis():
+    fx, stage = guide(spatial=True)
+    m = fx.model()
+    C = spacar.compliance(m, stage.node, rotation=stage.rotation_node)   # (x, y, z, rotation vector)
+    planar, pstage = guide()
+    Cp = spacar.compliance(planar.model(), pstage.node, rotation=pstage.rotation_node)
+    assert C[0, 0] == pytest.approx(Cp[0, 0], rel=1e-9)      # in the leaves' plane: the planar guide
+    assert C[1, 1] == pytest.approx(Cp[1, 1], rel=1e-9)
+    # Sideways the stage tilts about x freely: two cantilevers bending about the wide axis.
+    assert 1 / C[2, 2] == pytest.approx(2 * 3 * EI_WIDE / L**3, rel=1e-9)
+    assert m.elements[fx.flexures[0].elements[0]].type_name == "BEAM"
+
+
+@pytest.mark.parametrize("alpha", [0.5, 0.3])
+def test_cross_spring_pivot(alpha):
+    """Leaves at ±45° crossing at the origin, a = αL from their upper ends on the body."""
+    fx = flexure.Flexure()
+    body = fx.body(at=(0.0, 0.0))                       # its reference point at the crossing
+    for d in (np.array([1.0, 1.0]) / np.sqrt(2), np.array([-1.0, 1.0]) / np.sqrt(2)):
+        start = -(1 - alpha) * L * d
+        fx.leaf_spring(fx.ground, body, start, start + L * d, LEAF, n=N)
+    m = fx.model()
+    K = 1 / spacar.compliance(m, body.rotation_node)[0, 0]
+    assert K == pytest.approx(2 * EI / L * (12 * alpha**2 - 12 * alpha + 4), rel=1e-4)
+    assert K == pytest.approx(stiffness(pivot(alpha=alpha)[0]), rel=1e-10)
+
+
+def test_wire_cantilever_tip_compliance():
+    """A round wire from the ground to a body at its end: the body's translation under a tip
+    force is L³/3EI and its rotation L²/2EI per unit force (cubic elements: exact)."""
+    wire = section.circle(d=0.001, material=section.STEEL)
+    EIw = section.STEEL.E * wire.Iz
+    fx = flexure.Flexure(spatial=True)
+    tip = fx.body(at=(0.0, 0.0, L))
+    fx.wire(fx.ground, tip, (0.0, 0.0, 0.0), (0.0, 0.0, L), wire, n=4)
+    C = spacar.compliance(fx.model(), tip.node, rotation=tip.rotation_node)
+    assert C[0, 0] == pytest.approx(L**3 / (3 * EIw), rel=1e-9)
+    assert C[1, 1] == pytest.approx(L**3 / (3 * EIw), rel=1e-9)
+    assert abs(C[4, 0]) == pytest.approx(L**2 / (2 * EIw), rel=1e-9)   # rotation about y per Fx
+
+
+def test_stage_mass_gives_the_guide_its_frequencies():
+    """Massless leaves (a material without density) and a stage of mass m and inertia J: the
+    modes are those of the stage on its stiffness, the inverse of its compliance in (x, y, β)
+    (the leaves statically condensed, exactly); the lowest nearly √(24EI/L³ m)/2π."""
+    light = section.rectangle(b=B, h=T, material=section.Material(210e9, nu=0.3, rho=0.0))
+    fx, stage = guide(stage_mass=0.5, inertia=1e-4, leaf=light)
+    m = fx.model()
+    K = np.linalg.inv(spacar.compliance(m, stage.node, rotation=stage.rotation_node))
+    expected = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.solve(np.diag([0.5, 0.5, 1e-4]), K)).real)) / (2 * np.pi)
+    f = spacar.linearize(m).eigenfrequencies()
+    np.testing.assert_allclose(f[:3], expected, rtol=1e-9)
+    assert f[0] == pytest.approx(np.sqrt(24 * EI / L**3 / 0.5) / (2 * np.pi), rel=5e-4)
+    # Steel leaves add their mass: a lower frequency.
+    fx2, _ = guide(stage_mass=0.5, inertia=1e-4)
+    assert spacar.linearize(fx2.model()).eigenfrequencies()[0] < f[0]
+
+
+def test_attachments_and_numbering():
+    fx = flexure.Flexure()
+    stage = fx.body(at=(D / 2, L))
+    one = fx.leaf_spring(fx.ground, stage, (0.0, 0.0), (0.0, L), LEAF, n=2)
+    two = fx.leaf_spring(fx.ground, stage, (0.0, 0.0), (D / 2, L), LEAF, n=2)   # the same ground point; the body's own
+    assert one.nodes[0] == two.nodes[0]                 # one clamp where two flexures meet the ground
+    assert two.nodes[-1] == stage.node                  # at the body's reference point: its nodes
+    m = fx.model()
+    assert spacar.check(m).ok
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda fx, s: fx.leaf_spring(fx.ground, s, (0, 0), (0, 0), LEAF), "no length"),
+    (lambda fx, s: fx.leaf_spring(fx.ground, fx.ground, (0, 0), (0, 1), LEAF), "two different bodies"),
+    (lambda fx, s: fx.leaf_spring(fx.ground, s, (0, 0), (0, 1), "leaf"), "section"),
+    (lambda fx, s: fx.leaf_spring(fx.ground, s, (0, 0), (0, 1), LEAF, n=0), "number of elements"),
+    (lambda fx, s: fx.leaf_spring(fx.ground, s, (0, 0, 0), (0, 1), LEAF), "point of 2"),
+    (lambda fx, s: fx.leaf_spring(fx.ground, object(), (0, 0), (0, 1), LEAF), "body of this flexure"),
+    (lambda fx, s: fx.leaf_spring(fx.ground, s, (0, 0), (0, 1), section.rectangle(1, 1)), "no material"),
+    (lambda fx, s: fx.body(at=(0, 1), mass=-1.0), "mass"),
+    (lambda fx, s: fx.body(at=(0, 1), inertia=(1, 2)), "inertia"),
+    (lambda fx, s: fx.model(), "no flexures"),
+])
+def test_bad_input_is_refused_by_name(call, match):
+    fx = flexure.Flexure()
+    stage = fx.body(at=(0.0, 1.0))
+    with pytest.raises(spacar.InputError, match=match):
+        call(fx, stage)
+
+
+def test_spatial_errors_and_an_unjoined_body():
+    fx = flexure.Flexure(spatial=True)
+    stage = fx.body(at=(0.0, 1.0, 0.0))
+    with pytest.raises(spacar.InputError, match="direction of its thickness"):
+        fx.leaf_spring(fx.ground, stage, (0, 0, 0), (0, 1, 0), LEAF)
+    with pytest.raises(spacar.InputError, match="along the beam"):
+        fx.leaf_spring(fx.ground, stage, (0, 0, 0), (0, 1, 0), LEAF, thickness=(0, 2, 0))
+    fx.leaf_spring(fx.ground, stage, (0, 0, 0), (0, 1, 0), LEAF, thickness=(1, 0, 0))
+    fx.body(at=(5.0, 5.0, 5.0), name="loose")
+    with pytest.raises(spacar.InputError, match="'loose' is joined to nothing"):
+        fx.model()
