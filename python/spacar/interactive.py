@@ -313,10 +313,14 @@ def explore(source, *, input=None, input_range=None, parameters=None, trace=(), 
                     quantity=quantity, points=points, figsize=figsize, dpi=dpi).widget
 
 
-def view3d(res: Results, k: int = -1, *, beam_points: int = 21):
+def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, stress_kind: str = "normal",
+           colorscale: str = "Plasma"):
     """The mechanism at output index ``k`` as an interactive plotly figure (turn, zoom, hover
     for names), one trace per drawn shape; without plotly the matplotlib drawing of
-    :func:`spacar.draw` (a :class:`spacar.plotting.Scene`)."""
+    :func:`spacar.draw` (a :class:`spacar.plotting.Scene`). ``stress``: the
+    :func:`spacar.section.stresses` of these results, drawn as in :func:`spacar.draw`: each of
+    its elements in the colour of its largest stress (``stress_kind``), the peak marked."""
+    from .plotting import _stress_values
     from .results import require_results
 
     require_results(res, "view3d")
@@ -325,10 +329,14 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21):
     except ImportError:
         from .plotting import draw
 
-        return draw(res, k, beam_points=beam_points)
+        return draw(res, k, beam_points=beam_points, stress=stress, stress_kind=stress_kind)
     if res.geometry is None:
         raise InputError("these results have no geometry to draw (results of spacar.simulate have)")
     k = range(len(res.t))[k]
+    values = _stress_values(res, stress, k, stress_kind) if stress is not None else {}
+    top = max(values.values(), default=0.0) or 1.0
+    if values:
+        from plotly.colors import sample_colorscale
     coords = frame_coordinates(res.node_columns, res.x[k])
     pts = np.vstack([p for n, p in coords.items() if res.geometry.node_kinds.get(n) in ("XY", "XYZ")])
     scale = float(np.ptp(pts, axis=0).max()) or 1.0
@@ -341,10 +349,23 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21):
         p[:, : sh.points.shape[1]] = sh.points
         name = f"{sh.kind} {'element' if sh.element is not None else 'node'} {sh.element if sh.element is not None else sh.node}"
         single = len(p) == 1
+        colour = colours.get(sh.kind, "#000000")
+        if sh.element in values and not single:
+            colour = sample_colorscale(colorscale, [values[sh.element] / top])[0]
+            name += f": {values[sh.element]:.4g}"
         fig.add_trace(go.Scatter3d(x=p[:, 0], y=p[:, 1], z=p[:, 2], name=name, mode="markers" if single else "lines",
-                                   line=dict(color=colours.get(sh.kind, "#000000"), width=6 if sh.kind == "beam" else 3),
-                                   marker=dict(size=5, color=colours.get(sh.kind, "#000000")),
+                                   line=dict(color=colour, width=6 if sh.kind == "beam" else 3),
+                                   marker=dict(size=5, color=colour),
                                    surfaceaxis=2 if sh.kind == "body" and not res.geometry.spatial else -1,
                                    showlegend=False))
+        if values and sh.element == max(values, key=values.get) and not single:
+            m = p[len(p) // 2]
+            fig.add_trace(go.Scatter3d(x=[m[0]], y=[m[1]], z=[m[2]], mode="markers+text", showlegend=False,
+                                       marker=dict(size=6, color="red", symbol="diamond"),
+                                       text=[f"{values[sh.element]:.3g} (element {sh.element})"], name="peak"))
+    if values:  # the colour bar, on an invisible marker
+        fig.add_trace(go.Scatter3d(x=[None], y=[None], z=[None], mode="markers", showlegend=False, hoverinfo="skip",
+                                   marker=dict(colorscale=colorscale, cmin=0.0, cmax=top, color=[0.0], showscale=True,
+                                               colorbar=dict(title=stress_kind.replace("_", " ") + " stress"))))
     fig.update_layout(scene=dict(aspectmode="data"), title=f"t = {res.t[k]:.4g} s", margin=dict(l=0, r=0, t=30, b=0))
     return fig

@@ -339,7 +339,7 @@ def snapshot(sim, geometry) -> Results:
 
 def draw(res: Results, k: int = -1, *, time: float | None = None, ax=None, labels: bool = False,
          trace=(), beam_points: int = 21, figsize=None, mode=None, scale: float | None = None,
-         magnify: float = 1.0):
+         magnify: float = 1.0, stress=None, stress_kind: str = "normal", cmap: str = "plasma"):
     """Draw the mechanism at output index ``k`` (default the last) or at the output time nearest
     to ``time``. ``labels`` writes the node numbers; ``trace`` lists position nodes whose paths
     over the whole run are drawn (e.g. a coupler curve). ``mode``: a shape in the nodal
@@ -348,15 +348,68 @@ def draw(res: Results, k: int = -1, *, time: float | None = None, ax=None, label
     tenth of the model's size); beams are drawn through the displaced nodes with the cubic
     (Hermite) shape of their displaced end slopes. ``magnify`` multiplies the deflections of the
     flexible beams, relative to their rigid-body motion (:func:`spacar.geometry.magnified`),
-    e.g. ``magnify=50`` to see a stiff leaf spring bend. Returns the :class:`Scene` (its ``ax``
-    is the axes)."""
+    e.g. ``magnify=50`` to see a stiff leaf spring bend. ``stress``: the
+    :func:`spacar.section.stresses` of these results; each of its elements is drawn in the colour
+    of its largest stress at that output (``stress_kind`` "normal", "shear" or "von_mises"; the
+    colour map ``cmap``, a colour bar beside), and the most stressed element is marked with its
+    value. Returns the :class:`Scene` (its ``ax`` is the axes)."""
     require_results(res, "draw")
     if time is not None:
         k = res.time_index(time)
     k = range(len(res.t))[k]
+    values = None
+    if stress is not None:
+        values = _stress_values(res, stress, k, stress_kind)
     if mode is not None:
         if res.geometry is None:
             raise InputError("these results have no geometry to draw (results of spacar.simulate have)")
         res, k = _displaced(res, k, mode, scale), 0
-    return Scene(res, ax, k, labels=labels, trace=trace, beam_points=beam_points, figsize=figsize,
-                 magnify=magnify)
+    scene = Scene(res, ax, k, labels=labels, trace=trace, beam_points=beam_points, figsize=figsize,
+                  magnify=magnify)
+    if values:
+        _colour_by_stress(scene, values, stress_kind, cmap)
+    return scene
+
+
+def _stress_values(res, stress, k: int, kind: str) -> dict:
+    """{element: stress} of ``stress`` (section.Stresses of ``res``) at output k."""
+    from .section import Stresses
+
+    if not isinstance(stress, Stresses):
+        raise InputError(f"stress must be the spacar.section.stresses of these results, got {type(stress).__name__}")
+    if len(stress.t) != len(res.t) or not np.array_equal(np.asarray(stress.t), np.asarray(res.t)):
+        raise InputError("stress holds the stresses of other results (their output times differ)")
+    return stress.at(k, kind)
+
+
+def _colour_by_stress(scene, values: dict, kind: str, cmap: str):
+    """The elements of ``values`` in the colour of their stress, a colour bar, the peak marked."""
+    from matplotlib import colormaps
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
+    try:
+        colours = colormaps[cmap]
+    except KeyError:
+        raise InputError(f"cmap must be a matplotlib colour map name, got {cmap!r}") from None
+    peak_element = max(values, key=values.get)
+    norm = Normalize(0.0, values[peak_element] or 1.0)
+    peak_line = None
+    for line in scene.lines:
+        gid = line.get_gid() or ""
+        if gid.startswith("element-") and int(gid[8:]) in values:
+            e = int(gid[8:])
+            line.set_color(colours(norm(values[e])))
+            line.set_zorder(4)
+            if e == peak_element:
+                peak_line = line
+    ax = scene.ax
+    label = {"normal": "largest normal stress", "shear": "largest shear stress",
+             "von_mises": "equivalent stress √(σ² + 3τ²)"}[kind]
+    scene.colorbar = ax.figure.colorbar(ScalarMappable(norm=norm, cmap=colours), ax=ax, shrink=0.8, label=label)
+    if peak_line is not None:
+        points = np.column_stack(peak_line.get_data_3d() if scene.spatial else peak_line.get_data())
+        middle = points[len(points) // 2]
+        ax.plot(*middle, marker="*", ms=12, color="red", zorder=8, linestyle="none")
+        ax.text(*middle, f"  {values[peak_element]:.3g} (element {peak_element})", color="red", fontsize=8, zorder=8)
+    scene.stress_peak = (peak_element, values[peak_element])

@@ -262,6 +262,19 @@ class Stresses:
             out[name] = (float(a[i, k]), self.elements[k], int(i))
         return out
 
+    KINDS = ("normal", "shear", "von_mises")
+
+    def at(self, k: int, kind: str = "normal") -> dict:
+        """``{element: stress}`` at output index ``k``: the largest ``"normal"`` or ``"shear"``
+        stress of each element, or ``"von_mises"``, √(σ² + 3τ²) of the two (an upper bound of
+        the equivalent stress: the largest σ and τ need not occur at the same point)."""
+        if kind not in self.KINDS:
+            raise InputError(f"kind must be one of {', '.join(self.KINDS)}, got {show(kind)}")
+        k = range(len(self.t))[k]
+        values = {"normal": self.normal[k], "shear": self.shear[k],
+                  "von_mises": np.sqrt(self.normal[k] ** 2 + 3.0 * self.shear[k] ** 2)}[kind]
+        return dict(zip(self.elements, (float(v) for v in values)))
+
     def __repr__(self):
         return f"<spacar.section.Stresses: {len(self.t)} outputs x {len(self.elements)} elements>"
 
