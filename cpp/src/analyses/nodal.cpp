@@ -33,23 +33,46 @@ NodalLayout::NodalLayout(const System& sys) {
 
 namespace {
 
+// out(:, j) += row · r_j (n x n, column-major): the outer product row rᵀ. The element sizes of
+// the beams (6 coordinates planar, 14 spatial) with their loops unrolled at compile time; they
+// run for every element in every Newton iteration.
+template <int N>
+void add_outer_fixed(const double* row, const double* r, double* out) {
+  for (int j = 0; j < N; ++j) {
+    const double rj = r[j];
+    double* column = out + j * N;
+    for (int i = 0; i < N; ++i) column[i] += row[i] * rj;
+  }
+}
+
+void add_outer_rows(const double* row, const double* r, int n, double* out) {
+  switch (n) {
+    case 6: add_outer_fixed<6>(row, r, out); return;
+    case 14: add_outer_fixed<14>(row, r, out); return;
+    default:
+      for (int j = 0; j < n; ++j) {
+        const double rj = r[j];
+        if (rj == 0.0) continue;
+        double* column = out + static_cast<Eigen::Index>(j) * n;
+        for (int i = 0; i < n; ++i) column[i] += row[i] * rj;
+      }
+  }
+}
+
 // out += scale B(a, :)ᵀ r (n x n; r: n values `stride` apart).
 void add_outer(const Eigen::MatrixXd& B, int a, const double* r, Eigen::Index stride, double scale,
                Eigen::MatrixXd& out) {
   const int n = static_cast<int>(B.cols());
-  // B's row a copied to a contiguous array first: the column updates then vectorize (read
-  // through B's stride, and with `out` possibly aliasing it, they did not).
-  double stack[32];
-  std::vector<double> heap(n > 32 ? n : 0);
+  // B's row a and r copied to contiguous arrays first (B's rows are strided).
+  double stack[64];
+  std::vector<double> heap(n > 32 ? 2 * n : 0);
   double* row = n > 32 ? heap.data() : stack;
-  for (int i = 0; i < n; ++i) row[i] = B(a, i);
-  double* o = out.data();
-  for (int j = 0; j < n; ++j) {
-    const double rj = scale * r[j * stride];
-    if (rj == 0.0) continue;
-    double* column = o + static_cast<Eigen::Index>(j) * n;
-    for (int i = 0; i < n; ++i) column[i] += row[i] * rj;
+  double* rs = row + n;
+  for (int i = 0; i < n; ++i) {
+    row[i] = B(a, i);
+    rs[i] = scale * r[i * stride];
   }
+  add_outer_rows(row, rs, n, out.data());
 }
 
 // Bᵀ C B over the element's constitutive deformations (C: its S or D; σ_a = Σ_b C_ab e_b for
