@@ -235,11 +235,13 @@ void bind_states(py::class_<Simulation>& sim) {
              out["n_constraints"] = d.n_constraints;
              out["n_calculable"] = d.n_calculable;
              out["rank"] = d.rank;
-             py::list red, und;
+             py::list red, und, det;
              for (int k : d.redundant) red.append(py::make_tuple(sys.def_label[k][0], sys.def_label[k][1]));
              for (int g : d.undetermined) und.append(py::make_tuple(sys.coord_label[g][0], sys.coord_label[g][1]));
+             for (int g : d.determined) det.append(py::make_tuple(sys.coord_label[g][0], sys.coord_label[g][1]));
              out["redundant"] = red;
              out["undetermined"] = und;
+             out["determined"] = det;
              out["text"] = d.text;
              return out;
            },

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from . import _core
 from ._util import seconds_or_none, show, time_limited
@@ -63,6 +63,9 @@ class Diagnosis:
     redundant: list      # (element, deformation): release these (RLSE) to remove the redundancy
     undetermined: list   # (node, component): fix them, make them DOFs or add elements
     text: str
+    # (node, component) of DYNX/INPUTX coordinates that the constraints determine: over-constrained,
+    # making one of them calculable again removes a redundancy (e.g. a DYNX added too many)
+    determined: list = field(default_factory=list)
 
     @property
     def detailed(self) -> bool:
@@ -96,6 +99,19 @@ class Check:
         return text + (f"\nassembly: {self.assembly}" if self.assembly else "")
 
 
+def _latest_prescribed(model, determined) -> str:
+    """Of the DYNX/INPUTX coordinates the constraints determine, the one whose line came last
+    (the likeliest slip: a line just added), with where it was given; "" if none is known."""
+    records = getattr(model, "_prescribed", {})
+    known = [records.get((n, c)) or records.get((n, 0)) for n, c in determined]
+    known = [r for r in known if r is not None]
+    if not known:
+        return ""
+    _, line, origin = max(known)
+    return f"\n  the latest line that prescribed one of them: {line}" + (f" ({origin})" if origin else "") + \
+        "; removing it removes the redundancy"
+
+
 def check(model, time_limit=None) -> Check:
     """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly).
     ``time_limit``: wall-clock seconds the set-up and the diagnosis may take (None: no limit);
@@ -113,7 +129,8 @@ def check(model, time_limit=None) -> Check:
     sim = _core.Simulation(copy.core, time_limit=limit, time_spent=time.monotonic() - started)
     d = sim.diagnose(time_limit=limit, time_spent=time.monotonic() - started)
     diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
-                          list(d["undetermined"]), d["text"])
+                          list(d["undetermined"]), d["text"] + _latest_prescribed(model, d["determined"]),
+                          list(d["determined"]))
     assembly = ""
     if diagnosis.ok:  # the constraints are independent: can they be met? (lengths that close no loop)
         left = None if not limit else max(limit - (time.monotonic() - started), 1e-9)  # one limit for all of check

@@ -109,6 +109,9 @@ class Model:
         # State-space inputs and outputs (INPUTF, INPUTS; OUTX, OUTXP, OUTE, OUTEP, OUTS): {k: Signal}
         self.state_space_inputs = {}
         self.state_space_outputs = {}
+        # The lines that prescribed coordinates (DYNX, INPUTX), for the constraint diagnosis's
+        # "the latest of them": (node, component or 0 for all) → (order, "DYNX 3 1", origin).
+        self._prescribed = {}
 
     # --- dispatch used by the reader ---------------------------------------------------------
 
@@ -180,6 +183,10 @@ class Model:
         node = self._core.nodes.get(n) if name in ("DYNX", "INPUTX") else None
         before = [c.name for c in node.cls] if node is not None else []
         self._core.set_coordinate_class(n, comps, _COORD[name])
+        if name in ("DYNX", "INPUTX"):
+            line = f"{name} {n}" + "".join(f" {c}" for c in comps)
+            for c in comps or (0,):
+                self._prescribed[(n, c)] = (len(self._prescribed), line, self._origin)
         if before:  # a FIX that a later line frees is more often a slip than meant
             freed = [i + 1 for i, c in enumerate(before) if c == "fixed" and (not comps or i + 1 in comps)]
             if freed:
@@ -443,6 +450,7 @@ class Model:
         other.output_stem = self.output_stem
         other.state_space_inputs = dict(self.state_space_inputs)
         other.state_space_outputs = dict(self.state_space_outputs)
+        other._prescribed = dict(self._prescribed)
         copies = {"urdf_joints": list, "urdf_links": dict, "urdf_base": lambda base: base}  # set by spacar.from_urdf
         for name, copy in copies.items():
             if hasattr(self, name):

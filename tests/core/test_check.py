@@ -265,3 +265,26 @@ def test_check_does_not_change_the_model():
     before = model.dump(digits=17)
     model.check()
     assert model.dump(digits=17) == before and not model.core.frozen
+
+
+def test_a_redundant_dynx_is_named_with_its_line(tmp_path, capsys):
+    """Issue 41: a DYNX on a coordinate the loop already determines (node 3's x of the crank-rocker)
+    over-constrains it by one. Besides a deformation to release, the check names the prescribed
+    coordinates whose freeing removes the redundancy — the crank's input and the new DYNX — and
+    the latest line that prescribed one of them, with its place in the file."""
+    text = (EXAMPLES / "fourbar_coupler.dat").read_text().replace("\nEND", "\nDYNX 3 1\nEND", 1)
+    path = tmp_path / "fourbar_dynx.dat"
+    path.write_text(text)
+    d = spacar.check(spacar.read(path)).diagnosis
+    assert not d.ok and d.rank == d.n_calculable == d.n_constraints - 1
+    assert (3, 1) in d.determined and len(d.redundant) == 1
+    line = text[: text.index("DYNX 3 1")].count("\n") + 1
+    assert f"the latest line that prescribed one of them: DYNX 3 1 ({path}, line {line}, keyword DYNX)" in d.text
+    assert "DYNX 3 1   (node 3 component 1, a degree of freedom)" in d.text
+    # Removing that line (x of node 3 calculable again) gives the model that passes.
+    assert spacar.check(spacar.read(EXAMPLES / "fourbar_coupler.dat")).ok
+    # Built in Python: the same diagnosis, without a file line.
+    m = spacar.read(EXAMPLES / "fourbar_coupler.dat")
+    m.dynx(3, 1)
+    d = spacar.check(m).diagnosis
+    assert (3, 1) in d.determined and "the latest line that prescribed one of them: DYNX 3 1;" in d.text

@@ -40,6 +40,33 @@ std::vector<int> dependent_columns(const Eigen::MatrixXd& V, const std::vector<i
   return dependent;
 }
 
+// The prescribed coordinates (DYNX, INPUTX) whose column of the constraint Jacobian is not
+// orthogonal to the left null space N (the combinations of redundant rows): freeing such a
+// coordinate adds a column the redundant combination sees, and the rank grows by one.
+std::vector<int> determined_prescribed(const System& sys, const Data& data, const std::vector<int>& rows,
+                                       const Eigen::MatrixXd& N) {
+  std::vector<int> row_of(sys.ne, -1);
+  for (size_t r = 0; r < rows.size(); ++r) row_of[rows[r]] = static_cast<int>(r);
+  std::vector<int> out;
+  Eigen::VectorXd column(static_cast<Eigen::Index>(rows.size()));
+  for (const std::vector<int>* list : {&sys.x_dyn, &sys.x_input})
+    for (int g : *list) {
+      column.setZero();
+      for (size_t i = 0; i < sys.elements.size(); ++i) {
+        const SystemElement& se = sys.elements[i];
+        for (size_t l = 0; l < se.coords.size(); ++l) {
+          if (se.coords[l] != g) continue;
+          for (int a = 0; a < se.nd; ++a)
+            if (const int r = row_of[se.def_offset + a]; r >= 0) column[r] += data.work[i].B(a, static_cast<Eigen::Index>(l));
+        }
+      }
+      const double norm = column.norm();
+      if (norm > 0.0 && (N.transpose() * column).norm() > 1e-8 * norm) out.push_back(g);
+    }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace
 
 ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
@@ -77,6 +104,7 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
         if (std::abs(u[r]) > 0.1 * umax) group.push_back({rows[r], u[r] / umax});
       d.redundant_groups.push_back(group);
     }
+    if (d.rank < nP) d.determined = determined_prescribed(sys, data, rows, svd.matrixU().rightCols(nP - d.rank));
     for (int i = d.rank; i < nc; ++i) {  // right null vectors: undetermined motions
       const Eigen::VectorXd v = svd.matrixV().col(i);
       const double vmax = v.cwiseAbs().maxCoeff();
@@ -132,6 +160,17 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
   auto more = [&os](size_t shown, size_t total, const char* what) {
     if (total > shown) os << "\n   ... and " << total - shown << " more " << what;
   };
+  if (!d.determined.empty()) {
+    os << "\n  prescribed coordinates that the constraints determine; make one calculable again (remove its "
+          "DYNX or INPUTX)\n  or release a constraint (below) for each redundancy:";
+    for (size_t i = 0; i < d.determined.size() && i < kItems; ++i) {
+      const int g = d.determined[i];
+      const bool dof = sys.coord_class[g] == CoordClass::Dynamic;
+      os << "\n   - " << (dof ? "DYNX " : "INPUTX ") << sys.coord_label[g][0] << " " << sys.coord_label[g][1] << "   ("
+         << sys.coord_name(g) << (dof ? ", a degree of freedom" : ", an input") << ")";
+    }
+    more(kItems, d.determined.size(), "prescribed coordinates");
+  }
   if (!d.redundant.empty()) {
     os << "\n  redundant constraints; release these (RLSE) to remove the redundancy:";
     for (size_t i = 0; i < d.redundant.size() && i < kItems; ++i) {

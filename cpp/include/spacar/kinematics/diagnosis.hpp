@@ -25,6 +25,10 @@ struct ConstraintDiagnosis {
   int n_constraints = 0, n_calculable = 0, rank = 0;  // rank -1: not computed (too large)
   std::vector<int> redundant;     // deformations whose release removes the redundancy
   std::vector<int> undetermined;  // calculable coordinates left undetermined
+  // Over-constrained: the coordinates the user prescribed (DYNX degrees of freedom, INPUTX
+  // inputs) that the constraints determine; making one of them calculable again removes a
+  // redundancy as releasing a deformation does (the usual cause: a DYNX added too many).
+  std::vector<int> determined;
   // From the SVD: dependent combinations of rows and free motions, (index, weight).
   std::vector<std::vector<std::pair<int, double>>> redundant_groups, undetermined_groups;
   std::string text;               // readable report naming elements and nodes
