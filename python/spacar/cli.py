@@ -190,6 +190,15 @@ def _static(args) -> int:
     return 0
 
 
+def _html(args) -> int:
+    from .notebook import to_html
+
+    out = args.output or str(Path(args.notebook).with_suffix(".html"))
+    to_html(args.notebook, out)
+    print(f"spacar: wrote {out}")
+    return 0
+
+
 def _check(args) -> int:
     model = read(args.file)
     _comment(f"spacar check: {args.file}")
@@ -274,6 +283,11 @@ def main(argv=None) -> int:
     check.add_argument("--time-limit", type=_seconds, default=None, metavar="SECONDS",
                        help="wall-clock limit of the set-up and diagnosis (default: none)")
     check.set_defaults(func=_check)
+    html = sub.add_parser("html", help="a notebook as an HTML page that keeps spacar's widgets (as their pictures) "
+                                       "and 3-D views, offline")
+    html.add_argument("notebook")
+    html.add_argument("-o", "--output", default=None, metavar="FILE", help="the page (default: NOTEBOOK.html)")
+    html.set_defaults(func=_html)
     args = parser.parse_args(argv)
     try:
         with _terminations_as_interrupts():

@@ -33,6 +33,31 @@ def _widgets():
     return ipywidgets
 
 
+_BOX = None
+
+
+def _static_fallback_box():
+    """An ipywidgets VBox whose display also carries the picture it shows as a PNG: a live
+    notebook shows the widget, a notebook exported to HTML (:func:`spacar.notebook.to_html`,
+    which drops widget views that have a static fallback) the picture of its last state."""
+    global _BOX
+    if _BOX is None:
+        widgets = _widgets()
+
+        class Box(widgets.VBox):
+            def _repr_mimebundle_(self, **kwargs):
+                import base64
+
+                bundle = super()._repr_mimebundle_(**kwargs) or {}
+                explorer = getattr(self, "explorer", None)
+                if explorer is not None and explorer.image.value:
+                    bundle["image/png"] = base64.b64encode(explorer.image.value).decode("ascii")
+                return bundle
+
+        _BOX = Box
+    return _BOX
+
+
 class Explorer:
     """The state behind an :func:`explore` widget: ``widget`` (the ipywidgets box), ``scene``
     (the :class:`spacar.plotting.Scene` of the mechanism), ``figure``, ``sliders`` ({name:
@@ -86,7 +111,7 @@ class Explorer:
             self.set_frame(0)
         for name, slider in self.sliders.items():
             slider.observe(self._on_change(name), names="value")
-        self.widget = widgets.VBox(list(self.sliders.values()) + [self.message, self.image])
+        self.widget = _static_fallback_box()(list(self.sliders.values()) + [self.message, self.image])
         self.widget.explorer = self
 
     # --- the model's input and parameters --------------------------------------------------

@@ -1,0 +1,70 @@
+"""Notebooks handed out as HTML (docs/getting-started.md, "Sharing a notebook"): the exported page
+keeps what spacar shows, offline::
+
+    spacar.notebook.to_html("07_flexures.ipynb", "07_flexures.html")   # or: spacar html NOTEBOOK
+
+nbconvert alone renders a widget (``spacar.explore``) as an empty box when the notebook holds no
+widget state, and drops a plotly figure (``spacar.view3d``) it cannot represent. Here each
+output that has both a widget view and a static picture keeps the picture (``explore`` displays
+the PNG of its last state beside its widget), and each plotly figure becomes its self-contained
+HTML (plotly.js written once into the page, not fetched from a network). Needs nbconvert
+(``pip install ".[classroom]"``) and, for figures, plotly.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .errors import InputError
+
+WIDGET = "application/vnd.jupyter.widget-view+json"
+PLOTLY = "application/vnd.plotly.v1+json"
+STATIC = ("image/png", "image/svg+xml", "text/html")
+
+
+def static_outputs(nb) -> int:
+    """Replace, in place, the outputs of notebook ``nb`` (an nbformat node) that an HTML page
+    cannot show: a widget view with a static picture beside it loses the view; a plotly figure
+    gains its HTML (plotly.js in the first). Returns the number of outputs changed."""
+    changed, plotly_js = 0, True
+    for cell in nb.get("cells", []):
+        for output in cell.get("outputs", []) if cell.get("cell_type") == "code" else []:
+            data = output.get("data")
+            if not data:
+                continue
+            if WIDGET in data and any(kind in data for kind in STATIC):
+                del data[WIDGET]
+                changed += 1
+            if PLOTLY in data and "text/html" not in data:
+                import plotly.io
+
+                data["text/html"] = plotly.io.to_html(data[PLOTLY], include_plotlyjs=plotly_js, full_html=False)
+                plotly_js = False  # loaded once for the page
+                changed += 1
+    return changed
+
+
+def to_html(notebook, path=None) -> str:
+    """The HTML page of a notebook (a path, its outputs as saved) with :func:`static_outputs`
+    applied; written to ``path`` if given. Returns the page."""
+    try:
+        import nbformat
+        from nbconvert import HTMLExporter
+    except ImportError:
+        raise ImportError('spacar.notebook.to_html needs nbconvert: pip install ".[classroom]"') from None
+    source = Path(notebook)
+    if not source.is_file():
+        raise InputError(f"{source}: no such notebook")
+    try:
+        nb = nbformat.read(source, as_version=4)
+    except Exception as err:  # nbformat raises its own and JSON errors
+        raise InputError(f"{source}: not a readable notebook ({type(err).__name__}: {err})") from None
+    static_outputs(nb)
+    html, _ = HTMLExporter().from_notebook_node(nb)
+    if path is not None:
+        from .io.files import write_replacing
+
+        def write(temporary):
+            Path(temporary).write_text(html, encoding="utf-8")
+
+        write_replacing(str(path), write, "write the page")
+    return html
