@@ -15,9 +15,21 @@ import sys
 DELAY = 1.0  # seconds before an automatic bar appears: short runs stay quiet
 
 
+def in_kernel() -> bool:
+    """Running inside a Jupyter kernel (not merely with ipykernel imported, as a notebook
+    client or exporter does)."""
+    if "ipykernel" not in sys.modules:
+        return False
+    try:
+        from IPython import get_ipython
+    except ImportError:
+        return False
+    return getattr(get_ipython(), "kernel", None) is not None
+
+
 def interactive() -> bool:
     """A terminal on standard error or a Jupyter kernel."""
-    if "ipykernel" in sys.modules:
+    if in_kernel():
         return True
     try:
         return sys.stderr is not None and sys.stderr.isatty()
@@ -37,7 +49,7 @@ def tqdm_class():
     """The tqdm bar class for this session, None without tqdm: the notebook bar in a Jupyter
     kernel with ipywidgets (without them the notebook bar cannot show), the text bar otherwise."""
     try:
-        if "ipykernel" in sys.modules:
+        if in_kernel():
             try:
                 import ipywidgets  # noqa: F401  (tqdm.auto needs it for the notebook bar)
 
