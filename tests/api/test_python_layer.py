@@ -61,6 +61,7 @@ def test_sweep_and_simulate_detect_a_jupyter_kernel_alike(capsys, monkeypatch):
 
     tqdm = pytest.importorskip("tqdm")
     monkeypatch.setitem(sys.modules, "ipykernel", types.ModuleType("ipykernel"))
+    monkeypatch.setattr(spacar.progress, "in_kernel", lambda: True)   # a running kernel (get_ipython().kernel)
     monkeypatch.setitem(sys.modules, "ipywidgets", None)   # import ipywidgets now fails
     monkeypatch.delenv("SPACAR_PROGRESS", raising=False)
     assert spacar.progress.interactive() and spacar.progress.automatic()

@@ -14,12 +14,11 @@ import spacar
 pytest.importorskip("exudyn")
 from spacar.compare import UnsupportedModelError, exudyn_static  # noqa: E402
 
-import core.test_cross_spring_pivot as pivot_test  # noqa: E402
-import core.test_flexure_guide as guide_test  # noqa: E402
+import support.flexures as flexures  # noqa: E402
 
 
 def _with_mesh(module, build, n):
-    """The model that build() makes with n elements per leaf (the test module's node numbers
+    """The model that build() makes with n elements per leaf (support.flexures' node numbers
     follow its N)."""
     saved, module.N = module.N, n
     try:
@@ -34,13 +33,13 @@ def _richardson(fine, coarse):
 
 
 def _guide(n, drive):
-    m = _with_mesh(guide_test, lambda: guide_test.leaf_guide("plbeamnl"), n)
+    m = _with_mesh(flexures, lambda: flexures.leaf_guide("plbeamnl"), n)
     m.force(2 * n + 1, drive, 0.0)
     return m, 2 * n + 1
 
 
 def _pivot(n, moment):
-    m = _with_mesh(pivot_test, lambda: pivot_test.pivot("plbeamnl"), n)
+    m = _with_mesh(flexures, lambda: flexures.pivot("plbeamnl"), n)
     m.force(2 * n + 2, moment)
     return m, 2 * n + 1
 
@@ -64,15 +63,15 @@ def test_flexure_equilibrium_equals_exudyn(case):
     mine = _richardson(fine[0], coarse[0])
     theirs = _richardson(fine[1], coarse[1])
     if case == "guide":
-        u, drop, rotation = mine[0], guide_test.L - mine[1], mine[2]
+        u, drop, rotation = mine[0], flexures.L - mine[1], mine[2]
         assert u == pytest.approx(theirs[0], rel=1e-5)        # found 9e-7
-        assert drop == pytest.approx(guide_test.L - theirs[1], rel=1e-4)   # the parasitic drop, 0.27 mm (5e-6)
+        assert drop == pytest.approx(flexures.L - theirs[1], rel=1e-4)   # the parasitic drop, 0.27 mm (5e-6)
         assert rotation == pytest.approx(theirs[2], rel=1e-2)              # the stage's tilt, 1.3e-4 rad (4e-3: exudyn's stage is 1e5 EI, not rigid)
-        assert 0.09 < u / guide_test.L < 0.1
+        assert 0.09 < u / flexures.L < 0.1
     else:
         theta = mine[2]
         assert theta == pytest.approx(theirs[2], rel=2e-5)   # found 5e-6
-        np.testing.assert_allclose(mine[:2], theirs[:2], atol=1e-4 * pivot_test.L)
+        np.testing.assert_allclose(mine[:2], theirs[:2], atol=1e-4 * flexures.L)
         assert 0.19 < theta < 0.21
 
 
