@@ -112,18 +112,23 @@ class Flexure:
              kind: str = "beam") -> Beam:
         """A flexible beam from point ``a`` of ``body_a`` to point ``b`` of ``body_b``, meshed
         into ``n`` elements of the cross-section ``section`` (its ESTIFF, and its EMASS when the
-        material has a density). In space, ``y`` is the direction of the section's y axis (the
+        material has a density), or of the ``n`` sections of a list, from ``a`` to ``b`` (a
+        tapered or notched flexure). In space, ``y`` is the direction of the section's y axis (the
         axis of its ``h``: a leaf's thickness), not along the beam; None: a direction
         perpendicular to the beam (for round sections)."""
         self._check_body(body_a, "body_a")
         self._check_body(body_b, "body_b")
         if body_a is body_b:
             raise InputError(f"a {kind} joins two different bodies, got {body_a.name!r} twice")
-        if not isinstance(section, Section):
-            raise InputError(f"section must be a spacar.section Section (rectangle, circle, tube), got {show(section)}")
-        section._mat()  # a material, for E, G and rho
         if isinstance(n, bool) or not isinstance(n, numbers.Integral) or not 1 <= n <= 100_000:
             raise InputError(f"n must be a number of elements from 1 to 100000, got {show(n)}")
+        sections = [section] * n if isinstance(section, Section) else \
+            list(section) if isinstance(section, (list, tuple)) else None
+        if sections is None or len(sections) != n or not all(isinstance(c, Section) for c in sections):
+            raise InputError(f"section must be a spacar.section Section (rectangle, circle, tube) or a list of n = {n} "
+                             f"of them, got {show(section)}")
+        for c in sections:
+            c._mat()  # a material, for E, G and rho
         a, b = self._point(a, "a"), self._point(b, "b")
         axis = np.subtract(b, a)
         length = float(np.linalg.norm(axis))
@@ -143,7 +148,7 @@ class Flexure:
         elements = []
         for k in range(n):
             elements.append(self._add_element((nodes[k], rotations[k], nodes[k + 1], rotations[k + 1]), vector,
-                                              section))
+                                              sections[k]))
         for arm_nodes, arm_vector in arms:
             self._add_element(arm_nodes, arm_vector, None)
         flexure = Beam(kind, a, b, section, elements, nodes, rotations)
@@ -157,6 +162,38 @@ class Flexure:
         if self.spatial and thickness is None:
             raise InputError("a leaf spring in space needs the direction of its thickness: thickness=(x, y, z)")
         return self.beam(body_a, body_b, a, b, section, n=n, y=thickness, kind="leaf spring")
+
+    def notch_hinge(self, body_a: Body, body_b: Body, at, direction, *, radius: float, thickness: float,
+                    width: float, material, n: int = 40, thickness_axis=None) -> Beam:
+        """A right-circular notch hinge: material of width ``width`` between two circular cuts of
+        radius ``radius`` that leave ``thickness`` at ``at``, joining ``body_a`` (at
+        ``at − radius · d``) to ``body_b`` (at ``at + radius · d``), ``d`` the unit ``direction``
+        through the hinge from a to b; in space ``thickness_axis`` is the direction across the
+        thin section. Meshed into ``n`` short beams of rectangular section, each as thick as the
+        profile t(x) = thickness + 2 (R − √(R² − x²)) at its middle: its compliance is the
+        midpoint sum of Euler–Bernoulli's ∫ dx / E I(x) (Paros and Weisbord's closed form),
+        to 1e-5 with the default 40 (docs/flexures.md)."""
+        from .section import Material, rectangle
+
+        R = _positive(radius, "radius")
+        t = _positive(thickness, "thickness")
+        w = _positive(width, "width")
+        if not isinstance(material, Material):
+            raise InputError(f"material must be a spacar.section.Material, got {show(material)}")
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or not 1 <= n <= 100_000:
+            raise InputError(f"n must be a number of elements from 1 to 100000, got {show(n)}")
+        at = np.asarray(self._point(at, "at"))
+        d = np.asarray(self._point(direction, "direction"))
+        if not np.linalg.norm(d) > 0:
+            raise InputError("direction must not be zero")
+        d = d / np.linalg.norm(d)
+        x = -R + (np.arange(n) + 0.5) * (2 * R / n)              # the middles of the pieces
+        profile = t + 2 * (R - np.sqrt(R * R - x * x))
+        sections = [rectangle(b=w, h=float(h), material=material) for h in profile]
+        if self.spatial and thickness_axis is None:
+            raise InputError("a notch hinge in space needs the direction across its thin section: thickness_axis=(x, y, z)")
+        return self.beam(body_a, body_b, tuple(at - R * d), tuple(at + R * d), sections, n=int(n), y=thickness_axis,
+                         kind="notch hinge")
 
     def wire(self, body_a: Body, body_b: Body, a, b, section: Section, *, n: int = 8) -> Beam:
         """A wire flexure (a slender rod of a round section) from ``a`` on ``body_a`` to ``b`` on
@@ -283,6 +320,12 @@ def _numbers(value) -> bool:
     except (TypeError, ValueError):
         return False
     return not isinstance(value, (str, bytes, bool))
+
+
+def _positive(value, name) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) or not value > 0:
+        raise InputError(f"{name} must be a positive number, got {show(value)}")
+    return float(value)
 
 
 def _non_negative(value, name) -> float:
