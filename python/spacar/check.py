@@ -103,8 +103,7 @@ def _latest_prescribed(model, determined) -> str:
     """Of the DYNX/INPUTX coordinates the constraints determine, the one whose line came last
     (the likeliest slip: a line just added), with where it was given; "" if none is known."""
     records = getattr(model, "_prescribed", {})
-    known = [records.get((n, c)) or records.get((n, 0)) for n, c in determined]
-    known = [r for r in known if r is not None]
+    known = [r for n, c in determined for r in (records.get((n, c)), records.get((n, 0))) if r is not None]
     if not known:
         return ""
     _, line, origin = max(known)

@@ -194,7 +194,10 @@ def _html(args) -> int:
     from .notebook import to_html
 
     out = args.output or str(Path(args.notebook).with_suffix(".html"))
-    to_html(args.notebook, out)
+    try:
+        to_html(args.notebook, out)
+    except ImportError as err:  # nbconvert or plotly missing: one line, not a traceback
+        raise SpacarError(str(err)) from None
     print(f"spacar: wrote {out}")
     return 0
 

@@ -85,7 +85,7 @@ class Flexure:
         self._dynamic: set = set()      # nodes whose coordinates are DYNX
         self._fixed: set = set()        # nodes fixed
         self._elements: list = []       # (number, nodes, vector or None, section or None, flexible)
-        self._ground_points: dict = {}  # point (rounded) → (node, rotation node)
+        self._ground_points: dict = {}  # ground point → its (node, rotation node)
         self.bodies: list = []
         self.flexures: list = []
         self.ground = self._new_body("ground", (0.0,) * self.dim, 0.0, None, fixed=True)
@@ -244,7 +244,7 @@ class Flexure:
         body = Body(self, name, at, node, rotation, mass, inertia, fixed)
         self.bodies.append(body)
         if fixed:
-            self._ground_points[self._key(at)] = (node, rotation)
+            self._ground_points[tuple(at)] = (node, rotation)
         return body
 
     def _new_point(self, at):
@@ -266,12 +266,13 @@ class Flexure:
         if self._same(point, body.at):
             return body.node, body.rotation_node
         if body.fixed:
-            key = self._key(point)
-            if key not in self._ground_points:
-                nodes = self._new_point(point)
-                self._fixed.update(nodes)
-                self._ground_points[key] = nodes
-            return self._ground_points[key]
+            for where, nodes in self._ground_points.items():  # a clamp there already
+                if self._same(point, where):
+                    return nodes
+            nodes = self._new_point(point)
+            self._fixed.update(nodes)
+            self._ground_points[tuple(point)] = nodes
+            return nodes
         node, rotation = self._new_point(point)
         arm = np.subtract(point, body.at)
         arms.append(((body.node, body.rotation_node, node, rotation), self._y_axis(arm, None) if self.spatial else None))
@@ -285,9 +286,10 @@ class Flexure:
             y = np.eye(3)[int(np.argmin(np.abs(axis)))]
         else:
             y = self._point(y, "the y axis")
+        given = float(np.linalg.norm(y))
         y = np.asarray(y, dtype=float) - np.dot(y, axis) * axis
         norm = np.linalg.norm(y)
-        if not norm > 1e-9 * max(1.0, float(np.linalg.norm(y))):
+        if not norm > 1e-9 * given:
             raise InputError(f"the direction {tuple(float(v) for v in y)} lies along the beam: give one across it")
         return tuple(float(v) for v in y / norm)
 
@@ -305,9 +307,6 @@ class Flexure:
 
     def _same(self, p, q) -> bool:
         return math.dist(p, q) <= _CLOSE * self._size(p, q)
-
-    def _key(self, point):
-        return tuple(round(v / self._size(point), 9) for v in point)
 
     def _check_body(self, body, name):
         if not isinstance(body, Body) or body.flexure is not self:

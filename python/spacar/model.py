@@ -185,8 +185,9 @@ class Model:
         self._core.set_coordinate_class(n, comps, _COORD[name])
         if name in ("DYNX", "INPUTX"):
             line = f"{name} {n}" + "".join(f" {c}" for c in comps)
+            self._prescribed_lines = getattr(self, "_prescribed_lines", 0) + 1  # the order of the lines
             for c in comps or (0,):
-                self._prescribed[(n, c)] = (len(self._prescribed), line, self._origin)
+                self._prescribed[(n, c)] = (self._prescribed_lines, line, self._origin)
         if before:  # a FIX that a later line frees is more often a slip than meant
             freed = [i + 1 for i, c in enumerate(before) if c == "fixed" and (not comps or i + 1 in comps)]
             if freed:
@@ -451,6 +452,7 @@ class Model:
         other.state_space_inputs = dict(self.state_space_inputs)
         other.state_space_outputs = dict(self.state_space_outputs)
         other._prescribed = dict(self._prescribed)
+        other._prescribed_lines = getattr(self, "_prescribed_lines", 0)
         copies = {"urdf_joints": list, "urdf_links": dict, "urdf_base": lambda base: base}  # set by spacar.from_urdf
         for name, copy in copies.items():
             if hasattr(self, name):

@@ -185,3 +185,36 @@ def test_notch_hinge_compliance_is_the_closed_form():
                                                   width=w, material=section.STEEL)
     with pytest.raises(spacar.InputError, match="radius must be a positive number"):
         notch(4, R=-1.0)
+
+
+def test_column_past_its_buckling_load_is_reported_unstable():
+    """A leaf as a clamped-free column (PLBEAMNL, RLSE, every node DYNX, as the builder makes it)
+    under 1.05 of its buckling load in 10 load steps: the axial problem is linear, so Newton
+    converges in one iteration per step, and the stability verdict must come from a tangent at
+    the new load (not the step start's): unstable from λ = 1/1.05 on. Its buckling load is
+    π²EI/4L² to 3e-6."""
+    def column(P):
+        fx = flexure.Flexure(nonlinear=True)
+        top = fx.body(at=(0.0, L))
+        fx.leaf_spring(fx.ground, top, (0.0, 0.0), (0.0, L), LEAF, n=N)
+        m = fx.model()
+        m.force(top.node, 0.0, -P)
+        return m
+
+    m = column(1.0)
+    spacar.static(m, steps=1)
+    P_cr = spacar.linearize(m).buckling_factors(k=1)[0]
+    assert P_cr == pytest.approx(np.pi**2 * EI / (4 * L**2), rel=3e-6)
+    m = column(1.05 * P_cr)
+    res = spacar.static(m, steps=10)
+    assert res.stats["indefinite_at"] == pytest.approx(1 / 1.05, abs=1e-3)
+    assert any("indefinite" in w for w in m.warnings)
+
+
+def test_ground_points_are_shared_at_any_scale():
+    fx = flexure.Flexure()
+    stage = fx.body(at=(15.0, 50.0))                   # millimetres
+    one = fx.leaf_spring(fx.ground, stage, (0.0, 0.0), (0.0, 50.0), LEAF, n=2)
+    fx.body(at=(500.0, 500.0), name="far")             # the model grows
+    two = fx.leaf_spring(fx.ground, stage, (0.0, 0.0), (30.0, 50.0), LEAF, n=2)
+    assert one.nodes[0] == two.nodes[0]

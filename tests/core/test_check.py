@@ -288,3 +288,14 @@ def test_a_redundant_dynx_is_named_with_its_line(tmp_path, capsys):
     m.dynx(3, 1)
     d = spacar.check(m).diagnosis
     assert (3, 1) in d.determined and "the latest line that prescribed one of them: DYNX 3 1;" in d.text
+
+
+def test_the_latest_prescribing_line_is_the_last_given():
+    from spacar.check import _latest_prescribed
+
+    m = spacar.read(EXAMPLES / "fourbar_coupler.dat")
+    for n, c in ((3, 1), (6, 1), (3, 1)):
+        m.dynx(n, c)
+    assert "DYNX 3 1;" in _latest_prescribed(m, [(3, 1), (6, 1)])
+    m.dynx(6)                                        # the whole node, after the component lines
+    assert "DYNX 6;" in _latest_prescribed(m, [(3, 1), (6, 1)])

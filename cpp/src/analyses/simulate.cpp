@@ -140,12 +140,14 @@ void Simulation::assemble(ExplicitChain* chain) {
   const double tol = simulation_kinematic_tolerance(sys);
   bool solved = false;
   if (chain) {
-    const Eigen::VectorXd start = data_->x;
+    const Eigen::VectorXd start = data_->x, angles = data_->angle_ref;
     try {
       chain->solve_positions(sys, *data_, std::max(sys.settings.maxiterat, 50), tol);
       solved = true;
     } catch (const KinematicsError&) {
-      data_->x = start;  // the general iteration from the given positions, with its diagnosis
+      // The general iteration from the given positions and angle branches, with its diagnosis.
+      data_->x = start;
+      data_->angle_ref = angles;
     }
   }
   if (!solved) solve_positions(sys, *data_, sys.settings.maxiterat, tol, true);

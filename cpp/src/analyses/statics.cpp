@@ -81,11 +81,14 @@ class EquilibriumPath {
         a.why = "the forces or the stiffness are not finite";
         return a;
       }
-      // Converged on the residual after an iteration: the tangent of the last iterate, one
-      // Newton correction away (about √tolerance relative), stands for this state's in the
-      // checks of its determinant's sign and of stability (indefinite()), and the factorization
-      // at the solution (a sixth of the work of a solve in five iterations) is not made.
-      if (it > 0 && nd_ > 0 && factorized_) {
+      // Converged on the residual after a small Newton correction: the tangent of the last
+      // iterate, that correction away (below 1e-4 of the DOFs' scale; about √tolerance when
+      // Newton converges quadratically), stands for this state's in the checks of its
+      // determinant's sign and of stability (indefinite()), and the factorization at the
+      // solution (a sixth of the work of a solve in five iterations) is not made. Not after the
+      // first iteration: its tangent is the one at the start of the step (the previous load), on
+      // the other side of any critical point the step passes (a linear problem converges there).
+      if (it >= 2 && last_correction <= 1e-4 && nd_ > 0 && factorized_) {
         const double r = Rs.cwiseAbs().maxCoeff();
         if (r <= opt_.tolerance * force || (last_correction <= 1e-12 && r <= 1e-6 * force)) {
           if (crossed && last_sign == start_sign) {
