@@ -164,18 +164,20 @@ class Flexure:
         return self.beam(body_a, body_b, a, b, section, n=n, y=thickness, kind="leaf spring")
 
     def notch_hinge(self, body_a: Body, body_b: Body, at, direction, *, radius: float, thickness: float,
-                    width: float, material, n: int = 40, thickness_axis=None) -> Beam:
-        """A right-circular notch hinge: material of width ``width`` between two circular cuts of
-        radius ``radius`` that leave ``thickness`` at ``at``, joining ``body_a`` (at
-        ``at − radius · d``) to ``body_b`` (at ``at + radius · d``), ``d`` the unit ``direction``
-        through the hinge from a to b; in space ``thickness_axis`` is the direction across the
-        thin section. Meshed into ``n`` short beams of rectangular section, each as thick as the
-        profile t(x) = thickness + 2 (R − √(R² − x²)) at its middle: its compliance is the
-        midpoint sum of Euler–Bernoulli's ∫ dx / E I(x) (Paros and Weisbord's closed form),
-        to 1e-5 with the default 40 (docs/flexures.md)."""
+                    width: float, material, n: int = 40, thickness_axis=None, depth: float | None = None) -> Beam:
+        """A notch hinge: material of width ``width`` between two cuts that leave ``thickness`` at
+        ``at``, joining ``body_a`` (at ``at − radius · d``) to ``body_b`` (at ``at + radius · d``),
+        ``d`` the unit ``direction`` through the hinge from a to b; in space ``thickness_axis``
+        is the direction across the thin section. The cuts are circles of radius ``radius``
+        (right-circular), or with ``depth`` ellipses of semi-axes ``radius`` along the hinge and
+        ``depth`` across it. Meshed into ``n`` short beams of rectangular section, each as thick
+        as the profile t(x) = thickness + 2 depth (1 − √(1 − (x/radius)²)) at its middle: its
+        compliance is the midpoint sum of Euler–Bernoulli's ∫ dx / E I(x) (for circles Paros and
+        Weisbord's closed form), to 1e-5 with the default 40 (docs/flexures.md)."""
         from .section import Material, rectangle
 
         R = _positive(radius, "radius")
+        b = R if depth is None else _positive(depth, "depth")
         t = _positive(thickness, "thickness")
         w = _positive(width, "width")
         if not isinstance(material, Material):
@@ -188,7 +190,7 @@ class Flexure:
             raise InputError("direction must not be zero")
         d = d / np.linalg.norm(d)
         x = -R + (np.arange(n) + 0.5) * (2 * R / n)              # the middles of the pieces
-        profile = t + 2 * (R - np.sqrt(R * R - x * x))
+        profile = t + 2 * b * (1 - np.sqrt(1 - (x / R) ** 2))
         sections = [rectangle(b=w, h=float(h), material=material) for h in profile]
         if self.spatial and thickness_axis is None:
             raise InputError("a notch hinge in space needs the direction across its thin section: thickness_axis=(x, y, z)")

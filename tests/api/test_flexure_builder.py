@@ -187,6 +187,29 @@ def test_notch_hinge_compliance_is_the_closed_form():
         notch(4, R=-1.0)
 
 
+def test_elliptical_notch_hinge():
+    """An elliptical notch (semi-axes 8 mm along the hinge, 3 mm deep): its compliance is the
+    quadrature of ∫ dx / E I(x) over its profile t + 2b(1 − √(1 − x²/a²)) to 1e-5; with the depth
+    equal to the radius it is the circular hinge exactly; longer and shallower cuts make it more
+    compliant than the circle of the same radius."""
+    from scipy.integrate import quad
+
+    a, b, t, w, E = 0.008, 0.003, 0.0005, 0.01, section.STEEL.E
+
+    def hinge(depth):
+        fx = flexure.Flexure()
+        body = fx.body(at=(0.0, a + 0.01))
+        fx.notch_hinge(fx.ground, body, (0.0, 0.0), (0.0, 1.0), radius=a, depth=depth, thickness=t, width=w,
+                       material=section.STEEL)
+        return spacar.compliance(fx.model(), body.rotation_node)[0, 0]
+
+    profile = lambda x: t + 2 * b * (1 - np.sqrt(1 - (x / a) ** 2))  # noqa: E731
+    exact = quad(lambda x: 12 / (E * w * profile(x) ** 3), -a, a, points=[0], limit=200, epsrel=1e-13)[0]
+    assert hinge(b) == pytest.approx(exact, rel=1e-5)
+    assert hinge(a) == pytest.approx(hinge(None), rel=1e-14)
+    assert hinge(b) > hinge(a)
+
+
 def test_column_past_its_buckling_load_is_reported_unstable():
     """A leaf as a clamped-free column (PLBEAMNL, RLSE, every node DYNX, as the builder makes it)
     under 1.05 of its buckling load in 10 load steps: the axial problem is linear, so Newton
