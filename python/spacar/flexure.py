@@ -82,6 +82,7 @@ class Flexure:
         self._next_node = 1
         self._next_element = 1
         self._positions: dict = {}      # node → coordinates
+        self._extent = 1.0              # the largest coordinate of the positions (at least 1)
         self._dynamic: set = set()      # nodes whose coordinates are DYNX
         self._fixed: set = set()        # nodes fixed
         self._elements: list = []       # (number, nodes, vector or None, section or None, flexible)
@@ -253,6 +254,7 @@ class Flexure:
         node, rotation = self._next_node, self._next_node + 1
         self._next_node += 2
         self._positions[node] = tuple(at)
+        self._extent = max([self._extent] + [abs(v) for v in at])
         return node, rotation
 
     def _add_element(self, nodes, vector, section) -> int:
@@ -304,8 +306,9 @@ class Flexure:
         return tuple(float(v) for v in p)
 
     def _size(self, *points) -> float:
-        every = [p for p in self._positions.values()] + list(points)
-        return max(1.0, max(max(abs(v) for v in p) for p in every))
+        """The model's size (its largest coordinate, at least 1) with ``points``: the scale of
+        "the same point" and "no length"."""
+        return max([self._extent] + [abs(v) for p in points for v in p])
 
     def _same(self, p, q) -> bool:
         return math.dist(p, q) <= _CLOSE * self._size(p, q)

@@ -112,6 +112,7 @@ class Model:
         # The lines that prescribed coordinates (DYNX, INPUTX), for the constraint diagnosis's
         # "the latest of them": (node, component or 0 for all) → (order, "DYNX 3 1", origin).
         self._prescribed = {}
+        self._prescribed_lines = 0  # DYNX/INPUTX lines applied so far: the order of the records
 
     # --- dispatch used by the reader ---------------------------------------------------------
 
@@ -185,7 +186,7 @@ class Model:
         self._core.set_coordinate_class(n, comps, _COORD[name])
         if name in ("DYNX", "INPUTX"):
             line = f"{name} {n}" + "".join(f" {c}" for c in comps)
-            self._prescribed_lines = getattr(self, "_prescribed_lines", 0) + 1  # the order of the lines
+            self._prescribed_lines += 1
             for c in comps or (0,):
                 self._prescribed[(n, c)] = (self._prescribed_lines, line, self._origin)
         if before:  # a FIX that a later line frees is more often a slip than meant
@@ -452,7 +453,7 @@ class Model:
         other.state_space_inputs = dict(self.state_space_inputs)
         other.state_space_outputs = dict(self.state_space_outputs)
         other._prescribed = dict(self._prescribed)
-        other._prescribed_lines = getattr(self, "_prescribed_lines", 0)
+        other._prescribed_lines = self._prescribed_lines
         copies = {"urdf_joints": list, "urdf_links": dict, "urdf_base": lambda base: base}  # set by spacar.from_urdf
         for name, copy in copies.items():
             if hasattr(self, name):

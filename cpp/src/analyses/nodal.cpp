@@ -439,6 +439,7 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
     const SystemElement& se = sys.elements[i];
     const Eigen::MatrixXd& B = data.work[i].B;
     const int n = static_cast<int>(se.coords.size());
+    const double* sc = element_scale_.data() + element_scale_start_[i];
     Eigen::MatrixXd& As = rows_;
     As.setZero(se.nd, n);
     local_.setZero(n, n);
@@ -446,7 +447,7 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
       const int r = layout_.row_of[se.def_offset + a];
       if (r < 0) continue;
       for (int b = 0; b < n; ++b)
-        if (layout_.free_of[se.coords[b]] >= 0) As(a, b) = B(a, b) * scale_of(se.coords[b]) / s[nf + r];
+        if (layout_.free_of[se.coords[b]] >= 0) As(a, b) = B(a, b) * sc[b] / s[nf + r];
       const double norm = As.row(a).norm();
       if (!(norm > 0.0)) continue;
       As.row(a) *= h / norm;

@@ -81,24 +81,30 @@ class EquilibriumPath {
         a.why = "the forces or the stiffness are not finite";
         return a;
       }
-      // Converged on the residual after a small Newton correction: the tangent of the last
-      // iterate, that correction away (below 1e-4 of the DOFs' scale; about √tolerance when
-      // Newton converges quadratically), stands for this state's in the checks of its
-      // determinant's sign and of stability (indefinite()), and the factorization at the
-      // solution (a sixth of the work of a solve in five iterations) is not made. Not after the
-      // first iteration: its tangent is the one at the start of the step (the previous load), on
-      // the other side of any critical point the step passes (a linear problem converges there).
-      if (it >= 2 && last_correction <= 1e-4 && nd_ > 0 && factorized_) {
-        const double r = Rs.cwiseAbs().maxCoeff();
-        if (r <= opt_.tolerance * force || (last_correction <= 1e-12 && r <= 1e-6 * force)) {
-          if (crossed && last_sign == start_sign) {
-            a.why = "past a limit point: the only equilibrium found lies on a distant branch (a snap-through)";
-            return a;
-          }
+      // Converged on the residual: small against the forces it balances, or near it once the
+      // corrections have reached round-off.
+      auto residual_converged = [&](double r) {
+        return r <= opt_.tolerance * force || (last_correction <= 1e-12 && r <= 1e-6 * force);
+      };
+      // A converged step that ends with the determinant's sign of its start after a crossing has
+      // jumped past a limit point.
+      auto converged = [&](int sign) {
+        if (crossed && sign == start_sign)
+          a.why = "past a limit point: the only equilibrium found lies on a distant branch (a snap-through)";
+        else
           a.converged = true;
-          return a;
-        }
-      }
+        return a;
+      };
+      // Converged after a small Newton correction: the tangent of the last iterate, that
+      // correction away (below 1e-4 of the DOFs' scale; about √tolerance when Newton converges
+      // quadratically), stands for this state's in the checks of its determinant's sign and of
+      // stability (indefinite()), and the factorization at the solution (a sixth of the work of
+      // a solve in five iterations) is not made. Not after the first iteration: its tangent is
+      // the one at the start of the step (the previous load), on the other side of any critical
+      // point the step passes (a linear problem converges there).
+      if (it >= 2 && last_correction <= 1e-4 && nd_ > 0 && factorized_ &&
+          residual_converged(Rs.cwiseAbs().maxCoeff()))
+        return converged(last_sign);
       factorize_here(lambda);
       if (!factorized_) {
         a.why = "the forces or the stiffness are not finite";
@@ -123,18 +129,9 @@ class EquilibriumPath {
           correction = dq.cwiseQuotient(scale_).cwiseAbs().maxCoeff();
         }
       }
-      // Converged: the residual is small against the forces it balances; or it would move the
-      // DOFs by less than round-off (nothing is loaded: a mechanism moved by its inputs); or the
-      // corrections have reached round-off with a residual near it.
-      if (res_max <= opt_.tolerance * force || (!singular && correction <= 1e-13) ||
-          (last_correction <= 1e-12 && res_max <= 1e-6 * force)) {
-        if (crossed && sign == start_sign) {
-          a.why = "past a limit point: the only equilibrium found lies on a distant branch (a snap-through)";
-          return a;
-        }
-        a.converged = true;
-        return a;
-      }
+      // Converged on the residual, or the correction would move the DOFs by less than round-off
+      // (nothing is loaded: a mechanism moved by its inputs).
+      if (residual_converged(res_max) || (!singular && correction <= 1e-13)) return converged(sign);
       if (it == opt_.max_iterations) {
         a.why = "Newton's method did not converge in " + std::to_string(opt_.max_iterations) + " iterations";
         return a;

@@ -42,27 +42,36 @@ std::vector<int> dependent_columns(const Eigen::MatrixXd& V, const std::vector<i
 
 // The prescribed coordinates (DYNX, INPUTX) whose column of the constraint Jacobian is not
 // orthogonal to the left null space N (the combinations of redundant rows): freeing such a
-// coordinate adds a column the redundant combination sees, and the rank grows by one.
+// coordinate adds a column the redundant combination sees, and the rank grows by one. One pass
+// over the elements: each row belongs to one element, so a column's entries come from the
+// elements of its rows, and Nᵀ column and |column|² are summed entry by entry.
 std::vector<int> determined_prescribed(const System& sys, const Data& data, const std::vector<int>& rows,
                                        const Eigen::MatrixXd& N) {
-  std::vector<int> row_of(sys.ne, -1);
+  std::vector<int> row_of(sys.ne, -1), slot(sys.nx, -1), prescribed;
   for (size_t r = 0; r < rows.size(); ++r) row_of[rows[r]] = static_cast<int>(r);
-  std::vector<int> out;
-  Eigen::VectorXd column(static_cast<Eigen::Index>(rows.size()));
   for (const std::vector<int>* list : {&sys.x_dyn, &sys.x_input})
     for (int g : *list) {
-      column.setZero();
-      for (size_t i = 0; i < sys.elements.size(); ++i) {
-        const SystemElement& se = sys.elements[i];
-        for (size_t l = 0; l < se.coords.size(); ++l) {
-          if (se.coords[l] != g) continue;
-          for (int a = 0; a < se.nd; ++a)
-            if (const int r = row_of[se.def_offset + a]; r >= 0) column[r] += data.work[i].B(a, static_cast<Eigen::Index>(l));
-        }
-      }
-      const double norm = column.norm();
-      if (norm > 0.0 && (N.transpose() * column).norm() > 1e-8 * norm) out.push_back(g);
+      slot[g] = static_cast<int>(prescribed.size());
+      prescribed.push_back(g);
     }
+  Eigen::MatrixXd seen = Eigen::MatrixXd::Zero(N.cols(), static_cast<Eigen::Index>(prescribed.size()));
+  Eigen::VectorXd norm2 = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(prescribed.size()));
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    for (size_t l = 0; l < se.coords.size(); ++l) {
+      const int j = slot[se.coords[l]];
+      if (j < 0) continue;
+      for (int a = 0; a < se.nd; ++a)
+        if (const int r = row_of[se.def_offset + a]; r >= 0) {
+          const double v = data.work[i].B(a, static_cast<Eigen::Index>(l));
+          seen.col(j) += v * N.row(r).transpose();
+          norm2[j] += v * v;
+        }
+    }
+  }
+  std::vector<int> out;
+  for (size_t j = 0; j < prescribed.size(); ++j)
+    if (norm2[j] > 0.0 && seen.col(j).norm() > 1e-8 * std::sqrt(norm2[j])) out.push_back(prescribed[j]);
   std::sort(out.begin(), out.end());
   return out;
 }
