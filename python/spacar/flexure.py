@@ -29,7 +29,7 @@ import numpy as np
 from ._util import show
 from .errors import InputError
 from .model import Model
-from .section import Section
+from .section import Section, _positive
 
 __all__ = ["Body", "Flexure", "Beam"]
 
@@ -99,7 +99,7 @@ class Flexure:
         (Ixx, Ixy, Ixz, Iyy, Iyz, Izz) in the body's axes, which are the global axes at the
         start), both optional (a static analysis needs none)."""
         at = self._point(at, "at")
-        mass = _non_negative(mass, "mass")
+        mass = _positive(mass, "mass", zero=True)
         if inertia is not None:
             size = 6 if self.spatial else 1
             values = np.atleast_1d(np.asarray(inertia, dtype=float)) if _numbers(inertia) else None
@@ -121,8 +121,7 @@ class Flexure:
         self._check_body(body_b, "body_b")
         if body_a is body_b:
             raise InputError(f"a {kind} joins two different bodies, got {body_a.name!r} twice")
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or not 1 <= n <= 100_000:
-            raise InputError(f"n must be a number of elements from 1 to 100000, got {show(n)}")
+        n = _element_count(n)
         sections = [section] * n if isinstance(section, Section) else \
             list(section) if isinstance(section, (list, tuple)) else None
         if sections is None or len(sections) != n or not all(isinstance(c, Section) for c in sections):
@@ -183,8 +182,7 @@ class Flexure:
         w = _positive(width, "width")
         if not isinstance(material, Material):
             raise InputError(f"material must be a spacar.section.Material, got {show(material)}")
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or not 1 <= n <= 100_000:
-            raise InputError(f"n must be a number of elements from 1 to 100000, got {show(n)}")
+        n = _element_count(n)
         at = np.asarray(self._point(at, "at"))
         d = np.asarray(self._point(direction, "direction"))
         if not np.linalg.norm(d) > 0:
@@ -195,7 +193,7 @@ class Flexure:
         sections = [rectangle(b=w, h=float(h), material=material) for h in profile]
         if self.spatial and thickness_axis is None:
             raise InputError("a notch hinge in space needs the direction across its thin section: thickness_axis=(x, y, z)")
-        return self.beam(body_a, body_b, tuple(at - R * d), tuple(at + R * d), sections, n=int(n), y=thickness_axis,
+        return self.beam(body_a, body_b, tuple(at - R * d), tuple(at + R * d), sections, n=n, y=thickness_axis,
                          kind="notch hinge")
 
     def wire(self, body_a: Body, body_b: Body, a, b, section: Section, *, n: int = 8) -> Beam:
@@ -326,13 +324,7 @@ def _numbers(value) -> bool:
     return not isinstance(value, (str, bytes, bool))
 
 
-def _positive(value, name) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) or not value > 0:
-        raise InputError(f"{name} must be a positive number, got {show(value)}")
-    return float(value)
-
-
-def _non_negative(value, name) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) or value < 0:
-        raise InputError(f"{name} must be a non-negative number, got {show(value)}")
-    return float(value)
+def _element_count(n) -> int:
+    if isinstance(n, bool) or not isinstance(n, numbers.Integral) or not 1 <= n <= 100_000:
+        raise InputError(f"n must be a number of elements from 1 to 100000, got {show(n)}")
+    return int(n)
