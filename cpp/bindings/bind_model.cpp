@@ -112,6 +112,7 @@ void bind_model(py::module_& m) {
       .def("set_edampp", &Model::set_edampp)
       .def("set_force", &Model::set_force)
       .def("set_torquel", &Model::set_torquel)
+      .def("set_torqueg", &Model::set_torqueg)
       .def("set_gravity", &Model::set_gravity)
       .def("set_timestep", &Model::set_timestep)
       .def("set_hmax", &Model::set_hmax)

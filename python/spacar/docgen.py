@@ -34,6 +34,7 @@ NOTES = {
     "EDAMPP": "The same matrices as ESTIFF, applied to the deformation rates.",
     "FORCE": "Global (dead) directions; on a BETA node a torque, on a LAMBDA node λ-forces.",
     "TORQUEL": "Body-frame (follower) torque; missing components are 0.",
+    "TORQUEG": "Extension: torque fixed in global axes (dead), e.g. SPACAR Light's moment; missing components are 0.",
     "GRAVITY": "Extension: loads of all nodal masses on position nodes and of the element masses.",
     "TIMESTEP": "Without TIMESTEP (or Tp = 0) END analyses the current time only.",
     "HMAX": "9.999E+03 (SPACAR95's 'undefined') means no limit.",

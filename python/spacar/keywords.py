@@ -138,6 +138,8 @@ _OTHER = [
     Keyword("FORCE", PROPERTIES, (_p("n"), _p("f", REAL, 1, 4)), "prescribed constant force x1..x4 at node n"),
     Keyword("TORQUEL", PROPERTIES, (_p("n"), _p("T", REAL, 1, 3)),
             "body-fixed constant torque at LAMBDA node n"),
+    Keyword("TORQUEG", PROPERTIES, (_p("n"), _p("T", REAL, 1, 3)),
+            "constant torque in global axes at LAMBDA node n", extension=True),
     Keyword("GRAVITY", PROPERTIES, (_p("g", REAL, 2, 3),),
             "uniform gravity acceleration gx gy [gz] acting on all masses", extension=True),
     Keyword("TIMESTEP", SETTINGS, (_p("n"), _p("Tp", REAL)),

@@ -305,6 +305,12 @@ class Model:
         n, v = self._call("TORQUEL", n, *values)
         self._core.set_torquel(n, v)
 
+    def torqueg(self, n, *values):
+        """TORQUEG n T1 [T2 T3] (extension): constant torque in global axes (a dead load) at
+        LAMBDA node n."""
+        n, v = self._call("TORQUEG", n, *values)
+        self._core.set_torqueg(n, v)
+
     def gravity(self, *g):
         """GRAVITY gx gy [gz] (extension): uniform gravity acting on all masses."""
         (v,) = self._call("GRAVITY", *g)

@@ -167,16 +167,6 @@ bool symmetric_constitutive(const System& sys, const SystemElement& se, const No
 }
 
 // −∂f/∂λ of a body-fixed torque T: f_λ = 2 G(λ)ᵀ T is linear in λ (4 x 4, unsymmetric).
-Eigen::Matrix4d torque_stiffness(const Eigen::Vector3d& T) {
-  Eigen::Matrix4d K;
-  for (int b = 0; b < 4; ++b) {
-    double unit[4] = {0, 0, 0, 0};
-    unit[b] = 1.0;
-    K.col(b) = -2.0 * euler_G(unit).transpose() * T;
-  }
-  return K;
-}
-
 }  // namespace
 
 Eigen::SparseMatrix<double> nodal_part(const System& sys, Data& data, const Eigen::VectorXd& sigma, unsigned part) {
@@ -208,10 +198,10 @@ Eigen::SparseMatrix<double> nodal_matrix(const System& sys, Data& data, const Ei
           entries.emplace_back(sys.bodies[b].coord + i, sys.bodies[b].coord + j, c.mass * data.body_M[b](i, j));
   }
   if (c.geometric != 0.0 && c.load_factor != 0.0)
-    for (const auto& [coord, T] : sys.torquel) {
-      const Eigen::Matrix4d K = c.geometric * c.load_factor * torque_stiffness(T);
+    for (const Torque& t : sys.torques) {
+      const Eigen::Matrix4d K = c.geometric * c.load_factor * t.stiffness();
       for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) entries.emplace_back(coord + i, coord + j, K(i, j));
+        for (int i = 0; i < 4; ++i) entries.emplace_back(t.coord + i, t.coord + j, K(i, j));
     }
   Eigen::SparseMatrix<double> A(sys.nx, sys.nx);
   A.setFromTriplets(entries.begin(), entries.end());
@@ -257,9 +247,9 @@ Eigen::Vector4d nodal_energies(const System& sys, Data& data, const Eigen::Vecto
     const Eigen::Vector4d vb = v.segment<4>(sys.bodies[b].coord);
     out[2] += vb.dot(data.body_M[b] * vb);
   }
-  for (const auto& [coord, T] : sys.torquel) {
-    const Eigen::Vector4d vb = v.segment<4>(coord);
-    out[1] += vb.dot(torque_stiffness(T) * vb);
+  for (const Torque& t : sys.torques) {
+    const Eigen::Vector4d vb = v.segment<4>(t.coord);
+    out[1] += vb.dot(t.stiffness() * vb);
   }
   return out;
 }
@@ -329,9 +319,9 @@ Eigen::SparseMatrix<double> nodal_dof_map(const System& sys, const Data& data) {
 SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_(layout) {
   const int nf = layout.n_free;
   n_ = nf + layout.n_rows;
-  // Symmetric unless body-fixed torques (follower loads), slip rates (their derivatives are
-  // not integrable) or an unsymmetric constitutive matrix make H unsymmetric.
-  symmetric_ = sys.torquel.empty();
+  // Symmetric unless torques (their load stiffness), slip rates (their derivatives are not
+  // integrable) or an unsymmetric constitutive matrix make H unsymmetric.
+  symmetric_ = sys.torques.empty();
   for (int k = 0; k < sys.ne; ++k) symmetric_ = symmetric_ && !sys.def_velocity_level[k];
   for (const SystemElement& se : sys.elements) symmetric_ = symmetric_ && symmetric_constitutive(sys, se, layout);
   kkt_.reset(n_, n_);
@@ -361,7 +351,7 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
     return kkt_.add_block(fi, fi);
   };
   for (const BodyInertia& b : sys.bodies) body_block_.push_back(four(b.coord));
-  for (const auto& t : sys.torquel) torque_block_.push_back(four(t.first));
+  for (const Torque& t : sys.torques) torque_block_.push_back(four(t.coord));
   kkt_.finalize();
   const Eigen::SparseMatrix<double>& A = kkt_.matrix();
   diagonal_.assign(nf, -1);
@@ -424,8 +414,8 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
       kkt_.add(body_block_[b], c.mass * data.body_M[b]);
   }
   if (c.geometric != 0.0 && c.load_factor != 0.0)
-    for (size_t t = 0; t < sys.torquel.size(); ++t)
-      kkt_.add(torque_block_[t], c.geometric * c.load_factor * torque_stiffness(sys.torquel[t].second));
+    for (size_t t = 0; t < sys.torques.size(); ++t)
+      kkt_.add(torque_block_[t], c.geometric * c.load_factor * sys.torques[t].stiffness());
   // The size of H for W: its largest diagonal entry (1 if H vanishes: a mechanism unloaded).
   double h = 0.0;
   const double* v = kkt_.matrix().valuePtr();
@@ -642,8 +632,8 @@ Eigen::VectorXd ReducedSystem::product(const Eigen::VectorXd& q, Eigen::VectorXd
       f.segment<4>(sys_.bodies[b].coord) += c_.mass * data_.body_M[b] * dx.segment<4>(sys_.bodies[b].coord);
   }
   if (c_.geometric != 0.0 && c_.load_factor != 0.0)
-    for (const auto& [coord, T] : sys_.torquel)
-      f.segment<4>(coord) += c_.geometric * c_.load_factor * torque_stiffness(T) * dx.segment<4>(coord);
+    for (const Torque& t : sys_.torques)
+      f.segment<4>(t.coord) += c_.geometric * c_.load_factor * t.stiffness() * dx.segment<4>(t.coord);
   y += reduce(f);
   if (dx_out) *dx_out = dx;
   return y;

@@ -81,8 +81,7 @@ void compute_inertia_and_loads(const System& sys, Data& data) {
                            data.body_M[b].data(), data.body_h[b].data());
     data.h.segment<4>(c) += data.body_h[b];
   }
-  for (const auto& [coord, T] : sys.torquel)
-    data.f.segment<4>(coord) += 2.0 * euler_G(data.x.data() + coord).transpose() * T;
+  for (const Torque& t : sys.torques) data.f.segment<4>(t.coord) += t.force(data.x.data() + t.coord);
 }
 
 void inertia_force(const System& sys, Data& data) {
@@ -348,11 +347,10 @@ EnergyRates energy_rates(const System& sys, const Data& data) {
     for (int a = 0; a < se.nd; ++a)
       if (constitutive_class(sys.def_class[se.def_offset + a])) r.dissipated += ed[a] * se.D.row(a).dot(ed);
   }
-  // Applied loads: FORCE, the time-dependent loads and the body-fixed torques.
+  // Applied loads: FORCE, the time-dependent loads and the torques.
   r.external = sys.force.dot(data.xd);
   if (data.time_load.size()) r.external += data.time_load.dot(data.xd);
-  for (const auto& [coord, T] : sys.torquel)
-    r.external += (2.0 * euler_G(data.x.data() + coord).transpose() * T).dot(data.xd.segment<4>(coord));
+  for (const Torque& t : sys.torques) r.external += t.force(data.x.data() + t.coord).dot(data.xd.segment<4>(t.coord));
   // Drivers of input deformations: their reaction stresses against the prescribed rates (fixed
   // deformations do not move).
   for (int k = 0; k < sys.ne; ++k)

@@ -461,13 +461,24 @@ void Model::set_force(int id, const std::vector<double>& values) {
   for (size_t i = 0; i < values.size(); ++i) n.force[i] = values[i];
 }
 
+namespace {
+void set_torque(Node& n, int id, const std::vector<double>& values, const char* keyword, std::vector<double>& out) {
+  require_finite(values, keyword);
+  if (n.kind != NodeKind::Lambda) fail(keyword, " applies to LAMBDA nodes; node ", id, " is ", node_keyword(n.kind));
+  require_count(values, 1, 3, keyword);
+  out.assign(3, 0.0);
+  for (size_t i = 0; i < values.size(); ++i) out[i] = values[i];
+}
+}  // namespace
+
 void Model::set_torquel(int id, const std::vector<double>& values) {
-  require_finite(values, "TORQUEL");
   Node& n = node(id);
-  if (n.kind != NodeKind::Lambda) fail("TORQUEL applies to LAMBDA nodes; node ", id, " is ", node_keyword(n.kind));
-  require_count(values, 1, 3, "TORQUEL");
-  n.torquel.assign(3, 0.0);
-  for (size_t i = 0; i < values.size(); ++i) n.torquel[i] = values[i];
+  set_torque(n, id, values, "TORQUEL", n.torquel);
+}
+
+void Model::set_torqueg(int id, const std::vector<double>& values) {
+  Node& n = node(id);
+  set_torque(n, id, values, "TORQUEG", n.torqueg);
 }
 
 void Model::set_gravity(const std::vector<double>& g) {

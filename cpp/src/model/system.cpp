@@ -4,9 +4,25 @@
 #include <cmath>
 #include <sstream>
 
+#include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
 
 namespace spacar {
+
+Eigen::Vector4d Torque::force(const double* l) const {
+  const Eigen::Matrix<double, 3, 4> P = global ? euler_E(Eigen::Map<const Eigen::Vector4d>(l)) : euler_G(l);
+  return 2.0 * P.transpose() * T;
+}
+
+Eigen::Matrix4d Torque::stiffness() const {
+  Eigen::Matrix4d K;
+  for (int b = 0; b < 4; ++b) {  // P is linear in λ: column b is the force at the unit vector e_b
+    double unit[4] = {0, 0, 0, 0};
+    unit[b] = 1.0;
+    K.col(b) = -force(unit);
+  }
+  return K;
+}
 
 std::string System::coord_name(int g) const {
   std::ostringstream os;
@@ -281,7 +297,8 @@ void masses_and_loads(const Model& model, System& sys, const NodeOffsets& node_o
       }
     }
     for (size_t i = 0; i < n.force.size(); ++i) sys.force[off + i] = n.force[i];
-    if (!n.torquel.empty()) sys.torquel.push_back({off, Eigen::Vector3d(n.torquel[0], n.torquel[1], n.torquel[2])});
+    if (!n.torquel.empty()) sys.torques.push_back({off, Eigen::Vector3d(n.torquel[0], n.torquel[1], n.torquel[2]), false});
+    if (!n.torqueg.empty()) sys.torques.push_back({off, Eigen::Vector3d(n.torqueg[0], n.torqueg[1], n.torqueg[2]), true});
   }
   sys.gravity = Eigen::Vector3d(model.gravity[0], model.gravity[1], model.gravity[2]);
 }

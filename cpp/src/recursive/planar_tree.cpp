@@ -49,7 +49,7 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
     if (!sys_.e_line.empty() || !sys_.e_nonholonomic.empty() || !sys_.e_kinematic.empty() || !sys_.y_defs.empty())
       return refuse("LINE, nonholonomic or kinematic deformations");
     if (!sys_.auto_released.empty()) return refuse("automatically released deformations");
-    if (!sys_.bodies.empty() || !sys_.torquel.empty()) return refuse("inertia tensors or TORQUEL");
+    if (!sys_.bodies.empty() || !sys_.torques.empty()) return refuse("inertia tensors or torques (TORQUEL, TORQUEG)");
     return true;
   }
 

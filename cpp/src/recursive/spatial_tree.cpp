@@ -221,11 +221,12 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
       for (const Follower& fl : tree_.followers_)  // every moving point follows one body
         if (fl.coord == n.coord) tree_.loads_.push_back({fl.body, fl.b, f.head<3>()});
     }
-    for (const auto& [coord, T] : sys_.torquel) {
-      auto it = lambda_body_.find(coord);
+    for (const Torque& t : sys_.torques) {
+      auto it = lambda_body_.find(t.coord);
       if (it == lambda_body_.end()) continue;  // on the ground
-      const Eigen::Vector4d l = x_.segment<4>(coord);  // constant in body coordinates
-      tree_.bodies_[it->second].load.head<3>() += euler_R(l) * T;  // R(λ0) T′
+      if (t.global) return refuse("TORQUEG (a torque fixed in space, not in the body)");
+      const Eigen::Vector4d l = x_.segment<4>(t.coord);  // constant in body coordinates
+      tree_.bodies_[it->second].load.head<3>() += euler_R(l) * t.T;  // R(λ0) T′
     }
     return true;
   }

@@ -331,8 +331,9 @@ def _convertible(model) -> bool:
     for n, nd in nodes.items():
         if any(abs(v) > 0 for v in nd.force):
             raise UnsupportedModelError(f"node {n} has a FORCE; loads other than GRAVITY are not converted")
-        if any(abs(v) > 0 for v in nd.torquel):
-            raise UnsupportedModelError(f"node {n} has a TORQUEL; loads other than GRAVITY are not converted")
+        for torque in ("torquel", "torqueg"):
+            if any(abs(v) > 0 for v in getattr(nd, torque)):
+                raise UnsupportedModelError(f"node {n} has a {torque.upper()}; loads other than GRAVITY are not converted")
         if nd.kind in POSITION_KINDS and any(c == CC.input for c in nd.cls):
             raise UnsupportedModelError(f"node {n}: prescribed positions (INPUTX) are not converted")
         if nd.kind == NK.LAMBDA and any(c == CC.input for c in nd.cls):

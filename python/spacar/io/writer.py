@@ -119,7 +119,7 @@ def dump(model, digits: int = 4) -> str:
         for eid, el in sorted(elements.items()):
             if getattr(el, attr):
                 out.add(keyword, [eid], getattr(el, attr))
-    for attr, keyword in (("force", "FORCE"), ("torquel", "TORQUEL")):
+    for attr, keyword in (("force", "FORCE"), ("torquel", "TORQUEL"), ("torqueg", "TORQUEG")):
         for nid, n in sorted(nodes.items()):
             if getattr(n, attr):
                 out.add(keyword, [nid], getattr(n, attr))

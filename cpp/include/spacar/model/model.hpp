@@ -34,6 +34,7 @@ struct Node {
   std::vector<double> force;      // FORCE values (empty: none)
   std::vector<double> mass;       // MASS values as given (empty: none)
   std::vector<double> torquel;    // TORQUEL values (empty: none)
+  std::vector<double> torqueg;    // TORQUEG values (empty: none)
   bool used = false;              // referenced by an element
   int x_given = 0;                // number of coordinates given explicitly (X/XY/...)
   std::string origin;             // where the node was first defined by X/XY/... (for messages)
@@ -103,6 +104,7 @@ inline constexpr auto kNodeFields = std::make_tuple(
     field("force", &Node::force, "FORCE values (empty: none)"),
     field("mass", &Node::mass, "MASS values as given (empty: none)"),
     field("torquel", &Node::torquel, "TORQUEL values (empty: none)"),
+    field("torqueg", &Node::torqueg, "TORQUEG values (empty: none)"),
     field("used", &Node::used, "referenced by an element"),
     field("x_given", &Node::x_given, "number of coordinates given explicitly (X/XY/...)"),
     field("origin", &Node::origin, "where the node was first defined (for messages)"));
@@ -175,6 +177,7 @@ class Model {
   void set_edampp(int element, const std::vector<double>& values);
   void set_force(int node, const std::vector<double>& values);
   void set_torquel(int node, const std::vector<double>& values);
+  void set_torqueg(int node, const std::vector<double>& values);
   void set_gravity(const std::vector<double>& g);
 
   // --- settings ---

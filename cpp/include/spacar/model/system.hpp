@@ -44,6 +44,17 @@ struct BodyInertia {
   Eigen::Matrix3d J;
 };
 
+// A constant torque on a LAMBDA node: body-fixed (TORQUEL, a follower load) or in global axes
+// (TORQUEG, a dead load). Its generalized force 2 Pᵀ(λ) T, P = G (body) or E (global), is linear
+// in λ: the load stiffness is a constant 4 x 4 matrix.
+struct Torque {
+  int coord;          // first λ coordinate
+  Eigen::Vector3d T;  // components in the body frame (TORQUEL) or global axes (TORQUEG)
+  bool global;
+  Eigen::Vector4d force(const double* l) const;  // 2 Pᵀ(λ) T
+  Eigen::Matrix4d stiffness() const;             // −∂force/∂λ
+};
+
 struct System {
   System() = default;
   System(const System&) = delete;  // owns the element kernels
@@ -104,7 +115,7 @@ struct System {
   std::vector<BodyInertia> bodies;
   std::vector<FreeRotation> free_rotations;
   Eigen::VectorXd force;        // constant applied loads per coordinate (FORCE)
-  std::vector<std::pair<int, Eigen::Vector3d>> torquel;  // (first λ coordinate, body torque)
+  std::vector<Torque> torques;  // TORQUEL and TORQUEG
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   int dim = 2;                  // 2 for planar models, 3 if any spatial node exists
   double length_scale = 1.0;    // mean reference length of the elements (1 if none): step sizes
