@@ -60,17 +60,19 @@ class EquilibriumPath {
   // fails unless `last_chance` (the smallest step): then an end beyond a bifurcation, where the
   // sign has changed, is accepted (an unstable equilibrium, reported as indefinite), while a
   // return to the start's sign (the jump past a limit point) fails.
-  Attempt solve(double lambda, bool last_chance) {
+  // `from`: the load factor of the current state, for the predictor of moving inputs.
+  Attempt solve(double lambda, bool last_chance, double from) {
     Attempt a;
     Eigen::VectorXd qhat = with_inputs(data_.qhat, lambda);
     Eigen::VectorXd R, dq, dx;
+    const bool predicted = predict(from, lambda, qhat, dx);
     double last_correction = std::numeric_limits<double>::infinity();
     int start_sign = 0, last_sign = 0;
     bool crossed = false;
     for (int it = 0;; ++it) {
       check_thread_deadline("(in the static analysis)");
       try {
-        place(qhat, it > 0 ? &dx : nullptr);
+        place(qhat, it > 0 || predicted ? &dx : nullptr);
       } catch (const KinematicsError& err) {
         a.why = std::string("the kinematics has no solution there (") + err.what() + ")";
         return a;
@@ -198,6 +200,25 @@ class EquilibriumPath {
     gs.resize(nd_);
     for (int j = 0; j < nd_; ++j) gs[j] = scale_[j] * (out[sys_.dof_cols[j]] + R0_[j]);
     return force;
+  }
+  // The first-order predictor of a step whose inputs move: the DOFs' change dq = −K⁻¹ ∂R/∂λ Δλ
+  // from the current equilibrium at `from` (added to qhat) and the coordinates' change dx with it.
+  // Without it Newton starts from the DOFs of the last step with only the inputs moved: where the
+  // DOFs are deformations (DYNE), the released deformations next to the input then take the
+  // whole motion, and Newton needs dozens of iterations and step cuts to spread it.
+  bool predict(double from, double lambda, Eigen::VectorXd& qhat, Eigen::VectorXd& dx) {
+    if (nd_ == 0 || sys_.n_input() == 0 || p1_ == p0_ || lambda == from) return false;
+    Eigen::VectorXd Fs, gs, dq;
+    try {
+      evaluate(data_.qhat, from, nullptr, Fs, gs);
+    } catch (const KinematicsError&) {
+      return false;
+    }
+    if (!factorized_ || tangent_.singular()) return false;
+    solve_dofs(-(lambda - from) * gs.cwiseQuotient(scale_), dq, dx);
+    if (!dq.allFinite() || !dx.allFinite()) return false;
+    for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += dq[j];
+    return true;
   }
   bool factorized() const { return factorized_; }
   bool singular() const { return tangent_.singular(); }
@@ -568,7 +589,7 @@ void follow_load_steps(const System& sys, EquilibriumPath& path, const StaticOpt
     // The last chance: the smallest step allowed, or one whose half would not change λ (with
     // max_cuts near 50 the steps fall below the round-off of λ, and halving forever would hang).
     const bool last_chance = step <= smallest * (1.0 + 1e-9) || lambda + 0.5 * step == lambda;
-    const EquilibriumPath::Attempt a = path.solve(next, last_chance);
+    const EquilibriumPath::Attempt a = path.solve(next, last_chance, lambda);
     iterations += a.iterations;
     if (!a.converged) {
       const bool hopeless = a.singular_at_start || last_chance;
@@ -649,7 +670,7 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
       EquilibriumPath::Attempt last;
       try {
         path.evaluate(qhat, 1.0, nullptr, Fs, gs);
-        last = path.solve(1.0, true);
+        last = path.solve(1.0, true, 1.0);
       } catch (const KinematicsError& err) {
         last.converged = false;
         last.why = std::string("the kinematics has no solution there (") + err.what() + ")";
