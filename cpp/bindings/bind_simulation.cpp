@@ -227,9 +227,9 @@ void bind_linearization(py::class_<Simulation>& sim) {
 void bind_states(py::class_<Simulation>& sim) {
   sim
       .def("diagnose",
-           [](Simulation& s, double time_limit, double time_spent) {
+           [](Simulation& s, double time_limit, double time_spent, bool release_dynamic) {
              const DeadlineScope deadline(time_limit, time_spent);
-             const ConstraintDiagnosis d = diagnose(s.system(), s.data());
+             const ConstraintDiagnosis d = diagnose(s.system(), s.data(), false, release_dynamic);
              const System& sys = s.system();
              py::dict out;
              out["n_constraints"] = d.n_constraints;
@@ -245,9 +245,10 @@ void bind_states(py::class_<Simulation>& sim) {
              out["text"] = d.text;
              return out;
            },
-           py::arg("time_limit") = 0.0, py::arg("time_spent") = 0.0,
+           py::arg("time_limit") = 0.0, py::arg("time_spent") = 0.0, py::arg("release_dynamic") = false,
            "The constraint diagnosis at the current geometry, within `time_limit` seconds of which "
-           "`time_spent` are spent.")
+           "`time_spent` are spent; `release_dynamic`: the redundant rows named among the DYNE "
+           "deformations where possible.")
       .def("evaluate", py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::evaluate))
       .def("solve_state",
            py::overload_cast<double, const Eigen::VectorXd&, const Eigen::VectorXd&>(&Simulation::solve_state),

@@ -78,7 +78,7 @@ std::vector<int> determined_prescribed(const System& sys, const Data& data, cons
 
 }  // namespace
 
-ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
+ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity, bool release_dynamic) {
   ConstraintDiagnosis d;
   const std::vector<int>& rows = velocity ? sys.defs_V : sys.defs_P;
   BlockMatrix& block = velocity ? data.AV : data.AP;
@@ -123,13 +123,14 @@ ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity) {
       d.undetermined_groups.push_back(group);
     }
     // A concrete set to release: keep prescribed rows (inputs, DOFs) first, then fixed ones in
-    // ascending order; each row dependent on the kept ones is redundant.
+    // ascending order (release_dynamic: fixed and inputs first, the DOFs last); each row
+    // dependent on the kept ones is redundant.
     std::vector<int> order;
     for (int pass = 0; pass < 2; ++pass)
       for (int r = 0; r < nP; ++r) {
         const DefClass c = sys.def_class[rows[r]];
-        const bool fixed = c == DefClass::Fixed || c == DefClass::Nonholonomic;
-        if ((pass == 1) == fixed) order.push_back(r);
+        const bool last = release_dynamic ? c == DefClass::Dynamic : c == DefClass::Fixed || c == DefClass::Nonholonomic;
+        if ((pass == 1) == last) order.push_back(r);
       }
     // (The selections cost O(n^3): skipped when the SVD shows full rank.)
     if (d.rank < nP)

@@ -34,7 +34,10 @@ struct ConstraintDiagnosis {
   std::string text;               // readable report naming elements and nodes
 };
 // velocity: the velocity block (rows V) instead of the position block (rows P).
-ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity = false);
+// release_dynamic: name the redundancy among the dynamic deformations (DYNE) where it can, keeping
+// the fixed and input rows (SPACAR Light's automatic release turns such DYNE into RLSE); by
+// default among the fixed deformations, keeping the prescribed rows.
+ConstraintDiagnosis diagnose(const System& sys, Data& data, bool velocity = false, bool release_dynamic = false);
 std::string diagnose_constraints(const System& sys, Data& data, bool velocity = false);
 // If the velocity constraint block is nearly singular (a dead point): which constraints lose
 // their independence and which coordinates move; "" otherwise.
