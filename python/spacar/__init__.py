@@ -40,6 +40,7 @@ from .model import Model
 from .geometry import Geometry
 from .results import Results
 from .simulate import simulate
+from .spacar_light import LightResults, light, light_model
 from .statics import StaticError, static
 from .statespace import StateSpace, state_space
 from .sweep import SweepError, SweepResult, sweep
@@ -125,6 +126,9 @@ __all__ = [
     "support_stiffness",
     "section",
     "flexure",
+    "light",
+    "light_model",
+    "LightResults",
     "mechanism",
     "sweep",
     "SweepResult",
