@@ -143,7 +143,7 @@ def test_catalogue_flags():
     assert [n for n, t in cat.items() if t.automatic] == ["L2MIN1"]
     assert [n for n, t in cat.items() if t.signed_emass_extras] == ["PLBELT"]
     families = {n: t.family.name for n, t in cat.items()}
-    assert [n for n, f in families.items() if f == "Beam"] == ["BEAM", "BEAMNL", "PLBEAM", "PLBEAMNL"]
+    assert [n for n, f in families.items() if f == "Beam"] == ["BEAM", "BEAMNL", "PLBEAM", "PLBEAMNL", "PLBEAMC"]
     assert [n for n, f in families.items() if f == "Hinge"] == ["HINGE", "PLHINGE"]
     assert [n for n, f in families.items() if f == "Truss"] == ["TRUSS", "PLTRUSS"]
     assert [n for n, f in families.items() if f == "Wheel"] == ["PLWHEEL", "WHEEL"]

@@ -1,4 +1,4 @@
-"""Element-level verification of the planar elements PLTRUSS, PLBEAM, PLBEAMNL, PLHINGE
+"""Element-level verification of the planar elements PLTRUSS, PLBEAM, PLBEAMNL, PLBEAMC, PLHINGE
 (issue #3; formulation.md §4.1–4.4, §10.1) through `spacar._testing.element_kernel`.
 
 The generic finite-difference and invariance checks live in support/element_checks.py (one line per
@@ -31,11 +31,12 @@ PLANAR_CASES = [
     ElementCase("PLTRUSS", chord),
     ElementCase("PLBEAM", chord),
     ElementCase("PLBEAMNL", chord),
+    ElementCase("PLBEAMC", chord),
     ElementCase("PLHINGE", orientations_only),
 ]
 CASES = {c.type: c for c in PLANAR_CASES}
 BEAMS = ["PLBEAM", "PLBEAMNL"]
-WITH_MASS = ["PLTRUSS", "PLBEAM", "PLBEAMNL"]
+WITH_MASS = ["PLTRUSS", "PLBEAM", "PLBEAMNL", "PLBEAMC"]
 
 
 @pytest.fixture(params=PLANAR_CASES, ids=str)
@@ -66,6 +67,12 @@ def closed_form(type_, x, l0, alpha0):
         return np.array([math.hypot(x[2] - x[0], x[3] - x[1]) - l0])
     d = x[3:5] - x[0:2]
     l, alpha = math.hypot(*d), math.atan2(d[1], d[0])
+    if type_ == "PLBEAMC":  # the angles, wrapped to (−π, π], and the arc's length
+        dp = math.remainder(alpha0 + x[2] - alpha, 2 * math.pi)
+        dq = math.remainder(alpha - alpha0 - x[5], 2 * math.pi)
+        dm = 0.5 * (dp + dq)
+        b = 0.5 * l0 * (dp - dq)
+        return np.array([l * (dm / math.sin(dm) if dm else 1.0) - l0 + b * b / (10 * l0), l0 * dp, l0 * dq])
     e2 = l0 * math.sin(alpha0 + x[2] - alpha)  # l0 sin(φp − α)
     e3 = l0 * math.sin(alpha - alpha0 - x[5])  # l0 sin(α − φq)
     e1 = l - l0
@@ -126,6 +133,24 @@ def test_constant_curvature_bending(type_):
             assert e[1] < 0 and e[2] < 0
 
 
+def test_plbeamc_is_exact_on_a_circular_arc():
+    """PLBEAMC on an arc of length l0 turning by 2θ: e2 = e3 = −l0 θ (the angles) and no
+    elongation, for any θ up to a half turn; its elongation is PLBEAMNL's to second order."""
+    rng = np.random.default_rng(13)
+    for _ in range(N_CONFIGS):
+        l0, alpha0 = rng.uniform(0.5, 2), rng.uniform(-math.pi, math.pi)
+        k = _testing.element_kernel("PLBEAMC", l0=l0, lgeomy=[alpha0])
+        for theta in (1e-4, 0.3, -1.2, 3.0):
+            e = k.deformations(arc(rng.uniform(-1, 1, 2), alpha0, l0, theta))
+            np.testing.assert_allclose(e, [0.0, -l0 * theta, -l0 * theta], rtol=0, atol=2e-15 * l0 / abs(math.sin(theta)))
+    nl = _testing.element_kernel("PLBEAMNL", l0=1.0, lgeomy=[0.0])
+    arc_beam = _testing.element_kernel("PLBEAMC", l0=1.0, lgeomy=[0.0])
+    for s in (1e-2, 5e-3):                                   # a cubic bend, symmetric and antisymmetric parts
+        x = np.array([0.0, 0.0, 3 * s, 1.0, 0.1 * s, -s])
+        a, b = arc_beam.deformations(x), nl.deformations(x)
+        assert abs(a[0] - b[0]) < 2 * s**3
+
+
 def test_plbeamnl_circular_arc_elongation():
     """Arc of length l0 (inextensible bending): e1 = −(17/360) l0 θ⁴ + O(θ⁶), e2 = e3 = −l0 sin θ
     (§10.1). Exact series: e1/(−17/360 l0 θ⁴) = 1 − (109/714) θ² + O(θ⁴)."""
@@ -170,7 +195,7 @@ def test_constitutive_matrix(type_):
     for _ in range(5):
         l0, a, b = rng.uniform(0.5, 2), rng.uniform(1, 1e4), rng.uniform(1, 1e2)
         k = _testing.element_kernel(type_, l0=l0)
-        if type_ in BEAMS:  # ESTIFF EA EI
+        if type_ in BEAMS or type_ == "PLBEAMC":  # ESTIFF EA EI
             expected = np.zeros((3, 3))
             expected[0, 0] = a / l0
             expected[1:, 1:] = b / l0**3 * np.array([[4.0, -2.0], [-2.0, 4.0]])

@@ -6,6 +6,13 @@
 //   e3 = +l0 (e_l · n_q) = l0 sin(α − φq)         bending at q
 // PLBEAMNL adds the bending correction (2e2² + e2e3 + 2e3²)/(30 l0) to e1: the excess of the
 // arc length of the cubic deflection over the chord.
+// PLBEAMC (extension, exact for constant curvature) bends by the angles instead of their sines
+// and measures the elongation along the arc:
+//   e2 = l0 δp, δp = φp − α;  e3 = l0 δq, δq = α − φq  (angles in (−π, π])
+//   e1 = l δm / sin δm − l0 + b² / (10 l0),  δm = (δp + δq)/2, b = (e2 − e3)/2
+// A circular arc (δp = δq) is the chord l = 2R sin δm of the arc 2R δm: e1 is its stretch, and
+// a pure moment rolls any mesh into the exact circle; b²/(10 l0) is PLBEAMNL's correction for the
+// antisymmetric (S-shaped) part, to which the symmetric part's l δm²/6 adds its own second order.
 // Mass: consistent mass of the cubic Hermite interpolation with the nodal material tangents.
 #include <cmath>
 
@@ -14,8 +21,16 @@
 namespace spacar {
 namespace {
 
-template <bool Nonlinear>
-class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
+// The bending measure of the planar beam: the manual's (sines), with the bending-corrected
+// elongation, or the arc's (angles).
+enum class Bending { Sine, SineCorrected, Arc };
+
+template <Bending Kind>
+class PlBeam : public AutoDiffElement<PlBeam<Kind>, 6, 3, 4, 2> {
+  static constexpr bool Nonlinear = Kind == Bending::SineCorrected;
+  static constexpr bool Arc = Kind == Bending::Arc;
+  using Base = AutoDiffElement<PlBeam<Kind>, 6, 3, 4, 2>;
+
  public:
   explicit PlBeam(const ElementSetup& s) : l0_(s.l0), alpha0_(s.lgeomy.empty() ? 0.0 : s.lgeomy[0]) {
     const double rhoA = s.emass.empty() ? 0.0 : s.emass[0];
@@ -27,6 +42,15 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
     const S dx = x[3] - x[0], dy = x[4] - x[1];
     const S l = sqrt(dx * dx + dy * dy);
     const S phip = alpha0_ + x[2], phiq = alpha0_ + x[5];
+    if constexpr (Arc) {
+      const S dp = atan2(dx * sin(phip) - dy * cos(phip), dx * cos(phip) + dy * sin(phip));  // φp − α
+      const S dq = atan2(dy * cos(phiq) - dx * sin(phiq), dx * cos(phiq) + dy * sin(phiq));  // α − φq
+      e[1] = l0_ * dp;
+      e[2] = l0_ * dq;
+      const S b = 0.5 * (e[1] - e[2]);
+      e[0] = l * arc_over_chord(0.5 * (dp + dq)) - l0_ + b * b / (10.0 * l0_);
+      return;
+    }
     // e_l · n(φ) = (−dx sin φ + dy cos φ) / l
     e[1] = -l0_ * (dy * cos(phip) - dx * sin(phip)) / l;
     e[2] = l0_ * (dy * cos(phiq) - dx * sin(phiq)) / l;
@@ -39,6 +63,7 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   // u = d · n: ∂e1/∂d = t, ∂e2/∂d = −(l0 / l)(n_p − (u_p / l) t), ∂e2/∂φp = (l0 / l) d · (cos φp, sin φp),
   // and e3 likewise at q with the opposite sign.
   void first_derivatives(const double* x, double* e, double* B) const override {
+    if constexpr (Arc) return Base::first_derivatives(x, e, B);  // PLBEAMC: from the jets
     const double dx = x[3] - x[0], dy = x[4] - x[1];
     const double l = std::sqrt(dx * dx + dy * dy), inv = 1.0 / l;
     const double tx = dx * inv, ty = dy * inv, k = l0_ * inv;
@@ -79,6 +104,7 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   //   ∂²g/∂φ² = −(l0/l) u,  and ∂²l/∂d² = (I − t tᵀ)/l;
   // e2 = −g(d, φp), e3 = g(d, φq); PLBEAMNL's elongation adds the bending term's Hessian.
   void stress_hessian(const double* x, const double* sigma, double* G) const override {
+    if constexpr (Arc) return Base::stress_hessian(x, sigma, G);
     const double dx = x[3] - x[0], dy = x[4] - x[1];
     const double l = std::sqrt(dx * dx + dy * dy), inv = 1.0 / l;
     const Eigen::Vector2d d(dx, dy), t = d * inv;
@@ -142,8 +168,9 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   // Each bend δ (φp − α, α − φq) is taken on the arcsine's branch (below or above π/2) and the
   // turn of the guess's δ; the solved rotation then follows the known one continuously, however
   // far that has turned since the guess.
-  bool has_closed_form() const override { return true; }
+  bool has_closed_form() const override { return !Arc; }
   bool solve_end(int end, const double* e, const double* guess, double* x) const override {
+    if constexpr (Arc) return false;
     const double l = l0_ + e[0] - (Nonlinear ? bending_elongation(e[1], e[2]) : 0.0);
     if (!(l > 0.0) || !(std::abs(e[1]) <= l0_) || !(std::abs(e[2]) <= l0_)) return false;
     const double guess_alpha = std::atan2(guess[4] - guess[1], guess[3] - guess[0]);
@@ -208,6 +235,17 @@ class PlBeam : public AutoDiffElement<PlBeam<Nonlinear>, 6, 3, 4, 2> {
   }
 
  private:
+  // δ / sin δ, the arc over the chord of a circular arc turning by 2δ (its series near 0, where
+  // the quotient loses its digits).
+  template <class S>
+  static S arc_over_chord(const S& d) {
+    if (std::abs(value_of(d)) < 1e-3) {
+      const S d2 = d * d;
+      return 1.0 + d2 / 6.0 + 7.0 * d2 * d2 / 360.0;
+    }
+    return d / sin(d);
+  }
+
   // PLBEAMNL's second-order elongation from bending, (2 e2² + e2 e3 + 2 e3²) / (30 l0).
   template <class S>
   S bending_elongation(const S& e2, const S& e3) const {
@@ -272,25 +310,34 @@ void reference_plbeam(const double* x, const std::vector<double>&, double& l0, s
   lgeomy = {std::atan2(x[4] - x[1], x[3] - x[0])};
 }
 
-template <bool Nonlinear>
+template <Bending Kind>
 ElementType plbeam_type() {
   const NodeKind p = NodeKind::XY, o = NodeKind::Beta;
-  ElementType t = element_type<PlBeam<Nonlinear>>(
-      Nonlinear ? "PLBEAMNL" : "PLBEAM", {p, o, p, o}, {"p1", "o1", "p2", "o2"},
-      {Nonlinear ? "bending-corrected elongation" : "elongation", "bending at p1", "bending at p2"},
-      Nonlinear ? "planar beam with bending-corrected elongation" : "planar beam");
+  static const char* const name[] = {"PLBEAM", "PLBEAMNL", "PLBEAMC"};
+  static const char* const first[] = {"elongation", "bending-corrected elongation", "elongation along the arc"};
+  static const char* const title[] = {"planar beam", "planar beam with bending-corrected elongation",
+                                      "planar beam exact for constant curvature: bending angles, elongation along the arc "
+                                      "(extension)"};
+  const int k = static_cast<int>(Kind);
+  const bool arc = Kind == Bending::Arc;
+  ElementType t = element_type<PlBeam<Kind>>(name[k], {p, o, p, o}, {"p1", "o1", "p2", "o2"},
+                                             {first[k], arc ? "bending angle at p1" : "bending at p1",
+                                              arc ? "bending angle at p2" : "bending at p2"},
+                                             title[k]);
   set_stiffness(t, 3, "EA EI kGA");
   set_emass(t, 1, "rhoA");
   t.has_length = true;
   t.n_lgeomy = 1;
   t.reference = reference_plbeam;
   t.family = ElementFamily::Beam;
+  t.extension = arc;
   return t;
 }
 
 }  // namespace
 
-ElementType plbeam_element_type() { return plbeam_type<false>(); }
-ElementType plbeamnl_element_type() { return plbeam_type<true>(); }
+ElementType plbeam_element_type() { return plbeam_type<Bending::Sine>(); }
+ElementType plbeamnl_element_type() { return plbeam_type<Bending::SineCorrected>(); }
+ElementType plbeamc_element_type() { return plbeam_type<Bending::Arc>(); }
 
 }  // namespace spacar
