@@ -7,7 +7,8 @@ tip turns by 56.5°), n = 16 … 2048 elements, each solver from the straight be
 load steps that converge (one, for all three):
 
 * spacar: n PLBEAMs, axially rigid, bending DYNE, ``spacar.static`` (the whole call, Python
-  included; the model built and copied outside the timing);
+  included; the model built and copied outside the timing); for the time to accuracy also n
+  PLBEAMCs (the extension exact for constant curvature) the same way;
 * exudyn, geometrically exact beam: n ``ObjectBeamGeometricallyExact2D`` (the model of
   spacar.compare.exudyn_static, EA = 1e4 EI/l², but shear stiffness GA = EA instead of its 100 EA,
   with which Newton needs adaptive load stepping);
@@ -46,7 +47,8 @@ FULL = {"sizes": [16, 32, 64, 128, 256, 512, 1024, 2048], "targets": [1e-4, 1e-6
 QUICK = {"sizes": [4, 8], "targets": [1e-2, 1e-3], "memory": [8], "probe": 8, "fit_from": 4,
          "repeat": 3, "budget": 0.3, "min_time": 0.02, "max_n": 64, "passes": 1}
 SOLVERS = ("spacar", "ge", "ancf")
-NAMES = {"spacar": "spacar PLBEAM", "ge": "exudyn GE beam", "ancf": "exudyn ANCF cable"}
+ARC = "spacar_arc"                   # PLBEAMC: in the time to accuracy only
+NAMES = {"spacar": "spacar PLBEAM", "ge": "exudyn GE beam", "ancf": "exudyn ANCF cable", ARC: "spacar PLBEAMC"}
 STEP_CHOICES = (1, 2, 5, 10, 20)   # load steps tried, the fewest first
 TOL, TIGHT = 1e-8, 1e-10           # exudyn's Newton increment tolerance: timed, answer check
 SANE = 0.05                        # a tip farther than this from the elastica (/ L) is no answer
@@ -86,10 +88,10 @@ def elastica_tip(alpha):
 
 # --- the solvers --------------------------------------------------------------------------
 
-def cantilever(n):
+def cantilever(n, element="plbeam"):
     m = spacar.Model()
     for k in range(1, n + 1):
-        m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
+        getattr(m, element)(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
         m.x(2 * k + 1, k / n, 0.0)
         m.estiff(k, 0.0, 1.0)
         m.dyne(k, 2, 3)
@@ -100,11 +102,11 @@ def cantilever(n):
 
 
 class SpacarRunner:
-    """spacar.static on n PLBEAMs; ``solve`` copies the model outside the timing."""
-    kind = "spacar"
+    """spacar.static on n PLBEAMs (or PLBEAMCs); ``solve`` copies the model outside the timing."""
 
-    def __init__(self, n):
-        self.n, self.model = n, cantilever(n)
+    def __init__(self, n, kind="spacar"):
+        self.n, self.kind = n, kind
+        self.model = cantilever(n, "plbeamc" if kind == ARC else "plbeam")
 
     def solve(self, steps, tolerance=None):
         m = self.model.copy()
@@ -134,7 +136,11 @@ class ExudynRunner:
 
 
 def runner(kind, n):
-    return SpacarRunner(n) if kind == "spacar" else ExudynRunner(kind, n)
+    return SpacarRunner(n, kind) if _spacar(kind) else ExudynRunner(kind, n)
+
+
+def _spacar(kind):
+    return kind in ("spacar", ARC)
 
 
 def _fewest_steps(run, ref):
@@ -146,7 +152,7 @@ def _fewest_steps(run, ref):
         if not out["ok"] or np.linalg.norm(out["tip"] - ref) > SANE:
             continue
         gap = None
-        if run.kind != "spacar":
+        if not _spacar(run.kind):
             tight = run.solve(steps, TIGHT, max_iterations=100)
             if tight["ok"]:
                 gap = float(np.linalg.norm(out["tip"] - tight["tip"]))
@@ -191,18 +197,18 @@ def measure(jobs, ref, cfg, timed=True):
         row.update(error=float(np.linalg.norm(out["tip"] - ref)), iterations=out["iterations"],
                    steps_taken=out["steps"], tip=[float(v) for v in out["tip"]])
         calls[job + ("EigenSparse",)] = lambda run=run, steps=steps: run.solve(steps)
-        if kind != "spacar":
+        if not _spacar(kind):
             row.update(coordinates=run.case.coordinates(), linear_solver="EigenSparse")
             if row["coordinates"] <= DENSE_MAX:   # small systems: exudyn's dense solver may be faster
                 calls[job + ("EigenDense",)] = lambda run=run, steps=steps: run.solve(steps, linear_solver="EigenDense")
     if timed:
         for (kind, n, linear), (wall, out) in _interleaved(calls, cfg).items():
             row = rows[(kind, n)]
-            if kind != "spacar":
+            if not _spacar(kind):
                 row["wall_" + linear] = wall
             if wall is not None and (row["wall"] is None or wall < row["wall"]):
                 row.update(wall=wall, iterations=out["iterations"], steps_taken=out["steps"])
-                if kind != "spacar":
+                if not _spacar(kind):
                     row["linear_solver"] = linear
     return rows
 
@@ -386,7 +392,10 @@ def run(a) -> dict:
            "exudyn_settings": {"tolerance": TOL, "check_tolerance": TIGHT, "ea_factor": X.EA_FACTOR},
            "runs": {k: [] for k in SOLVERS}}
     least = {}   # target: {kind: (the smallest mesh reaching it, the meshes tried)}
-    out["accuracy"] = {k: [] for k in SOLVERS}
+    accuracy = SOLVERS + (ARC,)
+    out["accuracy"] = {k: [] for k in accuracy}
+    # PLBEAMC's errors on the smallest meshes, to start its bisections from.
+    out["runs"][ARC] = list(measure([(ARC, n) for n in cfg["sizes"][:2]], ref, cfg, timed=False).values())
     for p in range(cfg["passes"]):   # two passes over everything timed: a quiet spell for each figure
         for n in cfg["sizes"]:
             for (kind, _), row in measure([(k, n) for k in SOLVERS], ref, cfg).items():
@@ -395,7 +404,7 @@ def run(a) -> dict:
                                                       f"({C.fmt_err(_row(out['runs'][k], n)['error'])})" for k in SOLVERS))
         for i, target in enumerate(cfg["targets"]):
             if target not in least:
-                least[target] = {k: least_mesh(k, target, out["runs"][k], ref, cfg) for k in SOLVERS}
+                least[target] = {k: least_mesh(k, target, out["runs"][k], ref, cfg) for k in accuracy}
             rows = measure([(k, n) for k, (n, _) in least[target].items() if n is not None], ref, cfg)
             for k, (n, tried) in least[target].items():
                 row = {"target": target, **(rows[(k, n)] if n is not None else {"n": None, "wall": None}), "tried": tried}
@@ -403,7 +412,7 @@ def run(a) -> dict:
                     out["accuracy"][k].append(row)
                 elif row["wall"] is not None and (out["accuracy"][k][i]["wall"] is None or row["wall"] < out["accuracy"][k][i]["wall"]):
                     out["accuracy"][k][i] = row
-        for k in SOLVERS:
+        for k in accuracy:
             C.log(f"pass {p + 1}, {k}: " + ", ".join(f"{r['target']:g} at n={r['n']} in {C.fmt_time(r['wall'])}"
                                                      for r in out["accuracy"][k]))
         if p == 0:
@@ -474,8 +483,13 @@ def _words(r) -> list:
         else:
             lines.append(f"* Per mesh, spacar is faster than {NAMES[k]} at every n of {sizes[0]}…{sizes[-1]}.")
     for t_i, target in enumerate(cfg["targets"]):
-        acc = {k: r["accuracy"][k][t_i] for k in SOLVERS}
+        acc = {k: r["accuracy"][k][t_i] for k in r["accuracy"]}
         s = acc["spacar"]
+        c = acc.get(ARC)
+        if c is not None and c["wall"] is not None:
+            peers = [f"{NAMES[k]} {C.fmt_ratio(acc[k]['wall'], c['wall'])}" for k in ("ge", "ancf") if acc[k]["wall"]]
+            lines.append(f"* To {target:g} L, PLBEAMC needs {c['n']} elements and {C.fmt_time(c['wall'])} "
+                         f"(PLBEAM {s['n']}): against it " + ", ".join(peers) + " (peer's time / PLBEAMC's).")
         for k in ("ge", "ancf"):
             e = acc[k]
             if s["wall"] is None or e["wall"] is None:
@@ -557,17 +571,23 @@ def section(r: dict, plots: dict | None = None) -> str:
               f"n = {cfg['sizes'][0]}…{min(ERROR_FIT_TO, cfg['sizes'][-1])}): " + ", ".join(f"{NAMES[k]} q = {orders[k]:.2f}" for k in SOLVERS)
               + ".", "",
               "**Time to a tip accuracy**: the least wall time of any mesh and number of load steps reaching the "
-              "target — the smallest mesh that does (bisection on n; one load step is the fastest for all three), "
-              "timed as above", "",
-              "| target (/ L) | spacar | exudyn GE beam | exudyn ANCF cable | GE / spacar | ANCF / spacar |",
-              "|---|---|---|---|---|---|"]
+              "target — the smallest mesh that does (bisection on n; one load step is the fastest for all), "
+              "timed as above; beside PLBEAM the extension PLBEAMC, the planar beam exact for constant curvature "
+              "([static analysis](statics.md#accuracy))", "",
+              "| target (/ L) | spacar PLBEAM | spacar PLBEAMC | exudyn GE beam | exudyn ANCF cable | GE / PLBEAM | "
+              "ANCF / PLBEAM | GE / PLBEAMC | ANCF / PLBEAMC |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    arc = r["accuracy"].get(ARC)
     for i, target in enumerate(cfg["targets"]):
-        acc = [r["accuracy"][k][i] for k in SOLVERS]
+        s, g, a = (r["accuracy"][k][i] for k in SOLVERS)
+        c = arc[i] if arc else {"wall": None}
         cells = [("not reached" if x["wall"] is None else
                   f"{C.fmt_time(x['wall'])} (n = {x['n']}, {x['iterations']} it."
-                  f"{', dense' if x.get('linear_solver') == 'EigenDense' else ''}) / {C.fmt_err(x['error'])}") for x in acc]
-        lines.append(f"| {target:g} | {' | '.join(cells)} | {C.fmt_ratio(acc[1]['wall'], acc[0]['wall'])} | "
-                     f"{C.fmt_ratio(acc[2]['wall'], acc[0]['wall'])} |")
+                  f"{', dense' if x.get('linear_solver') == 'EigenDense' else ''}) / {C.fmt_err(x['error'])}")
+                 for x in (s, c, g, a)]
+        lines.append(f"| {target:g} | {' | '.join(cells)} | {C.fmt_ratio(g['wall'], s['wall'])} | "
+                     f"{C.fmt_ratio(a['wall'], s['wall'])} | {C.fmt_ratio(g['wall'], c['wall'])} | "
+                     f"{C.fmt_ratio(a['wall'], c['wall'])} |")
     lines += ["", "**Peak memory** (each solve in a fresh process, `ru_maxrss` in MiB): after the imports; what "
               "building the model adds (exudyn: with `Assemble`); what the solve adds over the built model; the "
               "process's peak", "",
