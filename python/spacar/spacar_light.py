@@ -29,8 +29,9 @@ import numpy as np
 
 from ._util import show
 from .errors import InputError, SingularMassError
+from .geometry import rotation
 from .model import Model
-from .section import Material, Section, circle, rectangle, stresses
+from .section import Material, circle, rectangle, stresses
 
 __all__ = ["light", "LightResults", "light_model"]
 
@@ -75,7 +76,9 @@ def _fields(value, what: str) -> dict:
 
 
 def _empty(v) -> bool:
-    return v is None or (isinstance(v, (list, tuple, np.ndarray, str)) and len(v) == 0)
+    if v is None or isinstance(v, str):
+        return v is None or v == ""
+    return isinstance(v, (list, tuple, np.ndarray)) and np.size(np.asarray(v, dtype=object)) == 0
 
 
 def _per_item(value, count: int, what: str, item: str) -> list:
@@ -101,14 +104,15 @@ def _per_item(value, count: int, what: str, item: str) -> list:
 
 
 def _unknown(fields: dict, allowed, what: str):
-    bad = sorted(set(fields) - set(allowed))
+    bad = sorted(set(fields) - set(allowed), key=str)
     if bad:
         raise InputError(f"unknown {what} field {bad[0]!r} (SPACAR Light's fields: {', '.join(allowed)})")
 
 
 def _vector(value, size: int, what: str) -> np.ndarray:
     try:
-        v = np.asarray(value, dtype=float).ravel()
+        v = np.asarray(value)
+        v = v.astype(float).ravel() if v.dtype.kind in "iuf" else None  # numbers only: no text, no flags
     except (TypeError, ValueError):
         v = None
     if v is None or v.size != size or not np.isfinite(v).all():
@@ -116,25 +120,41 @@ def _vector(value, size: int, what: str) -> np.ndarray:
     return v
 
 
+def _number(value, what: str) -> float:
+    return float(_vector(value, 1, what)[0])
+
+
+def _whole(value, what: str, low: int, high: int) -> int:
+    v = _number(value, what) if not isinstance(value, (bool, np.bool_)) else math.nan
+    if not (v.is_integer() and low <= v <= high):
+        raise InputError(f"{what} must be a whole number from {low} to {high}, got {show(value)}")
+    return int(v)
+
+
 def _flag(value, what: str) -> bool:
+    if isinstance(value, np.ndarray) and value.size == 1:
+        value = value.item()
     if isinstance(value, (bool, np.bool_)) or (isinstance(value, numbers.Integral) and value in (0, 1)):
         return bool(value)
     raise InputError(f"{what} must be true or false, got {show(value)}")
 
 
 def _numbers_list(value, what: str, low: int, high: int) -> list:
-    v = np.atleast_1d(np.asarray(value)).ravel()
+    try:
+        v = np.atleast_1d(np.asarray(value)).ravel()
+    except ValueError:  # ragged
+        v = np.array(["?"])
     if v.dtype.kind not in "iuf" or not all(float(x).is_integer() and low <= x <= high for x in v):
         raise InputError(f"{what} must be numbers from {low} to {high}, got {show(value)}")
     return [int(x) for x in v]
 
 
-def _quaternion_axis_angle(axang) -> np.ndarray:
+def _quaternion_axis_angle(axang, what: str) -> np.ndarray:
     """SPACAR Light's rotation [angle, axis x, y, z] as Euler parameters."""
-    v = _vector(axang, 4, "rot")
+    v = _vector(axang, 4, what)
     axis = v[1:]
     if not np.linalg.norm(axis) > 0:
-        raise InputError(f"rot must be [angle, x, y, z] with a nonzero axis, got {show(axang)}")
+        raise InputError(f"{what} must be [angle, x, y, z] with a nonzero axis, got {show(axang)}")
     return np.r_[math.cos(v[0] / 2), math.sin(v[0] / 2) * axis / np.linalg.norm(axis)]
 
 
@@ -162,9 +182,9 @@ def _section(props: dict, k: int, need_stiffness: bool, need_mass: bool):
         if name not in props:
             raise InputError(f"{where} needs {name!r} for its {'flexible' if name in ('emod', 'smod') else ''} "
                              f"elements {show(props.get('elems'))}".replace("  ", " "))
-    E = float(props["emod"]) if "emod" in props else 1.0
-    G = float(props["smod"]) if "smod" in props else E / 2.6
-    rho = float(props.get("dens", 0.0))
+    E = _number(props["emod"], f"{where}.emod") if "emod" in props else 1.0
+    G = _number(props["smod"], f"{where}.smod") if "smod" in props else E / 2.6
+    rho = _number(props.get("dens", 0.0), f"{where}.dens")
     try:
         material = Material(E, G=G, rho=rho, name=where)
     except InputError as err:
@@ -190,7 +210,7 @@ class _Light:
         self.opt = _fields(opt, "opt")
         _unknown(self.opt, OPT, "opt")
         for name, why in _REFUSED_OPT.items():
-            if name in self.opt and not (name == "mode" and self.opt[name] == 10):
+            if name in self.opt and not (name == "mode" and _number(self.opt[name], "opt.mode") == 10):
                 raise InputError(f"opt.{name} is not supported by spacar.light: {why}")
         if rls is not None and "rls" in self.opt:
             raise InputError("the releases are given twice: as the argument rls and as opt.rls")
@@ -205,11 +225,20 @@ class _Light:
         self.eprops = [_fields(e, f"eprops({k + 1})") for k, e in enumerate(sets)]
         for k, e in enumerate(self.eprops):
             _unknown(e, EPROPS, f"eprops({k + 1})")
-        self.rls = None if rls is None else [
-            _numbers_list(r.get("def", []), f"rls({k + 1}).def", 1, 6) if r else []
-            for k, r in enumerate(_per_item(rls, len(self.elements), "rls", "element"))]
+        self.rls = None if rls is None else [self._releases(k + 1, r) for k, r in
+                                             enumerate(_per_item(rls, len(self.elements), "rls", "element"))]
         self._element_sets()
-        self.loadsteps = self._loadsteps()
+        self.loadsteps = _whole(self.opt.get("loadsteps", 10), "opt.loadsteps", 1, 10**5)
+        self.transfer = self._transfer()
+        for node in range(1, n + 1):  # every load and motion read now, before any work
+            self._combinations(node)
+            self.loads(node, 1.0)
+            self.inputs(node, 1.0)
+
+    @staticmethod
+    def _releases(k: int, r: dict) -> list:
+        _unknown(r, ("def",), f"rls({k})")
+        return _numbers_list(r["def"], f"rls({k}).def", 1, 6) if r else []
 
     @staticmethod
     def _nodes(nodes) -> np.ndarray:
@@ -222,7 +251,10 @@ class _Light:
         return a
 
     def _elements(self, elements, n) -> list:
-        a = np.asarray(elements)
+        try:
+            a = np.asarray(elements)
+        except ValueError:  # ragged
+            a = np.zeros(0)
         if a.ndim == 1 and a.size == 2:
             a = a.reshape(1, 2)
         if a.ndim != 2 or a.shape[1] != 2 or len(a) == 0 or a.dtype.kind not in "iuf":
@@ -246,7 +278,10 @@ class _Light:
         for k, props in enumerate(self.eprops, start=1):
             if "elems" not in props:
                 continue  # SPACAR Light ignores a set without elements (with a warning)
-            for e in _numbers_list(props["elems"], f"eprops({k}).elems", 1, len(self.elements)):
+            elems = _numbers_list(props["elems"], f"eprops({k}).elems", 1, len(self.elements))
+            if len(set(elems)) < len(elems):
+                raise InputError(f"eprops({k}).elems lists an element twice: {elems}")
+            for e in elems:
                 el = self.elements[e - 1]
                 if el.set is not None:
                     raise InputError(f"element {e} is in eprops({el.set}) and eprops({k}): one set per element")
@@ -255,31 +290,72 @@ class _Light:
                         _flag(props.get("cw", False), f"eprops({k}).cw"):
                     raise InputError(f"eprops({k}).warping: the warping beam (BEAMW) is not implemented in spacar yet; "
                                      "leave warping out (free warping, torsion stiffness GJ)")
-                nb = props.get("nbeams", 1)
-                if isinstance(nb, bool) or not isinstance(nb, numbers.Real) or not float(nb).is_integer() or \
-                        not 1 <= nb <= 10000:
-                    raise InputError(f"eprops({k}).nbeams must be a whole number from 1 to 10000, got {show(nb)}")
-                el.nbeams = int(nb)
+                el.nbeams = _whole(props.get("nbeams", 1), f"eprops({k}).nbeams", 1, 10000)
                 if "orien" in props:
                     el.orien = _vector(props["orien"], 3, f"eprops({k}).orien")
                 el.flex = sorted(set(_numbers_list(props["flex"], f"eprops({k}).flex", 1, 6))) if "flex" in props else []
-                dens = float(props.get("dens", 0.0))
+                dens = _number(props.get("dens", 0.0), f"eprops({k}).dens")
                 if el.flex or dens > 0:
                     section = _section(props, k, bool(el.flex), dens > 0)
                     el.section = section if el.flex else None
                     el.mass_section = section if dens > 0 else None
-                axis = self.nodes[el.q - 1] - self.nodes[el.p - 1]
-                across = el.orien - np.dot(el.orien, axis) * axis / np.dot(axis, axis)
-                if not np.linalg.norm(across) > 1e-9 * np.linalg.norm(el.orien):
-                    raise InputError(f"eprops({k}).orien {show(list(el.orien))} lies along element {e}: give the "
-                                     "direction of the cross-section's width, across the element")
+        for el in self.elements:  # the width's direction across every element, given or the default
+            axis = self.nodes[el.q - 1] - self.nodes[el.p - 1]
+            across = el.orien - np.dot(el.orien, axis) * axis / np.dot(axis, axis)
+            if not np.linalg.norm(across) > 1e-9 * np.linalg.norm(el.orien):
+                where = f"eprops({el.set}).orien" if el.set and "orien" in self.eprops[el.set - 1] else \
+                    "the default orien (no orien given)"
+                raise InputError(f"{where} {show(el.orien.tolist())} lies along element {el.number}: give the "
+                                 "direction of the cross-section's width, across the element")
 
-    def _loadsteps(self) -> int:
-        steps = self.opt.get("loadsteps", 10)
-        if isinstance(steps, bool) or not isinstance(steps, numbers.Real) or not float(steps).is_integer() or \
-                not 1 <= steps <= 10**5:
-            raise InputError(f"opt.loadsteps must be a whole number from 1 to 100000, got {show(steps)}")
-        return int(steps)
+    def _transfer(self):
+        """opt.transfer = [true, ζ] with the nodes' transfer_in/out: (ζ or None, inputs, outputs,
+        their names); None without it."""
+        names = {}
+        for j, props in enumerate(self.nprops, start=1):
+            for field, allowed in (("transfer_in", _TRANSFER_IN), ("transfer_out", _TRANSFER_OUT)):
+                given = props.get(field, [])
+                given = [given] if isinstance(given, str) else given
+                if not isinstance(given, (list, tuple)) or not all(isinstance(g, str) and g in allowed for g in given) \
+                        or len(set(given)) < len(given):
+                    raise InputError(f"nprops({j}).{field} must be distinct names of {', '.join(allowed)}, got "
+                                     f"{show(props.get(field))}")
+                names[j, field] = list(given)
+        spec = self.opt.get("transfer")
+        spec = list(spec) if isinstance(spec, (list, tuple)) else [spec]
+        if spec == [None] or not _flag(spec[0], "opt.transfer{1}"):
+            return None
+        zeta = None if len(spec) < 2 else _number(spec[1], "opt.transfer{2} (the relative damping)")
+        inputs = [("INPUTF", 3 * j - 2, _TRANSFER_IN[n]) for (j, f), ns in names.items() if f == "transfer_in"
+                  for n in ns]
+        outputs = [(_TRANSFER_OUT[n][0], 3 * j - 2, _TRANSFER_OUT[n][1]) for (j, f), ns in names.items()
+                   if f == "transfer_out" for n in ns]
+        label = lambda f: [f"{n.replace('_', '-')} n{j}" for (j, g), ns in names.items() if g == f for n in ns]  # noqa: E731
+        if not inputs or not outputs:
+            raise InputError("opt.transfer needs transfer_in and transfer_out in nprops")
+        return zeta, inputs, outputs, label("transfer_in"), label("transfer_out")
+
+    def _combinations(self, node: int):
+        """What spacarlight.m refuses on one node: a direction both fixed and loaded or moved."""
+        p = self.nprops[node - 1]
+        flag = lambda name: _flag(p.get(name, False), f"nprops({node}).{name}")  # noqa: E731
+        if flag("fix") and any(flag(f) for f in ("fix_pos", "fix_orien", "fix_x", "fix_y", "fix_z", "fix_warp")):
+            raise InputError(f"nprops({node}) combines fix with fix_pos, fix_orien, fix_warp or fix_x/y/z")
+        held = flag("fix") or flag("fix_pos")
+        for axis, i in _AXES.items():
+            loaded = any(name in p and _vector(p[name], 3, f"nprops({node}).{name}")[i] != 0
+                         for name in ("force", "force_initial"))
+            moved = f"displ_{axis}" in p or f"displ_initial_{axis}" in p
+            if (held or flag(f"fix_{axis}")) + loaded + moved > 1:
+                raise InputError(f"nprops({node}) fixes, loads or moves the {axis} position at once: one of them")
+        turned = [name for name in ("rot", "rot_x", "rot_y", "rot_z") if name in p or
+                  name.replace("rot", "rot_initial") in p]
+        if len(turned) > 1:
+            raise InputError(f"nprops({node}) prescribes {' and '.join(turned)}: one input rotation per node")
+        twisted = any(name in p and _vector(p[name], 3, f"nprops({node}).{name}").any()
+                      for name in ("moment", "moment_initial"))
+        if (flag("fix") or flag("fix_orien")) + twisted + bool(turned) > 1:
+            raise InputError(f"nprops({node}) fixes, loads (moment) or turns (rot) the orientation at once: one of them")
 
     # --- the spacar model ---
 
@@ -334,35 +410,22 @@ class _Light:
                 m.emass(e, *el.mass_section.emass(rotary=True))
 
     def _supports(self, m: Model, node: int, props: dict):
-        """FIX and INPUTX of a node of SPACAR Light."""
+        """FIX and INPUTX of a node of SPACAR Light (their combinations checked in _combinations;
+        fix_warp has nothing to fix without warping beams)."""
         pos, rot = 3 * node - 2, 3 * node - 1
         flag = lambda name: _flag(props.get(name, False), f"nprops({node}).{name}")  # noqa: E731
-        if flag("fix"):
-            if any(flag(f) for f in ("fix_pos", "fix_orien", "fix_x", "fix_y", "fix_z")):
-                raise InputError(f"nprops({node}) combines fix with fix_pos, fix_orien or fix_x/y/z")
+        if flag("fix") or flag("fix_pos"):
             m.fix(pos)
+        if flag("fix") or flag("fix_orien"):
             m.fix(rot)
-        if flag("fix_pos"):
-            m.fix(pos)
         for axis, i in _AXES.items():
             if flag(f"fix_{axis}"):
                 m.fix(pos, i + 1)
-        if flag("fix_orien"):
-            m.fix(rot)
-        flag("fix_warp")  # checked; without warping beams there is no warping to fix
-        for axis, i in _AXES.items():
             if f"displ_{axis}" in props or f"displ_initial_{axis}" in props:
-                if flag(f"fix_{axis}") or flag("fix") or flag("fix_pos"):
-                    raise InputError(f"nprops({node}) both fixes and prescribes the {axis} position")
                 m.inputx(pos, i + 1)
-        rotations = [name for name in ("rot", "rot_x", "rot_y", "rot_z") if name in props or
-                     name.replace("rot", "rot_initial") in props]
-        if len(rotations) > 1:
-            raise InputError(f"nprops({node}) prescribes {' and '.join(rotations)}: one input rotation per node")
-        if rotations:
-            if flag("fix") or flag("fix_orien"):
-                raise InputError(f"nprops({node}) both fixes and prescribes the orientation")
-            m.inputx(rot, *((2, 3, 4) if rotations[0] == "rot" else (_AXES[rotations[0][-1]] + 2,)))
+        for (target, c) in self.inputs(node, 0.0):
+            if target == rot:
+                m.inputx(rot, c)
 
     def loads(self, node: int, factor: float) -> dict:
         """{(keyword, node): values} of node's loads at the load factor (initial + factor · additional)."""
@@ -388,24 +451,22 @@ class _Light:
                 value += _vector(a, 1, f"nprops({node}).displ_initial_{axis}")[0] if a is not None else 0.0
                 value += factor * _vector(b, 1, f"nprops({node}).displ_{axis}")[0] if b is not None else 0.0
                 out[(3 * node - 2, i + 1)] = value
+        # Rotations as spacarlight.m writes them: INPUTX of the Euler parameters λ1..λ3 of the
+        # initial rotation, DELINPX of those of the additional one; they move linearly with the load.
         for name in ("rot", "rot_x", "rot_y", "rot_z"):
             a, b = props.get(name.replace("rot", "rot_initial")), props.get(name)
             if a is None and b is None:
                 continue
-            if name == "rot":  # axis-angle: the angle grows with the load, the axis stays
-                axang = np.zeros(4)
-                for part, f in ((a, 1.0), (b, factor)):
-                    if part is not None:
-                        v = _vector(part, 4, f"nprops({node}).{name}")
-                        axang = np.r_[axang[0] + f * v[0], v[1:]]
-                q = _quaternion_axis_angle(axang) if np.linalg.norm(axang[1:]) > 0 else np.r_[1.0, 0, 0, 0]
-                for c in (2, 3, 4):
-                    out[(3 * node - 1, c)] = q[c - 1]
-            else:
-                angle = sum(f * _vector(part, 1, f"nprops({node}).{name}")[0]
-                            for part, f in ((a, 1.0), (b, factor)) if part is not None)
-                axis = _AXES[name[-1]]
-                out[(3 * node - 1, axis + 2)] = _quaternion_about(axis, angle)[axis + 1]
+            components = (2, 3, 4) if name == "rot" else (_AXES[name[-1]] + 2,)
+            value = np.zeros(4)
+            for part, f, field in ((a, 1.0, name.replace("rot", "rot_initial")), (b, factor, name)):
+                if part is None:
+                    continue
+                what = f"nprops({node}).{field}"
+                value += f * (_quaternion_axis_angle(part, what) if name == "rot" else
+                              _quaternion_about(_AXES[name[-1]], _number(part, what)))
+            for c in components:
+                out[(3 * node - 1, c)] = value[c - 1]
         return out
 
     def has_additional(self) -> bool:
@@ -440,14 +501,19 @@ def _release(m: Model, light: _Light) -> list:
 
 
 def light_model(nodes, elements, nprops, eprops, rls=None, opt=None) -> Model:
-    """The spacar.Model that :func:`light` builds and solves (at its initial state, the releases
-    made), for a model to go on with in spacar."""
-    return _build(nodes, elements, nprops, eprops, rls, opt)[0]
+    """The spacar.Model that :func:`light` builds, the releases made, with all its loads (initial
+    and additional) and its prescribed motions set to reach their final values in one block:
+    ``spacar.static(light_model(...))`` solves the last load step; a model to go on with in
+    spacar."""
+    m, light_, _ = _build(nodes, elements, nprops, eprops, rls, opt)
+    _apply(m, light_, 1.0)
+    return m
 
 
 def _build(nodes, elements, nprops, eprops, rls, opt):
-    if opt is None and (isinstance(rls, dict) and "def" not in rls and
-                        not any(isinstance(k, numbers.Integral) for k in rls) or hasattr(rls, "__dict__")):
+    releases = isinstance(rls, (list, tuple)) or isinstance(rls, dict) and (
+        "def" in rls or any(isinstance(k, numbers.Integral) for k in rls))
+    if opt is None and rls is not None and not releases:
         rls, opt = None, rls  # the 1.38 call: opt fifth
     light = _Light(nodes, elements, nprops, eprops, rls, opt)
     m = light.model()
@@ -536,13 +602,6 @@ def _euler_zyx(q) -> np.ndarray:
                      math.atan2(2 * (y * z + w * x), w * w - x * x - y * y + z * z)])
 
 
-def _rotation(q) -> np.ndarray:
-    w, x, y, z = np.asarray(q) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
 def light(nodes, elements, nprops=None, eprops=None, rls=None, opt=None, *, time_limit=None) -> LightResults:
     """SPACAR Light's static analysis of the model given as spacarlight.m takes it (see the
     module's docstring and docs/light.md): ``light(nodes, elements, nprops, eprops, opt)`` (1.38,
@@ -557,6 +616,7 @@ def light(nodes, elements, nprops=None, eprops=None, rls=None, opt=None, *, time
     with ``opt["calcbuck"]``, the buckling load multipliers of the step's loads
     (:func:`spacar.linearize`), and the largest stress (:func:`spacar.section.stresses`).
     ``time_limit``: wall-clock seconds for each static solve."""
+    from .statespace import state_space
     from .statics import static
 
     m, light_, released = _build(nodes, elements, nprops, eprops, rls, opt)
@@ -579,21 +639,37 @@ def light(nodes, elements, nprops=None, eprops=None, rls=None, opt=None, *, time
     for k, factor in enumerate(factors):
         _apply(m, light_, factor)
         res = static(m, steps=10 if k == 0 else 1, time_limit=time_limit)
+        if res.stats["indefinite_at"] is not None:
+            out.warnings.append(f"load step {k + 1}: the equilibrium is unstable (the tangent stiffness became "
+                                "indefinite in it: a buckling load was passed)")
         steps.append(_step(m, light_, res, factor, n_nodes, calccompl, calcbuck, stressed, per_element, out))
+    out.warnings += [w for w in m.warnings if w not in out.warnings]
     out.step = _OneBased(steps, "step")
     out.ndof = len(steps[-1].results.dof_labels)
+    if out.ndof == 0:
+        out.warnings.append("the model has no degrees of freedom (no flex): everything is rigid")
     out.freq = _columns([s.freq for s in steps])
     if calcbuck:
         out.buck = _columns([s.buck for s in steps])
     out.stressmax = np.array([s.stressmax for s in steps])
     out.node = _OneBased([_history(steps, j) for j in range(n_nodes)], "node")
-    out.element = _OneBased([SimpleNamespace(spa_nrs=list(el.beams),
-                                             L0=np.full(el.nbeams, np.linalg.norm(light_.nodes[el.q - 1] -
-                                                                                  light_.nodes[el.p - 1]) / el.nbeams))
-                             for el in light_.elements], "element")
-    if "transfer" in opt:
-        out.statespace = _transfer(m, light_, opt["transfer"])
+    out.element = _OneBased([_element(light_, el) for el in light_.elements], "element")
+    if light_.transfer is not None:
+        zeta, inputs, outputs, in_names, out_names = light_.transfer
+        out.statespace = state_space(m, inputs=inputs, outputs=outputs, damping=zeta)
+        out.statespace.input_names, out.statespace.output_names = in_names, out_names
     return out
+
+
+def _element(light_: _Light, el: _Element) -> SimpleNamespace:
+    """``spa_nrs``: its beams; ``L0``: their lengths; ``Ri``: the axes of its beams at the start
+    (columns: along the element, the width's direction orien, their cross product)."""
+    axis = light_.nodes[el.q - 1] - light_.nodes[el.p - 1]
+    x = axis / np.linalg.norm(axis)
+    y = el.orien - np.dot(el.orien, x) * x
+    y /= np.linalg.norm(y)
+    return SimpleNamespace(spa_nrs=list(el.beams), L0=np.full(el.nbeams, np.linalg.norm(axis) / el.nbeams),
+                           Ri=np.column_stack([x, y, np.cross(x, y)]))
 
 
 def _releases(light_: _Light, released) -> list:
@@ -630,14 +706,13 @@ def _step(m, light_, res, factor, n_nodes, calccompl, calcbuck, stressed, per_el
                          Freac=res.node(pos).reaction[-1].copy(), Mreac=res.reaction_moment(rot)[-1])
         if calccompl:
             C = compliance(m, pos, rotation=rot)
-            R = _rotation(q)
-            T = np.kron(np.eye(2), R.T)
+            T = np.kron(np.eye(2), rotation(q).T)
             node.CMglob, node.CMloc = C, T @ C @ T.T
         nodes.append(node)
     step.node = _OneBased(nodes, "node")
     lin = linearize(m)
     try:
-        f, _, shapes = lin.mode_shapes()
+        f, shapes, _ = lin.mode_shapes()
         step.freq, step.freqmodes = np.asarray(f), shapes
     except SingularMassError:
         step.freq, step.freqmodes = np.zeros(0), None
@@ -672,36 +747,8 @@ def _history(steps, j) -> LightNode:
     nodes = [s.node[j] for s in steps]
     out = LightNode(**{name: np.stack([getattr(n, name) for n in nodes], axis=-1)
                        for name in ("p", "r_quat", "r_axang", "r_eulzyx", "Freac", "Mreac")})
+    out.spa_nrs = [3 * j + 1, 3 * j + 2]  # its XYZ and LAMBDA nodes
     if hasattr(nodes[0], "CMglob"):
         out.CMglob = np.stack([n.CMglob for n in nodes], axis=-1)
         out.CMloc = np.stack([n.CMloc for n in nodes], axis=-1)
     return out
-
-
-def _transfer(m: Model, light_: _Light, transfer):
-    """SPACAR Light's opt.transfer = {true, ζ}: the state space from the nodes' transfer_in forces to
-    their transfer_out displacements and velocities, with the modal damping ratio ζ."""
-    from .statespace import state_space
-
-    spec = list(transfer) if isinstance(transfer, (list, tuple)) else [transfer]
-    if not spec or not _flag(spec[0], "opt.transfer{1}"):
-        return None
-    zeta = None if len(spec) < 2 else float(_vector(spec[1], 1, "opt.transfer{2} (relative damping)")[0])
-    inputs, outputs, in_names, out_names = [], [], [], []
-    for j, props in enumerate(light_.nprops, start=1):
-        for name in np.atleast_1d(props.get("transfer_in", [])):
-            if name not in _TRANSFER_IN:
-                raise InputError(f"nprops({j}).transfer_in: {show(name)} is not one of {', '.join(_TRANSFER_IN)}")
-            inputs.append(("INPUTF", 3 * j - 2, _TRANSFER_IN[name]))
-            in_names.append(f"{name.replace('_', '-')} n{j}")
-        for name in np.atleast_1d(props.get("transfer_out", [])):
-            if name not in _TRANSFER_OUT:
-                raise InputError(f"nprops({j}).transfer_out: {show(name)} is not one of {', '.join(_TRANSFER_OUT)}")
-            keyword, c = _TRANSFER_OUT[name]
-            outputs.append((keyword, 3 * j - 2, c))
-            out_names.append(f"{name.replace('_', '-')} n{j}")
-    if not inputs or not outputs:
-        raise InputError("opt.transfer needs transfer_in and transfer_out in nprops")
-    ss = state_space(m, inputs=inputs, outputs=outputs, damping=zeta)
-    ss.input_names, ss.output_names = in_names, out_names
-    return ss

@@ -154,6 +154,40 @@ def test_prescribed_rotation_bends_the_leaf_into_an_arc(rotation):
     assert out.step(len(out.step)).node(1).Mreac == pytest.approx(-tip.Mreac, rel=1e-9, abs=1e-12)
 
 
+def test_rotations_move_the_euler_parameters_as_spacarlight_writes_them():
+    """rot_initial_x then rot_x: INPUTX of λ1 = sin(a/2), DELINPX of sin(b/2), linear in the load."""
+    a, b = 0.004, 0.01
+    out = light([[0, 0, 0], [L, 0, 0]], [[1, 2]], [dict(fix=True), dict(rot_initial_x=a, rot_x=b)],
+                [leaf_set([1], nbeams=4)], dict(loadsteps=3))
+    for k, step in enumerate(out.step):
+        assert step.node(2).r_quat[1] == pytest.approx(np.sin(a / 2) + k / 2 * np.sin(b / 2), rel=1e-12)
+
+
+def test_a_column_driven_past_buckling_is_reported_unstable():
+    """A clamped leaf shortened by three times its critical shortening π² t²/(12 L) in one step:
+    the step is cut back to the critical point and the instability reported in out.warnings."""
+    critical = np.pi**2 * T**2 / 12 / L
+    out = light([[0, 0, 0], [L, 0, 0]], [[1, 2]], [dict(fix=True), dict(fix_orien=True, displ_x=-3 * critical)],
+                [leaf_set([1], nbeams=8)], dict(loadsteps=2, calccompl=False))
+    assert out.step(2).results.stats["indefinite_at"] == pytest.approx(1 / 3, rel=2e-2)  # (the cuts' resolution)
+    assert any("unstable" in w for w in out.warnings)
+
+
+def test_light_model_carries_the_full_loads():
+    args = guide_input(load=dict(force=[1e-3, -1.0, 0], moment_initial=[0, 0, 1e-4]))
+    res = spacar.static(light_model(*args))
+    out = light(*args)
+    assert res.node(10).x[-1] == pytest.approx(out.step(10).node(4).p, rel=1e-9)
+
+
+def test_a_rigid_model_has_no_compliance_and_says_so():
+    out = light([[0, 0, 0], [L, 0, 0]], [[1, 2]], [dict(fix=True), dict(force=[0, 1, 0])],
+                [dict(elems=[1], dens=STEEL.rho, cshape="rect", dim=[W, T])])
+    assert out.ndof == 0 and "no degrees of freedom" in out.warnings[0]
+    assert not out.step(10).node(2).CMglob.any() and out.step(10).node(1).Freac == pytest.approx([0, -1, 0])
+    assert out.node(2).spa_nrs == [4, 5] and out.element(1).Ri == pytest.approx(np.eye(3))  # orien: y, the default
+
+
 def test_support_stiffness_drops_along_the_stroke():
     """The stroke held at the middle of the stage (displ_x there) and the support stiffness at that
     point: Awtar, Slocum and Sevincer's 2 / (L/EA + L u²/(700 EI)) to the size of its next term
@@ -223,6 +257,15 @@ def test_a_massless_model_has_stiffness_but_no_frequencies():
     (lambda a: a[3][0].pop("emod"), "eprops\\(1\\) needs 'emod'"),
     (lambda a: a[2].__setitem__(3, dict(mass=0.5, fix=True, fix_x=True)), "combines fix with"),
     (lambda a: a.__setitem__(2, [None, None, None, dict(mass=0.5)]), "not exactly constrained"),
+    (lambda a: a.__setitem__(1, [[1, 3], [2, 4], [3]]), "elements must be an m x 2 array"),
+    (lambda a: a[3][0].update(dens="steel"), "eprops\\(1\\).dens must be 1 number"),
+    (lambda a: a[3][0].update(elems=[1, 1]), "lists an element twice"),
+    (lambda a: a[2][3].update(transfer_in=[["force_y"]]), "transfer_in must be distinct names"),
+    (lambda a: a[2][3].update(force=[1, 0, 0], displ_x=1e-4), "fixes, loads or moves the x position at once"),
+    (lambda a: a[2][3].update(moment=[0, 0, 1], rot_z=0.1), "loads \\(moment\\) or turns \\(rot\\)"),
+    (lambda a: a[2][3].update(rot=[0.1, 0, 0, 0]), "rot must be \\[angle, x, y, z\\] with a nonzero axis"),
+    (lambda a: a[4].update(rls=[None, {"deff": [1]}]), "unknown rls\\(2\\) field 'deff'"),
+    (lambda a: a[4].update(transfer=[True, "much"]), "opt.transfer\\{2\\}"),
 ])
 def test_bad_input_is_refused_by_name(change, match):
     args = list(guide_input())

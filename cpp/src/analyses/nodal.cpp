@@ -166,7 +166,6 @@ bool symmetric_constitutive(const System& sys, const SystemElement& se, const No
   return true;
 }
 
-// −∂f/∂λ of a body-fixed torque T: f_λ = 2 G(λ)ᵀ T is linear in λ (4 x 4, unsymmetric).
 }  // namespace
 
 Eigen::SparseMatrix<double> nodal_part(const System& sys, Data& data, const Eigen::VectorXd& sigma, unsigned part) {

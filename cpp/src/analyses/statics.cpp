@@ -65,9 +65,10 @@ class EquilibriumPath {
     Attempt a;
     Eigen::VectorXd qhat = with_inputs(data_.qhat, lambda);
     Eigen::VectorXd R, dq, dx;
-    const bool predicted = predict(from, lambda, qhat, dx);
-    double last_correction = std::numeric_limits<double>::infinity();
     int start_sign = 0, last_sign = 0;
+    // The predictor factorizes the tangent at the step's start: its sign is the start's.
+    const bool predicted = predict(from, lambda, qhat, dx, start_sign);
+    double last_correction = std::numeric_limits<double>::infinity();
     bool crossed = false;
     for (int it = 0;; ++it) {
       check_thread_deadline("(in the static analysis)");
@@ -114,7 +115,7 @@ class EquilibriumPath {
       }
       const bool singular = tangent_.singular();
       const int sign = singular || nd_ == 0 ? 0 : tangent_.sign_determinant();
-      if (it == 0) start_sign = sign;
+      if (it == 0 && !predicted) start_sign = sign;
       else if (sign != start_sign) crossed = true;
       last_sign = sign;
       if (crossed && !last_chance) {
@@ -152,7 +153,7 @@ class EquilibriumPath {
 
   // The tangent stiffness of the last evaluation has a negative eigenvalue: the equilibrium is
   // unstable. For a symmetric stiffness (conservative loads) its inertia, counted by the
-  // symmetric factorization, decides. Follower loads (TORQUEL) make it unsymmetric and only
+  // symmetric factorization, decides. Torques (TORQUEL, TORQUEG) make it unsymmetric and only
   // the sign of its determinant is known: a negative determinant means a real negative
   // eigenvalue (a divergence instability); a pair of complex eigenvalues with negative real
   // parts (flutter) is not detected. Returns "" or the description of the direction of the
@@ -206,7 +207,7 @@ class EquilibriumPath {
   // Without it Newton starts from the DOFs of the last step with only the inputs moved: where the
   // DOFs are deformations (DYNE), the released deformations next to the input then take the
   // whole motion, and Newton needs dozens of iterations and step cuts to spread it.
-  bool predict(double from, double lambda, Eigen::VectorXd& qhat, Eigen::VectorXd& dx) {
+  bool predict(double from, double lambda, Eigen::VectorXd& qhat, Eigen::VectorXd& dx, int& start_sign) {
     if (nd_ == 0 || sys_.n_input() == 0 || p1_ == p0_ || lambda == from) return false;
     Eigen::VectorXd Fs, gs, dq;
     try {
@@ -215,6 +216,7 @@ class EquilibriumPath {
       return false;
     }
     if (!factorized_ || tangent_.singular()) return false;
+    start_sign = tangent_.sign_determinant();
     solve_dofs(-(lambda - from) * gs.cwiseQuotient(scale_), dq, dx);
     if (!dq.allFinite() || !dx.allFinite()) return false;
     for (int j = 0; j < nd_; ++j) qhat[sys_.dof_cols[j]] += dq[j];

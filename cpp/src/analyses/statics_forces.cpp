@@ -178,6 +178,10 @@ Eigen::MatrixXd static_compliance(Model& model, const std::vector<int>& nodes, d
     data.jacobian_reusable = false;
     solve_positions(sys, data, std::max(sys.settings.maxiterat, 50), std::min(sys.settings.epskin, 1e-10), false);
   }
+  if (sys.n_dof() == 0) {  // nothing can move: the supports and rigid deformations hold every point
+    const Eigen::Index rows = displacement_rows(sys, data, nodes).rows();
+    return Eigen::MatrixXd::Zero(rows, rows);
+  }
   Eigen::VectorXd R;
   static_forces(sys, data, load_factor, R);
   ReducedSystem reduced(sys, data);

@@ -297,8 +297,10 @@ void masses_and_loads(const Model& model, System& sys, const NodeOffsets& node_o
       }
     }
     for (size_t i = 0; i < n.force.size(); ++i) sys.force[off + i] = n.force[i];
-    if (!n.torquel.empty()) sys.torques.push_back({off, Eigen::Vector3d(n.torquel[0], n.torquel[1], n.torquel[2]), false});
-    if (!n.torqueg.empty()) sys.torques.push_back({off, Eigen::Vector3d(n.torqueg[0], n.torqueg[1], n.torqueg[2]), true});
+    // A zero torque is no load (and would make the static tangent unsymmetric for nothing).
+    for (const auto& [values, global] : {std::pair{&n.torquel, false}, std::pair{&n.torqueg, true}})
+      if (!values->empty() && Eigen::Vector3d((*values)[0], (*values)[1], (*values)[2]).any())
+        sys.torques.push_back({off, Eigen::Vector3d((*values)[0], (*values)[1], (*values)[2]), global});
   }
   sys.gravity = Eigen::Vector3d(model.gravity[0], model.gravity[1], model.gravity[2]);
 }
