@@ -173,7 +173,7 @@ class Section:
 
 
 # The ESTIFF method of each element type a section describes.
-_ESTIFF = {"PLBEAM": "plbeam_estiff", "PLBEAMNL": "plbeam_estiff", "BEAM": "beam_estiff",
+_ESTIFF = {"PLBEAM": "plbeam_estiff", "PLBEAMNL": "plbeam_estiff", "PLBEAMC": "plbeam_estiff", "BEAM": "beam_estiff",
            "BEAMNL": "beam_estiff", "PLTRUSS": "truss_estiff", "TRUSS": "truss_estiff"}
 
 
@@ -290,7 +290,7 @@ def section_forces(results, e: int, type_name: str, l0: float) -> dict:
     if type_name in ("PLTRUSS", "TRUSS"):
         ends = np.zeros((len(zero), 2))
         return {"N": s(1), "T": zero, "My": ends, "Mz": ends, "Vy": zero, "Vz": zero}
-    if type_name in ("PLBEAM", "PLBEAMNL"):
+    if type_name in ("PLBEAM", "PLBEAMNL", "PLBEAMC"):
         return {"N": s(1), "T": zero, "My": np.zeros((len(zero), 2)), "Mz": l0 * np.column_stack([s(2), s(3)]),
                 "Vy": s(2) - s(3), "Vz": zero}
     return {"N": s(1), "T": l0 * s(2), "My": l0 * np.column_stack([s(3), s(4)]),
