@@ -100,7 +100,7 @@ def fig_truss(t, planar=True):
     return fig
 
 
-def fig_plbeam(t, nonlinear=False):
+def fig_plbeam(t, nonlinear=False, arc=False):
     fig, ax, axt = _figure()
     l0 = 1.0
     p, q = np.array([0.0, 0.0]), np.array([1.0, 0.12])
@@ -118,10 +118,15 @@ def fig_plbeam(t, nonlinear=False):
     ax.annotate("chord α", (0.5, 0.06), xytext=(0.6, 0.005), fontsize=7, color="0.4")
     ax.set_xlim(-0.25, 1.55)
     ax.set_ylim(-0.35, 0.65)
-    e1 = "e1 = l − l0 + (2e2² + e2e3 + 2e3²)/(30 l0)" if nonlinear else "e1 = l − l0"
-    _legend(axt, t, [e1, "e2 = l0 sin(φ1 − α)", "e3 = l0 sin(α − φ2)"],
+    if arc:
+        lines = ["e1 = l δ/sin δ − l0 + b²/(10 l0), δ = (δ1 + δ2)/2, b = (e2 − e3)/2",
+                 "e2 = l0 δ1, δ1 = φ1 − α", "e3 = l0 δ2, δ2 = α − φ2"]
+    else:
+        e1 = "e1 = l − l0 + (2e2² + e2e3 + 2e3²)/(30 l0)" if nonlinear else "e1 = l − l0"
+        lines = [e1, "e2 = l0 sin(φ1 − α)", "e3 = l0 sin(α − φ2)"]
+    _legend(axt, t, lines,
             "ESTIFF EA EI: σ1 = EA e1/l0, [σ2 σ3] = EI/l0³ [[4 −2] [−2 4]] [e2 e3]. "
-            "Constant curvature κ > 0 gives e2 = e3 < 0.")
+            "Constant curvature κ > 0 gives e2 = e3 < 0" + (" and e1 = 0 along the arc." if arc else "."))
     return fig
 
 
@@ -371,6 +376,7 @@ FIGURES_BY_TYPE = {
     "TRUSS": lambda t: fig_truss(t, False),
     "PLBEAM": lambda t: fig_plbeam(t, False),
     "PLBEAMNL": lambda t: fig_plbeam(t, True),
+    "PLBEAMC": lambda t: fig_plbeam(t, arc=True),
     "PLHINGE": fig_plhinge,
     "BEAM": lambda t: fig_beam(t, False),
     "BEAMNL": lambda t: fig_beam(t, True),
