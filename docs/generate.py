@@ -169,7 +169,7 @@ def _quat(axis, angle):
     return np.concatenate([[math.cos(angle / 2)], math.sin(angle / 2) * axis])
 
 
-def fig_beam(t, nonlinear=False):
+def fig_beam(t, nonlinear=False, arc=False):
     fig, ax, axt = _figure(dim3=True)
     p, q = np.zeros(3), np.array([1.0, 0.1, 0.15])
     lp = _quat([0.2, -0.5, 0.6], 0.45)
@@ -183,6 +183,12 @@ def fig_beam(t, nonlinear=False):
     ax.text(*(p + [0, 0, -0.25]), "p1, o1", fontsize=9)
     ax.text(*(q + [0, 0, -0.25]), "p2, o2", fontsize=9)
     _axes3(ax)
+    if arc:
+        _legend(axt, t, ["e1 = |c|/|g| − l0 + l0 (βy² + βz²)/10", "e2 = l0 φx",
+                         "e3, e4 = l0 (−φy/2 ∓ βy)", "e5, e6 = l0 (−φz/2 ∓ βz)"],
+                "φ: the rotation vector from the section at p to the one at q; c: the chord in the mid "
+                "frame; g: the chord of the unit helix of curvature and twist φ; β: the rotation from g to c.")
+        return fig
     e1 = "e1 = l − l0 + (2e3²+e3e4+2e4²+2e5²+e5e6+2e6²)/(30 l0)" if nonlinear else "e1 = l − l0"
     _legend(axt, t, [e1, "e2 = l0 (ez(p)·ey(q) − ey(p)·ez(q))/2",
                      "e3 = l0 el·ez(p)", "e4 = −l0 el·ez(q)", "e5 = −l0 el·ey(p)", "e6 = l0 el·ey(q)"],
@@ -380,6 +386,7 @@ FIGURES_BY_TYPE = {
     "PLHINGE": fig_plhinge,
     "BEAM": lambda t: fig_beam(t, False),
     "BEAMNL": lambda t: fig_beam(t, True),
+    "BEAMC": lambda t: fig_beam(t, arc=True),
     "HINGE": fig_hinge,
     "L2MIN1": fig_l2min1,
 }

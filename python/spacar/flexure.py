@@ -70,22 +70,22 @@ class Flexure:
     """A flexure mechanism in the plane (PLBEAM, the default) or in space (``spatial=True``:
     BEAM). ``nonlinear=True`` meshes the flexures with PLBEAMNL/BEAMNL, whose elongation includes
     the shortening by bending: the stiffness of a loaded flexure along its stroke (support
-    stiffness, buckling) needs it. ``arc=True`` (planar) meshes them with PLBEAMC, exact for
-    constant curvature (its elongation along the arc includes the shortening too): large
-    deflections to 1e-6 of the length with a dozen elements where PLBEAM needs hundreds.
+    stiffness, buckling) needs it. ``arc=True`` meshes them with PLBEAMC/BEAMC, exact for
+    constant curvature (and twist, in space; their elongation along the arc includes the
+    shortening too): large deflections to 1e-6 of the length with a dozen elements where PLBEAM
+    needs hundreds.
     ``ground``: the fixed body. Bodies, flexures, then :meth:`model` builds the spacar.Model (each
     call a new one)."""
 
     def __init__(self, spatial: bool = False, nonlinear: bool = False, arc: bool = False):
         if not all(isinstance(v, bool) for v in (spatial, nonlinear, arc)):
             raise InputError("Flexure: spatial, nonlinear and arc must be True or False")
-        if arc and (spatial or nonlinear):
-            raise InputError("Flexure: arc=True meshes planar flexures with PLBEAMC (its elongation already includes "
-                             "the bending's shortening): not with nonlinear=True, and the spatial beam exact for "
-                             "constant curvature is not built yet")
+        if arc and nonlinear:
+            raise InputError("Flexure: arc=True meshes the flexures with PLBEAMC/BEAMC, whose elongation already "
+                             "includes the bending's shortening: not with nonlinear=True")
         self.spatial, self.nonlinear, self.arc = spatial, nonlinear, arc
         self.dim = 3 if spatial else 2
-        self._element_type = "PLBEAMC" if arc else ("BEAM" if spatial else "PLBEAM") + ("NL" if nonlinear else "")
+        self._element_type = ("BEAM" if spatial else "PLBEAM") + ("C" if arc else "NL" if nonlinear else "")
         self._next_node = 1
         self._next_element = 1
         self._positions: dict = {}      # node → coordinates

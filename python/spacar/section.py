@@ -174,7 +174,7 @@ class Section:
 
 # The ESTIFF method of each element type a section describes.
 _ESTIFF = {"PLBEAM": "plbeam_estiff", "PLBEAMNL": "plbeam_estiff", "PLBEAMC": "plbeam_estiff", "BEAM": "beam_estiff",
-           "BEAMNL": "beam_estiff", "PLTRUSS": "truss_estiff", "TRUSS": "truss_estiff"}
+           "BEAMNL": "beam_estiff", "BEAMC": "beam_estiff", "PLTRUSS": "truss_estiff", "TRUSS": "truss_estiff"}
 
 
 def _rectangle_torsion(a: float, c: float) -> tuple:

@@ -268,5 +268,30 @@ def test_arc_flexures_follow_the_stroke_with_few_elements():
     _, u_nl, k_nl = stroke(8, nonlinear=True)
     assert abs(u - u_ref) < 3e-8 and abs(u_nl - u_ref) > 2e-6
     assert k == pytest.approx(k_ref, rel=2e-3) and k_nl == pytest.approx(k_ref, rel=1e-3)
-    with pytest.raises(spacar.InputError, match="spatial beam exact for constant curvature is not built yet"):
-        flexure.Flexure(spatial=True, arc=True)
+    with pytest.raises(spacar.InputError, match="not with nonlinear=True"):
+        flexure.Flexure(arc=True, nonlinear=True)
+
+
+def test_arc_flexures_in_space_are_beamcs():
+    """Flexure(spatial=True, arc=True): the 3-D guide of BEAMCs, at rest the BEAM guide, and
+    along the stroke in its plane the planar guide of PLBEAMCs."""
+    fx = flexure.Flexure(spatial=True, arc=True)
+    stage = fx.body(at=(D / 2, L, 0.0), name="stage")
+    for x0 in (0.0, D):
+        fx.leaf_spring(fx.ground, stage, (x0, 0.0, 0.0), (x0, L, 0.0), LEAF, n=N, thickness=(1.0, 0.0, 0.0))
+    m = fx.model()
+    assert m.elements[fx.flexures[0].elements[0]].type_name == "BEAMC"
+    beams, beams_stage = guide(spatial=True)
+    C = spacar.compliance(m, stage.node, rotation=stage.rotation_node)
+    assert C == pytest.approx(spacar.compliance(beams.model(), beams_stage.node, rotation=beams_stage.rotation_node),
+                              rel=1e-9, abs=1e-12 * np.abs(C).max())
+    m.force(stage.node, 40.0, 0.0, 0.0)
+    planar = flexure.Flexure(arc=True)
+    pstage = planar.body(at=(D / 2, L), name="stage")
+    for x0 in (0.0, D):
+        planar.leaf_spring(planar.ground, pstage, (x0, 0.0), (x0, L), LEAF, n=N)
+    pm = planar.model()
+    pm.force(pstage.node, 40.0, 0.0)
+    u = spacar.static(m, steps=4).node(stage.node).x[-1]
+    up = spacar.static(pm, steps=4).node(pstage.node).x[-1]
+    assert u[:2] == pytest.approx(up, abs=1e-12) and abs(u[2]) < 1e-15

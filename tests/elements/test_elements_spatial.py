@@ -94,11 +94,13 @@ SPATIAL_CASES = [
     ElementCase("BEAM", beam(rotary=True), label="BEAM+rotary"),
     ElementCase("BEAMNL", beam()),
     ElementCase("BEAMNL", beam(rotary=True), label="BEAMNL+rotary"),
+    ElementCase("BEAMC", beam(), max_rotation=1.0),
+    ElementCase("BEAMC", beam(rotary=True), label="BEAMC+rotary", max_rotation=1.0),
     ElementCase("HINGE", hinge_axis, angles=(0,)),
     ElementCase("L2MIN1", orientations_only),
 ]
 CASES = {str(c): c for c in SPATIAL_CASES}
-BEAMS = ["BEAM", "BEAMNL"]
+BEAMS = ["BEAM", "BEAMNL", "BEAMC"]
 
 
 @pytest.fixture(params=SPATIAL_CASES, ids=str)
@@ -167,6 +169,27 @@ def beam_closed_form(x, l0, C0, nonlinear):
     return e
 
 
+def beamc_closed_form(x, l0, C0):
+    """BEAMC (formulation.md): the relative rotation vector φ of the material frames (SciPy's
+    log map), the chord c in the mid frame, the unit helix's chord g = G(φ) e_x and the rotation
+    β from g to c; the Euler parameters normalized."""
+    from scipy.spatial.transform import Rotation
+
+    unit_frame = lambda lam: rotation_matrix(lam / np.linalg.norm(lam)) @ C0  # noqa: E731
+    Mp, Mq = unit_frame(x[3:7]), unit_frame(x[10:14])
+    phi = Rotation.from_matrix(Mp.T @ Mq).as_rotvec()
+    c = (Mp @ Rotation.from_rotvec(phi / 2).as_matrix()).T @ (x[7:10] - x[0:3])
+    a = np.linalg.norm(phi)
+    s1 = 2 * math.sin(a / 2) / a if a > 1e-4 else 1 - a**2 / 24
+    s2 = (1 - s1) / a**2 if a > 1e-4 else 1 / 24
+    g = s1 * np.array([1.0, 0.0, 0.0]) + s2 * phi * phi[0]
+    axis = np.cross(g, c)
+    beta = axis / np.linalg.norm(axis) * math.atan2(np.linalg.norm(axis), g @ c)
+    return np.array([np.linalg.norm(c) / np.linalg.norm(g) - l0 + l0 * (beta[1]**2 + beta[2]**2) / 10,
+                     l0 * phi[0], l0 * (-phi[1] / 2 - beta[1]), l0 * (-phi[1] / 2 + beta[1]),
+                     l0 * (-phi[2] / 2 - beta[2]), l0 * (-phi[2] / 2 + beta[2])])
+
+
 def hinge_closed_form(x, axis):
     C0 = hinge_frame(axis)
     Rh = C0.T @ rotation_matrix(x[0:4]).T @ rotation_matrix(x[4:8]) @ C0
@@ -181,6 +204,8 @@ def closed_form(type_, x, ref):
     if type_ == "HINGE":
         return hinge_closed_form(x, ref.params)
     C0 = np.reshape(ref.lgeomy, (3, 3)).T
+    if type_ == "BEAMC":
+        return beamc_closed_form(x, ref.l0, C0)
     return beam_closed_form(x, ref.l0, C0, type_ == "BEAMNL")
 
 
@@ -233,7 +258,10 @@ def planar_beam_pair(type_, rng):
     p = rng.uniform(-2, 2, 2)
     xp = np.array([*p, 0.0, *(p + l0 * np.array([math.cos(alpha0), math.sin(alpha0)])), 0.0])
     xp[[0, 1, 3, 4]] += rng.uniform(-0.2, 0.2, 4) * l0
-    xp[[2, 5]] = rng.uniform(-math.pi, math.pi, 2)
+    # BEAMC's angles are those of PLBEAMC below a half turn of the ends (where the relative rotation
+    # of the spatial frames wraps); the others: any rotations.
+    turn = 1.2 if type_ == "BEAMC" else math.pi
+    xp[[2, 5]] = rng.uniform(-turn, turn, 2)
     return k3, k2, xp, l0
 
 
@@ -325,7 +353,9 @@ def test_bending_pair_and_torsion_signs(type_):
     """Straight reference, one end rotated by θ about a local axis (relative to the chord):
     about y: p → e3 = +l0 sin θ, q → e4 = −l0 sin θ; about z: p → e5 = +l0 sin θ, q → e6 = −l0 sin θ
     (each pair = (l0 sin θp, −l0 sin θq), §4.8); about x (twist ψ of q relative to p): e2 = l0 sin ψ.
-    Everything else 0 (BEAMNL: e1 = the bending correction)."""
+    Everything else 0 (BEAMNL: e1 = the bending correction). BEAMC: the angles l0 θ, l0 ψ, and
+    e1 the stretch of the arc whose end tangents turn by θ over the chord l0, l0 θ/(2 sin(θ/2)) − l0,
+    with its antisymmetric bending θ/2: + l0 θ²/40."""
     rng = np.random.default_rng(29)
     for _ in range(N_CONFIGS):
         k, l0, C0, p0 = straight_beam(type_, rng)
@@ -337,16 +367,18 @@ def test_bending_pair_and_torsion_signs(type_):
             lam_p, lam_q = (rot, IDENTITY) if node == "p" else (IDENTITY, rot)
             x = configuration(np.zeros(3), [l0, 0, 0], lam_p, lam_q, p0, C0, rigid)
             expected = np.zeros(6)
-            expected[index] = sign * l0 * math.sin(theta)
+            expected[index] = sign * l0 * (theta if type_ == "BEAMC" else math.sin(theta))
             if type_ == "BEAMNL" and axis != 0:
                 expected[0] = 2 * expected[index] ** 2 / (30 * l0)
+            if type_ == "BEAMC" and axis != 0:
+                expected[0] = l0 * theta / (2 * math.sin(theta / 2)) - l0 + l0 * theta**2 / 40
             np.testing.assert_allclose(k.deformations(x), expected, rtol=0, atol=TOL * 4 * l0)
         # twist of both ends: only the relative twist counts
         psi_p, psi_q = rng.uniform(-1, 1, 2)
         x = configuration(np.zeros(3), [l0, 0, 0], axis_angle(C0[:, 0], psi_p), axis_angle(C0[:, 0], psi_q), p0, C0,
                           rigid)
-        np.testing.assert_allclose(k.deformations(x), [0, l0 * math.sin(psi_q - psi_p), 0, 0, 0, 0],
-                                   rtol=0, atol=TOL * 4 * l0)
+        twist = psi_q - psi_p if type_ == "BEAMC" else math.sin(psi_q - psi_p)
+        np.testing.assert_allclose(k.deformations(x), [0, l0 * twist, 0, 0, 0, 0], rtol=0, atol=TOL * 4 * l0)
 
 
 def arc_configuration(l0, kappa):
@@ -363,7 +395,8 @@ def arc_configuration(l0, kappa):
 @pytest.mark.parametrize("axis", [1, 2], ids=["about_y", "about_z"])
 def test_constant_curvature(type_, axis):
     """Constant curvature gives equal pair values e3 = e4 (e5 = e6) = −l0 sin(κl0/2) (as PLBEAM),
-    the other pair and the torsion 0; BEAMNL: arc of length l0 ⇒ e1 = −(17/360) l0 θ⁴ + O(θ⁶)."""
+    the other pair and the torsion 0; BEAMNL: arc of length l0 ⇒ e1 = −(17/360) l0 θ⁴ + O(θ⁶);
+    BEAMC: the angle, −l0 κl0/2, and no elongation."""
     rng = np.random.default_rng(31 + axis)
     pair = [2, 3] if axis == 1 else [4, 5]
     for _ in range(N_CONFIGS):
@@ -373,8 +406,10 @@ def test_constant_curvature(type_, axis):
         x = configuration(pl, ql, axis_angle(C0[:, axis], thp), axis_angle(C0[:, axis], thq), p0, C0,
                           random_rigid(rng))
         e = k.deformations(x)
-        expected = -l0 * math.sin(kappa * l0 / 2)
+        expected = -l0 * (kappa * l0 / 2 if type_ == "BEAMC" else math.sin(kappa * l0 / 2))
         np.testing.assert_allclose(e[pair], [expected, expected], rtol=0, atol=TOL * 4 * l0)
+        if type_ == "BEAMC":
+            assert abs(e[0]) < TOL * 8 * l0
         others = [i for i in range(1, 6) if i not in pair]
         np.testing.assert_allclose(e[others], 0.0, rtol=0, atol=TOL * 4 * l0)
     if type_ == "BEAMNL":

@@ -195,6 +195,10 @@ class ElementCase:
     reference: Callable[["ElementCase", np.random.Generator], Reference]  # random reference geometry
     label: str = ""        # test id and seed name when one type has several cases (default: type)
     angles: tuple = ()     # 0-based indices of angle-type deformations (atan2 branch, mod 2π)
+    # The largest rotation of a LAMBDA node from the reference in the random configurations (None:
+    # any): an element whose deformations are angles between its frames and its chord (BEAMC) is
+    # singular where they reach π, far from any state of a beam.
+    max_rotation: float | None = None
 
     def __str__(self):
         return self.label or self.type
@@ -232,8 +236,8 @@ class ElementCase:
         rng = self.rng(check + ("@off-sphere" if off_sphere else ""))
         for _ in range(n):
             ref = self.reference(self, rng)
-            x = random_configuration(rng, self.kinds, ref,
-                                     lambda_norms=OFF_SPHERE_NORMS if off_sphere else None)
+            x = random_configuration(rng, self.kinds, ref, lambda_norms=OFF_SPHERE_NORMS if off_sphere else None,
+                                     max_rotation=self.max_rotation)
             yield rng, ref, self.kernel(ref), x
 
     def derivative_samples(self, check: str):
@@ -325,11 +329,12 @@ def orientations_only(case: ElementCase, rng) -> Reference:
     return Reference(x=assemble(case.kinds, []))
 
 
-def random_configuration(rng, kinds, ref: Reference, spread: float = 0.2, lambda_norms=None):
+def random_configuration(rng, kinds, ref: Reference, spread: float = 0.2, lambda_norms=None, max_rotation=None):
     """Position nodes moved independently by up to ±spread·scale per component from the
     reference (for a chord this keeps l ≥ (1 − 2√2·spread) l0); BETA uniform in [−π, π];
-    LAMBDA random unit Euler parameters, or, with lambda_norms = (lo, hi), random Euler
-    parameters of norm uniform in [lo, hi]."""
+    LAMBDA random unit Euler parameters (with max_rotation: a rotation about a random axis by at
+    most that angle), or, with lambda_norms = (lo, hi), random Euler parameters of norm uniform
+    in [lo, hi]."""
     x = np.array(ref.x, dtype=float)
     for k, s in zip(kinds, node_slices(kinds)):
         if k in POSITION_KINDS:
@@ -337,7 +342,11 @@ def random_configuration(rng, kinds, ref: Reference, spread: float = 0.2, lambda
         elif k == NodeKind.BETA:
             x[s] = rng.uniform(-math.pi, math.pi)
         elif k == NodeKind.LAMBDA:
-            x[s] = random_unit_quaternion(rng)
+            if max_rotation is None:
+                x[s] = random_unit_quaternion(rng)
+            else:
+                axis, angle = rng.normal(size=3), rng.uniform(0.0, max_rotation)
+                x[s] = np.r_[math.cos(angle / 2), math.sin(angle / 2) * axis / np.linalg.norm(axis)]
             if lambda_norms is not None:
                 x[s] *= rng.uniform(*lambda_norms)
         else:

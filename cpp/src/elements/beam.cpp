@@ -8,6 +8,16 @@
 //   e5 = −l0 (e_l·e_y^p),  e6 = +l0 (e_l·e_y^q)    bending about local z
 // so that motion in the x–y plane with e_y0 = n(α0) reproduces PLBEAM: e5, e6 = PLBEAM e2, e3.
 // BEAMNL adds (2e3² + e3e4 + 2e4² + 2e5² + e5e6 + 2e6²)/(30 l0) to e1.
+// BEAMC (extension, exact for constant curvature and twist: circles and helices) measures the
+// same deformations by angles. With the material frames M_p = R(λp) C0, M_q = R(λq) C0:
+//   φ = log(M_pᵀ M_q)             the relative rotation vector (its components in both frames)
+//   M_m = M_p exp(φ/2)            the mid frame; c = M_mᵀ (x_q − x_p) the chord in it
+//   g = G(φ) e_x, G(φ) = ∫ exp(u φ̂) du over u in [−½, ½]   the chord of an arc of unit length
+//                                  whose curvature and twist are φ (a helix) in that frame
+//   β = the rotation vector from g to c   (the chord's departure from that arc)
+//   e1 = |c|/|g| − l0 + l0 (βy² + βz²)/10   elongation along the arc
+//   e2 = l0 φx;  e3, e4 = l0 (−φy/2 ∓ βy);  e5, e6 = l0 (−φz/2 ∓ βz)
+// In the x–y plane it is PLBEAMC; to first order at the straight reference it is BEAM.
 // Mass: the cubic Hermite interpolation with nodal tangents R(λ)e_x0 (as PLBEAM); rotary
 // inertia of the cross-section only with the extension EMASS e rhoA rhoIp [rhoIy rhoIz].
 #include <cmath>
@@ -19,17 +29,49 @@
 namespace spacar {
 namespace {
 
-template <bool Nonlinear>
-class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
-  using Base = AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3>;
+// Quaternions (w, x, y, z) of any scalar: a ⊗ b, and R(q)ᵀ v.
+template <class S, class T>
+std::array<S, 4> qmul(const std::array<S, 4>& a, const std::array<T, 4>& b) {
+  return {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3], a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+          a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1], a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+}
+template <class S>
+Vec3<S> rotate_back(const std::array<S, 4>& q, const Vec3<S>& v) {  // R(q)ᵀ v = R(q̄) v
+  const S w = q[0], x = -q[1], y = -q[2], z = -q[3];
+  const S s = w * w - (x * x + y * y + z * z), lv = x * v[0] + y * v[1] + z * v[2];
+  return {s * v[0] + 2.0 * x * lv + 2.0 * w * (y * v[2] - z * v[1]),
+          s * v[1] + 2.0 * y * lv + 2.0 * w * (z * v[0] - x * v[2]),
+          s * v[2] + 2.0 * z * lv + 2.0 * w * (x * v[1] - y * v[0])};
+}
+// atan2(√n2, w)/√n2 for w > 0 near n2 = 0 too (the series in n2/w², whose derivatives stay finite
+// where √n2 has none: the straight reference).
+template <class S>
+S atan_ratio(const S& n2, const S& w) {
+  const double r = value_of(n2) / (value_of(w) * value_of(w));
+  if (value_of(w) > 0.0 && r < 1e-10) {
+    const S t = n2 / (w * w);
+    return (1.0 - t / 3.0 + t * t / 5.0) / w;
+  }
+  const S n = sqrt(n2);
+  return atan2(n, w) / n;
+}
+
+template <Bending Kind>
+class Beam : public AutoDiffElement<Beam<Kind>, 14, 6, 4, 3> {
+  using Base = AutoDiffElement<Beam<Kind>, 14, 6, 4, 3>;
+  static constexpr bool Nonlinear = Kind == Bending::SineCorrected;
+  static constexpr bool Arc = Kind == Bending::Arc;
 
  public:
   explicit Beam(const ElementSetup& s) : l0_(s.l0) {
     if (s.lgeomy.size() != 9)
-      throw InputError(std::string(Nonlinear ? "BEAMNL" : "BEAM") + ": LGEOMY needs 9 values (e_x0, e_y0, e_z0), got " +
+      throw InputError(std::string(Arc ? "BEAMC" : Nonlinear ? "BEAMNL" : "BEAM") +
+                       ": LGEOMY needs 9 values (e_x0, e_y0, e_z0), got " +
                        std::to_string(s.lgeomy.size()));
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) C0_(i, j) = s.lgeomy[3 * j + i];
+    const Eigen::Quaterniond q0(C0_);
+    c0_ = {q0.w(), q0.x(), q0.y(), q0.z()};
     const double rhoA = s.emass.empty() ? 0.0 : s.emass[0];
     mass_ = hermite_mass<3>(rhoA, l0_);
     // Rotary inertia: T = (l0/6)(Ω_pᵀJΩ_p + Ω_pᵀJΩ_q + Ω_qᵀJΩ_q), Ω the section angular velocity.
@@ -43,6 +85,7 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
 
   template <class S>
   void deform(const S* x, S* e) const {
+    if constexpr (Arc) return deform_arc(x, e);
     const S dx = x[7] - x[0], dy = x[8] - x[1], dz = x[9] - x[2];
     const S l = sqrt(dx * dx + dy * dy + dz * dz);
     const Vec3<S> el = {dx / l, dy / l, dz / l};
@@ -63,6 +106,7 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
   // times more, in every Newton iteration and output of a spatial model. The generic element
   // checks test these against finite differences like any other kernel's derivatives.
   void first_derivatives(const double* x, double* e, double* B) const override {
+    if constexpr (Arc) return Base::first_derivatives(x, e, B);  // BEAMC: from the jets
     const Axes a = axes(x);
     Eigen::Map<Eigen::Matrix<double, 6, 14>> Bm(B);
     Bm.setZero();
@@ -96,6 +140,7 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
   // ẅ = 2 R(λ̇)c0 (R(λ)c0 is quadratic in λ) and, of the chord, l̈ = (|ḋ|² − l̇²)/l and
   // ë_l = −(2 ė_l l̇ + e_l l̈)/l.
   void convective(const double* x, const double* v, double* c) const override {
+    if constexpr (Arc) return Base::convective(x, v, c);
     const Axes a = axes(x);
     const Eigen::Vector3d dd(v[7] - v[0], v[8] - v[1], v[9] - v[2]);
     const double ld = a.el.dot(dd);
@@ -228,6 +273,49 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
     return a;
   }
 
+  // BEAMC's deformations (see the top of the file).
+  template <class S>
+  void deform_arc(const S* x, S* e) const {
+    const std::array<S, 4> lp = {x[3], x[4], x[5], x[6]}, lq = {x[10], x[11], x[12], x[13]};
+    const std::array<S, 4> mp = qmul(lp, c0_), mq = qmul(lq, c0_);
+    std::array<S, 4> r = qmul(std::array<S, 4>{mp[0], -mp[1], -mp[2], -mp[3]}, mq);  // M_pᵀ M_q
+    // The rotations of the Euler parameters normalized (L2MIN1 holds them on the unit sphere).
+    const double sign = value_of(r[0]) < 0.0 ? -1.0 : 1.0;  // the same rotation, by an angle below π
+    const S rn = sign * sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
+    for (S& v : r) v = v / rn;
+    const S n2 = r[1] * r[1] + r[2] * r[2] + r[3] * r[3];
+    const S k = 2.0 * atan_ratio(n2, r[0]);
+    const Vec3<S> phi = {k * r[1], k * r[2], k * r[3]};
+    // The mid frame M_p exp(φ/2): the half rotation (1 + w, v̄) normalized.
+    const S hn = sqrt((1.0 + r[0]) * (1.0 + r[0]) + n2);
+    const std::array<S, 4> mm = qmul(mp, std::array<S, 4>{(1.0 + r[0]) / hn, r[1] / hn, r[2] / hn, r[3] / hn});
+    const S mm2 = mm[0] * mm[0] + mm[1] * mm[1] + mm[2] * mm[2] + mm[3] * mm[3];  // |λp|²
+    Vec3<S> c = rotate_back(mm, Vec3<S>{x[7] - x[0], x[8] - x[1], x[9] - x[2]});
+    for (S& v : c) v = v / mm2;
+    // g = G(φ) e_x = s1 e_x + s2 φ φx with s1 = 2 sin(a/2)/a, s2 = (1 − s1)/a², a = |φ|.
+    const S a2 = dot3(phi, phi);
+    S s1, s2;
+    if (value_of(a2) < 1e-6) {
+      s1 = 1.0 - a2 / 24.0 + a2 * a2 / 1920.0;
+      s2 = 1.0 / 24.0 - a2 / 1920.0 + a2 * a2 / 322560.0;
+    } else {
+      const S a = sqrt(a2);
+      s1 = 2.0 * sin(0.5 * a) / a;
+      s2 = (1.0 - s1) / a2;
+    }
+    const Vec3<S> g = {s1 + s2 * phi[0] * phi[0], s2 * phi[0] * phi[1], s2 * phi[0] * phi[2]};
+    // β: the rotation vector from g to c.
+    const Vec3<S> gc = {g[1] * c[2] - g[2] * c[1], g[2] * c[0] - g[0] * c[2], g[0] * c[1] - g[1] * c[0]};
+    const S kb = atan_ratio(dot3(gc, gc), dot3(g, c));
+    const S by = kb * gc[1], bz = kb * gc[2];
+    e[0] = sqrt(dot3(c, c) / dot3(g, g)) - l0_ + l0_ * (by * by + bz * bz) / 10.0;
+    e[1] = l0_ * phi[0];
+    e[2] = l0_ * (-0.5 * phi[1] - by);
+    e[3] = l0_ * (-0.5 * phi[1] + by);
+    e[4] = l0_ * (-0.5 * phi[2] - bz);
+    e[5] = l0_ * (-0.5 * phi[2] + bz);
+  }
+
   // BEAMNL's bending correction of the elongation.
   template <class S>
   S correction(const S* e) const {
@@ -244,6 +332,7 @@ class Beam : public AutoDiffElement<Beam<Nonlinear>, 14, 6, 4, 3> {
 
   double l0_;
   Eigen::Matrix3d C0_;
+  std::array<double, 4> c0_{};  // C0 as a quaternion (BEAMC)
   MassPoints<4, 3> mass_;
   bool rotary_ = false;
   Eigen::Matrix3d A_[4];
@@ -259,14 +348,21 @@ void reference_beam(const double* x, const std::vector<double>& params, double& 
   lgeomy.assign(C.data(), C.data() + 9);
 }
 
-template <bool Nonlinear>
+template <Bending Kind>
 ElementType beam_type() {
   const NodeKind p = NodeKind::XYZ, o = NodeKind::Lambda;
-  ElementType t = element_type<Beam<Nonlinear>>(
-      Nonlinear ? "BEAMNL" : "BEAM", {p, o, p, o}, {"p1", "o1", "p2", "o2"},
-      {Nonlinear ? "bending-corrected elongation" : "elongation", "torsion", "bending about local y at p1",
-       "bending about local y at p2", "bending about local z at p1", "bending about local z at p2"},
-      Nonlinear ? "spatial beam with bending-corrected elongation" : "spatial beam");
+  static const char* const name[] = {"BEAM", "BEAMNL", "BEAMC"};
+  static const char* const first[] = {"elongation", "bending-corrected elongation", "elongation along the arc"};
+  static const char* const title[] = {"spatial beam", "spatial beam with bending-corrected elongation",
+                                      "spatial beam exact for constant curvature and twist: bending and torsion "
+                                      "angles, elongation along the helix (extension)"};
+  const int k = static_cast<int>(Kind);
+  ElementType t = element_type<Beam<Kind>>(
+      name[k], {p, o, p, o}, {"p1", "o1", "p2", "o2"},
+      {first[k], "torsion", "bending about local y at p1", "bending about local y at p2", "bending about local z at p1",
+       "bending about local z at p2"},
+      title[k]);
+  t.extension = Kind == Bending::Arc;
   set_params(t, 3, 3, "x y z: initial direction of the principal y-axis of the cross-section");
   set_stiffness(t, 6, "EA GIp EIy EIz kGAy kGAz");
   set_emass(t, 4, "rhoA [rhoIp rhoIy rhoIz] (rotary inertia: extension)");
@@ -280,7 +376,8 @@ ElementType beam_type() {
 
 }  // namespace
 
-ElementType beam_element_type() { return beam_type<false>(); }
-ElementType beamnl_element_type() { return beam_type<true>(); }
+ElementType beam_element_type() { return beam_type<Bending::Sine>(); }
+ElementType beamnl_element_type() { return beam_type<Bending::SineCorrected>(); }
+ElementType beamc_element_type() { return beam_type<Bending::Arc>(); }
 
 }  // namespace spacar

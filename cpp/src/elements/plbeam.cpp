@@ -21,10 +21,6 @@
 namespace spacar {
 namespace {
 
-// The bending measure of the planar beam: the manual's (sines), with the bending-corrected
-// elongation, or the arc's (angles).
-enum class Bending { Sine, SineCorrected, Arc };
-
 template <Bending Kind>
 class PlBeam : public AutoDiffElement<PlBeam<Kind>, 6, 3, 4, 2> {
   static constexpr bool Nonlinear = Kind == Bending::SineCorrected;

@@ -134,6 +134,11 @@ MassPoints<4, DIM> hermite_mass(double rhoA, double l0) {
 // Timoshenko's, (EI/(l0³ (1 + Φ)))[[4 + Φ, Φ − 2], [Φ − 2, 4 + Φ]], Φ = 12 EI/(kGA l0²): the
 // beam whose shear force is constant along it, so that a cantilever's tip deflection under a tip
 // force, P L³/(3 EI) + P L/(kGA), is exact with one element.
+// The bending measure of the beams (PLBEAM/BEAM, PLBEAMNL/BEAMNL, PLBEAMC/BEAMC): the manual's
+// (the sines of the end rotations), the same with the bending-corrected elongation, or the arc's
+// (the angles, and the elongation along the arc: exact for constant curvature).
+enum class Bending { Sine, SineCorrected, Arc };
+
 struct BendingPair {
   double diagonal, coupling;
 };

@@ -7,6 +7,7 @@
 // No include guard: the includer defines SPACAR_ELEMENT, includes this file, undefines it.
 SPACAR_ELEMENT(beam)
 SPACAR_ELEMENT(beamnl)
+SPACAR_ELEMENT(beamc)
 SPACAR_ELEMENT(truss)
 SPACAR_ELEMENT(hinge)
 SPACAR_ELEMENT(bearing)
