@@ -99,8 +99,9 @@ def animate_mode(source, mode: int = 0, *, at: int = -1, scale: float | None = N
     ``source``: :class:`spacar.Results` whose model asked for linearizations (LINEAR, LINE;
     ``at`` picks the output time, default the last), or a :class:`spacar.Model` (linearized at
     its current state, as :func:`spacar.linearize`). The nodal shape
-    (``Linearization.mode_shapes()[2]``) is added with ``scale`` times sin(2π j / frames),
-    j = 0 .. frames − 1 (``scale`` as in :func:`spacar.draw`'s ``mode``: default the largest
+    (``Linearization.mode_shapes()[2]``) is added with ``scale`` times cos(2π j / frames),
+    j = 0 .. frames − 1 (the first frame, the still picture of a notebook exported to HTML, at
+    the largest amplitude) (``scale`` as in :func:`spacar.draw`'s ``mode``: default the largest
     displacement a tenth of the model's size); beams are drawn through the displaced nodes with
     the cubic (Hermite) shape of their displaced end slopes. One period lasts ``period`` ms.
     Other keyword arguments go to :func:`animate`."""
@@ -112,7 +113,7 @@ def animate_mode(source, mode: int = 0, *, at: int = -1, scale: float | None = N
     frames = int(frames)
     if frames < 2:
         raise InputError(f"frames must be at least 2, got {frames}")
-    phases = np.sin(2 * np.pi * np.arange(frames) / frames)
+    phases = np.cos(2 * np.pi * np.arange(frames) / frames)
     moving = _displaced(res, k, shapes_x[:, mode], scale, phases)
     f = float(freqs[mode])
     animate_kwargs.setdefault("caption", lambda j: f"mode {mode + 1}: {f:.4g} Hz")

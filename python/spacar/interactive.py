@@ -339,37 +339,73 @@ def explore(source, *, input=None, input_range=None, parameters=None, trace=(), 
 
 
 def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, stress_kind: str = "normal",
-           colorscale: str = "Plasma"):
+           colorscale: str = "Plasma", mode=None, scale: float | None = None, frames: int = 0):
     """The mechanism at output index ``k`` as an interactive plotly figure (turn, zoom, hover
     for names), one trace per drawn shape; without plotly the matplotlib drawing of
     :func:`spacar.draw` (a :class:`spacar.plotting.Scene`). ``stress``: the
     :func:`spacar.section.stresses` of these results, drawn as in :func:`spacar.draw`: each of
-    its elements in the colour of its largest stress (``stress_kind``), the peak marked."""
-    from .plotting import _stress_values
+    its elements in the colour of its largest stress (``stress_kind``), the peak marked.
+    ``mode``: a shape in the nodal coordinates (a vibration or buckling mode,
+    ``Linearization.mode_shapes()[2][:, i]``) added to that state times ``scale`` (as in
+    :func:`spacar.draw`); with ``frames`` ≥ 2 it is animated, times cos(2π j / frames) (the
+    still picture, frame 0, at the largest amplitude), with a play button and a slider (the
+    animation is kept in the figure's HTML)."""
+    from .plotting import _displaced, _stress_values
     from .results import require_results
 
     require_results(res, "view3d")
+    frames = _frame_count(frames)
     try:
         import plotly.graph_objects as go
     except ImportError:
         from .plotting import draw
 
-        return draw(res, k, beam_points=beam_points, stress=stress, stress_kind=stress_kind)
+        return draw(res, k, beam_points=beam_points, stress=stress, stress_kind=stress_kind, mode=mode, scale=scale)
     if res.geometry is None:
         raise InputError("these results have no geometry to draw (results of spacar.simulate have)")
     k = range(len(res.t))[k]
     values = _stress_values(res, stress, k, stress_kind) if stress is not None else {}
+    time = res.t[k]
+    rows = [res.x[k]]
+    if mode is not None:
+        phases = np.cos(2 * np.pi * np.arange(frames) / frames) if frames else (1.0,)
+        rows = list(_displaced(res, k, mode, scale, phases).x)
+    # The scale of the drawing (clamps, triads) from the undisplaced state, the same in every frame.
+    coords = frame_coordinates(res.node_columns, res.x[k])
+    pts = np.vstack([p for n, p in coords.items() if res.geometry.node_kinds.get(n) in ("XY", "XYZ")])
+    size = float(np.ptp(pts, axis=0).max()) or 1.0
+    traces = [_view3d_traces(go, res.geometry, frame_coordinates(res.node_columns, x), size, beam_points, values,
+                             colorscale, stress_kind) for x in rows]
+    fig = go.Figure(data=traces[0])
+    fig.update_layout(scene=dict(aspectmode="data"), title=f"t = {time:.4g} s", margin=dict(l=0, r=0, t=30, b=0))
+    if len(traces) > 1:
+        fig.frames = [go.Frame(data=t, name=str(j)) for j, t in enumerate(traces)]
+        play = dict(frame=dict(duration=1500 // len(traces), redraw=True), fromcurrent=True, mode="immediate")
+        fig.update_layout(updatemenus=[dict(type="buttons", showactive=False, x=0.0, y=0.0, buttons=[
+            dict(label="play", method="animate", args=[None, {**play, "loop": True}]),
+            dict(label="pause", method="animate", args=[[None], dict(mode="immediate", frame=dict(duration=0))])])],
+            sliders=[dict(steps=[dict(method="animate", label=str(j), args=[[str(j)], dict(mode="immediate")])
+                                 for j in range(len(traces))], x=0.1, len=0.9, currentvalue=dict(prefix="frame "))])
+    return fig
+
+
+def _frame_count(frames) -> int:
+    if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)) or frames < 0 or frames == 1 or \
+            frames > 1000:
+        raise InputError(f"frames must be 0 (a still picture) or a whole number from 2 to 1000, got {frames!r}")
+    return int(frames)
+
+
+def _view3d_traces(go, geometry, coords, size, beam_points, values, colorscale, stress_kind) -> list:
+    """The plotly traces of one state: one per drawn shape, the stress peak, the colour bar."""
     top = max(values.values(), default=0.0) or 1.0
     if values:
         from plotly.colors import sample_colorscale
-    coords = frame_coordinates(res.node_columns, res.x[k])
-    pts = np.vstack([p for n, p in coords.items() if res.geometry.node_kinds.get(n) in ("XY", "XYZ")])
-    scale = float(np.ptp(pts, axis=0).max()) or 1.0
     colours = {"beam": "#1f77b4", "truss": "#ff7f0e", "body": "#1f77b4", "ground": "#777777", "clamp": "#222222",
                "pin": "#000000", "slider": "#999999", "mass": "#000000", "triad-x": "red", "triad-y": "green",
                "triad-z": "blue", "wheel": "#000000", "belt": "#2ca02c"}
-    fig = go.Figure()
-    for sh in shapes(res.geometry, coords, scale, beam_points):
+    out = []
+    for sh in shapes(geometry, coords, size, beam_points):
         p = np.zeros((len(sh.points), 3))
         p[:, : sh.points.shape[1]] = sh.points
         name = f"{sh.kind} {'element' if sh.element is not None else 'node'} {sh.element if sh.element is not None else sh.node}"
@@ -378,19 +414,17 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
         if sh.element in values and not single:
             colour = sample_colorscale(colorscale, [values[sh.element] / top])[0]
             name += f": {values[sh.element]:.4g}"
-        fig.add_trace(go.Scatter3d(x=p[:, 0], y=p[:, 1], z=p[:, 2], name=name, mode="markers" if single else "lines",
-                                   line=dict(color=colour, width=6 if sh.kind == "beam" else 3),
-                                   marker=dict(size=5, color=colour),
-                                   surfaceaxis=2 if sh.kind == "body" and not res.geometry.spatial else -1,
-                                   showlegend=False))
+        out.append(go.Scatter3d(x=p[:, 0], y=p[:, 1], z=p[:, 2], name=name, mode="markers" if single else "lines",
+                                line=dict(color=colour, width=6 if sh.kind == "beam" else 3),
+                                marker=dict(size=5, color=colour),
+                                surfaceaxis=2 if sh.kind == "body" and not geometry.spatial else -1, showlegend=False))
         if values and sh.element == max(values, key=values.get) and not single:
             m = p[len(p) // 2]
-            fig.add_trace(go.Scatter3d(x=[m[0]], y=[m[1]], z=[m[2]], mode="markers+text", showlegend=False,
-                                       marker=dict(size=6, color="red", symbol="diamond"),
-                                       text=[f"{values[sh.element]:.3g} (element {sh.element})"], name="peak"))
+            out.append(go.Scatter3d(x=[m[0]], y=[m[1]], z=[m[2]], mode="markers+text", showlegend=False,
+                                    marker=dict(size=6, color="red", symbol="diamond"),
+                                    text=[f"{values[sh.element]:.3g} (element {sh.element})"], name="peak"))
     if values:  # the colour bar, on an invisible marker
-        fig.add_trace(go.Scatter3d(x=[None], y=[None], z=[None], mode="markers", showlegend=False, hoverinfo="skip",
-                                   marker=dict(colorscale=colorscale, cmin=0.0, cmax=top, color=[0.0], showscale=True,
-                                               colorbar=dict(title=stress_kind.replace("_", " ") + " stress"))))
-    fig.update_layout(scene=dict(aspectmode="data"), title=f"t = {res.t[k]:.4g} s", margin=dict(l=0, r=0, t=30, b=0))
-    return fig
+        out.append(go.Scatter3d(x=[None], y=[None], z=[None], mode="markers", showlegend=False, hoverinfo="skip",
+                                marker=dict(colorscale=colorscale, cmin=0.0, cmax=top, color=[0.0], showscale=True,
+                                            colorbar=dict(title=stress_kind.replace("_", " ") + " stress"))))
+    return out

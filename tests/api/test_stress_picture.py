@@ -87,3 +87,29 @@ def test_view3d_colours_and_marks_the_peak():
     assert any(n and n.startswith(f"beam element {peak}:") for n in names)
     assert "peak" in names
     assert any(getattr(t.marker, "showscale", False) for t in fig.data)   # the colour bar
+
+
+def test_view3d_animates_a_mode_from_its_peak():
+    """view3d(res, mode=..., frames=n): n plotly frames of the state plus cos(2πj/n) times the
+    mode, the still picture at the peak, a play button; a still picture with frames=0."""
+    pytest.importorskip("plotly")
+    m = spacar.Model()
+    for k in range(4):
+        m.plbeam(k + 1, 2 * k + 1, 2 * k + 2, 2 * k + 3, 2 * k + 4)
+        m.x(2 * k + 3, (k + 1) / 4, 0.0)
+        m.dyne(k + 1, 2, 3)
+        m.emass(k + 1, 1.0)
+        m.estiff(k + 1, 0.0, 1.0)
+    m.fix(1)
+    m.fix(2)
+    res = spacar.static(m)
+    shape = spacar.linearize(m).mode_shapes(1)[2][:, 0]
+    fig = spacar.view3d(res, mode=shape, frames=8)
+    assert len(fig.frames) == 8 and fig.layout.updatemenus[0].buttons[0].label == "play"
+    tip_y = lambda data: next(abs(t.y[-1]) for t in data if t.name == "beam element 4")  # noqa: E731
+    assert tip_y(fig.data) == pytest.approx(tip_y(fig.frames[0].data)) and tip_y(fig.data) > 0.05
+    assert tip_y(fig.frames[2].data) < 1e-9 * tip_y(fig.data) + 1e-12     # cos(π/2): at rest
+    still = spacar.view3d(res, mode=shape)
+    assert not still.frames and tip_y(still.data) == pytest.approx(tip_y(fig.data))
+    with pytest.raises(spacar.InputError, match="frames must be 0"):
+        spacar.view3d(res, mode=shape, frames=1)
