@@ -21,7 +21,7 @@ from matplotlib import animation as _mpl_animation
 from .errors import InputError
 from .geometry import Geometry
 from .io.files import check_output_path, write_replacing
-from .plotting import Scene, _displaced, snapshot
+from .plotting import Scene, _displaced, mode_phases, snapshot
 from .results import Results, require_results
 
 
@@ -110,10 +110,7 @@ def animate_mode(source, mode: int = 0, *, at: int = -1, scale: float | None = N
     if isinstance(mode, bool) or not isinstance(mode, (int, np.integer)) or not 0 <= mode < shapes_x.shape[1]:
         raise InputError(f"mode must be a mode number 0..{shapes_x.shape[1] - 1} (0: the lowest frequency), "
                          f"got {mode!r}")
-    frames = int(frames)
-    if frames < 2:
-        raise InputError(f"frames must be at least 2, got {frames}")
-    phases = np.cos(2 * np.pi * np.arange(frames) / frames)
+    phases = mode_phases(frames)
     moving = _displaced(res, k, shapes_x[:, mode], scale, phases)
     f = float(freqs[mode])
     animate_kwargs.setdefault("caption", lambda j: f"mode {mode + 1}: {f:.4g} Hz")

@@ -350,11 +350,13 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
     :func:`spacar.draw`); with ``frames`` ≥ 2 it is animated, times cos(2π j / frames) (the
     still picture, frame 0, at the largest amplitude), with a play button and a slider (the
     animation is kept in the figure's HTML)."""
-    from .plotting import _displaced, _stress_values
+    from .plotting import _displaced, _stress_values, mode_phases
     from .results import require_results
 
     require_results(res, "view3d")
-    frames = _frame_count(frames)
+    if frames != 0 and mode is None:
+        raise InputError("frames animate a mode: give mode= too (a shape in the nodal coordinates)")
+    phases = mode_phases(frames) if frames != 0 else (1.0,)
     try:
         import plotly.graph_objects as go
     except ImportError:
@@ -368,7 +370,6 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
     time = res.t[k]
     rows = [res.x[k]]
     if mode is not None:
-        phases = np.cos(2 * np.pi * np.arange(frames) / frames) if frames else (1.0,)
         rows = list(_displaced(res, k, mode, scale, phases).x)
     # The scale of the drawing (clamps, triads) from the undisplaced state, the same in every frame.
     coords = frame_coordinates(res.node_columns, res.x[k])
@@ -387,13 +388,6 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
             sliders=[dict(steps=[dict(method="animate", label=str(j), args=[[str(j)], dict(mode="immediate")])
                                  for j in range(len(traces))], x=0.1, len=0.9, currentvalue=dict(prefix="frame "))])
     return fig
-
-
-def _frame_count(frames) -> int:
-    if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)) or frames < 0 or frames == 1 or \
-            frames > 1000:
-        raise InputError(f"frames must be 0 (a still picture) or a whole number from 2 to 1000, got {frames!r}")
-    return int(frames)
 
 
 def _view3d_traces(go, geometry, coords, size, beam_points, values, colorscale, stress_kind) -> list:

@@ -94,6 +94,7 @@ def _element_keywords():
 
 # The most ESTIFF (and EDAMPP) values any element type takes (the spatial beam's six with shear).
 _MOST_ESTIFF = max(t.n_estiff for t in _core.element_catalogue())
+_MOST_EMASS = max(t.n_emass for t in _core.element_catalogue())
 
 _OTHER = [
     Keyword("X", NODES, (_p("n"), _p("x", REAL, 1, 4)), "any node n with coordinates x1..x4"),
@@ -129,7 +130,7 @@ _OTHER = [
             aliases=("LENGTH0",)),
     Keyword("MASS", PROPERTIES, (_p("n"), _p("m", REAL, 1, 6)),
             "concentrated mass m (XY, XYZ), Izz (BETA) or inertia tensor Ixx Ixy Ixz Iyy Iyz Izz (LAMBDA) at node n"),
-    Keyword("EMASS", PROPERTIES, (_p("e"), _p("rhoA", REAL, 1, 4)),
+    Keyword("EMASS", PROPERTIES, (_p("e"), _p("rhoA", REAL, 1, _MOST_EMASS)),
             "distributed mass rhoA per length of element e (PLBELT: rhoA a1 a2)"),
     Keyword("ESTIFF", PROPERTIES, (_p("e"), _p("x", REAL, 1, _MOST_ESTIFF)),
             "stiffness parameters of element e (meaning per element type)"),

@@ -25,6 +25,7 @@ import numpy as np
 from ._util import show
 from .errors import InputError
 from .model import Model
+from .section import PLANAR_BEAMS
 
 __all__ = ["Grashof", "FourBar", "synthesize", "limit_positions", "instant_centres", "transmission_angle"]
 
@@ -274,7 +275,7 @@ def instant_centres(model, bodies, at=None) -> dict:
     for e in bodies:
         if e == 0:
             continue
-        if e not in elements or elements[e].type_name not in ("PLBEAM", "PLBEAMNL", "PLBEAMC"):
+        if e not in elements or elements[e].type_name not in PLANAR_BEAMS:
             raise InputError(f"instant_centres: body {show(e)} must be 0 (the ground) or a PLBEAM of the model")
         p, o = elements[e].nodes[0], elements[e].nodes[1]
         point = np.array([tf.x[rows[(p, 1)]], tf.x[rows[(p, 2)]]])

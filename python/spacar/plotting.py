@@ -16,6 +16,7 @@ import numpy as np
 
 import matplotlib.pyplot as plt
 
+from ._util import show
 from .errors import InputError
 from .geometry import frame_coordinates, magnified, shapes
 from .results import _ARRAYS, STATE_ARRAYS, Results, require_results
@@ -300,11 +301,25 @@ class Scene:
         return [ln for ln in self.lines if ln.get_gid() == f"element-{element}"]
 
 
+def mode_phases(frames) -> np.ndarray:
+    """The amplitudes of an animated mode, cos(2π j / frames) for j = 0 .. frames − 1: the first
+    frame (the still picture) at the peak. ``frames``: a whole number from 2 to 1000."""
+    if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)) or not 2 <= frames <= 1000:
+        raise InputError(f"frames must be a whole number from 2 to 1000, got {show(frames)}")
+    return np.cos(2 * np.pi * np.arange(int(frames)) / int(frames))
+
+
 def _displaced(res: Results, k: int, mode, scale, amplitudes=(1.0,)) -> Results:
     """Results at row k displaced by ``scale`` times the nodal shape ``mode`` (nx), one row per
     amplitude (default one row, amplitude 1); by default scaled so that the largest displacement
     of a position is a tenth of the model's extent. Euler parameters are normalised again."""
-    dx = np.real(np.asarray(mode)).astype(float).reshape(-1)
+    try:
+        dx = np.real(np.asarray(mode)).astype(float).reshape(-1)
+    except (TypeError, ValueError):
+        dx = np.full(1, np.nan)
+    if scale is not None and (isinstance(scale, bool) or not isinstance(scale, (int, float, np.number))
+                              or not np.isfinite(scale)):
+        raise InputError(f"scale must be a finite number (or None: a tenth of the model's size), got {show(scale)}")
     if dx.shape != res.x[k].shape or not np.isfinite(dx).all():
         raise InputError(f"mode must hold {res.x.shape[1]} finite numbers (one per nodal coordinate, as "
                          f"Linearization.buckling_modes()[2][:, i]), got shape {np.shape(mode)}")

@@ -65,13 +65,16 @@ class Section:
     :func:`tube`): area ``A``, second moments ``Iy``, ``Iz`` and polar ``Ip = Iy + Iz``, the
     torsion constant ``J`` (Saint-Venant; ``Ip`` for round sections), the section moduli ``Wy``,
     ``Wz`` (bending stress |M|/W) and ``Wt`` (torsion: τ = |T|/Wt), the transverse shear factor
-    ``shear_factor`` (largest shear stress k V / A), and the ``material`` (None: geometry only)."""
+    ``shear_factor`` (largest shear stress k V / A), the warping constant ``Iw`` (BEAMW's EIw:
+    b³h³/144 for a rectangle, as SPACAR Light gives it; 0 for round sections, which do not
+    warp), and the ``material`` (None: geometry only)."""
 
-    def __init__(self, shape: str, dims: dict, material, *, A, Iy, Iz, J, Wy, Wz, Wt, shear_factor, round_: bool):
+    def __init__(self, shape: str, dims: dict, material, *, A, Iy, Iz, J, Wy, Wz, Wt, shear_factor, round_: bool,
+                 Iw: float = 0.0):
         if material is not None and not isinstance(material, Material):
             raise InputError(f"material must be a spacar.section.Material, got {show(material)}")
         self.shape, self.dims, self.material = shape, dims, material
-        self.A, self.Iy, self.Iz, self.Ip, self.J = A, Iy, Iz, Iy + Iz, J
+        self.A, self.Iy, self.Iz, self.Ip, self.J, self.Iw = A, Iy, Iz, Iy + Iz, J, Iw
         self.Wy, self.Wz, self.Wt = Wy, Wz, Wt
         self.shear_factor = shear_factor
         self._round = round_  # bending about any axis has the same modulus: |M| = hypot(My, Mz)
@@ -107,22 +110,24 @@ class Section:
         values = (m.E * self.A, m.E * self.Iz)
         return values + (self.shear_coefficient() * m.G * self.A,) if shear else values
 
-    def beam_estiff(self, shear: bool = False) -> tuple:
+    def beam_estiff(self, shear: bool = False, warping: bool = False) -> tuple:
         """ESTIFF of BEAM/BEAMNL: (EA, GIp, EIy, EIz), the torsional stiffness being G J (the
-        catalogue's "GIp"; J = Ip only for round sections); with ``shear`` also (kGAy, kGAz)."""
+        catalogue's "GIp"; J = Ip only for round sections); with ``shear`` also (kGAy, kGAz);
+        with ``warping`` (BEAMW) the seventh value EIw (the shear values 0 without ``shear``)."""
         m = self._mat()
         values = (m.E * self.A, m.G * self.J, m.E * self.Iy, m.E * self.Iz)
-        if shear:
-            kGA = self.shear_coefficient() * m.G * self.A
+        if shear or warping:
+            kGA = self.shear_coefficient() * m.G * self.A if shear else 0.0
             values += (kGA, kGA)
-        return values
+        return values + (m.E * self.Iw,) if warping else values
 
-    def emass(self, rotary: bool = False) -> tuple:
+    def emass(self, rotary: bool = False, warping: bool = False) -> tuple:
         """EMASS: (ρA,), or for BEAM with ``rotary=True`` (ρA, ρIp, ρIy, ρIz), the rotary inertia
-        of the cross-section per unit length (an extension of the manual's EMASS)."""
+        of the cross-section per unit length (an extension of the manual's EMASS); with
+        ``warping`` (BEAMW) also ρIw, the warping inertia."""
         rho = self._mat().rho
-        if rotary:
-            return (rho * self.A, rho * self.Ip, rho * self.Iy, rho * self.Iz)
+        if rotary or warping:
+            return (rho * self.A, rho * self.Ip, rho * self.Iy, rho * self.Iz) + ((rho * self.Iw,) if warping else ())
         return (rho * self.A,)
 
     def apply(self, model, *elements, rotary: bool = True, shear: bool = False):
@@ -131,7 +136,7 @@ class Section:
         rotary inertia of the section (ρIp, ρIy, ρIz; since issue 39 the default, without which
         the torsion of a leaf has no inertia and a 3-D leaf guide's modes fail), ``rotary=False``
         for ρA alone as the manual's EMASS; ``shear``: the beams' shear stiffness too
-        (Timoshenko). Returns ``model``."""
+        (Timoshenko); a BEAMW also its warping stiffness EIw and inertia ρIw. Returns ``model``."""
         table = model.elements
         if not elements:
             elements = [e for e, el in table.items() if el.type_name in _ESTIFF]
@@ -142,9 +147,12 @@ class Section:
             if kind not in _ESTIFF:
                 raise InputError(f"a cross-section gives the data of beams and trusses, not of element {e} ({kind})")
             estiff = getattr(self, _ESTIFF[kind])
-            model.estiff(e, *(estiff(shear=True) if shear and kind != "PLTRUSS" and kind != "TRUSS" else estiff()))
+            options = {"shear": True} if shear and kind not in ("PLTRUSS", "TRUSS") else {}
+            if kind == "BEAMW":  # its warping stiffness and inertia
+                options["warping"] = True
+            model.estiff(e, *estiff(**options))
             if self._mat().rho > 0.0:
-                model.emass(e, *self.emass(rotary and kind in ("BEAM", "BEAMNL")))
+                model.emass(e, *self.emass(rotary and kind in SPATIAL_BEAMS, warping=kind == "BEAMW"))
         return model
 
     # --- stresses ----------------------------------------------------------------------------
@@ -172,9 +180,19 @@ class Section:
         return f"<spacar.section {self.shape}({dims}){mat}: A = {self.A:.6g}, Iy = {self.Iy:.6g}, Iz = {self.Iz:.6g}>"
 
 
+def _beam_types() -> tuple:
+    """The planar and the spatial beams of the element catalogue (family Beam; planar: XY nodes)."""
+    from . import _core
+
+    beams = [t for t in _core.element_catalogue() if t.family.name == "Beam"]
+    return (frozenset(t.name for t in beams if t.nodes[0].name == "XY"),
+            frozenset(t.name for t in beams if t.nodes[0].name == "XYZ"))
+
+
+PLANAR_BEAMS, SPATIAL_BEAMS = _beam_types()
 # The ESTIFF method of each element type a section describes.
-_ESTIFF = {"PLBEAM": "plbeam_estiff", "PLBEAMNL": "plbeam_estiff", "PLBEAMC": "plbeam_estiff", "BEAM": "beam_estiff",
-           "BEAMNL": "beam_estiff", "BEAMC": "beam_estiff", "PLTRUSS": "truss_estiff", "TRUSS": "truss_estiff"}
+_ESTIFF = {**dict.fromkeys(PLANAR_BEAMS, "plbeam_estiff"), **dict.fromkeys(SPATIAL_BEAMS, "beam_estiff"),
+           "PLTRUSS": "truss_estiff", "TRUSS": "truss_estiff"}
 
 
 def _rectangle_torsion(a: float, c: float) -> tuple:
@@ -201,7 +219,7 @@ def rectangle(b, h, material: Material | None = None) -> Section:
     b, h = _positive(b, "b"), _positive(h, "h")
     J, Wt = _rectangle_torsion(max(b, h), min(b, h))
     return Section("rectangle", {"b": b, "h": h}, material, A=b * h, Iy=h * b**3 / 12, Iz=b * h**3 / 12, J=J,
-                   Wy=h * b**2 / 6, Wz=b * h**2 / 6, Wt=Wt, shear_factor=1.5, round_=False)
+                   Wy=h * b**2 / 6, Wz=b * h**2 / 6, Wt=Wt, shear_factor=1.5, round_=False, Iw=b**3 * h**3 / 144)
 
 
 def circle(d, material: Material | None = None) -> Section:
@@ -290,7 +308,7 @@ def section_forces(results, e: int, type_name: str, l0: float) -> dict:
     if type_name in ("PLTRUSS", "TRUSS"):
         ends = np.zeros((len(zero), 2))
         return {"N": s(1), "T": zero, "My": ends, "Mz": ends, "Vy": zero, "Vz": zero}
-    if type_name in ("PLBEAM", "PLBEAMNL", "PLBEAMC"):
+    if type_name in PLANAR_BEAMS:
         return {"N": s(1), "T": zero, "My": np.zeros((len(zero), 2)), "Mz": l0 * np.column_stack([s(2), s(3)]),
                 "Vy": s(2) - s(3), "Vz": zero}
     return {"N": s(1), "T": l0 * s(2), "My": l0 * np.column_stack([s(3), s(4)]),

@@ -170,6 +170,7 @@ class _Element:
     def __init__(self, number, p, q):
         self.number, self.p, self.q = number, p, q
         self.nbeams, self.orien, self.flex, self.section, self.set = 1, np.array([0.0, 1.0, 0.0]), [], None, None
+        self.warping = False  # eprops.warping: BEAMW, flexible in its warping deformations 7 and 8 too
         self.mass_section = None
         self.beams: list = []
 
@@ -238,7 +239,7 @@ class _Light:
     @staticmethod
     def _releases(k: int, r: dict) -> list:
         _unknown(r, ("def",), f"rls({k})")
-        return _numbers_list(r["def"], f"rls({k}).def", 1, 6) if r else []
+        return _numbers_list(r["def"], f"rls({k}).def", 1, 8) if r else []
 
     @staticmethod
     def _nodes(nodes) -> np.ndarray:
@@ -286,14 +287,14 @@ class _Light:
                 if el.set is not None:
                     raise InputError(f"element {e} is in eprops({el.set}) and eprops({k}): one set per element")
                 el.set = k
-                if _flag(props.get("warping", False), f"eprops({k}).warping") or \
-                        _flag(props.get("cw", False), f"eprops({k}).cw"):
-                    raise InputError(f"eprops({k}).warping: the warping beam (BEAMW) is not implemented in spacar yet; "
-                                     "leave warping out (free warping, torsion stiffness GJ)")
+                el.warping = _flag(props.get("warping", False), f"eprops({k}).warping") or \
+                    _flag(props.get("cw", False), f"eprops({k}).cw")
                 el.nbeams = _whole(props.get("nbeams", 1), f"eprops({k}).nbeams", 1, 10000)
                 if "orien" in props:
                     el.orien = _vector(props["orien"], 3, f"eprops({k}).orien")
                 el.flex = sorted(set(_numbers_list(props["flex"], f"eprops({k}).flex", 1, 6))) if "flex" in props else []
+                if el.warping and el.flex:
+                    el.flex += [7, 8]  # BEAMW's warping deformations (spacarlight.m: "always calculable")
                 dens = _number(props.get("dens", 0.0), f"eprops({k}).dens")
                 if el.flex or dens > 0:
                     section = _section(props, k, bool(el.flex), dens > 0)
@@ -365,18 +366,28 @@ class _Light:
         for i, x in enumerate(self.nodes):
             self._declare(m, 3 * i + 1, x)
         next_node, beam = 3 * n + 1, 1
+        warped, restrained = set(), set()  # warping nodes used; those held (by rigid warping elements)
         for el in self.elements:
-            points = [(3 * el.p - 2, 3 * el.p - 1)]
+            # (position, orientation, warping) nodes of the points along the element
+            points = [(3 * el.p - 2, 3 * el.p - 1, 3 * el.p)]
             a, b = self.nodes[el.p - 1], self.nodes[el.q - 1]
             for k in range(1, el.nbeams):
                 self._declare(m, next_node, a + (b - a) * k / el.nbeams)
-                points.append((next_node, next_node + 1))
+                points.append((next_node, next_node + 1, next_node + 2))
                 next_node += 3
-            points.append((3 * el.q - 2, 3 * el.q - 1))
+            points.append((3 * el.q - 2, 3 * el.q - 1, 3 * el.q))
             el.beams = list(range(beam, beam + el.nbeams))
             for k, e in enumerate(el.beams):
-                m.beam(e, *points[k], *points[k + 1], *el.orien)
+                (p, o, w), (q, r, v) = points[k], points[k + 1]
+                if el.warping and el.flex:
+                    m.beamw(e, p, o, q, r, w, v, *el.orien)
+                    warped.update((w, v))
+                else:
+                    m.beam(e, p, o, q, r, *el.orien)
+                    if el.warping:  # a rigid element with warping holds the warping of its ends
+                        restrained.update(pt[2] for pt in points)
             beam += el.nbeams
+        self._warping_supports(m, warped, restrained)
         for el in self.elements:
             self._properties(m, el)
         for i, props in enumerate(self.nprops):
@@ -391,6 +402,16 @@ class _Light:
         m.timestep(1, 1.0)  # a static block moves its inputs by XD over this period
         return m
 
+    def _warping_supports(self, m: Model, warped: set, restrained: set):
+        """The warping nodes fixed: at a node fixed (fix) or with fix_warp, and where a rigid
+        element with warping ends (spacarlight.m's rules)."""
+        for i, props in enumerate(self.nprops, start=1):
+            if _flag(props.get("fix", False), f"nprops({i}).fix") or _flag(props.get("fix_warp", False),
+                                                                          f"nprops({i}).fix_warp"):
+                restrained.add(3 * i)
+        for w in sorted(warped & restrained):
+            m.fix(w)
+
     @staticmethod
     def _declare(m: Model, node: int, x):
         m.xyz(node, *x)
@@ -404,14 +425,15 @@ class _Light:
                 m.dyne(e, *dynamic)
             if k == len(el.beams) - 1 and released:
                 m.rlse(e, *released)
+            warping = el.warping and bool(el.flex)
             if el.section is not None:
-                m.estiff(e, *el.section.beam_estiff(shear=True))
+                m.estiff(e, *el.section.beam_estiff(shear=True, warping=warping))
             if el.mass_section is not None:
-                m.emass(e, *el.mass_section.emass(rotary=True))
+                m.emass(e, *el.mass_section.emass(rotary=True, warping=warping))
 
     def _supports(self, m: Model, node: int, props: dict):
         """FIX and INPUTX of a node of SPACAR Light (their combinations checked in _combinations;
-        fix_warp has nothing to fix without warping beams)."""
+        its warping node in _warping_supports)."""
         pos, rot = 3 * node - 2, 3 * node - 1
         flag = lambda name: _flag(props.get(name, False), f"nprops({node}).{name}")  # noqa: E731
         if flag("fix") or flag("fix_pos"):

@@ -285,6 +285,8 @@ def test_arc_flexures_in_space_are_beamcs():
     C = spacar.compliance(m, stage.node, rotation=stage.rotation_node)
     assert C == pytest.approx(spacar.compliance(beams.model(), beams_stage.node, rotation=beams_stage.rotation_node),
                               rel=1e-9, abs=1e-12 * np.abs(C).max())
+    # the leaves' mass and rotary inertia as the BEAMs' (the stage massless): the same modes
+    assert spacar.linearize(m).M0 == pytest.approx(spacar.linearize(beams.model()).M0, rel=1e-12, abs=1e-15)
     m.force(stage.node, 40.0, 0.0, 0.0)
     planar = flexure.Flexure(arc=True)
     pstage = planar.body(at=(D / 2, L), name="stage")

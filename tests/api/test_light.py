@@ -248,7 +248,7 @@ def test_a_massless_model_has_stiffness_but_no_frequencies():
 
 @pytest.mark.parametrize("change, match", [
     (lambda a: a[2][0].update(fixed=True), "unknown nprops\\(1\\) field 'fixed'"),
-    (lambda a: a[3][0].update(warping=True), "warping beam \\(BEAMW\\) is not implemented"),
+    (lambda a: a[3][0].update(warping="yes"), "eprops\\(1\\).warping must be true or false"),
     (lambda a: a[3][0].update(orien=[0, 1, 0]), "orien .* lies along element 1"),
     (lambda a: a[1].__setitem__(2, [3, 3]), "element 3 joins node 3 to itself"),
     (lambda a: a[1].__setitem__(2, [3, 5]), "element 3 joins nodes \\[3, 5\\]: node numbers run from 1 to 4"),

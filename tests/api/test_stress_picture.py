@@ -111,5 +111,9 @@ def test_view3d_animates_a_mode_from_its_peak():
     assert tip_y(fig.frames[2].data) < 1e-9 * tip_y(fig.data) + 1e-12     # cos(π/2): at rest
     still = spacar.view3d(res, mode=shape)
     assert not still.frames and tip_y(still.data) == pytest.approx(tip_y(fig.data))
-    with pytest.raises(spacar.InputError, match="frames must be 0"):
+    with pytest.raises(spacar.InputError, match="frames must be a whole number from 2 to 1000"):
         spacar.view3d(res, mode=shape, frames=1)
+    for bad, match in ((dict(mode="abc"), "mode must hold"), (dict(mode=shape, scale=np.inf), "scale must be a finite"),
+                       (dict(mode=shape, scale="big"), "scale must be a finite"), (dict(frames=24), "give mode= too")):
+        with pytest.raises(spacar.InputError, match=match):
+            spacar.view3d(res, **bad)

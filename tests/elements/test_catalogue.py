@@ -99,7 +99,7 @@ def test_lambda_nodes_get_an_automatic_l2min1():
 
 # Definition-line numbers that make a valid element of each type (test_elements_*.py cover the
 # physics; here only the sizes matter).
-DEFINITION_NUMBERS = {"BEAM": [0.0, 1.0, 0.3], "BEAMNL": [0.0, 1.0, 0.3], "BEAMC": [0.0, 1.0, 0.3],
+DEFINITION_NUMBERS = {"BEAM": [0.0, 1.0, 0.3], "BEAMNL": [0.0, 1.0, 0.3], "BEAMC": [0.0, 1.0, 0.3], "BEAMW": [0.0, 1.0, 0.3],
                       "HINGE": [0.0, 0.0, 1.0],
                       "BEARING": [0.0, 0.0, 1.0], "SURFACE": [1.0] * 10, "PLBELT": [0.1, 0.2],
                       "PLWHEEL": [0.1, 1.0, 0.0], "WHEEL": [0.0, 1.0, 0.0, 0.3]}
@@ -144,7 +144,8 @@ def test_catalogue_flags():
     assert [n for n, t in cat.items() if t.automatic] == ["L2MIN1"]
     assert [n for n, t in cat.items() if t.signed_emass_extras] == ["PLBELT"]
     families = {n: t.family.name for n, t in cat.items()}
-    assert [n for n, f in families.items() if f == "Beam"] == ["BEAM", "BEAMNL", "BEAMC", "PLBEAM", "PLBEAMNL", "PLBEAMC"]
+    assert [n for n, f in families.items() if f == "Beam"] == ["BEAM", "BEAMNL", "BEAMC", "BEAMW", "PLBEAM", "PLBEAMNL",
+                                                                     "PLBEAMC"]
     assert [n for n, f in families.items() if f == "Hinge"] == ["HINGE", "PLHINGE"]
     assert [n for n, f in families.items() if f == "Truss"] == ["TRUSS", "PLTRUSS"]
     assert [n for n, f in families.items() if f == "Wheel"] == ["PLWHEEL", "WHEEL"]

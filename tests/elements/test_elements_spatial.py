@@ -56,10 +56,10 @@ def lgeomy_of(C0):
     return tuple(C0.T.ravel())
 
 
-def beam(rotary=False):
+def beam(rotary=False, warping=False):
     """Random reference of a BEAM(NL): chord of length l0 ∈ [0.5, 2] in a random direction, random
     cross-section frame, ρA ∈ [0.5, 3]; rotary: EMASS ρA ρIp ρIy ρIz with ρIy, ρIz = ρA (radius of
-    gyration 0.07…0.3 l0)², ρIp = ρIy + ρIz."""
+    gyration 0.07…0.3 l0)², ρIp = ρIy + ρIz; warping (BEAMW): ρIw = ρIy ρIz / ρA as well."""
     def reference(case, rng):
         l0 = rng.uniform(0.5, 2.0)
         p = rng.uniform(-2.0, 2.0, size=3)
@@ -69,7 +69,7 @@ def beam(rotary=False):
         emass = (rhoA,)
         if rotary:
             Iy, Iz = rhoA * (rng.uniform(0.07, 0.3, size=2) * l0) ** 2
-            emass = (rhoA, Iy + Iz, Iy, Iz)
+            emass = (rhoA, Iy + Iz, Iy, Iz) + ((Iy * Iz / rhoA,) if warping else ())
         return Reference(x=assemble(case.kinds, [p, p + l0 * d]), l0=l0, lgeomy=lgeomy_of(C0),
                          emass=emass, scale=l0)
     return reference
@@ -95,6 +95,7 @@ SPATIAL_CASES = [
     ElementCase("BEAMNL", beam()),
     ElementCase("BEAMNL", beam(rotary=True), label="BEAMNL+rotary"),
     ElementCase("BEAMC", beam(), max_rotation=1.0),
+    ElementCase("BEAMW", beam(rotary=True, warping=True), label="BEAMW+rotary"),
     ElementCase("BEAMC", beam(rotary=True), label="BEAMC+rotary", max_rotation=1.0),
     ElementCase("HINGE", hinge_axis, angles=(0,)),
     ElementCase("L2MIN1", orientations_only),
@@ -206,6 +207,9 @@ def closed_form(type_, x, ref):
     C0 = np.reshape(ref.lgeomy, (3, 3)).T
     if type_ == "BEAMC":
         return beamc_closed_form(x, ref.l0, C0)
+    if type_ == "BEAMW":  # BEAM's, and the end rates of twist against the mean one
+        e = beam_closed_form(x[:14], ref.l0, C0, False)
+        return np.r_[e, ref.l0**2 * x[14] - e[1], e[1] - ref.l0**2 * x[15]]
     return beam_closed_form(x, ref.l0, C0, type_ == "BEAMNL")
 
 

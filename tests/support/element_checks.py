@@ -357,7 +357,8 @@ def random_configuration(rng, kinds, ref: Reference, spread: float = 0.2, lambda
 def random_rigid_motion(rng, kinds, scale=1.0):
     """A random rigid motion as a function x ↦ x′ on the element's coordinates. Planar: rotation
     by θ about a random point, translation; every BETA gets + θ. Spatial: rotation Q = R(q) about
-    a random point, translation; every LAMBDA λ ↦ q ⊗ λ (so R(λ′) = Q R(λ))."""
+    a random point, translation; every LAMBDA λ ↦ q ⊗ λ (so R(λ′) = Q R(λ)); a BETA node of a
+    spatial element is a scalar of its own (BEAMW's rates of twist), unchanged."""
     slices = node_slices(kinds)
     planar = all(k in PLANAR_KINDS for k in kinds)
     dim = 2 if planar else 3
@@ -376,7 +377,7 @@ def random_rigid_motion(rng, kinds, scale=1.0):
             if k in POSITION_KINDS:
                 y[s] = centre + Q @ (x[s] - centre) + shift
             elif k == NodeKind.BETA:
-                y[s] = x[s] + theta
+                y[s] = x[s] + theta if planar else x[s]
             elif k == NodeKind.LAMBDA:
                 y[s] = quat_mul(q, x[s])
             else:

@@ -17,7 +17,19 @@
 //   β = the rotation vector from g to c   (the chord's departure from that arc)
 //   e1 = |c|/|g| − l0 + l0 (βy² + βz²)/10   elongation along the arc
 //   e2 = l0 φx;  e3, e4 = l0 (−φy/2 ∓ βy);  e5, e6 = l0 (−φz/2 ∓ βz)
-// In the x–y plane it is PLBEAMC; to first order at the straight reference it is BEAM.
+// In the x–y plane it is PLBEAMC while the end sections turn by less than π relative to each
+// other (one element of either can bend through less than a half turn; PLBEAMC's angles reach
+// further); to first order at the straight reference it is BEAM.
+// BEAMW (extension, warping torsion after Vlasov) is BEAM with the rate of twist at each end as a
+// coordinate of its own (the warping nodes w1, w2: one coordinate each, placed after BEAM's four
+// nodes) and two deformations more, the departure of the end rates from the mean twist:
+//   e7 = l0 (l0 w1) − e2,  e8 = e2 − l0 (l0 w2)      (e2 = l0 ψ to first order)
+// With the twist interpolated by the cubic of those end values and rates, the warping energy
+// ½∫EIw ψ''² and the torsion ½∫GJ ψ'² give the pair EIw/l0⁵ [[4, −2], [−2, 4]] +
+// GJ/(30 l0³) [[4, 1], [1, 4]] on (e7, e8) beside GJ/l0³ on e2 (e7/l0² is a rate of twist, where
+// the bending deformations over l0 are angles). A warping node fixed restrains
+// the section's warping (a clamp); free, the rates settle at the mean twist and the beam is BEAM.
+// EMASS's fifth value ρIw gives the warping inertia ½∫ρIw ẇ² with w linear between the ends.
 // Mass: the cubic Hermite interpolation with nodal tangents R(λ)e_x0 (as PLBEAM); rotary
 // inertia of the cross-section only with the extension EMASS e rhoA rhoIp [rhoIy rhoIz].
 #include <cmath>
@@ -52,7 +64,8 @@ S atan_ratio(const S& n2, const S& w) {
     const S t = n2 / (w * w);
     return (1.0 - t / 3.0 + t * t / 5.0) / w;
   }
-  const S n = sqrt(n2);
+  // (n2 = 0 with w < 0: the half turn, whose axis is undefined; kept finite, its vector is 0.)
+  const S n = sqrt(value_of(n2) > 0.0 ? n2 : S(1e-300));
   return atan2(n, w) / n;
 }
 
@@ -70,8 +83,12 @@ class Beam : public AutoDiffElement<Beam<Kind>, 14, 6, 4, 3> {
                        std::to_string(s.lgeomy.size()));
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) C0_(i, j) = s.lgeomy[3 * j + i];
-    const Eigen::Quaterniond q0(C0_);
-    c0_ = {q0.w(), q0.x(), q0.y(), q0.z()};
+    if constexpr (Arc) {  // its angles are those of the frame's rotation: it must be one
+      if (!((C0_.transpose() * C0_ - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-9 && C0_.determinant() > 0.0))
+        throw InputError("BEAMC: LGEOMY must be a right-handed orthonormal frame (e_x0, e_y0, e_z0 = e_x0 × e_y0)");
+      const Eigen::Quaterniond q0(C0_);
+      c0_ = {q0.w(), q0.x(), q0.y(), q0.z()};
+    }
     const double rhoA = s.emass.empty() ? 0.0 : s.emass[0];
     mass_ = hermite_mass<3>(rhoA, l0_);
     // Rotary inertia: T = (l0/6)(Ω_pᵀJΩ_p + Ω_pᵀJΩ_q + Ω_qᵀJΩ_q), Ω the section angular velocity.
@@ -338,6 +355,82 @@ class Beam : public AutoDiffElement<Beam<Kind>, 14, 6, 4, 3> {
   Eigen::Matrix3d A_[4];
 };
 
+// BEAMW: BEAM's coordinates and deformations (its first 14 and 6), and the warping rates w1, w2
+// (coordinates 15, 16) with e7, e8. The mass and BEAM's stiffness are BEAM's.
+class BeamW : public AutoDiffElement<BeamW, 16, 8, 4, 3> {
+  using Base = AutoDiffElement<BeamW, 16, 8, 4, 3>;
+
+ public:
+  explicit BeamW(const ElementSetup& s)
+      : beam_(s), l0_(s.l0), rhoIw_(s.emass.size() > 4 ? s.emass[4] : 0.0) {}
+
+  template <class S>
+  void deform(const S* x, S* e) const {
+    beam_.deform(x, e);
+    e[6] = l0_ * l0_ * x[14] - e[1];
+    e[7] = e[1] - l0_ * l0_ * x[15];
+  }
+
+  // The mass of BEAM's 14 coordinates and the warping inertia of the rates.
+  template <class S>
+  void mass_points(const S* x, S* g) const {
+    beam_.mass_points(x, g);
+  }
+  const MassPoints<4, 3>& mass_model() const { return beam_.mass_model(); }
+  bool has_mass() const override { return beam_.has_mass() || rhoIw_ != 0.0; }
+  void mass(const double* x, const double* v, double* M, double* h) const override {
+    double M14[196], h14[14];
+    beam_.mass(x, v, M14, h14);
+    widen(M14, h14, M, h);
+  }
+  void mass_and_gravity(const double* x, const double* v, const double* g, double* M, double* h,
+                        double* f) const override {
+    double M14[196], h14[14], f14[14];
+    beam_.mass_and_gravity(x, v, g, M14, h14, f14);
+    widen(M14, h14, M, h);
+    for (int i = 0; i < 16; ++i) f[i] = i < 14 ? f14[i] : 0.0;
+  }
+  void gravity(const double* x, const double* g, double* f) const override {
+    beam_.gravity(x, g, f);
+    f[14] = f[15] = 0.0;
+  }
+  double gravity_potential(const double* x, const double* g) const override { return beam_.gravity_potential(x, g); }
+  double kinetic_energy(const double* x, const double* v) const override {
+    const double k = rhoIw_ * l0_ / 6.0;
+    return beam_.kinetic_energy(x, v) + k * (v[14] * v[14] + v[14] * v[15] + v[15] * v[15]);
+  }
+
+  // BEAM's σ = S e of e1 … e6 (ESTIFF values 1–6) and the warping pair of e7, e8 (EIw, the
+  // seventh value, and GJ, the second).
+  void constitutive(const std::vector<double>& v, double* S) const override {
+    double S6[36];
+    beam_.constitutive(std::vector<double>(v.begin(), v.begin() + std::min<size_t>(v.size(), 6)), S6);
+    Eigen::Map<Eigen::Matrix<double, 8, 8>> Sm(S);
+    Sm.setZero();
+    Sm.topLeftCorner<6, 6>() = Eigen::Map<const Eigen::Matrix<double, 6, 6>>(S6);
+    const double GJ = v.size() > 1 ? v[1] : 0.0, EIw = v.size() > 6 ? v[6] : 0.0, l3 = l0_ * l0_ * l0_;
+    const double l5 = l3 * l0_ * l0_;
+    Sm(6, 6) = Sm(7, 7) = 4.0 * EIw / l5 + 4.0 * GJ / (30.0 * l3);
+    Sm(6, 7) = Sm(7, 6) = -2.0 * EIw / l5 + GJ / (30.0 * l3);
+  }
+
+ private:
+  // BEAM's 14 × 14 mass and 14 inertia forces into the 16 coordinates, with the warping
+  // inertia ρIw l0/6 [[2, 1], [1, 2]] of the rates (constant: no inertia force).
+  void widen(const double* M14, const double* h14, double* M, double* h) const {
+    Eigen::Map<Eigen::Matrix<double, 16, 16>> Mm(M);
+    Mm.setZero();
+    Mm.topLeftCorner<14, 14>() = Eigen::Map<const Eigen::Matrix<double, 14, 14>>(M14);
+    const double k = rhoIw_ * l0_ / 6.0;
+    Mm(14, 14) = Mm(15, 15) = 2.0 * k;
+    Mm(14, 15) = Mm(15, 14) = k;
+    for (int i = 0; i < 16; ++i) h[i] = i < 14 ? h14[i] : 0.0;
+  }
+
+  Beam<Bending::Sine> beam_;
+  double l0_, rhoIw_;
+};
+
 // LGEOMY (the frame C0, column by column) and LENGTHO from the reference geometry x = (p(3),
 // λp(4), q(3), λq(4)); params: the initial direction of the cross-section's principal y-axis.
 void reference_beam(const double* x, const std::vector<double>& params, double& l0, std::vector<double>& lgeomy) {
@@ -374,10 +467,31 @@ ElementType beam_type() {
   return t;
 }
 
+ElementType beamw_type() {
+  const NodeKind p = NodeKind::XYZ, o = NodeKind::Lambda, w = NodeKind::Beta;
+  ElementType t = element_type<BeamW>(
+      "BEAMW", {p, o, p, o, w, w}, {"p1", "o1", "p2", "o2", "w1", "w2"},
+      {"elongation", "torsion", "bending about local y at p1", "bending about local y at p2",
+       "bending about local z at p1", "bending about local z at p2", "warping at p1", "warping at p2"},
+      "spatial beam with warping torsion (Vlasov): the rates of twist at its ends as the one coordinate of the "
+      "nodes w1, w2 (extension)");
+  set_params(t, 3, 3, "x y z: initial direction of the principal y-axis of the cross-section");
+  set_stiffness(t, 7, "EA GIp EIy EIz kGAy kGAz EIw");
+  set_emass(t, 5, "rhoA [rhoIp rhoIy rhoIz rhoIw]");
+  t.has_length = true;
+  t.n_lgeomy = 9;
+  t.has_direction = true;
+  t.reference = reference_beam;  // BEAM's, from its first 14 coordinates
+  t.family = ElementFamily::Beam;
+  t.extension = true;
+  return t;
+}
+
 }  // namespace
 
 ElementType beam_element_type() { return beam_type<Bending::Sine>(); }
 ElementType beamnl_element_type() { return beam_type<Bending::SineCorrected>(); }
 ElementType beamc_element_type() { return beam_type<Bending::Arc>(); }
+ElementType beamw_element_type() { return beamw_type(); }
 
 }  // namespace spacar
