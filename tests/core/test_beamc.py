@@ -19,6 +19,8 @@ import pytest
 
 import spacar
 
+from support.spatial_models import bathe_bend
+
 
 def cantilever(n, kind="beamc", EI=1.0, GJ=1.0, EA=1e6):
     """n beams along x (L = 1) from the clamped nodes 1, 2; all deformations DYNE."""
@@ -82,21 +84,8 @@ def test_a_skew_moment_makes_the_exact_helix(n):
 
 
 def bend(n, kind):
-    """Bathe and Bolourchi's 45° bend (radius 100, unit square section, E = 1e7, tip load 600 out
-    of its plane), as in tests/core/test_sparse_modes.py."""
-    R, E = 100.0, 1e7
-    m = spacar.Model()
-    for i in range(n):
-        getattr(m, kind)(i + 1, i + 1, 1001 + i, i + 2, 1002 + i, 0.0, 0.0, 1.0)
-        m.dyne(i + 1)
-        m.estiff(i + 1, E, 0.5 * E * 0.1406, E / 12, E / 12)
-    for i in range(n + 1):
-        a = np.pi / 4 * i / n
-        m.x(i + 1, R * np.sin(a), R * (1 - np.cos(a)), 0.0)
-    m.fix(1)
-    m.fix(1001)
-    m.force(n + 1, 0.0, 0.0, 600.0)
-    return spacar.static(m, steps=1).node(n + 1).x[-1]
+    """The tip of Bathe and Bolourchi's 45° bend (tests/support/spatial_models.py)."""
+    return spacar.static(bathe_bend(n, kind), steps=1).node(n + 1).x[-1]
 
 
 def test_a_left_handed_frame_is_refused():

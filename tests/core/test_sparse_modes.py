@@ -15,7 +15,7 @@ import spacar
 from support.paths import EXAMPLES
 from support.planar_models import compressed_cantilever
 from support.planar_models import tip_loaded_beam as beam
-from support.spatial_models import cantilever as beam_cantilever
+from support.spatial_models import bathe_bend, cantilever as beam_cantilever
 
 BETA = np.array([1.8751040687119611, 4.694091132974175, 7.854757438237613, 10.995540734875467, 14.13716839104647])
 
@@ -153,20 +153,8 @@ def test_large_flexures_solve_statically_in_linear_time():
     """The spatial 45° bend of Bathe and Bolourchi (64 BEAMs) and a 3-D parallel leaf-spring guide
     of 400 BEAMs (the issue's cases, timed in benchmarks/statics.py): static solutions in one load
     step, the guide's drive stiffness 24 EI/L³ less the softening of its vertical load."""
-    R, E = 100.0, 1e7
-    bend = spacar.Model()
     n = 64
-    for i in range(n):
-        bend.beam(i + 1, i + 1, 1001 + i, i + 2, 1002 + i, 0.0, 0.0, 1.0)
-        bend.dyne(i + 1, 1, 2, 3, 4, 5, 6)
-        bend.estiff(i + 1, E, 0.5 * E * 0.1406, E / 12, E / 12)
-    for i in range(n + 1):
-        a = np.pi / 4 * i / n
-        bend.x(i + 1, R * np.sin(a), R * (1 - np.cos(a)), 0.0)
-    bend.fix(1)
-    bend.fix(1001)
-    bend.force(n + 1, 0.0, 0.0, 600.0)
-    tip = spacar.static(bend, steps=1).node(n + 1).x[-1]
+    tip = spacar.static(bathe_bend(n), steps=1).node(n + 1).x[-1]
     # Published (Simo and Vu-Quoc; Crisfield): about (47.2, 15.8, 53.4); the torsion constant's
     # value differs between them by a few per cent.
     np.testing.assert_allclose(tip, [47.0, 15.6, 53.5], atol=0.4)

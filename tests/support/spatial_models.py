@@ -207,3 +207,23 @@ def linearize(model, h=1e-9):
         dqdd[:, j] = (a - b) / (2 * h)
     labels = [tuple(system.def_label[k]) for k in system.e_dyn]
     return Mbar, -Mbar @ dqdd, labels
+
+
+def bathe_bend(n, element="beam"):
+    """Bathe and Bolourchi's 45° bend: a cantilever of radius 100 over 45° in the x–y plane, unit
+    square section (E = 1e7, G J = 0.5 E · 0.1406), n beams of ``element`` with all their
+    deformations DYNE, a tip load of 600 out of its plane (along z). Published tip: about (47.2,
+    15.8, 53.4) (Simo and Vu-Quoc; Crisfield; the torsion constant differs between them)."""
+    R, E = 100.0, 1e7
+    m = spacar.Model()
+    for i in range(n):
+        getattr(m, element)(i + 1, i + 1, 1001 + i, i + 2, 1002 + i, 0.0, 0.0, 1.0)
+        m.dyne(i + 1, 1, 2, 3, 4, 5, 6)
+        m.estiff(i + 1, E, 0.5 * E * 0.1406, E / 12, E / 12)
+    for i in range(n + 1):
+        a = np.pi / 4 * i / n
+        m.x(i + 1, R * np.sin(a), R * (1 - np.cos(a)), 0.0)
+    m.fix(1)
+    m.fix(1001)
+    m.force(n + 1, 0.0, 0.0, 600.0)
+    return m

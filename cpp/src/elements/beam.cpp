@@ -441,6 +441,17 @@ void reference_beam(const double* x, const std::vector<double>& params, double& 
   lgeomy.assign(C.data(), C.data() + 9);
 }
 
+// What every spatial beam's catalogue row shares: the y-axis vector of its definition line, its
+// length and frame (LGEOMY, from the first 14 coordinates), its drawing.
+void spatial_beam_row(ElementType& t) {
+  set_params(t, 3, 3, "x y z: initial direction of the principal y-axis of the cross-section");
+  t.has_length = true;
+  t.n_lgeomy = 9;
+  t.has_direction = true;
+  t.reference = reference_beam;
+  t.family = ElementFamily::Beam;
+}
+
 template <Bending Kind>
 ElementType beam_type() {
   const NodeKind p = NodeKind::XYZ, o = NodeKind::Lambda;
@@ -456,14 +467,9 @@ ElementType beam_type() {
        "bending about local z at p2"},
       title[k]);
   t.extension = Kind == Bending::Arc;
-  set_params(t, 3, 3, "x y z: initial direction of the principal y-axis of the cross-section");
+  spatial_beam_row(t);
   set_stiffness(t, 6, "EA GIp EIy EIz kGAy kGAz");
   set_emass(t, 4, "rhoA [rhoIp rhoIy rhoIz] (rotary inertia: extension)");
-  t.has_length = true;
-  t.n_lgeomy = 9;
-  t.has_direction = true;
-  t.reference = reference_beam;
-  t.family = ElementFamily::Beam;
   return t;
 }
 
@@ -475,14 +481,9 @@ ElementType beamw_type() {
        "bending about local z at p1", "bending about local z at p2", "warping at p1", "warping at p2"},
       "spatial beam with warping torsion (Vlasov): the rates of twist at its ends as the one coordinate of the "
       "nodes w1, w2 (extension)");
-  set_params(t, 3, 3, "x y z: initial direction of the principal y-axis of the cross-section");
+  spatial_beam_row(t);
   set_stiffness(t, 7, "EA GIp EIy EIz kGAy kGAz EIw");
   set_emass(t, 5, "rhoA [rhoIp rhoIy rhoIz rhoIw]");
-  t.has_length = true;
-  t.n_lgeomy = 9;
-  t.has_direction = true;
-  t.reference = reference_beam;  // BEAM's, from its first 14 coordinates
-  t.family = ElementFamily::Beam;
   t.extension = true;
   return t;
 }
