@@ -94,10 +94,13 @@ class Section:
         """Timoshenko's shear coefficient k of the section (the shear stiffness is k G A), Cowper's
         (1966) values for the material's Poisson ratio ν: rectangle 10(1 + ν)/(12 + 11ν), circle
         6(1 + ν)/(7 + 6ν), tube of inner to outer diameter m
-        6(1 + ν)(1 + m²)² / ((7 + 6ν)(1 + m²)² + (20 + 12ν) m²) (the same for both axes)."""
+        6(1 + ν)(1 + m²)² / ((7 + 6ν)(1 + m²)² + (20 + 12ν) m²) (the same for both axes); an
+        I-section the web's share of the area, hw tw / A."""
         nu = self._mat().nu
         if self.shape == "rectangle":
             return 10 * (1 + nu) / (12 + 11 * nu)
+        if self.shape == "I-section":  # the web carries the shear
+            return 1.0 / self.shear_factor
         if self.shape == "circle":
             return 6 * (1 + nu) / (7 + 6 * nu)
         m2 = ((self.dims["d"] - 2 * self.dims["t"]) / self.dims["d"]) ** 2
@@ -245,6 +248,27 @@ def tube(d, t, material: Material | None = None) -> Section:
     k = 4.0 / 3.0 * (r * r + r * ri + ri * ri) / (r * r + ri * ri)
     return Section("tube", {"d": d, "t": t}, material, A=math.pi * (d**2 - di**2) / 4, Iy=I, Iz=I, J=2 * I,
                    Wy=2 * I / d, Wz=2 * I / d, Wt=4 * I / d, shear_factor=k, round_=True)
+
+
+def i_beam(h, b, tw, tf, material: Material | None = None) -> Section:
+    """A thin-walled, doubly symmetric I-section (fillets left out): depth ``h`` along y (the web),
+    flange width ``b`` along z, web thickness ``tw``, flange thickness ``tf``. With the web's
+    height hw = h − 2tf: A = 2 b tf + hw tw; Iz = (b h³ − (b − tw) hw³)/12 (the strong axis:
+    bending in the web's plane), Iy = (2 tf b³ + hw tw³)/12; the open section's torsion
+    J = (2 b tf³ + hw tw³)/3 and Wt = J / max(tf, tw); the warping constant
+    Iw = tf b³ (h − tf)²/24 (BEAMW's EIw: the tables' value for rolled profiles); the shear
+    carried by the web, shear factor A/(hw tw) (and Timoshenko's k = hw tw / A)."""
+    h, b, tw, tf = (_positive(v, name) for v, name in ((h, "h"), (b, "b"), (tw, "tw"), (tf, "tf")))
+    hw = h - 2 * tf
+    if not hw > 0 or tw > b:
+        raise InputError(f"an I-section needs h > 2 tf and tw ≤ b, got h = {h:g}, b = {b:g}, tw = {tw:g}, tf = {tf:g}")
+    A = 2 * b * tf + hw * tw
+    Iz = (b * h**3 - (b - tw) * hw**3) / 12
+    Iy = (2 * tf * b**3 + hw * tw**3) / 12
+    J = (2 * b * tf**3 + hw * tw**3) / 3
+    return Section("I-section", {"h": h, "b": b, "tw": tw, "tf": tf}, material, A=A, Iy=Iy, Iz=Iz, J=J,
+                   Wy=Iy / (b / 2), Wz=Iz / (h / 2), Wt=J / max(tf, tw), shear_factor=A / (hw * tw), round_=False,
+                   Iw=tf * b**3 * (h - tf) ** 2 / 24)
 
 
 # ------------------------------------------------------------------------------------------------

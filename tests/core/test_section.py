@@ -188,3 +188,25 @@ def test_stresses_bad_input():
         section.stresses(res, {7: sec})
     with pytest.raises(InputError, match="Section"):
         section.stresses(res, 3.0)
+
+
+def test_i_beam_constants_against_the_profile_tables_and_a_fine_grid():
+    """An IPE 200 without its fillets (h 200, b 100, tw 5.6, tf 8.5 mm): the warping constant is
+    the tables' 12.99e3 cm⁶; A, Iy, Iz from a fine grid of the shape; the open section's
+    J = Σ b t³/3; the BEAMW ESTIFF carries E Iw."""
+    s = section.i_beam(h=200e-3, b=100e-3, tw=5.6e-3, tf=8.5e-3, material=section.STEEL)
+    assert s.Iw == pytest.approx(12.99e3 * 1e-12, rel=1e-3)
+    n = 2000                                            # cells of a grid over the bounding box
+    y = (np.arange(n) + 0.5) / n * 0.2 - 0.1            # along the web (h)
+    z = (np.arange(n) + 0.5) / n * 0.1 - 0.05           # along the flanges (b)
+    Y, Z = np.meshgrid(y, z, indexing="ij")
+    inside = (np.abs(Y) >= 0.1 - 8.5e-3) | (np.abs(Z) <= 2.8e-3)
+    dA = (0.2 / n) * (0.1 / n)
+    assert s.A == pytest.approx(inside.sum() * dA, rel=2e-3)
+    assert s.Iz == pytest.approx((Y**2 * inside).sum() * dA, rel=2e-3)   # strong: the web's plane
+    assert s.Iy == pytest.approx((Z**2 * inside).sum() * dA, rel=5e-3)
+    assert s.J == pytest.approx((2 * 0.1 * 8.5e-3**3 + 0.183 * 5.6e-3**3) / 3)
+    assert s.beam_estiff(warping=True)[6] == pytest.approx(section.STEEL.E * s.Iw)
+    assert s.shear_coefficient() == pytest.approx(0.183 * 5.6e-3 / s.A)
+    with pytest.raises(spacar.InputError, match="h > 2 tf"):
+        section.i_beam(h=0.01, b=0.1, tw=0.005, tf=0.006)
