@@ -309,7 +309,7 @@ def hermite(xp, tp, xq, tq, l0: float, n: int = 21) -> np.ndarray:
 
 def beam_tangents(el: ElementGeometry, coords: dict):
     """Material tangents (t_p, t_q) of a beam element at the nodal coordinates ``coords``."""
-    p, rp, q, rq = el.nodes
+    p, rp, q, rq = el.nodes[:4]  # (BEAMW's warping nodes follow)
     if len(coords[rp]) == 1:  # a BETA node: a planar beam
         a0 = el.lgeomy[0] if el.lgeomy else 0.0
         bp, bq = a0 + coords[rp][0], a0 + coords[rq][0]
@@ -320,7 +320,7 @@ def beam_tangents(el: ElementGeometry, coords: dict):
 
 def beam_curve(el: ElementGeometry, coords: dict, n: int = 21) -> np.ndarray:
     """The cubic deflection shape of a beam element (n points from p to q)."""
-    p, _, q, _ = el.nodes
+    p, _, q, _ = el.nodes[:4]
     tp, tq = beam_tangents(el, coords)
     l0 = el.l0 if el.l0 is not None else float(np.linalg.norm(np.subtract(coords[q], coords[p])))
     return hermite(coords[p], tp, coords[q], tq, l0, n)

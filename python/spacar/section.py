@@ -106,12 +106,22 @@ class Section:
         m2 = ((self.dims["d"] - 2 * self.dims["t"]) / self.dims["d"]) ** 2
         return 6 * (1 + nu) * (1 + m2) ** 2 / ((7 + 6 * nu) * (1 + m2) ** 2 + (20 + 12 * nu) * m2)
 
+    def shear_areas(self) -> tuple:
+        """(kAy, kAz): the shear areas along y and z (the shear stiffnesses kGAy, kGAz over G):
+        k A for both but the I-section's, whose web takes shear along y (hw tw) and its flanges
+        along z ((5/6) 2 b tf)."""
+        if self.shape == "I-section":
+            d = self.dims
+            return (d["h"] - 2 * d["tf"]) * d["tw"], 5.0 / 6.0 * 2 * d["b"] * d["tf"]
+        kA = self.shear_coefficient() * self.A
+        return kA, kA
+
     def plbeam_estiff(self, shear: bool = False) -> tuple:
         """ESTIFF of PLBEAM/PLBEAMNL: (EA, EI) with I = Iz (bending in the plane); with ``shear``
         (EA, EI, kGA): the shear-flexible (Timoshenko) beam, for short and deep beams."""
         m = self._mat()
         values = (m.E * self.A, m.E * self.Iz)
-        return values + (self.shear_coefficient() * m.G * self.A,) if shear else values
+        return values + (m.G * self.shear_areas()[0],) if shear else values
 
     def beam_estiff(self, shear: bool = False, warping: bool = False) -> tuple:
         """ESTIFF of BEAM/BEAMNL: (EA, GIp, EIy, EIz), the torsional stiffness being G J (the
@@ -120,8 +130,8 @@ class Section:
         m = self._mat()
         values = (m.E * self.A, m.G * self.J, m.E * self.Iy, m.E * self.Iz)
         if shear or warping:
-            kGA = self.shear_coefficient() * m.G * self.A if shear else 0.0
-            values += (kGA, kGA)
+            kGAy, kGAz = (m.G * a for a in self.shear_areas()) if shear else (0.0, 0.0)
+            values += (kGAy, kGAz)
         return values + (m.E * self.Iw,) if warping else values
 
     def emass(self, rotary: bool = False, warping: bool = False) -> tuple:
@@ -129,8 +139,11 @@ class Section:
         of the cross-section per unit length (an extension of the manual's EMASS); with
         ``warping`` (BEAMW) also ρIw, the warping inertia."""
         rho = self._mat().rho
-        if rotary or warping:
-            return (rho * self.A, rho * self.Ip, rho * self.Iy, rho * self.Iz) + ((rho * self.Iw,) if warping else ())
+        if warping:
+            rotational = (rho * self.Ip, rho * self.Iy, rho * self.Iz) if rotary else (0.0, 0.0, 0.0)
+            return (rho * self.A, *rotational, rho * self.Iw)
+        if rotary:
+            return (rho * self.A, rho * self.Ip, rho * self.Iy, rho * self.Iz)
         return (rho * self.A,)
 
     def apply(self, model, *elements, rotary: bool = True, shear: bool = False):
@@ -175,7 +188,18 @@ class Section:
         shear is exact where both peak together, e.g. the surface of a round section on the
         neutral axis, and an upper bound otherwise)."""
         T, Vy, Vz = (np.abs(np.asarray(v, dtype=float)) for v in (T, Vy, Vz))
+        if self.shape == "I-section":  # Vy in the web, Vz in the flanges (parabolic: 3/2 of the mean)
+            d = self.dims
+            return T / self.Wt + np.maximum(Vy / ((d["h"] - 2 * d["tf"]) * d["tw"]), 1.5 * Vz / (2 * d["b"] * d["tf"]))
         return T / self.Wt + self.shear_factor * np.hypot(Vy, Vz) / self.A
+
+    @property
+    def omega(self) -> float:
+        """The largest sectorial coordinate (warping normal stress = bimoment · omega / Iw): b h/4
+        for the rectangle, b (h − tf)/4 at the flange tips of the I-section, 0 for round ones."""
+        d = self.dims
+        return {"rectangle": lambda: d["b"] * d["h"] / 4, "I-section": lambda: d["b"] * (d["h"] - d["tf"]) / 4}.get(
+            self.shape, lambda: 0.0)()
 
     def __repr__(self):
         dims = ", ".join(f"{k} = {v:g}" for k, v in self.dims.items())
@@ -326,7 +350,9 @@ def section_forces(results, e: int, type_name: str, l0: float) -> dict:
     axial force N = σ1; end moments M = l0 σ of the bending pairs (σ conjugate to the bending
     deformations l0 sin θ: M = l0 σ cos θ, the element's end rotations θ relative to its chord
     being small); shear force V = σp − σq of each pair ((Mp + Mq)/l0 in the beam's sign: zero
-    for constant curvature); twisting moment T = l0 σ2 (BEAM)."""
+    for constant curvature); twisting moment T = l0 σ2 (BEAM; BEAMW: l0 (σ2 − σ7 + σ8), the
+    warping torque included, and ``warping``, the twist's second derivative ψ'' at both ends,
+    whose bimoment EIw ψ'' gives the warping normal stress E ω ψ'')."""
     s = lambda i: results.sigma[:, results.deformation_index(e, i)]  # noqa: E731
     zero = np.zeros(len(results.t))
     if type_name in ("PLTRUSS", "TRUSS"):
@@ -335,8 +361,13 @@ def section_forces(results, e: int, type_name: str, l0: float) -> dict:
     if type_name in PLANAR_BEAMS:
         return {"N": s(1), "T": zero, "My": np.zeros((len(zero), 2)), "Mz": l0 * np.column_stack([s(2), s(3)]),
                 "Vy": s(2) - s(3), "Vz": zero}
-    return {"N": s(1), "T": l0 * s(2), "My": l0 * np.column_stack([s(3), s(4)]),
-            "Mz": l0 * np.column_stack([s(5), s(6)]), "Vz": s(3) - s(4), "Vy": s(5) - s(6)}
+    out = {"N": s(1), "T": l0 * s(2), "My": l0 * np.column_stack([s(3), s(4)]),
+           "Mz": l0 * np.column_stack([s(5), s(6)]), "Vz": s(3) - s(4), "Vy": s(5) - s(6)}
+    if type_name == "BEAMW":  # Saint-Venant's and the warping torque; the warping deformations
+        out["T"] = l0 * (s(2) - s(7) + s(8))
+        d = lambda i: results.e[:, results.deformation_index(e, i)]  # noqa: E731
+        out["warping"] = np.column_stack([4 * d(7) - 2 * d(8), 4 * d(8) - 2 * d(7)]) / l0**3  # ψ'' at the ends
+    return out
 
 
 def stresses(results, sections) -> Stresses:
@@ -369,7 +400,8 @@ def stresses(results, sections) -> Stresses:
         el = table[e]
         f = section_forces(results, e, el.type, el.l0)
         forces[e] = f
-        normal[:, k] = np.maximum(sec.normal_stress(f["N"], f["My"][:, 0], f["Mz"][:, 0]),
-                                  sec.normal_stress(f["N"], f["My"][:, 1], f["Mz"][:, 1]))
+        warping = np.abs(f["warping"]) * sec._mat().E * sec.omega if "warping" in f else np.zeros((nt, 2))
+        normal[:, k] = np.maximum(sec.normal_stress(f["N"], f["My"][:, 0], f["Mz"][:, 0]) + warping[:, 0],
+                                  sec.normal_stress(f["N"], f["My"][:, 1], f["Mz"][:, 1]) + warping[:, 1])
         shear[:, k] = sec.shear_stress(f["T"], f["Vy"], f["Vz"])
     return Stresses(np.asarray(results.t), elements, normal, shear, forces)

@@ -226,6 +226,7 @@ class _Light:
         self.eprops = [_fields(e, f"eprops({k + 1})") for k, e in enumerate(sets)]
         for k, e in enumerate(self.eprops):
             _unknown(e, EPROPS, f"eprops({k + 1})")
+        self.notes: list = []  # remarks for the results' warnings
         self.rls = None if rls is None else [self._releases(k + 1, r) for k, r in
                                              enumerate(_per_item(rls, len(self.elements), "rls", "element"))]
         self._element_sets()
@@ -239,7 +240,7 @@ class _Light:
     @staticmethod
     def _releases(k: int, r: dict) -> list:
         _unknown(r, ("def",), f"rls({k})")
-        return _numbers_list(r["def"], f"rls({k}).def", 1, 8) if r else []
+        return _numbers_list(r["def"], f"rls({k}).def", 1, 6) if r else []
 
     @staticmethod
     def _nodes(nodes) -> np.ndarray:
@@ -287,19 +288,21 @@ class _Light:
                 if el.set is not None:
                     raise InputError(f"element {e} is in eprops({el.set}) and eprops({k}): one set per element")
                 el.set = k
-                el.warping = _flag(props.get("warping", False), f"eprops({k}).warping") or \
-                    _flag(props.get("cw", False), f"eprops({k}).cw")
+                el.warping = _flag(props.get("warping", False), f"eprops({k}).warping")
+                _flag(props.get("cw", False), f"eprops({k}).cw")  # 1.38: deprecated, no effect
                 el.nbeams = _whole(props.get("nbeams", 1), f"eprops({k}).nbeams", 1, 10000)
                 if "orien" in props:
                     el.orien = _vector(props["orien"], 3, f"eprops({k}).orien")
                 el.flex = sorted(set(_numbers_list(props["flex"], f"eprops({k}).flex", 1, 6))) if "flex" in props else []
-                if el.warping and el.flex:
-                    el.flex += [7, 8]  # BEAMW's warping deformations (spacarlight.m: "always calculable")
                 dens = _number(props.get("dens", 0.0), f"eprops({k}).dens")
                 if el.flex or dens > 0:
                     section = _section(props, k, bool(el.flex), dens > 0)
                     el.section = section if el.flex else None
                     el.mass_section = section if dens > 0 else None
+                    if el.warping and section.Iw == 0.0:  # spacarlight.m: a round section does not warp
+                        el.warping = False
+                        self.notes.append(f"eprops({k}).warping: a circular cross-section does not warp; modelled "
+                                          "without warping")
         for el in self.elements:  # the width's direction across every element, given or the default
             axis = self.nodes[el.q - 1] - self.nodes[el.p - 1]
             across = el.orien - np.dot(el.orien, axis) * axis / np.dot(axis, axis)
@@ -403,14 +406,15 @@ class _Light:
         return m
 
     def _warping_supports(self, m: Model, warped: set, restrained: set):
-        """The warping nodes fixed: at a node fixed (fix) or with fix_warp, and where a rigid
-        element with warping ends (spacarlight.m's rules)."""
+        """The warping nodes fixed at a node fixed (fix) or with fix_warp and where a rigid element
+        with warping ends (spacarlight.m's rules); the others free, degrees of freedom (DYNX),
+        since BEAMW's warping deformations are released (spacarlight.m: "always calculable")."""
         for i, props in enumerate(self.nprops, start=1):
             if _flag(props.get("fix", False), f"nprops({i}).fix") or _flag(props.get("fix_warp", False),
                                                                           f"nprops({i}).fix_warp"):
                 restrained.add(3 * i)
-        for w in sorted(warped & restrained):
-            m.fix(w)
+        for w in sorted(warped):
+            (m.fix if w in restrained else m.dynx)(w)
 
     @staticmethod
     def _declare(m: Model, node: int, x):
@@ -426,6 +430,8 @@ class _Light:
             if k == len(el.beams) - 1 and released:
                 m.rlse(e, *released)
             warping = el.warping and bool(el.flex)
+            if warping:
+                m.rlse(e, 7, 8)
             if el.section is not None:
                 m.estiff(e, *el.section.beam_estiff(shear=True, warping=warping))
             if el.mass_section is not None:
@@ -643,7 +649,7 @@ def light(nodes, elements, nprops=None, eprops=None, rls=None, opt=None, *, time
 
     m, light_, released = _build(nodes, elements, nprops, eprops, rls, opt)
     opt = light_.opt
-    out = LightResults(version=VERSION, model=m, warnings=[], rls=_releases(light_, released))
+    out = LightResults(version=VERSION, model=m, warnings=list(light_.notes), rls=_releases(light_, released))
     out.sections = {e: el.section for el in light_.elements if el.section is not None for e in el.beams}
     if _flag(opt.get("showinputonly", False), "opt.showinputonly"):
         out.step = _OneBased([], "step")

@@ -362,7 +362,7 @@ class BeamW : public AutoDiffElement<BeamW, 16, 8, 4, 3> {
 
  public:
   explicit BeamW(const ElementSetup& s)
-      : beam_(s), l0_(s.l0), rhoIw_(s.emass.size() > 4 ? s.emass[4] : 0.0) {}
+      : beam_(checked(s)), l0_(s.l0), rhoIw_(s.emass.size() > 4 ? s.emass[4] : 0.0) {}
 
   template <class S>
   void deform(const S* x, S* e) const {
@@ -425,6 +425,12 @@ class BeamW : public AutoDiffElement<BeamW, 16, 8, 4, 3> {
     Mm(14, 14) = Mm(15, 15) = 2.0 * k;
     Mm(14, 15) = Mm(15, 14) = k;
     for (int i = 0; i < 16; ++i) h[i] = i < 14 ? h14[i] : 0.0;
+  }
+
+  static const ElementSetup& checked(const ElementSetup& s) {  // (BEAM's message would name BEAM)
+    if (s.lgeomy.size() != 9)
+      throw InputError("BEAMW: LGEOMY needs 9 values (e_x0, e_y0, e_z0), got " + std::to_string(s.lgeomy.size()));
+    return s;
   }
 
   Beam<Bending::Sine> beam_;
