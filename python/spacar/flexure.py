@@ -74,18 +74,25 @@ class Flexure:
     constant curvature (and twist, in space; their elongation along the arc includes the
     shortening too): large deflections to 1e-6 of the length with a dozen elements where PLBEAM
     needs hundreds.
+    ``warping=True`` (space) meshes them with BEAMW, Vlasov's warping torsion: each point along a
+    flexure gets a warping node (its rate of twist), fixed at both ends, where the ground or a
+    body holds the section from warping; the section's EIw and ρIw from ``section.apply``.
     ``ground``: the fixed body. Bodies, flexures, then :meth:`model` builds the spacar.Model (each
     call a new one)."""
 
-    def __init__(self, spatial: bool = False, nonlinear: bool = False, arc: bool = False):
-        if not all(isinstance(v, bool) for v in (spatial, nonlinear, arc)):
-            raise InputError("Flexure: spatial, nonlinear and arc must be True or False")
+    def __init__(self, spatial: bool = False, nonlinear: bool = False, arc: bool = False, warping: bool = False):
+        if not all(isinstance(v, bool) for v in (spatial, nonlinear, arc, warping)):
+            raise InputError("Flexure: spatial, nonlinear, arc and warping must be True or False")
         if arc and nonlinear:
             raise InputError("Flexure: arc=True meshes the flexures with PLBEAMC/BEAMC, whose elongation already "
                              "includes the bending's shortening: not with nonlinear=True")
-        self.spatial, self.nonlinear, self.arc = spatial, nonlinear, arc
+        if warping and (not spatial or arc or nonlinear):
+            raise InputError("Flexure: warping=True meshes the flexures with BEAMW, in space (spatial=True), and not "
+                             "with arc or nonlinear")
+        self.spatial, self.nonlinear, self.arc, self.warping = spatial, nonlinear, arc, warping
         self.dim = 3 if spatial else 2
-        self._element_type = ("BEAM" if spatial else "PLBEAM") + ("C" if arc else "NL" if nonlinear else "")
+        self._element_type = "BEAMW" if warping else \
+            ("BEAM" if spatial else "PLBEAM") + ("C" if arc else "NL" if nonlinear else "")
         self._next_node = 1
         self._next_element = 1
         self._positions: dict = {}      # node → coordinates
@@ -152,10 +159,16 @@ class Flexure:
             rotations.append(rotation)
         nodes.append(ends[1][0])
         rotations.append(ends[1][1])
+        warps = []  # BEAMW: the warping node of each point, held at the ends
+        if self.warping:
+            for k in range(n + 1):
+                warps.append(self._next_node)
+                (self._fixed if k in (0, n) else self._dynamic).add(self._next_node)
+                self._next_node += 1
         elements = []
         for k in range(n):
-            elements.append(self._add_element((nodes[k], rotations[k], nodes[k + 1], rotations[k + 1]), vector,
-                                              sections[k]))
+            ends = (nodes[k], rotations[k], nodes[k + 1], rotations[k + 1]) + (tuple(warps[k:k + 2]) if warps else ())
+            elements.append(self._add_element(ends, vector, sections[k]))
         for arm_nodes, arm_vector in arms:
             self._add_element(arm_nodes, arm_vector, None)
         flexure = Beam(kind, a, b, section, elements, nodes, rotations)

@@ -297,3 +297,32 @@ def test_arc_flexures_in_space_are_beamcs():
     u = spacar.static(m, steps=4).node(stage.node).x[-1]
     up = spacar.static(pm, steps=4).node(pstage.node).x[-1]
     assert u[:2] == pytest.approx(up, abs=1e-12) and abs(u[2]) < 1e-15
+
+
+def test_warping_leaves_are_beamws_held_at_their_clamps():
+    """Flexure(spatial=True, warping=True): the 3-D guide of BEAMWs, its leaves held from warping
+    at the ground and at the stage; equal to the same guide through spacar.light with warping
+    (the stage a rigid element with warping, which holds it too); the drive as the BEAM guide's to
+    1e-3 (it hardly twists the leaves), the stage's turn about the leaves' axis (their twist with
+    their bending about the wide axis) 2e-4 stiffer."""
+    leaf = section.rectangle(b=B, h=T, material=section.STEEL)
+    fx = flexure.Flexure(spatial=True, warping=True)
+    stage = fx.body(at=(D, L, 0.0), name="stage")
+    for x0 in (0.0, D):
+        fx.leaf_spring(fx.ground, stage, (x0, 0.0, 0.0), (x0, L, 0.0), leaf, n=N, thickness=(1.0, 0.0, 0.0))
+    m = fx.model()
+    assert {m.elements[e].type_name for e in fx.flexures[0].elements} == {"BEAMW"}
+    for lf in fx.flexures:
+        leaf.apply(m, *lf.elements, shear=True)
+    C = spacar.compliance(m, stage.node, rotation=stage.rotation_node)
+    props = dict(emod=section.STEEL.E, smod=section.STEEL.G, cshape="rect", dim=[B, T], orien=[0, 0, 1], nbeams=N,
+                 flex=[1, 2, 3, 4, 5, 6], warping=True)
+    out = spacar.light([[0, 0, 0], [D, 0, 0], [0, L, 0], [D, L, 0]], [[1, 3], [2, 4], [3, 4]],
+                       [dict(fix=True), dict(fix=True)], [dict(props, elems=[1, 2]), dict(elems=[3], warping=True)])
+    assert C == pytest.approx(out.step(1).node(4).CMglob, rel=1e-7, abs=1e-9 * np.abs(C).max())
+    beams, beams_stage = guide(spatial=True)
+    C_beam = spacar.compliance(beams.model(), beams_stage.node, rotation=beams_stage.rotation_node)
+    assert C[0, 0] == pytest.approx(C_beam[0, 0], rel=1e-3)
+    assert C[4, 4] < (1 - 1e-4) * C_beam[4, 4]
+    with pytest.raises(spacar.InputError, match="warping=True meshes the flexures with BEAMW, in space"):
+        flexure.Flexure(warping=True)
