@@ -111,11 +111,13 @@ def _latest_prescribed(model, determined) -> str:
         "; removing it removes the redundancy"
 
 
-def check(model, time_limit=None) -> Check:
+def check(model, time_limit=None, *, release_dynamic: bool = False) -> Check:
     """Summary and constraint diagnosis of ``model`` at its given geometry (no assembly).
     ``time_limit``: wall-clock seconds the set-up and the diagnosis may take (None: no limit);
     beyond it :class:`spacar.TimeLimitError` (the diagnosis's decomposition itself, of at most
-    1500 rows, is not interrupted: it starts only within the limit)."""
+    1500 rows, is not interrupted: it starts only within the limit). ``release_dynamic``: the
+    redundant deformations named among the degrees of freedom (DYNE) where they can be, the
+    fixed and input ones kept (spacar.light's automatic release), rather than among the fixed."""
     if not isinstance(model, Model):
         raise InputError(f"check: model must be a spacar.Model, got {show(model)}")
     limit = seconds_or_none(time_limit, "time_limit") or 0.0
@@ -126,7 +128,7 @@ def check(model, time_limit=None) -> Check:
     copy = model.copy()
     copy.prepare()
     sim = _core.Simulation(copy.core, time_limit=limit, time_spent=time.monotonic() - started)
-    d = sim.diagnose(time_limit=limit, time_spent=time.monotonic() - started)
+    d = sim.diagnose(time_limit=limit, time_spent=time.monotonic() - started, release_dynamic=release_dynamic)
     diagnosis = Diagnosis(d["n_constraints"], d["n_calculable"], d["rank"], list(d["redundant"]),
                           list(d["undetermined"]), d["text"] + _latest_prescribed(model, d["determined"]),
                           list(d["determined"]))

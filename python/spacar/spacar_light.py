@@ -502,20 +502,16 @@ class _Light:
         return any(name in p for p in self.nprops for name in names)
 
 
-def _release(m: Model, light: _Light) -> list:
-    """SPACAR Light's autosolve: the degrees of freedom (DYNE) the constraints make redundant
-    become released (RLSE); returns [(beam, deformation)] released."""
-    from . import _core
+def _release(m: Model, light: _Light, diagnosis) -> list:
+    """SPACAR Light's autosolve: the degrees of freedom (DYNE) that ``diagnosis`` (the model's,
+    named with release_dynamic) finds redundant become released (RLSE); returns [(beam,
+    deformation)] released."""
     from .check import check
 
-    copy = m.copy()
-    copy.prepare()
-    sim = _core.Simulation(copy.core)
-    d = sim.diagnose(release_dynamic=True)
-    if d["rank"] < 0:
-        raise InputError(f"the model has {d['n_constraints']} constraints, too many for the automatic release: give "
-                         "the releases (opt.rls) by hand")
-    redundant = [tuple(r) for r in d["redundant"]]
+    if not diagnosis.detailed:
+        raise InputError(f"the model has {diagnosis.n_constraints} constraints, too many for the automatic release: "
+                         "give the releases (opt.rls) by hand")
+    redundant = [tuple(r) for r in diagnosis.redundant]
     beams = {e: el for el in light.elements for e in el.beams}
     rigid = [(e, i) for e, i in redundant if e not in beams or i not in beams[e].flex]
     if rigid:
@@ -543,10 +539,14 @@ def _build(nodes, elements, nprops, eprops, rls, opt):
         "def" in rls or any(isinstance(k, numbers.Integral) for k in rls))
     if opt is None and rls is not None and not releases:
         rls, opt = None, rls  # the 1.38 call: opt fifth
+    from .check import check
+
     light = _Light(nodes, elements, nprops, eprops, rls, opt)
     m = light.model()
-    released = _release(m, light) if light.rls is None else []
-    diagnosis = m.check().diagnosis
+    diagnosis, released = check(m, release_dynamic=light.rls is None).diagnosis, []
+    if light.rls is None and (diagnosis.redundant or not diagnosis.detailed):  # released, then diagnosed again
+        released = _release(m, light, diagnosis)
+        diagnosis = check(m).diagnosis
     if not diagnosis.ok:
         raise InputError("the model is not exactly constrained (check the supports fix, fix_pos ..., the elements' "
                          f"flex and the releases rls):\n{diagnosis.text}")
