@@ -744,8 +744,9 @@ def _step(m, light_, res, factor, n_nodes, calccompl, calcbuck, stressed, per_el
         step.freq, step.freqmodes = np.asarray(f), shapes
     except SingularMassError:
         step.freq, step.freqmodes = np.zeros(0), None
-        if not out.warnings:
-            out.warnings.append("no eigenfrequencies: the model has no mass (give dens or mass)")
+        massless = "no eigenfrequencies: the model has no mass (give dens or mass)"
+        if massless not in out.warnings:  # once, beside the other warnings
+            out.warnings.append(massless)
     if calcbuck:
         step.buck = np.sort(np.abs(lin.buckling_factors()))
     elements = []
