@@ -44,6 +44,7 @@ from .spacar_light import LightResults, light, light_model
 from .statics import StaticError, static
 from .statespace import StateSpace, state_space
 from .sweep import SweepError, SweepResult, sweep
+from .periodic import PeriodicOrbit, floquet, periodic_orbit
 from .transfer import Transfer, TransferPath, transfer, transfer_path
 from .urdf import from_urdf
 
@@ -141,6 +142,9 @@ __all__ = [
     "transfer_path",
     "Transfer",
     "TransferPath",
+    "periodic_orbit",
+    "floquet",
+    "PeriodicOrbit",
     "summary",
     "check",
     "Check",
