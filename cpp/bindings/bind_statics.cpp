@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "spacar/analyses/sensitivity.hpp"
 #include "spacar/analyses/statics.hpp"
 
 namespace spacar::bindings {
@@ -93,6 +94,32 @@ void bind_statics(py::module_& m) {
       "compliance at the nodes (their coordinates; a LAMBDA node's rotation vector in global axes) under the "
       "tangent stiffness K0 + G0 of the static solve at load_factor times the block's loads (sparse); StaticError "
       "naming the direction if the stiffness is singular.");
+
+  py::class_<StaticPoint>(m, "StaticPoint",
+                          "A static equilibrium held for design sensitivities (spacar.sensitivity): the model put at "
+                          "the positions x with the deformations e (a row of static results), the block's loads in full.")
+      .def(py::init<Model&, const Eigen::VectorXd&, const Eigen::VectorXd&>(), py::arg("model"), py::arg("x"),
+           py::arg("e"), py::keep_alive<1, 2>())
+      .def_property_readonly("q", &StaticPoint::dofs, "The degrees of freedom at the current state.")
+      .def_property_readonly("x", [](StaticPoint& p) { return Eigen::VectorXd(p.x()); })
+      .def_property_readonly("e", [](StaticPoint& p) { return Eigen::VectorXd(p.e()); })
+      .def_property_readonly("residual", &StaticPoint::residual,
+                             "R = DF_qᵀ (Σ Bᵀσ − f) at the current state (zero at an equilibrium).")
+      .def("move_to", &StaticPoint::move_to, py::arg("q"), "Move the DOFs to q (positions and forces solved again).")
+      .def("solve", &StaticPoint::solve, py::arg("r"), "K_T⁻¹ r, K_T = K0 + G0 at the current state (sparse).")
+      .def("motion", &StaticPoint::motion, py::arg("dq"), "DF_q dq: the motion of every coordinate.")
+      .def("energies", &StaticPoint::energies, py::arg("dq"),
+           "(dqᵀK0dq, dqᵀG0dq, dqᵀM0dq, dqᵀD0dq) at the current state, element by element.")
+      .def(
+          "compliance",
+          [](StaticPoint& p, const std::vector<int>& nodes) {
+            Eigen::MatrixXd U;
+            Eigen::MatrixXd C = p.compliance(nodes, &U);
+            return py::make_tuple(C, U);
+          },
+          py::arg("nodes"),
+          "(C, U): the compliance at the nodes under K_T at the current state, and U = K_T⁻¹ DF_qᵀ Tᵀ, the DOFs' "
+          "response to each unit load.");
 }
 
 }  // namespace spacar::bindings

@@ -17,7 +17,7 @@ that use them (``plot``, ``draw``, ``animate``, ``animate_mode``, ``save_animati
 """
 from . import _core
 from ._util import show as _show
-from . import flexure, mechanism, notebook, section
+from . import flexure, mechanism, notebook, section, sensitivity
 from .check import Check, Diagnosis, Summary, check, summary
 from .compliance import compliance, support_stiffness
 from .control import Controller
@@ -126,6 +126,7 @@ __all__ = [
     "compliance",
     "support_stiffness",
     "section",
+    "sensitivity",
     "flexure",
     "light",
     "light_model",

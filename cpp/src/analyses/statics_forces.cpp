@@ -124,10 +124,6 @@ std::string dof_directions(const System& sys, const Eigen::MatrixXd& V) {
   return os.str();
 }
 
-namespace {
-
-// The rows T (m x nx) of the displacements of the nodes: a position node's coordinates, a BETA
-// node's angle, a LAMBDA node's small rotation vector in global axes, δθ = 2 E(λ) δλ.
 Eigen::MatrixXd displacement_rows(const System& sys, const Data& data, const std::vector<int>& nodes) {
   std::vector<Eigen::RowVectorXd> rows;
   for (int n : nodes) {
@@ -156,7 +152,22 @@ Eigen::MatrixXd displacement_rows(const System& sys, const Data& data, const std
   return T;
 }
 
-}  // namespace
+void put_at_static_row(const System& sys, Data& data, const Eigen::VectorXd& x, const Eigen::VectorXd& e,
+                       const char* where) {
+  if (x.size() != sys.nx || e.size() != sys.ne)
+    throw InputError(std::string(where) + ": x and e need " + std::to_string(sys.nx) + " and " +
+                     std::to_string(sys.ne) + " values, got " + std::to_string(x.size()) + " and " +
+                     std::to_string(e.size()));
+  // The row is a solved state: its positions, and the independent coordinates from them; the
+  // kinematics then only refreshes the deformations and their derivatives there.
+  data.x = x;
+  for (int g = 0; g < sys.nx; ++g)
+    if (sys.qhat_col_x[g] >= 0) data.qhat[sys.qhat_col_x[g]] = x[g];
+  for (int k = 0; k < sys.ne; ++k)
+    if (sys.qhat_col_e[k] >= 0) data.qhat[sys.qhat_col_e[k]] = e[k];
+  data.jacobian_reusable = false;
+  solve_positions(sys, data, std::max(sys.settings.maxiterat, 50), std::min(sys.settings.epskin, 1e-10), false);
+}
 
 Eigen::MatrixXd static_compliance(Model& model, const std::vector<int>& nodes, double load_factor,
                                   const Eigen::VectorXd* x, const Eigen::VectorXd* e) {
@@ -165,18 +176,8 @@ Eigen::MatrixXd static_compliance(Model& model, const std::vector<int>& nodes, d
   const System& sys = sim.system();
   Data& data = sim.data();
   if (x || e) {
-    if (!x || !e || x->size() != sys.nx || e->size() != sys.ne)
-      throw InputError("static_compliance: x and e must both be given, with " + std::to_string(sys.nx) + " and " +
-                       std::to_string(sys.ne) + " values");
-    // The row is a solved state: its positions, and the independent coordinates from them; the
-    // kinematics then only refreshes the deformations and their derivatives there.
-    data.x = *x;
-    for (int g = 0; g < sys.nx; ++g)
-      if (sys.qhat_col_x[g] >= 0) data.qhat[sys.qhat_col_x[g]] = (*x)[g];
-    for (int k = 0; k < sys.ne; ++k)
-      if (sys.qhat_col_e[k] >= 0) data.qhat[sys.qhat_col_e[k]] = (*e)[k];
-    data.jacobian_reusable = false;
-    solve_positions(sys, data, std::max(sys.settings.maxiterat, 50), std::min(sys.settings.epskin, 1e-10), false);
+    if (!x || !e) throw InputError("static_compliance: x and e must both be given");
+    put_at_static_row(sys, data, *x, *e, "static_compliance");
   }
   if (sys.n_dof() == 0) {  // nothing can move: the supports and rigid deformations hold every point
     const Eigen::Index rows = displacement_rows(sys, data, nodes).rows();

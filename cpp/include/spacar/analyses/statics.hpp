@@ -84,6 +84,15 @@ std::string dof_directions(const System& sys, const Eigen::MatrixXd& V);
 // with `res` holding the rows converged before it; the model is then not changed.
 void solve_static(Model& model, StaticResults& res, const StaticOptions& options = {});
 
+// The rows T (m x nx) of the displacements of the nodes: a position node's coordinates, a BETA
+// node's angle, a LAMBDA node's small rotation vector in global axes, δθ = 2 E(λ) δλ.
+// InputError for a node without coordinates used by an element.
+Eigen::MatrixXd displacement_rows(const System& sys, const Data& data, const std::vector<int>& nodes);
+// Put data (assembled) at a row of static results: the positions x, the independent
+// coordinates from x and e, the positions re-solved there; InputError naming `where` if a size
+// is wrong.
+void put_at_static_row(const System& sys, Data& data, const Eigen::VectorXd& x, const Eigen::VectorXd& e,
+                       const char* where);
 // The static compliance C = T DF_q K⁻¹ DF_qᵀ Tᵀ at the nodes (spacar.compliance), T the rows of
 // their displacements (m x nx: a position node's coordinates, a BETA node's angle, a LAMBDA
 // node's small rotation vector in global axes, δθ = 2 E(λ) δλ), K = K0 + G0 the tangent
