@@ -13,6 +13,8 @@ convective terms), G0 geometric stiffness (stresses incl. reaction stresses, loa
 """
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 
 from . import _core
@@ -366,7 +368,7 @@ class NodalMatrices:
     def __init__(self, d: dict, coordinate_labels):
         import scipy.sparse
 
-        for name in ("M", "D", "K", "G", "A", "E"):
+        for name in ("M", "D", "K", "G", "A", "E", "B", "S", "Dc"):
             setattr(self, name, scipy.sparse.csr_matrix(d[name]))
         self.free = np.asarray(d["free"], dtype=int)
         self.coordinate_labels = list(coordinate_labels)
@@ -395,11 +397,12 @@ class NodalMatrices:
         op = sla.LinearOperator(M.shape, matvec=lambda b: _bounded_solve(sim, np.asarray(b, dtype=float).ravel()),
                                 dtype=float)
         v0 = sim.nodal_solve(np.ones(M.shape[0]))
-        if info["symmetric"]:
-            w2, vf = sla.eigsh(M, k=k, M=M, sigma=sigma, OPinv=op, which="LM", v0=v0)
-        else:
-            w2, vf = sla.eigs(M, k=k, M=M, sigma=sigma, OPinv=op, which="LM", v0=v0)
-            vf = np.real(vf)
+        with _arpack("modes", k):
+            if info["symmetric"]:
+                w2, vf = sla.eigsh(M, k=k, M=M, sigma=sigma, OPinv=op, which="LM", v0=v0)
+            else:
+                w2, vf = sla.eigs(M, k=k, M=M, sigma=sigma, OPinv=op, which="LM", v0=v0)
+                vf = np.real(vf)
         w2 = np.real(w2)
         if info["symmetric"]:
             # The Rayleigh quotients, from the elements' energies (nodal_energies): the shift-invert
@@ -423,7 +426,8 @@ class NodalMatrices:
                               "the sparse buckling analysis needs a regular K0; use method='dense'")
         op = sla.LinearOperator(G.shape, matvec=lambda b: _bounded_solve(sim, -(G @ np.asarray(b, dtype=float).ravel())),
                                 dtype=float)
-        nu, vf = sla.eigs(op, k=k, which="LM", v0=sim.nodal_solve(np.ones(G.shape[0])))
+        with _arpack("buckling modes", k):
+            nu, vf = sla.eigs(op, k=k, which="LM", v0=sim.nodal_solve(np.ones(G.shape[0])))
         keep = np.abs(nu) > 0
         real = np.abs(np.imag(nu)) <= 1e-6 * np.abs(nu)
         nu, vf = np.real(nu[keep & real]), np.real(vf[:, keep & real])
@@ -434,6 +438,20 @@ class NodalMatrices:
         order = np.argsort(np.abs(mu))
         return mu[order], self._scatter(vf[:, order])
 
+
+
+@contextlib.contextmanager
+def _arpack(what: str, k: int):
+    """ARPACK's failures as a SpacarError that says what to do (its own message names workspace
+    sizes): typically fewer finite modes than asked, as when only a few point masses carry mass."""
+    import scipy.sparse.linalg as sla
+
+    try:
+        yield
+    except (sla.ArpackError, sla.ArpackNoConvergence) as err:
+        raise SpacarError(f"the sparse eigen-analysis of the {k} lowest {what} failed (ARPACK: {err}); a model with "
+                          "few masses (e.g. point masses alone, massless elements) or few loaded elements has "
+                          "fewer finite modes than asked: ask for fewer (k), or use method='dense'") from None
 
 
 def _bounded_solve(sim, b):

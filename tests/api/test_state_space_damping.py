@@ -139,3 +139,27 @@ def test_bad_reductions_are_input_errors(damped_beam):
         damped_beam.reduce(0)
     with pytest.raises(spacar.InputError, match="k = 91 modes of a model of 90"):
         damped_beam.reduce(91)
+
+
+def test_deformation_and_stress_signals_on_the_modal_state_space():
+    # The modal model takes its deformations' rows from the nodal B and S (they were missing:
+    # OUTE, OUTS and INPUTS raised AttributeError with modes=); its static gain equals the dense one.
+    from spacar import section
+
+    guide = spacar.read("examples/parallel_leaf_guide.dat")
+    section.rectangle(0.02, 0.5e-3, section.STEEL).apply(guide, *range(1, 9))
+    guide.mass(9, 0.2)
+    spacar.static(guide)
+    signals = dict(inputs=[("INPUTF", 9, 1), ("INPUTS", 2, 2)], outputs=[("OUTE", 1, 2), ("OUTX", 9, 1)])
+    modal = spacar.state_space(guide, modes=3, **signals)
+    dense = spacar.state_space(guide, **signals)
+    assert modal.static_gain() == pytest.approx(dense.static_gain(), rel=1e-9)
+
+
+def test_too_many_modes_for_the_masses_is_said_plainly():
+    # Only the stage carries mass: one finite mode, not two; ARPACK's own message names workspace.
+    guide = spacar.read("examples/parallel_leaf_guide.dat")
+    spacar.static(guide)
+    guide.mass(9, 0.2)
+    with pytest.raises(spacar.SpacarError, match="fewer finite modes than asked"):
+        spacar.state_space(guide, modes=2, inputs=[("INPUTF", 9, 1)], outputs=[("OUTX", 9, 1)])
