@@ -29,6 +29,10 @@ class Signal(NamedTuple):
     origin: str = ""
 
 
+# The state-space signals on a node's coordinate (the others are on an element's deformation).
+NODE_SIGNALS = ("INPUTF", "BASEX", "BASEXP", "BASEXPP", "OUTX", "OUTXP", "OUTXPP", "OUTR")
+
+
 def _check_value(kw: Keyword, pname: str, kind: str, value):
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]  # a 0-d array is its number
@@ -322,7 +326,7 @@ class Model:
         k, number, index = self._call(name, *args)
         if k < 1:
             raise InputError(f"the number k of an input or output must be 1 or more, got {k}")
-        on_node = name in ("INPUTF", "OUTX", "OUTXP")
+        on_node = name in NODE_SIGNALS
         items = self._core.nodes if on_node else self._core.elements
         what = "node" if on_node else "element"
         if number not in items:
@@ -341,6 +345,18 @@ class Model:
         """INPUTS k e i: state-space input k is an actuator stress on deformation i of element e."""
         self._signal("INPUTS", (k, e, i), self.state_space_inputs)
 
+    def basex(self, k, n, i):
+        """BASEX k n i: state-space input k is the position of the INPUTX coordinate i of node n."""
+        self._signal("BASEX", (k, n, i), self.state_space_inputs)
+
+    def basexp(self, k, n, i):
+        """BASEXP k n i: state-space input k is the velocity of the INPUTX coordinate i of node n."""
+        self._signal("BASEXP", (k, n, i), self.state_space_inputs)
+
+    def basexpp(self, k, n, i):
+        """BASEXPP k n i: state-space input k is the acceleration of the INPUTX coordinate i of node n."""
+        self._signal("BASEXPP", (k, n, i), self.state_space_inputs)
+
     def outx(self, k, n, i):
         """OUTX k n i: state-space output k is coordinate i of node n."""
         self._signal("OUTX", (k, n, i), self.state_space_outputs)
@@ -348,6 +364,14 @@ class Model:
     def outxp(self, k, n, i):
         """OUTXP k n i: state-space output k is the rate of coordinate i of node n."""
         self._signal("OUTXP", (k, n, i), self.state_space_outputs)
+
+    def outxpp(self, k, n, i):
+        """OUTXPP k n i: state-space output k is the acceleration of coordinate i of node n."""
+        self._signal("OUTXPP", (k, n, i), self.state_space_outputs)
+
+    def outr(self, k, n, i):
+        """OUTR k n i: state-space output k is the reaction on the fixed or input coordinate i of node n."""
+        self._signal("OUTR", (k, n, i), self.state_space_outputs)
 
     def oute(self, k, e, i):
         """OUTE k e i: state-space output k is deformation i of element e."""

@@ -21,11 +21,17 @@ from . import _core
 from ._util import show, time_limited
 from .errors import InputError, SingularMassError
 from .linearize import Linearization, _count, _modal_basis, linearized_simulation, second_order_eigenvalues
-from .model import Model, Signal
+from .model import NODE_SIGNALS, Model, Signal
 
-INPUT_KEYWORDS = ("INPUTF", "INPUTS")
-OUTPUT_KEYWORDS = ("OUTX", "OUTXP", "OUTE", "OUTEP", "OUTS")
-_NAMES = {"INPUTF": "f", "INPUTS": "sigma", "OUTX": "x", "OUTXP": "xd", "OUTE": "e", "OUTEP": "ed", "OUTS": "sigma"}
+INPUT_KEYWORDS = ("INPUTF", "INPUTS", "BASEX", "BASEXP", "BASEXPP")
+OUTPUT_KEYWORDS = ("OUTX", "OUTXP", "OUTXPP", "OUTE", "OUTEP", "OUTS", "OUTR")
+_NAMES = {"INPUTF": "f", "INPUTS": "sigma", "BASEX": "u", "BASEXP": "ud", "BASEXPP": "udd", "OUTX": "x",
+          "OUTXP": "xd", "OUTXPP": "xdd", "OUTE": "e", "OUTEP": "ed", "OUTS": "sigma", "OUTR": "r"}
+# The derivative of a support's motion that a base input prescribes (position, velocity, acceleration).
+_BASE_ORDER = {"BASEX": 0, "BASEXP": 1, "BASEXPP": 2}
+# The signals built on the nodal matrices of a state at rest (the supports' motion, accelerations
+# and reactions): _build_base.
+_AT_REST = ("BASEX", "BASEXP", "BASEXPP", "OUTXPP", "OUTR")
 
 
 class StateSpace:
@@ -280,8 +286,8 @@ def state_space(source, at=None, inputs=None, outputs=None, *, modes=None, dampi
     ratios = _damping_ratios(damping)
     alpha, beta = _rayleigh(rayleigh)
     with time_limited(time_limit, "in state_space"):
-        ss = _state_space(source, at, inputs, outputs, modes)
-    if ratios is not None or alpha or beta:
+        ss, damped = _state_space(source, at, inputs, outputs, modes, (ratios, alpha, beta))
+    if not damped and (ratios is not None or alpha or beta):
         ss = _add_damping(ss, ratios, alpha, beta)
     return ss
 
@@ -357,7 +363,8 @@ def _mass_normalized_modes(M, K):
     return w2[order], phi[:, order]
 
 
-def _state_space(source, at, inputs, outputs, modes) -> StateSpace:
+def _state_space(source, at, inputs, outputs, modes, extra_damping) -> tuple:
+    """(the state space, whether the extra damping is in it already)."""
     if hasattr(source, "linearizations") and hasattr(source, "time_index"):  # a spacar.Results
         if not source.linearizations:
             raise InputError("state_space: these results have no linearizations (run with LINE or LINEAR 1), "
@@ -378,9 +385,15 @@ def _state_space(source, at, inputs, outputs, modes) -> StateSpace:
         raise InputError(f"state_space: a spacar.Model, Linearization or Results, got {show(source)}")
     inputs = _checked(inputs, INPUT_KEYWORDS, "inputs")
     outputs = _checked(outputs, OUTPUT_KEYWORDS, "outputs")
+    at_rest = [s for s in inputs + outputs if s.keyword in _AT_REST]
+    if at_rest:
+        if not isinstance(source, Model) or modes is not None:
+            raise InputError(f"{_where(at_rest[0])}: the supports' motion, accelerations and reactions are built "
+                             "from the Model at rest (no Linearization or Results source, no modes=)")
+        return _build_base(lin, velocities[0], inputs, outputs, *extra_damping), True
     if modes is not None:
-        return _build_modal(lin, inputs, outputs, modes)
-    return _build(lin, inputs, outputs, velocities)
+        return _build_modal(lin, inputs, outputs, modes), False
+    return _build(lin, inputs, outputs, velocities), False
 
 
 def _state(at):
@@ -428,7 +441,7 @@ def _where(sig: Signal) -> str:
 
 def _row(lin: Linearization, sig: Signal) -> tuple:
     """(DF or DFe, the row of the signal's coordinate or deformation in it)."""
-    on_node = sig.keyword in ("INPUTF", "OUTX", "OUTXP")
+    on_node = sig.keyword in NODE_SIGNALS
     labels = lin.coordinate_labels if on_node else lin.deformation_labels
     key = (sig.number, sig.index)
     if key not in labels:
@@ -499,7 +512,7 @@ def _build_modal(lin: Linearization, inputs, outputs, modes) -> StateSpace:
     constitutive = (_core.DefClass.released, _core.DefClass.dynamic)
 
     def index(sig):
-        on_node = sig.keyword in ("INPUTF", "OUTX", "OUTXP")
+        on_node = sig.keyword in NODE_SIGNALS
         table = coords if on_node else defs
         key = (sig.number, sig.index)
         if key not in table:
@@ -559,6 +572,228 @@ def _build_modal(lin: Linearization, inputs, outputs, modes) -> StateSpace:
     return StateSpace(A, B, C, D, states, [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin,
                       (np.eye(k), damping, np.diag(w2), Q))
+
+
+def _build_base(lin, sim, inputs, outputs, ratios, alpha, beta) -> StateSpace:
+    """The state space at rest with the supports' motion as inputs (BASEX/BASEXP/BASEXPP: the
+    position, velocity or acceleration of INPUTX coordinates) and accelerations (OUTXPP) and
+    reactions (OUTR) among the outputs, from the nodal matrices (docs/linearization.md,
+    "Base motion").
+
+    The coordinates move as x = Z z + U u (Z = DF of the DOFs, U of the inputs u: the motion of
+    every coordinate per unit input at fixed DOFs), so that
+
+        M z̈ + C ż + K z = −M_u ü − C_u u̇ − K_u u + Q f,    M_u = Zᵀ M_n U, ...
+
+    with M_n, C_n, H_n = K_n + G_n the nodal mass, damping and tangent stiffness. An input
+    prescribing the acceleration a of u keeps u and u̇ as states; the velocity v, u as a state;
+    the position, neither: the DOFs are then shifted, z̃ = z + M⁻¹ M_0 u_0 and
+    p = ż̃ + M⁻¹ (M_1 v_1 − E_0 u_0), E_0 = C M⁻¹ M_0 − C_0, which removes the inputs' derivatives
+    from the equations (a proper realization). An output that follows a derivative of its input
+    the realization has not (the rate of a node under a position input coupled by mass) is refused."""
+    nodal = getattr(lin, "nodal", None)
+    if nodal is None or lin.n_line or getattr(lin, "y_labels", []):
+        raise InputError("state_space: the supports' motion (BASEX, BASEXP, BASEXPP), accelerations (OUTXPP) and "
+                         "reactions (OUTR) need a state at rest in static equilibrium without LINE parameters or "
+                         "nonholonomic constraints (e.g. after spacar.static, or an unloaded model at rest)")
+    lin._require_mass("the state space with the supports' motion")
+    from .transfer import _q_labels
+
+    # DF with the columns of the inputs too (the kinematic analysis at the state, no D2F).
+    system = sim.system
+    q_labels, is_input = _q_labels(system)
+    sim.kinematic_state(lin.t, np.asarray(system.q0, dtype=float))
+    DF_all = np.array(sim.data.DF).reshape(-1, len(q_labels))
+    Z = np.asarray(lin.DF, dtype=float)
+    n, nx = Z.shape[1], Z.shape[0]
+    coords = {label: i for i, label in enumerate(lin.coordinate_labels)}
+    defs = {label: i for i, label in enumerate(lin.deformation_labels)}
+    coord_class, def_class = list(system.coord_class), list(system.def_class)
+    Mn, Cn, Hn = nodal.M, nodal.D, nodal.K + nodal.G
+    B = nodal.B.toarray()
+
+    def index(sig):
+        table = coords if sig.keyword in NODE_SIGNALS else defs
+        key = (sig.number, sig.index)
+        if key not in table:
+            what = "node {} has no coordinate {}" if sig.keyword in NODE_SIGNALS else "element {} has no deformation {}"
+            raise InputError(f"{_where(sig)}: {what.format(*key)}")
+        return table[key]
+
+    # The inputs: loads F on the coordinates (forces, stresses), the supports' motion U.
+    base = [s for s in inputs if s.keyword in _BASE_ORDER]
+    forces = [s for s in inputs if s.keyword not in _BASE_ORDER]
+    F = np.zeros((nx, len(forces)))
+    for j, sig in enumerate(forces):
+        i = index(sig)
+        if sig.keyword == "INPUTF":
+            if not np.any(Z[i]):
+                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
+                                 "input coordinate)")
+            F[i, j] = 1.0
+        else:
+            if def_class[i] not in (_core.DefClass.released, _core.DefClass.dynamic):
+                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a deformation "
+                                 "that is not DYNE or released)")
+            F[:, j] = -B[i]
+    U = np.zeros((nx, len(base)))
+    for j, sig in enumerate(base):
+        label = ("x", sig.number, sig.index)
+        if label not in q_labels or not is_input[q_labels.index(label)]:
+            raise InputError(f"{_where(sig)}: coordinate {sig.index} of node {sig.number} is not an INPUTX coordinate "
+                             "(a support's motion is prescribed on an input coordinate)")
+        U[:, j] = DF_all[:, q_labels.index(label)]
+    M, C, K = (np.asarray(Z.T @ (A @ Z)) for A in (Mn, Cn, Hn))
+    Mu, Cu, Ku = (np.asarray(Z.T @ (A @ U)) for A in (Mn, Cn, Hn))
+    Q = Z.T @ F
+    # Added damping (damping=, rayleigh=) acts on the motion relative to the quasi-static one
+    # that follows the supports (z = −K⁻¹ K_u u): a support's rigid motion is not damped.
+    extra = alpha * M + beta * K
+    if ratios is not None:
+        w2, phi = _mass_normalized_modes(M, K)
+        zeta = np.zeros(n)
+        if ratios.ndim == 0:
+            zeta[:] = ratios
+        elif len(ratios) > n:
+            raise InputError(f"state_space: damping gives {len(ratios)} modal ratios for {n} modes")
+        else:
+            zeta[:len(ratios)] = ratios
+        Mphi = M @ phi
+        extra = extra + Mphi @ np.diag(2.0 * zeta * np.sqrt(np.abs(w2))) @ Mphi.T
+    reactions = [sig for sig in outputs if sig.keyword == "OUTR"]
+    if reactions and (alpha or ratios is not None):
+        raise InputError(f"{_where(reactions[0])}: a reaction with modal or mass-proportional added damping is not "
+                         "defined (those forces act on the degrees of freedom, not through the elements): model the "
+                         "damping as EDAMPP or rayleigh=(0, β)")
+    if np.any(extra):
+        try:
+            Cu = Cu + extra @ np.linalg.solve(K, Ku)
+        except np.linalg.LinAlgError:
+            raise InputError("state_space: damping= and rayleigh= with the supports' motion need a supported model "
+                             "(K0 + G0 regular)") from None
+        C = C + extra
+    # The outputs as rows over x, ẋ, ẍ of the coordinates, and over the force inputs.
+    rows = {"x": np.zeros((len(outputs), nx)), "v": np.zeros((len(outputs), nx)), "a": np.zeros((len(outputs), nx))}
+    cf = np.zeros((len(outputs), len(forces)))
+    for r, sig in enumerate(outputs):
+        i = index(sig)
+        if sig.keyword in ("OUTX", "OUTXP", "OUTXPP"):
+            rows[{"OUTX": "x", "OUTXP": "v", "OUTXPP": "a"}[sig.keyword]][r, i] = 1.0
+        elif sig.keyword in ("OUTE", "OUTEP"):
+            rows["x" if sig.keyword == "OUTE" else "v"][r] = B[i]
+        elif sig.keyword == "OUTS":
+            if def_class[i] not in (_core.DefClass.released, _core.DefClass.dynamic):
+                raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
+                                 "constitutive, σ = S e + D ė); this one is a reaction stress")
+            rows["x"][r] = nodal.S[i] @ B
+            rows["v"][r] = nodal.Dc[i] @ B
+        else:  # OUTR
+            rho = _reaction_row(sig, i, coord_class, def_class, B)
+            # Stiffness-proportional added damping, β H_n on the nodal rates, is carried by the elements.
+            rows["x"][r], rows["v"][r], rows["a"][r] = Hn.T @ rho, (Cn + beta * Hn).T @ rho, Mn.T @ rho
+            cf[r] = -rho @ F
+    return _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forces, lin)
+
+
+def _reaction_row(sig, g, coord_class, def_class, B) -> np.ndarray:
+    """ρ with the reaction at coordinate g = ρᵀ (M_n ẍ + C_n ẋ + H_n x − F f): the coordinate's own
+    row, and the reaction stresses of the rigid and input deformations (rows R) that hold the
+    calculable coordinates c in equilibrium, B_R[:, c]ᵀ λ = F f − w_c."""
+    if coord_class[g] not in (_core.CoordClass.fixed, _core.CoordClass.input):
+        raise InputError(f"{_where(sig)}: a reaction acts on a fixed or INPUTX coordinate; coordinate {sig.index} of "
+                         f"node {sig.number} moves freely")
+    rho = np.zeros(B.shape[1])
+    rho[g] = 1.0
+    held = [k for k, c in enumerate(def_class) if c in (_core.DefClass.fixed, _core.DefClass.input)]
+    calc = [c for c, k in enumerate(coord_class) if k == _core.CoordClass.calculable]
+    if held and calc and np.any(B[held, g]):
+        rho[calc] = -np.linalg.lstsq(B[np.ix_(held, calc)], B[held, g], rcond=None)[0]
+    return rho
+
+
+def _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forces, lin) -> StateSpace:
+    """A, B, C, D of the equations with the supports' motion (see _build_base)."""
+    n = M.shape[0]
+    order = np.array([_BASE_ORDER[s.keyword] for s in base], dtype=int)
+    o0, o1, o2 = (np.nonzero(order == k)[0] for k in (0, 1, 2))
+    Mi = np.linalg.inv(M)
+    E0 = C @ Mi @ Mu[:, o0] - Cu[:, o0]
+    F0 = K @ Mi @ Mu[:, o0] - Ku[:, o0]
+    # States [z̃, p, u of velocity and acceleration inputs, u̇ of acceleration inputs].
+    nu1, nu2 = len(o1), len(o2)
+    ns = 2 * n + nu1 + 2 * nu2
+    iz, ip = slice(0, n), slice(n, 2 * n)
+    iu1 = slice(2 * n, 2 * n + nu1)
+    iu2 = slice(2 * n + nu1, 2 * n + nu1 + nu2)
+    iv2 = slice(2 * n + nu1 + nu2, ns)
+    # The inputs' columns in the user's order.
+    col = {("f", j): inputs.index(s) for j, s in enumerate(forces)}
+    col.update({("u", j): inputs.index(s) for j, s in enumerate(base)})
+    m = len(inputs)
+    A = np.zeros((ns, ns))
+    Bm = np.zeros((ns, m))
+    A[iz, ip] = np.eye(n)
+    A[ip, ip] = -Mi @ C
+    A[ip, iz] = -Mi @ K
+    A[ip, iu1] = -Mi @ Ku[:, o1]
+    A[ip, iu2] = -Mi @ Ku[:, o2]
+    A[ip, iv2] = -Mi @ Cu[:, o2]
+    A[iu2, iv2] = np.eye(nu2)
+    for j in range(len(forces)):
+        Bm[ip, col[("f", j)]] = Mi @ Q[:, j]
+    for a, j in enumerate(o0):
+        Bm[iz, col[("u", j)]] = Mi @ E0[:, a]
+        Bm[ip, col[("u", j)]] = Mi @ (-C @ Mi @ E0[:, a] + F0[:, a])
+    for a, j in enumerate(o1):
+        Bm[iz, col[("u", j)]] = -Mi @ Mu[:, j]
+        Bm[ip, col[("u", j)]] = Mi @ (C @ Mi @ Mu[:, j] - Cu[:, j])
+        Bm[iu1.start + a, col[("u", j)]] = 1.0
+    for a, j in enumerate(o2):
+        Bm[ip, col[("u", j)]] = -Mi @ Mu[:, j]
+        Bm[iv2.start + a, col[("u", j)]] = 1.0
+    # The outputs: y = cz z + czd ż + czdd z̈ + cu u + cud u̇ + cudd ü + cf f, z̈ from the equations.
+    cz, czd, czdd = rows["x"] @ Z, rows["v"] @ Z, rows["a"] @ Z
+    cu, cud, cudd = rows["x"] @ U, rows["v"] @ U, rows["a"] @ U
+    G = czdd @ Mi
+    cz, czd = cz - G @ K, czd - G @ C
+    cu, cud, cudd = cu - G @ Ku, cud - G @ Cu, cudd - G @ Mu
+    cf = cf + G @ Q
+    Cm = np.zeros((len(outputs), ns))
+    Dm = np.zeros((len(outputs), m))
+    # z = z̃ − M⁻¹ M_0 u_0;  ż = p − M⁻¹ M_1 v_1 + M⁻¹ E_0 u_0 − M⁻¹ M_0 u̇_0.
+    Cm[:, iz], Cm[:, ip] = cz, czd
+    for a, j in enumerate(o0):
+        Dm[:, col[("u", j)]] += -cz @ Mi @ Mu[:, j] + czd @ Mi @ E0[:, a]
+        cud[:, j] = cud[:, j] - czd @ Mi @ Mu[:, j]
+    for j in o1:
+        Dm[:, col[("u", j)]] += -czd @ Mi @ Mu[:, j]
+    for j in range(len(forces)):
+        Dm[:, col[("f", j)]] += cf[:, j]
+    for a, j in enumerate(o1):
+        Cm[:, iu1.start + a] += cu[:, j]
+        Dm[:, col[("u", j)]] += cud[:, j]
+    for a, j in enumerate(o2):
+        Cm[:, iu2.start + a] += cu[:, j]
+        Cm[:, iv2.start + a] += cud[:, j]
+        Dm[:, col[("u", j)]] += cudd[:, j]
+    for j in o0:
+        Dm[:, col[("u", j)]] += cu[:, j]
+    # A derivative of an input the realization does not have: improper.
+    scale = max(np.abs(Cm).max(initial=0.0), np.abs(Dm).max(initial=0.0), 1e-300)
+    for what, coefficient, orders in (("rate", cud, (0,)), ("acceleration", cudd, (0, 1))):
+        for j in np.nonzero(np.isin(order, orders))[0]:
+            bad = np.nonzero(np.abs(coefficient[:, j]) > 1e-12 * scale)[0]
+            if bad.size:
+                raise InputError(f"{_where(outputs[bad[0]])}: this output follows the {what} of input "
+                                 f"{_where(base[j])} (its response is not proper): take the velocity or acceleration "
+                                 "of the support as the input (BASEXP, BASEXPP)")
+    z_names = [f"{kind}({a},{b})" for kind, a, b in lin.z_labels]
+    states = z_names + [f"p({name})" for name in z_names] + \
+        [f"u({s.number},{s.index})" for s in (base[j] for j in o1)] + \
+        [f"u({s.number},{s.index})" for s in (base[j] for j in o2)] + \
+        [f"ud({s.number},{s.index})" for s in (base[j] for j in o2)]
+    return StateSpace(A, Bm, Cm, Dm, states, [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
+                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin)
 
 
 def _sensitivities(lin, outputs, velocities) -> dict:
