@@ -105,6 +105,15 @@ void bind_statics(py::module_& m) {
       .def_property_readonly("e", [](StaticPoint& p) { return Eigen::VectorXd(p.e()); })
       .def_property_readonly("residual", &StaticPoint::residual,
                              "R = DF_qᵀ (Σ Bᵀσ − f) at the current state (zero at an equilibrium).")
+      .def_property_readonly("load_scale", &StaticPoint::load_scale,
+                             "The largest applied or elastic load on a coordinate (loads on lengths times the "
+                             "mean element length): the scale of the residual.")
+      .def_property_readonly("dof_scale", [](const StaticPoint& p) { return dof_scale(p.system()); },
+                             "The size of each DOF: the mean element length for lengths, 1 for angles.")
+      .def_property_readonly(
+          "coordinate_labels", [](const StaticPoint& p) { return p.system().coord_label; },
+          "(node, component) of every coordinate.")
+      .def("symmetric", &StaticPoint::symmetric, "Whether the tangent K0 + G0 is symmetric (factorizes it).")
       .def("move_to", &StaticPoint::move_to, py::arg("q"), "Move the DOFs to q (positions and forces solved again).")
       .def("solve", &StaticPoint::solve, py::arg("r"), "K_T⁻¹ r, K_T = K0 + G0 at the current state (sparse).")
       .def("motion", &StaticPoint::motion, py::arg("dq"), "DF_q dq: the motion of every coordinate.")

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import numbers
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -71,9 +72,10 @@ class PeriodicOrbit:
 class _Flow:
     """The flow over one period of a copy of the model: Φ(s) for s = (q, q̇) at t0."""
 
-    def __init__(self, model, period, tolerance, method, inputs, forces, deadline):
+    def __init__(self, model, period, integration_tolerance, method, inputs, forces, deadline):
         self.model, self.period, self.method = model, period, method
-        self.inputs, self.forces, self.tolerance, self.deadline = inputs, forces, tolerance, deadline
+        self.inputs, self.forces, self.deadline = inputs, forces, deadline
+        self.integration_tolerance = integration_tolerance
         system = _core.Simulation(model.core).system
         coords = [tuple(int(v) for v in c) for c in system.coord_label]
         defs = [tuple(int(v) for v in c) for c in system.def_label]
@@ -97,8 +99,8 @@ class _Flow:
             m.e(elem, i, float(q[j]))
             m.ed(elem, i, float(qd[j]))
         m.timestep(steps, self.period)
-        m.epsint(self.tolerance)
-        m.epsind(self.tolerance)
+        m.epsint(self.integration_tolerance)
+        m.epsind(self.integration_tolerance)
         m.matasc(0)
         m.animate(0)
         return m
@@ -149,6 +151,19 @@ def _check_common(model, period, tolerance, delta, method, steps, what):
     if isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 1:
         raise InputError(f"{what}: steps must be a positive integer, got {show(steps)}")
     return period, tolerance, delta
+
+
+def _check_tables(inputs, forces, t0, period, what):
+    """The input and load tables must cover the period: beyond its samples a table holds its end
+    values, which would make the drive something else than the one meant."""
+    from .table import Table
+
+    for name, given in (("inputs", inputs), ("forces", forces)):
+        for key, table in (given or {}).items() if isinstance(given, dict) else ():
+            if isinstance(table, Table) and (table.t[0] > t0 + 1e-12 * max(1.0, abs(t0)) or
+                                             table.t[-1] < t0 + period * (1 - 1e-12)):
+                raise InputError(f"{what}: the {name} table of {key} covers [{table.t[0]:g}, {table.t[-1]:g}], not "
+                                 f"the period [{t0:g}, {t0 + period:g}] from the model's current time")
 
 
 def _state(flow, q, qd, what):
@@ -204,6 +219,7 @@ def floquet(model, period, *, q=None, qd=None, inputs=None, forces=None, method:
     period, tol, delta = _check_common(model, period, integration_tolerance, delta, method, steps, "floquet")
     limit = seconds_or_none(time_limit, "floquet: time_limit")
     deadline = None if limit is None else time.monotonic() + limit
+    _check_tables(inputs, forces, float(model.current_time), period, "floquet")
     flow = _Flow(model, period, tol, method, inputs, forces, deadline)
     s = _state(flow, q, qd, "floquet")
     residual = float(np.max(np.abs(flow(s) - s)))
@@ -232,6 +248,7 @@ def periodic_orbit(model, period, *, q=None, qd=None, inputs=None, forces=None, 
         raise InputError(f"periodic_orbit: max_iterations must be a positive integer, got {show(max_iterations)}")
     limit = seconds_or_none(time_limit, "periodic_orbit: time_limit")
     deadline = None if limit is None else time.monotonic() + limit
+    _check_tables(inputs, forces, float(model.current_time), period, "periodic_orbit")
     flow = _Flow(model, period, tol, method, inputs, forces, deadline)
     s = _state(flow, q, qd, "periodic_orbit")
     history = []
@@ -240,7 +257,13 @@ def periodic_orbit(model, period, *, q=None, qd=None, inputs=None, forces=None, 
         residual = float(np.max(np.abs(r)))
         history.append(residual)
         if residual <= tolerance * max(1.0, float(np.max(np.abs(s)))):
-            return _orbit(flow, s, residual, iteration, steps, delta)
+            orbit = _orbit(flow, s, residual, iteration, steps, delta)
+            ones = np.abs(orbit.multipliers - 1.0) < 1e-6
+            if np.any(ones):
+                warnings.warn(f"periodic_orbit: a Floquet multiplier is 1 within {np.abs(orbit.multipliers - 1).min():.1g}: "
+                              "the orbit found may belong to a family (a free motion, not one set by the drive), or "
+                              "the drive is in resonance", RuntimeWarning, stacklevel=2)
+            return orbit
         if iteration == max_iterations:
             break
         jac = flow.monodromy(s, delta) - np.eye(2 * flow.n)

@@ -127,3 +127,19 @@ def test_bad_input_is_refused_by_name():
     with pytest.raises(spacar.TimeLimitError):
         periodic_orbit(flexible_slider_crank(1e-5), 2 * np.pi / 1.5, time_limit=0.05)
 
+
+
+def test_a_table_that_does_not_cover_the_period_is_refused():
+    period, inputs = support_motion(0.25)
+    half = spacar.Table(np.linspace(0.0, period / 2, 101), np.zeros(101))
+    with pytest.raises(spacar.InputError, match=r"the inputs table of \(1, 2\) covers"):
+        floquet(pendulum(), period, inputs={(1, 2): half})
+
+
+def test_a_free_pendulum_at_its_own_period_is_flagged():
+    # Not driven: every small swing is periodic with the pendulum's own period, a family whose
+    # multiplier along it is 1; the orbit found comes with a warning.
+    m = pendulum()
+    m.fix(1, 2)
+    with pytest.warns(RuntimeWarning, match="multiplier is 1"):
+        periodic_orbit(m, 2 * np.pi * np.sqrt(L / G), q=[0.3])

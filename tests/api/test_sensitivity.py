@@ -210,6 +210,73 @@ def test_bad_parameters_are_refused_by_name():
         sensitivity.displacements(m, [])
     with pytest.raises(spacar.InputError, match="positive number"):
         sensitivity.Dimension(lambda t: None, -1.0, [1])
+    with pytest.raises(spacar.InputError, match="whole numbers"):
+        sensitivity.displacements(m, [("ESTIFF", 1.7, 2)])
+    with pytest.raises(spacar.InputError, match="must return a spacar.section.Section"):
+        sensitivity.displacements(m, [sensitivity.Dimension(lambda t: 5, 1e-3, 2)])
+    with pytest.raises(spacar.InputError, match="k = 99 modes asked for, the model has 24"):
+        sensitivity.frequencies(m, ["ESTIFF", 1, 2], k=99)
+
+
+def test_results_that_are_not_an_equilibrium_of_the_model_are_refused():
+    m, _ = cantilever()
+    moving = cantilever()[0]
+    moving.timestep(5, 0.5)
+    with pytest.raises(spacar.InputError, match="not a static equilibrium of this model"):
+        sensitivity.displacements(m, [("ESTIFF", 1, 2)], results=spacar.simulate(moving, progress=False))
+
+
+def test_a_dimension_must_describe_the_model():
+    thick = sensitivity.Dimension(lambda t: section.rectangle(W, t, section.STEEL), 0.6e-3, list(range(1, 9)))
+    with pytest.raises(spacar.InputError, match="is not the section's at 0.0006"):
+        sensitivity.compliance(guide(), 9, [thick])
+
+
+def test_a_mass_added_where_there_is_none():
+    # The stage without mass: dω/dm at m = 0 (a one-sided difference of the whole analysis).
+    s = sensitivity.frequencies(guide(stage_mass=0.0), [("MASS", 9, 1)], k=1)
+    h = 1e-7
+    f = [lowest_frequencies(guide(stage_mass=v), 1)[0] for v in (0.0, h, 2 * h)]
+    assert s.df[0, 0] == pytest.approx((-3 * f[0] + 4 * f[1] - f[2]) / (2 * h), rel=1e-7)
+
+
+def spatial_cantilever(EIy=1.3, EIz=2.0):
+    """4 BEAMs along x clamped at nodes 1/2, the tip's LAMBDA node 10."""
+    m = spacar.Model()
+    for k in range(4):
+        m.beam(k + 1, 2 * k + 1, 2 * k + 2, 2 * k + 3, 2 * k + 4, 0, 1, 0)
+        m.x(2 * k + 3, (k + 1) / 4, 0, 0)
+        m.dyne(k + 1)
+        m.estiff(k + 1, 1e5, 1.0, EIy, EIz)
+        m.emass(k + 1, 1.0, 1e-3, 1e-3, 1e-3)
+    m.x(1, 0, 0, 0)
+    m.fix(1)
+    m.fix(2)
+    return m
+
+
+def test_an_unsymmetric_tangent_and_a_repeated_frequency_are_refused():
+    m = spatial_cantilever()
+    m.force(9, 0.0, 0.0, -0.2)
+    m.torqueg(10, 0.3, 0.2, 0.0)     # a dead moment: its load stiffness is not symmetric
+    with pytest.raises(spacar.InputError, match="tangent stiffness is not symmetric"):
+        sensitivity.frequencies(m, [("ESTIFF", 1, 2)], k=1)
+    with pytest.raises(spacar.InputError, match="tangent stiffness is not symmetric"):
+        sensitivity.compliance(m, 9, [("ESTIFF", 1, 2)])
+    d = sensitivity.displacements(m, [("ESTIFF", 2, 3)])        # the direct method needs no symmetry
+    reference = whole(lambda: (_loaded_torqued(), None), ("ESTIFF", 2, 3),
+                      lambda mm: spacar.static(mm).node(9).x[-1])
+    assert d.node(9)[:, 0] == pytest.approx(reference, rel=1e-7, abs=1e-9 * np.abs(reference).max())
+    # A square section: the bending modes come in pairs, whose derivatives are not defined.
+    with pytest.raises(spacar.SpacarError, match="modes 1 and 2 have the same frequency"):
+        sensitivity.frequencies(spatial_cantilever(2.0, 2.0), [("ESTIFF", 2, 3)], k=1)
+
+
+def _loaded_torqued():
+    m = spatial_cantilever()
+    m.force(9, 0.0, 0.0, -0.2)
+    m.torqueg(10, 0.3, 0.2, 0.0)
+    return m
 
 
 def test_the_static_results_given_are_the_equilibrium_used():

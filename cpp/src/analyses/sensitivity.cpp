@@ -23,7 +23,7 @@ Eigen::VectorXd StaticPoint::dofs() const {
 }
 
 void StaticPoint::forces() {
-  static_forces(sim_.system(), sim_.data(), 1.0, R_);
+  scale_ = static_forces(sim_.system(), sim_.data(), 1.0, R_);
   factorized_ = false;
 }
 
@@ -45,25 +45,34 @@ ReducedSystem& StaticPoint::reduced() {
   return *reduced_;
 }
 
+void StaticPoint::factorize() {
+  if (factorized_) return;
+  const System& sys = sim_.system();
+  ReducedSystem& red = reduced();
+  if (!red.factorize(sim_.data().sigma, NodalCoefficients{}))
+    throw StaticError("the tangent stiffness is not finite at this state");
+  if (red.saddle().singular()) {
+    const Eigen::VectorXd dx = red.saddle().null_direction();
+    const std::string where = dx.size() ? dof_directions(sys, red.dofs(dx).cwiseQuotient(dof_scale(sys)))
+                                        : "a direction not located";
+    throw StaticError("the tangent stiffness is singular: no stiffness in " + where);
+  }
+  factorized_ = true;
+}
+
+bool StaticPoint::symmetric() {
+  factorize();
+  return reduced().saddle().symmetric();
+}
+
 Eigen::VectorXd StaticPoint::solve(const Eigen::VectorXd& r) {
   const System& sys = sim_.system();
   if (r.size() != sys.n_dof())
     throw InputError("StaticPoint.solve: r needs " + std::to_string(sys.n_dof()) + " values, got " +
                      std::to_string(r.size()));
-  ReducedSystem& red = reduced();
-  if (!factorized_) {
-    if (!red.factorize(sim_.data().sigma, NodalCoefficients{}))
-      throw StaticError("the tangent stiffness is not finite at this state");
-    if (red.saddle().singular()) {
-      const Eigen::VectorXd dx = red.saddle().null_direction();
-      const std::string where = dx.size() ? dof_directions(sys, red.dofs(dx).cwiseQuotient(dof_scale(sys)))
-                                          : "a direction not located";
-      throw StaticError("the tangent stiffness is singular: no stiffness in " + where);
-    }
-    factorized_ = true;
-  }
+  factorize();
   Eigen::VectorXd q, dx;
-  red.solve(r, q, dx);
+  reduced().solve(r, q, dx);
   return q;
 }
 

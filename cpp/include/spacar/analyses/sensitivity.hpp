@@ -28,8 +28,12 @@ class StaticPoint {
   Eigen::VectorXd dofs() const;
   const Eigen::VectorXd& x() { return sim_.data().x; }
   const Eigen::VectorXd& e() { return sim_.data().e; }
-  // R(q) = DF_qᵀ (Σ Bᵀσ − f) at the current state (zero at an equilibrium).
+  // R(q) = DF_qᵀ (Σ Bᵀσ − f) at the current state (zero at an equilibrium), and its scale: the
+  // largest applied or elastic load on a coordinate (static_forces).
   const Eigen::VectorXd& residual() const { return R_; }
+  double load_scale() const { return scale_; }
+  // Whether K_T is symmetric (no body-fixed or global torques' load stiffness): factorizes it.
+  bool symmetric();
   // Move the degrees of freedom to q (positions re-solved from the current ones, forces again).
   void move_to(const Eigen::VectorXd& q);
   // K_T⁻¹ r for a load r on the DOFs (the tangent K0 + G0 factorized at the current state on
@@ -46,10 +50,12 @@ class StaticPoint {
 
  private:
   void forces();
+  void factorize();
   ReducedSystem& reduced();
 
   Simulation sim_;
   Eigen::VectorXd R_;
+  double scale_ = 0.0;
   std::unique_ptr<ReducedSystem> reduced_;
   bool factorized_ = false;
 };
