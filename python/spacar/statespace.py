@@ -461,6 +461,11 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
             raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
                              "input coordinate, or a deformation that is not DYNE, released or LINE)")
         Q[:, j] = T[r] if sig.keyword == "INPUTF" else -T[r]
+    if not k:
+        lin._require_mass("the state space")
+        massless = _massless_directions(lin.M0)
+        if massless is not None:
+            return _build_condensed(lin, inputs, outputs, Q, _sensitivities(lin, outputs, velocities), *massless)
     A = lin.state_matrix()
     B = np.vstack([np.zeros((n + k, len(inputs))), np.linalg.solve(lin.M0, Q)])
     C = np.zeros((len(outputs), 2 * n + k))
@@ -483,6 +488,60 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin,
                       None if k else (lin.M0, lin.damping, lin.stiffness, Q))
+
+
+def _massless_directions(M):
+    """(V, N): orthonormal bases of the directions of z with mass and without (M N = 0), or None
+    when M is regular."""
+    w, basis = np.linalg.eigh((M + M.T) / 2)
+    heavy = w > 1e-12 * max(w.max(initial=0.0), 1e-300)
+    if heavy.all():
+        return None
+    return basis[:, heavy], basis[:, ~heavy]
+
+
+def _build_condensed(lin, inputs, outputs, Q, sens, V, N) -> StateSpace:
+    """The state space of a model with massless degrees of freedom (a flexure whose leaves carry
+    no mass, its stage a point mass): the massless directions N follow the others statically,
+    z = T a + S u with T = V − N (Nᵀ K N)⁻¹ Nᵀ K V, S = N (Nᵀ K N)⁻¹ Nᵀ Q (exact when no damping
+    acts in them), and the states are a, ȧ in the directions V with mass."""
+    M, C, K = lin.M0, lin.damping, lin.stiffness
+    size = max(np.abs(C).max(initial=0.0), 1e-300)
+    if np.abs(N.T @ C).max(initial=0.0) > 1e-12 * size or np.abs(C @ N).max(initial=0.0) > 1e-12 * size:
+        raise InputError("state_space: degrees of freedom without mass but with damping (EDAMPP, or the motion's "
+                         "velocity terms) follow first-order dynamics that the state space does not model: give them "
+                         "mass (e.g. the leaves' EMASS) or remove their damping")
+    Knn = N.T @ K @ N
+    try:
+        follow = np.linalg.solve(Knn, np.hstack([N.T @ K @ V, N.T @ Q]))
+    except np.linalg.LinAlgError:
+        raise InputError("state_space: the degrees of freedom without mass have no stiffness of their own (a "
+                         "mechanism without mass): give them mass") from None
+    T = V - N @ follow[:, :V.shape[1]]
+    S = N @ follow[:, V.shape[1]:]
+    n, m = V.shape[1], len(inputs)
+    Mr, Cr, Kr, Qr = T.T @ M @ T, T.T @ C @ T, T.T @ K @ T, T.T @ Q
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(Mr, Kr), -np.linalg.solve(Mr, Cr)]])
+    B = np.vstack([np.zeros((n, m)), np.linalg.solve(Mr, Qr)])
+    Cm = np.zeros((len(outputs), 2 * n))
+    D = np.zeros((len(outputs), m))
+    for i, sig in enumerate(outputs):
+        T_out, r = _row(lin, sig)
+        if sig.keyword in ("OUTX", "OUTE"):
+            row = sens["x" if sig.keyword == "OUTX" else "e"][r]
+            Cm[i, :n], D[i] = row @ T, row @ S
+        elif sig.keyword in ("OUTXP", "OUTEP"):
+            Cm[i, n:] = T_out[r] @ T
+            Cm[i, :n] = sens["xd" if sig.keyword == "OUTXP" else "ed"][r] @ T
+            if np.abs(T_out[r] @ S).max(initial=0.0) > 1e-12 * max(np.abs(Cm[i]).max(initial=0.0), 1e-300):
+                raise InputError(f"{_where(sig)}: a rate that follows the inputs' rate through massless degrees of "
+                                 "freedom is not a proper output (give them mass, or take the position)")
+        else:
+            Cm[i, :n], Cm[i, n:] = sens["sigma"][r] @ T, sens["sigma_d"][r] @ T
+            D[i] = sens["sigma"][r] @ S
+    states = [f"mass({i + 1})" for i in range(n)] + [f"massd({i + 1})" for i in range(n)]
+    return StateSpace(A, B, Cm, D, states, [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
+                      [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin, (Mr, Cr, Kr, Qr))
 
 
 def _build_modal(lin: Linearization, inputs, outputs, modes) -> StateSpace:

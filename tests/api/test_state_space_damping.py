@@ -163,3 +163,32 @@ def test_too_many_modes_for_the_masses_is_said_plainly():
     guide.mass(9, 0.2)
     with pytest.raises(spacar.SpacarError, match="fewer finite modes than asked"):
         spacar.state_space(guide, modes=2, inputs=[("INPUTF", 9, 1)], outputs=[("OUTX", 9, 1)])
+
+
+def test_a_leaf_spring_stage_with_massless_leaves_is_its_single_mode():
+    # The parallel guide with its stage as a point mass and massless leaves: the leaves' DOFs
+    # follow the stage statically (condensed; the dense state space raised a LinAlgError before).
+    # With ζ = 0.01 its drive receptance is the single mode C / (1 − r² + 2iζr), r = f / f1, the
+    # y mode 70 times higher.
+    guide = spacar.read("examples/parallel_leaf_guide.dat")
+    guide.mass(9, 0.2)
+    spacar.static(guide)
+    compliance = spacar.compliance(guide, 9)[0, 0]
+    f1 = spacar.linearize(guide).eigenfrequencies()[0]
+    assert f1 == pytest.approx(np.sqrt(1 / (compliance * 0.2)) / (2 * np.pi), rel=1e-5)
+    ss = spacar.state_space(guide, damping=0.01, inputs=[("INPUTF", 9, 1)], outputs=[("OUTX", 9, 1)])
+    assert ss.A.shape == (4, 4)            # the stage's x and y
+    assert ss.static_gain()[0, 0] == pytest.approx(compliance, rel=1e-10)
+    r = np.array([0.1, 0.5, 0.9, 0.99, 1.0, 1.01, 1.1, 2.0, 3.0])
+    single = compliance / (1 - r**2 + 2j * 0.01 * r)
+    assert ss.frequency_response(r * f1)[:, 0, 0] == pytest.approx(single, rel=1e-5)
+
+
+def test_massless_degrees_of_freedom_with_damping_are_refused():
+    guide = spacar.read("examples/parallel_leaf_guide.dat")
+    guide.mass(9, 0.2)
+    for e in range(1, 9):
+        guide.edampp(e, 0.0, 1e-4)
+    spacar.static(guide)
+    with pytest.raises(spacar.InputError, match="without mass but with damping"):
+        spacar.state_space(guide, inputs=[("INPUTF", 9, 1)], outputs=[("OUTX", 9, 1)])
