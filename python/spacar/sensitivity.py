@@ -169,7 +169,9 @@ class _Equilibrium:
         except (AttributeError, IndexError, TypeError, ValueError):
             raise InputError("sensitivity: results must be the static results of the model (spacar.static)") from None
         self.point = _core.StaticPoint(self.model.core, self.x, self.e)
-        residual = np.abs(np.asarray(self.point.residual)).max(initial=0.0)
+        # R in units of energy (a length DOF's force times its size), as the load scale and the
+        # static solve's tolerance are.
+        residual = np.abs(np.asarray(self.point.residual) * np.asarray(self.point.dof_scale)).max(initial=0.0)
         if residual > _EQUILIBRIUM * self.point.load_scale:
             raise InputError(f"sensitivity: the results' last row is not a static equilibrium of this model (residual "
                              f"{residual:.3g} against loads of {self.point.load_scale:.3g}): pass the results of "

@@ -286,3 +286,15 @@ def test_the_static_results_given_are_the_equilibrium_used():
     solved = sensitivity.displacements(cantilever()[0], [("ESTIFF", 1, 2)])
     assert given.dx == pytest.approx(solved.dx, rel=1e-9, abs=1e-15)
     assert given.labels == ["ESTIFF 1 2"]
+
+
+def test_a_design_by_newtons_method_with_the_derivative():
+    # The leaf thickness that puts the guide's drive mode at 40 Hz, by scipy's Newton with df/dt.
+    from scipy.optimize import newton
+
+    def residual_and_slope(t):
+        s = sensitivity.frequencies(guide(thickness=t), [sensitivity.Dimension(
+            lambda v: section.rectangle(W, v, section.STEEL), t, list(range(1, 9)))], k=1)
+        return s.frequencies[0] - 40.0, s.df[0, 0]
+    t = newton(lambda v: residual_and_slope(v)[0], T_LEAF, fprime=lambda v: residual_and_slope(v)[1], tol=1e-12)
+    assert lowest_frequencies(guide(thickness=t), 1)[0] == pytest.approx(40.0, rel=1e-9)
