@@ -30,7 +30,7 @@ README_COMMANDS = [
 ]
 NOTEBOOKS = ["01_slidercrank.ipynb", "02_fourbar.ipynb", "03_cantilever.ipynb", "04_rigid_body.ipynb",
              "05_rolling_wheel_and_bicycle.ipynb", "06_peer_comparison.ipynb", "07_flexures.ipynb", "08_mechatronics.ipynb",
-             "09_explore.ipynb", "10_flexure_stage_3d.ipynb"]
+             "09_explore.ipynb", "10_flexure_stage_3d.ipynb", "11_mechanism_exercises.ipynb"]
 
 
 def read(name):
