@@ -99,7 +99,7 @@ class Section:
         nu = self._mat().nu
         if self.shape == "rectangle":
             return 10 * (1 + nu) / (12 + 11 * nu)
-        if self.shape == "I-section":  # the web carries the shear
+        if self.shape in ("I-section", "channel"):  # the web carries the shear
             return 1.0 / self.shear_factor
         if self.shape == "circle":
             return 6 * (1 + nu) / (7 + 6 * nu)
@@ -108,9 +108,9 @@ class Section:
 
     def shear_areas(self) -> tuple:
         """(kAy, kAz): the shear areas along y and z (the shear stiffnesses kGAy, kGAz over G):
-        k A for both but the I-section's, whose web takes shear along y (hw tw) and its flanges
-        along z ((5/6) 2 b tf)."""
-        if self.shape == "I-section":
+        k A for both but the I-section's and the channel's, whose web takes shear along y (hw tw)
+        and their flanges along z ((5/6) 2 b tf)."""
+        if self.shape in ("I-section", "channel"):
             d = self.dims
             return (d["h"] - 2 * d["tf"]) * d["tw"], 5.0 / 6.0 * 2 * d["b"] * d["tf"]
         kA = self.shear_coefficient() * self.A
@@ -188,7 +188,7 @@ class Section:
         shear is exact where both peak together, e.g. the surface of a round section on the
         neutral axis, and an upper bound otherwise)."""
         T, Vy, Vz = (np.abs(np.asarray(v, dtype=float)) for v in (T, Vy, Vz))
-        if self.shape == "I-section":  # Vy in the web, Vz in the flanges (parabolic: 3/2 of the mean)
+        if self.shape in ("I-section", "channel"):  # Vy in the web, Vz in the flanges (3/2 of the mean)
             d = self.dims
             return T / self.Wt + np.maximum(Vy / ((d["h"] - 2 * d["tf"]) * d["tw"]), 1.5 * Vz / (2 * d["b"] * d["tf"]))
         return T / self.Wt + self.shear_factor * np.hypot(Vy, Vz) / self.A
@@ -196,8 +196,13 @@ class Section:
     @property
     def omega(self) -> float:
         """The largest sectorial coordinate (warping normal stress = bimoment · omega / Iw): b h/4
-        for the rectangle, b (h − tf)/4 at the flange tips of the I-section, 0 for round ones."""
+        for the rectangle, b (h − tf)/4 at the flange tips of the I-section, for the channel
+        (h'/2) max(e, b' − e) at a flange's corner or tip (about the shear centre, e from the
+        web), 0 for round ones."""
         d = self.dims
+        if self.shape == "channel":
+            e, bc = self.shear_centre, d["b"] - d["tw"] / 2
+            return (d["h"] - d["tf"]) / 2 * max(e, bc - e)
         return {"rectangle": lambda: d["b"] * d["h"] / 4, "I-section": lambda: d["b"] * (d["h"] - d["tf"]) / 4}.get(
             self.shape, lambda: 0.0)()
 
@@ -293,6 +298,35 @@ def i_beam(h, b, tw, tf, material: Material | None = None) -> Section:
     return Section("I-section", {"h": h, "b": b, "tw": tw, "tf": tf}, material, A=A, Iy=Iy, Iz=Iz, J=J,
                    Wy=Iy / (b / 2), Wz=Iz / (h / 2), Wt=J / max(tf, tw), shear_factor=A / (hw * tw), round_=False,
                    Iw=tf * b**3 * (h - tf) ** 2 / 24)
+
+
+def channel(h, b, tw, tf, material: Material | None = None) -> Section:
+    """A thin-walled channel (C- or U-section, fillets left out): depth ``h`` along y (the web),
+    flange width ``b`` along z from the web's outer face, web thickness ``tw``, flange
+    thickness ``tf``; symmetric about z. With hw = h − 2tf: A = 2 b tf + hw tw,
+    Iz = (b h³ − (b − tw) hw³)/12 (the strong axis), Iy about the centroid's axis along the web
+    (the centroid z̄ = (b² tf + hw tw²/2)/A from the web's face), J = (2 b tf³ + hw tw³)/3; on the
+    centre lines (flanges h' = h − tf apart, b' = b − tw/2 from the web's) the warping constant
+    about the shear centre Iw = tf b'³ h'² (3 b' tf + 2 h' tw) / (12 (6 b' tf + h' tw)) and the
+    shear centre e = 3 b'² tf / (6 b' tf + h' tw) from the web's centre line, on the side away
+    from the flanges (``shear_centre``). spacar's beams put the shear centre on their axis: a
+    load through the centroid of a channel would also twist it, which the beam leaves out."""
+    h, b, tw, tf = (_positive(v, name) for v, name in ((h, "h"), (b, "b"), (tw, "tw"), (tf, "tf")))
+    hw = h - 2 * tf
+    if not hw > 0 or tw >= b:
+        raise InputError(f"a channel needs h > 2 tf and tw < b, got h = {h:g}, b = {b:g}, tw = {tw:g}, tf = {tf:g}")
+    A = 2 * b * tf + hw * tw
+    zc = (b * b * tf + hw * tw * tw / 2) / A
+    Iz = (b * h**3 - (b - tw) * hw**3) / 12
+    Iy = 2 * (tf * b**3 / 12 + b * tf * (b / 2 - zc) ** 2) + hw * tw**3 / 12 + hw * tw * (tw / 2 - zc) ** 2
+    J = (2 * b * tf**3 + hw * tw**3) / 3
+    hc, bc = h - tf, b - tw / 2
+    Iw = tf * bc**3 * hc**2 * (3 * bc * tf + 2 * hc * tw) / (12 * (6 * bc * tf + hc * tw))
+    section = Section("channel", {"h": h, "b": b, "tw": tw, "tf": tf}, material, A=A, Iy=Iy, Iz=Iz, J=J,
+                      Wy=Iy / max(zc, b - zc), Wz=Iz / (h / 2), Wt=J / max(tf, tw), shear_factor=A / (hw * tw),
+                      round_=False, Iw=Iw)
+    section.shear_centre = 3 * bc**2 * tf / (6 * bc * tf + hc * tw)
+    return section
 
 
 # ------------------------------------------------------------------------------------------------

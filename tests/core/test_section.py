@@ -210,3 +210,51 @@ def test_i_beam_constants_against_the_profile_tables_and_a_fine_grid():
     assert s.shear_coefficient() == pytest.approx(0.183 * 5.6e-3 / s.A)
     with pytest.raises(spacar.InputError, match="h > 2 tf"):
         section.i_beam(h=0.01, b=0.1, tw=0.005, tf=0.006)
+
+
+def centre_line_warping(points, thicknesses):
+    """(Iw, shear centre (y, z), largest |ω|) of a thin-walled open section along the chain of its
+    centre line (points (y, z), one thickness per segment), by the sectorial coordinate: ω about
+    the centroid, made orthogonal (t-weighted) to 1, y and z; the shear centre from the removed
+    parts (ω_S = ω_B + (z_S − z_B)(y − y_B) − (y_S − y_B)(z − z_B) + c). Exact on straight segments."""
+    P = np.asarray(points, dtype=float)
+    t = np.asarray(thicknesses, dtype=float)
+    L = np.linalg.norm(np.diff(P, axis=0), axis=1)
+
+    def inner(f, g):  # ∫ f g t ds for f, g linear on each segment (values at the points)
+        return float(np.sum(t * L * (2 * f[:-1] * g[:-1] + f[:-1] * g[1:] + f[1:] * g[:-1] + 2 * f[1:] * g[1:]) / 6))
+    one = np.ones(len(P))
+    c = np.array([inner(P[:, k], one) for k in (0, 1)]) / inner(one, one)
+    r = P - c
+    omega = np.concatenate([[0.0], np.cumsum(r[:-1, 0] * np.diff(P[:, 1]) - r[:-1, 1] * np.diff(P[:, 0]))])
+    basis = [one, r[:, 0], r[:, 1]]
+    G = np.array([[inner(a, b) for b in basis] for a in basis])
+    coef = np.linalg.solve(G, [inner(omega, a) for a in basis])
+    normal = omega - sum(k * a for k, a in zip(coef, basis))
+    return inner(normal, normal), (c[0] + coef[2], c[1] - coef[1]), float(np.abs(normal).max())
+
+
+def test_channel_constants_against_the_sectorial_coordinate_and_its_rectangles():
+    """A channel 200 x 75 mm, web 8.5, flanges 11.5 mm: A, Iz, Iy, the centroid from its three
+    rectangles; Iw, the shear centre and the largest sectorial coordinate from the sectorial
+    coordinate of the centre lines integrated along the section (not the closed form)."""
+    h, b, tw, tf = 0.200, 0.075, 0.0085, 0.0115
+    s = section.channel(h, b, tw, tf, material=section.STEEL)
+    hw = h - 2 * tf
+    rects = [(b, tf, (h - tf) / 2, b / 2), (b, tf, -(h - tf) / 2, b / 2), (tw, hw, 0.0, tw / 2)]  # (width z, height y, y, z)
+    A = sum(w * t for w, t, _, _ in rects)
+    zc = sum(w * t * z for w, t, _, z in rects) / A
+    assert s.A == pytest.approx(A, rel=1e-14)
+    assert s.Iz == pytest.approx(sum(w * t**3 / 12 + w * t * y**2 for w, t, y, _ in rects), rel=1e-12)
+    assert s.Iy == pytest.approx(sum(t * w**3 / 12 + w * t * (z - zc) ** 2 for w, t, _, z in rects), rel=1e-12)
+    hc, bc = h - tf, b - tw / 2
+    Iw, (ys, zs), omega = centre_line_warping([(hc / 2, bc), (hc / 2, 0), (-hc / 2, 0), (-hc / 2, bc)], [tf, tw, tf])
+    assert s.Iw == pytest.approx(Iw, rel=1e-12)
+    assert ys == pytest.approx(0.0, abs=1e-15)
+    assert s.shear_centre == pytest.approx(-zs, rel=1e-12)      # outside, away from the flanges
+    assert s.omega == pytest.approx(omega, rel=1e-12)
+    assert s.beam_estiff(warping=True)[6] == pytest.approx(section.STEEL.E * s.Iw)
+    assert s.shear_areas()[0] == pytest.approx(hw * tw)
+    with pytest.raises(spacar.InputError, match="h > 2 tf and tw < b"):
+        section.channel(0.2, 0.005, 0.0085, 0.0115)
+
