@@ -7,11 +7,14 @@ nbconvert alone renders a widget (``spacar.explore``) as an empty box when the n
 widget state, and drops a plotly figure (``spacar.view3d``) it cannot represent. Here each
 output that has both a widget view and a static picture keeps the picture (``explore`` displays
 the PNG of its last state beside its widget), and each plotly figure becomes its self-contained
-HTML (plotly.js written once into the page, not fetched from a network). Needs nbconvert
-(``pip install ".[classroom]"``) and, for figures, plotly.
+HTML (plotly.js written once into the page, not fetched from a network). The equations of the
+markdown cells ($…$, $$…$$), which nbconvert leaves to MathJax fetched from a network (raw TeX
+offline), become MathML, which browsers draw themselves (with latex2mathml installed; it is in
+the classroom extra). Needs nbconvert (``pip install ".[classroom]"``) and, for figures, plotly.
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from .errors import InputError
@@ -43,6 +46,37 @@ def static_outputs(nb) -> int:
     return changed
 
 
+_DISPLAY = re.compile(r"\$\$(.+?)\$\$", re.S)
+_INLINE = re.compile(r"(?<![\\$])\$(?!\$)([^$]+?)(?<!\\)\$")
+
+
+def mathml_equations(nb) -> int:
+    """Replace, in place, the TeX equations of the markdown cells of ``nb`` by MathML (display
+    equations as blocks). Returns the number replaced; 0 without latex2mathml. An equation it
+    cannot convert stays as it was."""
+    try:
+        from latex2mathml.converter import convert
+    except ImportError:
+        return 0
+    count = 0
+
+    def replace(match, display):
+        nonlocal count
+        try:
+            math = convert(match.group(1).strip(), display="block" if display else "inline")
+        except Exception:  # noqa: BLE001 - any TeX it does not know: leave the equation as written
+            return match.group(0)
+        count += 1
+        return math
+    for cell in nb.get("cells", []):
+        if cell.get("cell_type") != "markdown":
+            continue
+        text = cell.get("source", "")
+        text = _DISPLAY.sub(lambda m: replace(m, True), text)
+        cell["source"] = _INLINE.sub(lambda m: replace(m, False), text)
+    return count
+
+
 def to_html(notebook, path=None) -> str:
     """The HTML page of a notebook (a path, its outputs as saved) with :func:`static_outputs`
     applied; written to ``path`` if given. Returns the page."""
@@ -59,6 +93,7 @@ def to_html(notebook, path=None) -> str:
     except Exception as err:  # nbformat raises its own and JSON errors
         raise InputError(f"{source}: not a readable notebook ({type(err).__name__}: {err})") from None
     static_outputs(nb)
+    mathml_equations(nb)
     html, _ = HTMLExporter().from_notebook_node(nb)
     if path is not None:
         from .io.files import write_replacing

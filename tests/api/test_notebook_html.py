@@ -81,3 +81,23 @@ def test_cli_writes_the_page(tmp_path):
     assert (tmp_path / "class.html").is_file() and "wrote" in out.stdout
     with pytest.raises(spacar.InputError, match="no such notebook"):
         to_html(tmp_path / "missing.ipynb")
+
+
+def test_equations_become_mathml_that_needs_no_network():
+    # nbconvert leaves $…$ to MathJax fetched from a network: raw TeX offline. The page of notebook
+    # 02 carries Freudenstein's equation and the ratios as MathML instead; code cells keep their $.
+    pytest.importorskip("latex2mathml")
+    from support.paths import ROOT
+
+    html = to_html(ROOT / "notebooks" / "02_fourbar.ipynb")
+    body = html.split("<body", 1)[1]
+    assert body.count("<math") == 3 and 'display="block"' in body
+    assert "$$" not in body and "\\psi" not in body
+    from spacar.notebook import mathml_equations
+
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_markdown_cell("costs $5 and $x^2$ and \\$3, $\\unknowncommand{x}$"),
+                nbformat.v4.new_code_cell("s = '$x$'")]
+    assert mathml_equations(nb) >= 1
+    assert "<math" in nb.cells[0].source and "\\$3" in nb.cells[0].source
+    assert nb.cells[1].source == "s = '$x$'"
