@@ -339,7 +339,7 @@ def explore(source, *, input=None, input_range=None, parameters=None, trace=(), 
 
 
 def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, stress_kind: str = "normal",
-           colorscale: str = "Plasma", mode=None, scale: float | None = None, frames: int = 0):
+           colorscale: str = "Plasma", mode=None, scale: float | None = None, frames: int = 0, links: bool = True):
     """The mechanism at output index ``k`` as an interactive plotly figure (turn, zoom, hover
     for names), one trace per drawn shape; without plotly the matplotlib drawing of
     :func:`spacar.draw` (a :class:`spacar.plotting.Scene`). ``stress``: the
@@ -349,7 +349,9 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
     ``Linearization.mode_shapes()[2][:, i]``) added to that state times ``scale`` (as in
     :func:`spacar.draw`); with ``frames`` ≥ 2 it is animated, times cos(2π j / frames) (the
     still picture, frame 0, at the largest amplitude), with a play button and a slider (the
-    animation is kept in the figure's HTML)."""
+    animation is kept in the figure's HTML). ``links``: a robot read by :func:`spacar.from_urdf`
+    has its links drawn as surfaces too, its URDF <visual> shapes (boxes, cylinders, spheres; meshes
+    with trimesh installed, see :mod:`spacar.visuals`)."""
     from .plotting import _displaced, _stress_values, mode_phases
     from .results import require_results
 
@@ -375,8 +377,12 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
     coords = frame_coordinates(res.node_columns, res.x[k])
     pts = np.vstack([p for n, p in coords.items() if res.geometry.node_kinds.get(n) in ("XY", "XYZ")])
     size = float(np.ptp(pts, axis=0).max()) or 1.0
-    traces = [_view3d_traces(go, res.geometry, frame_coordinates(res.node_columns, x), size, beam_points, values,
-                             colorscale, stress_kind) for x in rows]
+    robot = getattr(res, "shapes", None) if links else None
+    traces = []
+    for x in rows:
+        coords = frame_coordinates(res.node_columns, x)
+        traces.append(_view3d_traces(go, res.geometry, coords, size, beam_points, values, colorscale, stress_kind)
+                      + ([] if robot is None else _link_surfaces(go, robot, coords)))
     fig = go.Figure(data=traces[0])
     fig.update_layout(scene=dict(aspectmode="data"), title=f"t = {time:.4g} s", margin=dict(l=0, r=0, t=30, b=0))
     if len(traces) > 1:
@@ -388,6 +394,16 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
             sliders=[dict(steps=[dict(method="animate", label=str(j), args=[[str(j)], dict(mode="immediate")])
                                  for j in range(len(traces))], x=0.1, len=0.9, currentvalue=dict(prefix="frame "))])
     return fig
+
+
+def _link_surfaces(go, robot, coords) -> list:
+    """The plotly surfaces of a URDF robot's link shapes at a state ({node: coordinates})."""
+    out = []
+    for link, role, V, F in robot.surfaces(coords):
+        out.append(go.Mesh3d(x=V[:, 0], y=V[:, 1], z=V[:, 2], i=F[:, 0], j=F[:, 1], k=F[:, 2], name=f"link {link}",
+                             color="#9ecae1" if role == "visual" else "#c7c7c7", opacity=0.5, flatshading=True,
+                             hoverinfo="name", showlegend=False))
+    return out
 
 
 def _view3d_traces(go, geometry, coords, size, beam_points, values, colorscale, stress_kind) -> list:

@@ -484,7 +484,8 @@ class Model:
         other.state_space_outputs = dict(self.state_space_outputs)
         other._prescribed = dict(self._prescribed)
         other._prescribed_lines = self._prescribed_lines
-        copies = {"urdf_joints": list, "urdf_links": dict, "urdf_base": lambda base: base}  # set by spacar.from_urdf
+        copies = {"urdf_joints": list, "urdf_links": dict, "urdf_base": lambda base: base,   # set by spacar.from_urdf
+                  "urdf_shapes": lambda shapes: shapes}
         for name, copy in copies.items():
             if hasattr(self, name):
                 setattr(other, name, copy(getattr(self, name)))

@@ -201,6 +201,7 @@ class Results:
             else _int_pairs(deformation_labels)
         self.stats = dict(stats)
         self.geometry = geometry
+        self.shapes = None  # a URDF robot's link shapes (spacar.visuals.RobotShapes), set by simulate
         self._lookup = None  # {label: column} of x and of e, made at the first lookup
         self._set_dofs(dof_labels)
 

@@ -55,6 +55,7 @@ _SAME_POINT = 1e-12
 @dataclass
 class _Link:
     name: str
+    shapes: list = field(default_factory=list)   # spacar.visuals.Shape: <visual> and <collision>
     mass: float = 0.0
     com: np.ndarray = field(default_factory=lambda: np.zeros(3))       # in the link frame
     inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))  # about the COM, in the link frame
@@ -141,6 +142,7 @@ class _Reader:
 
     def link(self, elem) -> _Link:
         link = _Link(self.name(elem, "link"))
+        link.shapes = self.shapes(elem, link.name)
         inertial = elem.find("inertial")
         if inertial is None:
             return link
@@ -158,6 +160,37 @@ class _Reader:
         R = rpy_matrix(rpy)
         link.com, link.inertia = xyz, R @ J @ R.T
         return link
+
+    def shapes(self, elem, link) -> list:
+        """The link's <visual> and <collision> geometries (spacar.visuals.Shape), for drawing."""
+        from .visuals import Shape, resolve
+
+        out = []
+        for role in ("visual", "collision"):
+            for k, v in enumerate(elem.findall(role)):
+                where = f"link {link!r} <{role}> {k + 1}"
+                xyz, rpy = self.origin(v, where)
+                geometry = v.find("geometry")
+                shape = None if geometry is None else next(iter(geometry), None)
+                if shape is None:
+                    continue
+                if shape.tag == "box":
+                    size = tuple(self.numbers(shape, "size", 3, (0, 0, 0), where))
+                elif shape.tag == "cylinder":
+                    size = (float(self.numbers(shape, "radius", 1, (0,), where)[0]),
+                            float(self.numbers(shape, "length", 1, (0,), where)[0]))
+                elif shape.tag == "sphere":
+                    size = (float(self.numbers(shape, "radius", 1, (0,), where)[0]),)
+                elif shape.tag == "mesh" and shape.get("filename"):
+                    size = tuple(self.numbers(shape, "scale", 3, (1, 1, 1), where))
+                    out.append(Shape(link, role, "mesh", size, (tuple(xyz), tuple(rpy)),
+                                     resolve(shape.get("filename"), self.path)))
+                    continue
+                else:
+                    self.warnings.append(f"{where}: a <{shape.tag}> geometry is not drawn")
+                    continue
+                out.append(Shape(link, role, shape.tag, size, (tuple(xyz), tuple(rpy))))
+        return out
 
     def joint(self, elem, links) -> _Joint:
         name = self.name(elem, "joint")
@@ -221,10 +254,10 @@ class _Reader:
 
     def ignored(self, root):
         """Warnings for what a dynamic model of rigid bodies leaves out."""
-        geometry = sum(len(link.findall(t)) for link in root.findall("link") for t in ("visual", "collision"))
+        geometry = sum(len(link.findall("collision")) for link in root.findall("link"))
         if geometry:
-            self.warnings.append(f"{geometry} <visual>/<collision> geometries (meshes, shapes) are not imported: "
-                                 "the model holds the links' inertias only")
+            self.warnings.append(f"{geometry} <collision> geometries are not used for contact: the model has none "
+                                 "(spacar.view3d draws the <visual> shapes)")
         for tag, text in (("transmission", "transmissions (actuators) are not imported"),
                           ("gazebo", "<gazebo> extensions are ignored")):
             n = len(root.findall(tag))
@@ -443,6 +476,11 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, max_by
         # robot (before the first END they would change its geometry instead).
         m.prepare()
     m.urdf_links = link_nodes
+    from .visuals import RobotShapes
+
+    shapes = [shape for link in links.values() for shape in link.shapes]
+    m.urdf_shapes = RobotShapes(shapes, {name: (*link_nodes[name], frame[name][0]) for name in link_nodes}) \
+        if shapes else None
     for w in reader.warnings:
         m.warnings.append(f"{reader.path}: {w}")
         warnings.warn(f"{reader.path}: {w}", stacklevel=2)

@@ -84,6 +84,7 @@ def test_what_is_left_out_is_reported(tmp_path):
     path = tmp_path / "mimic.urdf"
     path.write_text("""<robot name="r"><link name="a"/>
       <link name="b"><visual><geometry><mesh filename="b.stl"/></geometry></visual>
+        <collision><geometry><box size="1 1 1"/></geometry></collision>
         <inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
       <link name="c"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
       <joint name="j1" type="continuous"><parent link="a"/><child link="b"/><dynamics damping="0.5"/></joint>
