@@ -124,7 +124,7 @@ class Flexure:
         return self._new_body(name or f"body {len(self.bodies)}", at, mass, inertia, fixed=False)
 
     def beam(self, body_a: Body, body_b: Body, a, b, section: Section, *, n: int = 8, y=None,
-             kind: str = "beam") -> Beam:
+             kind: str = "beam", _stations=None) -> Beam:
         """A flexible beam from point ``a`` of ``body_a`` to point ``b`` of ``body_b``, meshed
         into ``n`` elements of the cross-section ``section`` (its ESTIFF, and its EMASS when the
         material has a density), or of the ``n`` sections of a list, from ``a`` to ``b`` (a
@@ -153,7 +153,8 @@ class Flexure:
         ends = [self._attach(body_a, a, arms), self._attach(body_b, b, arms)]
         nodes, rotations = [ends[0][0]], [ends[0][1]]
         for k in range(1, n):
-            node, rotation = self._new_point(tuple(float(v) for v in np.add(a, axis * (k / n))))
+            fraction = k / n if _stations is None else float(_stations[k])   # of the way from a to b
+            node, rotation = self._new_point(tuple(float(v) for v in np.add(a, axis * fraction)))
             self._dynamic.update((node, rotation))
             nodes.append(node)
             rotations.append(rotation)
@@ -184,22 +185,27 @@ class Flexure:
         return self.beam(body_a, body_b, a, b, section, n=n, y=thickness, kind="leaf spring")
 
     def notch_hinge(self, body_a: Body, body_b: Body, at, direction, *, radius: float, thickness: float,
-                    width: float, material, n: int = 40, thickness_axis=None, depth: float | None = None) -> Beam:
+                    width: float, material, n: int = 40, thickness_axis=None, depth: float | None = None,
+                    length: float = 0.0) -> Beam:
         """A notch hinge: material of width ``width`` between two cuts that leave ``thickness`` at
-        ``at``, joining ``body_a`` (at ``at − radius · d``) to ``body_b`` (at ``at + radius · d``),
-        ``d`` the unit ``direction`` through the hinge from a to b; in space ``thickness_axis``
-        is the direction across the thin section. The cuts are circles of radius ``radius``
-        (right-circular), or with ``depth`` ellipses of semi-axes ``radius`` along the hinge and
-        ``depth`` across it. Meshed into ``n`` short beams of rectangular section, each as thick
-        as the profile t(x) = thickness + 2 depth (1 − √(1 − (x/radius)²)) at its middle: its
-        compliance is the midpoint sum of Euler–Bernoulli's ∫ dx / E I(x) (for circles Paros and
-        Weisbord's closed form), to 1e-5 with the default 40 (docs/flexures.md)."""
+        ``at``, joining ``body_a`` (at ``at − (length/2 + radius) · d``) to ``body_b`` (at
+        ``at + (length/2 + radius) · d``), ``d`` the unit ``direction`` through the hinge from a to
+        b; in space ``thickness_axis`` is the direction across the thin section. The cuts are
+        circles of radius ``radius`` (right-circular), or with ``depth`` ellipses of semi-axes
+        ``radius`` along the hinge and ``depth`` across it; with ``length`` > 0 the thin section
+        runs straight over that length, the cuts its rounded ends (a corner-filleted hinge of
+        fillet radius ``radius``). Meshed into ``n`` short beams of rectangular section, each as
+        thick as the profile t(x) = thickness + 2 depth (1 − √(1 − (u/radius)²)), u = max(0,
+        |x| − length/2), at its middle: its compliance is the midpoint sum of Euler–Bernoulli's
+        ∫ dx / E I(x) (for circles Paros and Weisbord's closed form, for corner fillets
+        Lobontiu's), to 1e-5 with the default 40 (docs/flexures.md)."""
         from .section import Material, rectangle
 
         R = _positive(radius, "radius")
         b = R if depth is None else _positive(depth, "depth")
         t = _positive(thickness, "thickness")
         w = _positive(width, "width")
+        flat = _positive(length, "length", zero=True)
         if not isinstance(material, Material):
             raise InputError(f"material must be a spacar.section.Material, got {show(material)}")
         n = _element_count(n)
@@ -208,13 +214,24 @@ class Flexure:
         if not np.linalg.norm(d) > 0:
             raise InputError("direction must not be zero")
         d = d / np.linalg.norm(d)
-        x = -R + (np.arange(n) + 0.5) * (2 * R / n)              # the middles of the pieces
-        profile = t + 2 * b * (1 - np.sqrt(1 - (x / R) ** 2))
+        half = flat / 2 + R
+        if flat > 0:  # a quarter of the pieces in each fillet, the rest on the straight part
+            if n < 3:
+                raise InputError(f"a notch hinge with a straight part (length > 0) needs n ≥ 3 pieces, got {n}")
+            fillet = max(1, n // 4)
+            edges = np.concatenate([np.linspace(-half, -flat / 2, fillet + 1),
+                                    np.linspace(-flat / 2, flat / 2, n - 2 * fillet + 1)[1:-1],
+                                    np.linspace(flat / 2, half, fillet + 1)])
+        else:
+            edges = np.linspace(-half, half, n + 1)
+        x = (edges[:-1] + edges[1:]) / 2                          # the middles of the pieces
+        u = np.maximum(np.abs(x) - flat / 2, 0.0)
+        profile = t + 2 * b * (1 - np.sqrt(1 - (u / R) ** 2))
         sections = [rectangle(b=w, h=float(h), material=material) for h in profile]
         if self.spatial and thickness_axis is None:
             raise InputError("a notch hinge in space needs the direction across its thin section: thickness_axis=(x, y, z)")
-        return self.beam(body_a, body_b, tuple(at - R * d), tuple(at + R * d), sections, n=n, y=thickness_axis,
-                         kind="notch hinge")
+        return self.beam(body_a, body_b, tuple(at - half * d), tuple(at + half * d), sections, n=n, y=thickness_axis,
+                         kind="notch hinge", _stations=(edges + half) / (2 * half))
 
     def wire(self, body_a: Body, body_b: Body, a, b, section: Section, *, n: int = 8) -> Beam:
         """A wire flexure (a slender rod of a round section) from ``a`` on ``body_a`` to ``b`` on

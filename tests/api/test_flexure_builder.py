@@ -329,3 +329,43 @@ def test_warping_leaves_are_beamws_held_at_their_clamps():
     assert C[4, 4] < (1 - 1e-4) * C_beam[4, 4]
     with pytest.raises(spacar.InputError, match="warping=True meshes the flexures with BEAMW, in space"):
         flexure.Flexure(warping=True)
+
+
+def test_corner_filleted_hinge():
+    """A corner-filleted hinge (a thin section 0.5 mm thick running straight over l, fillets of
+    radius 1 mm into the bodies): its rotational compliance is the quadrature of ∫ dx / E I(x)
+    over the profile to 1e-4 with 40 pieces, 3e-5 with 80; long, it tends to the straight
+    section's 12 l / (E w t³) plus the two fillets; with l = 0 it is the right-circular hinge."""
+    from scipy.integrate import quad
+
+    R, t, w, E = 0.001, 0.0005, 0.01, section.STEEL.E
+
+    def compliance(length, n):
+        fx = flexure.Flexure()
+        body = fx.body(at=(0.0, length / 2 + R + 0.01))
+        hinge = fx.notch_hinge(fx.ground, body, (0.0, 0.0), (0.0, 1.0), radius=R, thickness=t, width=w,
+                               material=section.STEEL, n=n, length=length)
+        return spacar.compliance(fx.model(), body.rotation_node)[0, 0], hinge
+
+    def quadrature(length):
+        profile = lambda x: t + 2 * (R - np.sqrt(R * R - (abs(x) - length / 2) ** 2))  # noqa: E731 - the fillet
+        fillet = quad(lambda x: 12 / (E * w * profile(x) ** 3), length / 2, length / 2 + R, limit=400, epsrel=1e-14)[0]
+        return 2 * fillet + 12 * length / (E * w * t**3)
+    for length in (0.005, 0.001):
+        exact = quadrature(length)
+        assert compliance(length, 40)[0] == pytest.approx(exact, rel=1e-4)
+        assert compliance(length, 80)[0] == pytest.approx(exact, rel=3e-5)
+    C, hinge = compliance(0.005, 40)
+    ends = [np.asarray(p) for p in (hinge.a, hinge.b)]
+    assert np.linalg.norm(ends[1] - ends[0]) == pytest.approx(0.005 + 2 * R)
+    assert compliance(0.0, 40)[0] == pytest.approx(spacar.compliance(*_circular(R, t, w)), rel=1e-12)
+    with pytest.raises(spacar.InputError, match="length must be a non-negative number"):
+        compliance(-1.0, 40)
+
+
+def _circular(R, t, w):
+    fx = flexure.Flexure()
+    body = fx.body(at=(0.0, R + 0.01))
+    fx.notch_hinge(fx.ground, body, (0.0, 0.0), (0.0, 1.0), radius=R, thickness=t, width=w, material=section.STEEL,
+                   n=40)
+    return fx.model(), body.rotation_node
