@@ -330,23 +330,30 @@ def _add_damping(ss: StateSpace, ratios, alpha: float, beta: float) -> StateSpac
         raise SingularMassError("state_space: damping= and rayleigh= need masses: no node or element of the model "
                                 "carries mass")
     n = M.shape[0]
-    extra = alpha * M + beta * K
-    if ratios is not None:
-        w2, phi = _mass_normalized_modes(M, K)
-        zeta = np.zeros(n)
-        if ratios.ndim == 0:
-            zeta[:] = ratios
-        else:
-            if len(ratios) > n:
-                raise InputError(f"state_space: damping gives {len(ratios)} modal ratios for {n} modes")
-            zeta[:len(ratios)] = ratios
-        Mphi = M @ phi
-        extra = extra + Mphi @ np.diag(2.0 * zeta * np.sqrt(np.abs(w2))) @ Mphi.T
-    C = C + extra
+    C = C + _added_damping(M, K, ratios, alpha, beta)
     A = ss.A.copy()
     A[n:, n:] = -np.linalg.solve(M, C)
     return StateSpace(A, ss.B, ss.C, ss.D, ss.state_labels, ss.input_labels, ss.output_labels, ss.t,
                       ss.linearization, (M, C, K, Q))
+
+
+def _added_damping(M, K, ratios, alpha: float, beta: float) -> np.ndarray:
+    """The damping matrix of damping= and rayleigh=: α M + β K plus M Φ diag(2 ζ ω) Φᵀ M over the
+    undamped modes Φᵀ M Φ = I (the modal ratios ζ, one for all or the lowest modes')."""
+    extra = alpha * M + beta * K
+    if ratios is None:
+        return extra
+    n = M.shape[0]
+    w2, phi = _mass_normalized_modes(M, K)
+    zeta = np.zeros(n)
+    if ratios.ndim == 0:
+        zeta[:] = ratios
+    elif len(ratios) > n:
+        raise InputError(f"state_space: damping gives {len(ratios)} modal ratios for {n} modes")
+    else:
+        zeta[:len(ratios)] = ratios
+    Mphi = M @ phi
+    return extra + Mphi @ np.diag(2.0 * zeta * np.sqrt(np.abs(w2))) @ Mphi.T
 
 
 def _mass_normalized_modes(M, K):
@@ -707,18 +714,7 @@ def _build_base(lin, sim, inputs, outputs, ratios, alpha, beta) -> StateSpace:
     Q = Z.T @ F
     # Added damping (damping=, rayleigh=) acts on the motion relative to the quasi-static one
     # that follows the supports (z = −K⁻¹ K_u u): a support's rigid motion is not damped.
-    extra = alpha * M + beta * K
-    if ratios is not None:
-        w2, phi = _mass_normalized_modes(M, K)
-        zeta = np.zeros(n)
-        if ratios.ndim == 0:
-            zeta[:] = ratios
-        elif len(ratios) > n:
-            raise InputError(f"state_space: damping gives {len(ratios)} modal ratios for {n} modes")
-        else:
-            zeta[:len(ratios)] = ratios
-        Mphi = M @ phi
-        extra = extra + Mphi @ np.diag(2.0 * zeta * np.sqrt(np.abs(w2))) @ Mphi.T
+    extra = _added_damping(M, K, ratios, alpha, beta)
     reactions = [sig for sig in outputs if sig.keyword == "OUTR"]
     if reactions and (alpha or ratios is not None):
         raise InputError(f"{_where(reactions[0])}: a reaction with modal or mass-proportional added damping is not "
