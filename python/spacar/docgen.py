@@ -51,8 +51,8 @@ NOTES = {
     "INPUTF": "Modern SPACAR's name. A force on a BETA coordinate is a torque, on LAMBDA coordinates a λ-force.",
     "INPUTS": "σ is dual to e as the stresses of FORCEMODE: a PLHINGE input exerts the torque −u on its second node. "
               "An input motion (INPUTE) has no such input: make it DYNE for the state-space model.",
-    "BASEX": "Extension. A support's motion: see [linearization.md](linearization.md#state-space-models), *Base motion*.",
-    "OUTR": "Extension. The reaction of FORCEMODE (Σ Bᵀσ − f), linearized; at a state at rest.",
+    "BASEX": "A support's motion: see [linearization.md](linearization.md#state-space-models), *Base motion*.",
+    "OUTR": "The reaction of FORCEMODE (Σ Bᵀσ − f), linearized; at a state at rest.",
     "OUTX": "Outputs and inputs must be numbered 1, 2, ... without gaps; a later line with the same k replaces it.",
     "OUTE": "For nonholonomic models the position outputs OUTX and OUTE are refused (their dependence on the "
             "kinematic coordinates is not computed); the rates OUTXP and OUTEP are available.",

@@ -498,20 +498,25 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
 
 
 def _massless_directions(M):
-    """(V, N): orthonormal bases of the directions of z with mass and without (M N = 0), or None
-    when M is regular."""
-    w, basis = np.linalg.eigh((M + M.T) / 2)
-    heavy = w > 1e-12 * max(w.max(initial=0.0), 1e-300)
+    """(V, N): bases of the directions of z with mass and without (M N = 0), or None when M is
+    regular. Decided on M scaled to a unit diagonal (D^-½ M D^-½; its zero rows are the DOFs
+    without any mass), where translations and rotations, light and heavy parts compare: a model
+    whose every DOF carries mass is not condensed however ill-conditioned its M is."""
+    d = np.diag(M).copy()
+    s = np.where(d > 0, 1.0 / np.sqrt(np.where(d > 0, d, 1.0)), 1.0)
+    w, basis = np.linalg.eigh(s[:, None] * ((M + M.T) / 2) * s[None, :])
+    heavy = w > 1e-13 * max(w.max(initial=0.0), 1e-300)
     if heavy.all():
         return None
-    return basis[:, heavy], basis[:, ~heavy]
+    return s[:, None] * basis[:, heavy], s[:, None] * basis[:, ~heavy]
 
 
 def _build_condensed(lin, inputs, outputs, Q, sens, V, N) -> StateSpace:
     """The state space of a model with massless degrees of freedom (a flexure whose leaves carry
     no mass, its stage a point mass): the massless directions N follow the others statically,
     z = T a + S u with T = V − N (Nᵀ K N)⁻¹ Nᵀ K V, S = N (Nᵀ K N)⁻¹ Nᵀ Q (exact when no damping
-    acts in them), and the states are a, ȧ in the directions V with mass."""
+    acts in them), and the states are a, ȧ in the directions V with mass, whose equations
+    Vᵀ (M z̈ + C ż + K z − Q u) = 0 remain (K need not be symmetric)."""
     M, C, K = lin.M0, lin.damping, lin.stiffness
     size = max(np.abs(C).max(initial=0.0), 1e-300)
     if np.abs(N.T @ C).max(initial=0.0) > 1e-12 * size or np.abs(C @ N).max(initial=0.0) > 1e-12 * size:
@@ -527,7 +532,7 @@ def _build_condensed(lin, inputs, outputs, Q, sens, V, N) -> StateSpace:
     T = V - N @ follow[:, :V.shape[1]]
     S = N @ follow[:, V.shape[1]:]
     n, m = V.shape[1], len(inputs)
-    Mr, Cr, Kr, Qr = T.T @ M @ T, T.T @ C @ T, T.T @ K @ T, T.T @ Q
+    Mr, Cr, Kr, Qr = V.T @ M @ T, V.T @ C @ T, V.T @ K @ T, V.T @ (Q - K @ S)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(Mr, Kr), -np.linalg.solve(Mr, Cr)]])
     B = np.vstack([np.zeros((n, m)), np.linalg.solve(Mr, Qr)])
     Cm = np.zeros((len(outputs), 2 * n))
@@ -695,7 +700,7 @@ def _build_base(lin, sim, inputs, outputs, ratios, alpha, beta) -> StateSpace:
         if sig.keyword == "INPUTF":
             if not np.any(Z[i]):
                 raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
-                                 "input coordinate)")
+                                 "input coordinate, or one the constraints hold still)")
             F[i, j] = 1.0
         else:
             if def_class[i] not in (_core.DefClass.released, _core.DefClass.dynamic):
@@ -769,6 +774,10 @@ def _reaction_row(sig, g, coord_class, def_class, B) -> np.ndarray:
 def _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forces, lin) -> StateSpace:
     """A, B, C, D of the equations with the supports' motion (see _build_base)."""
     n = M.shape[0]
+    if _massless_directions(M) is not None:
+        raise SingularMassError("state_space: the supports' motion and the accelerations and reactions need every "
+                                "degree of freedom to carry mass (the reduced mass matrix is singular): give the "
+                                "massless parts their EMASS")
     order = np.array([_BASE_ORDER[s.keyword] for s in base], dtype=int)
     o0, o1, o2 = (np.nonzero(order == k)[0] for k in (0, 1, 2))
     Mi = np.linalg.inv(M)
@@ -810,6 +819,13 @@ def _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forc
     cz, czd, czdd = rows["x"] @ Z, rows["v"] @ Z, rows["a"] @ Z
     cu, cud, cudd = rows["x"] @ U, rows["v"] @ U, rows["a"] @ U
     G = czdd @ Mi
+    # The size of the terms that make up the coefficients of u̇ and ü, against which a remainder
+    # counts as a real dependence (rather than their rounding) for the properness check below.
+    # (The bounds of the products' rounding: each factor taken by its size.)
+    absG = np.abs(czdd) @ np.abs(Mi)
+    abs_czd = np.abs(czd) + absG @ np.abs(C)
+    size_ud = np.abs(rows["v"]) @ np.abs(U) + absG @ np.abs(Cu)
+    size_udd = np.abs(rows["a"]) @ np.abs(U) + absG @ np.abs(Mu)
     cz, czd = cz - G @ K, czd - G @ C
     cu, cud, cudd = cu - G @ Ku, cud - G @ Cu, cudd - G @ Mu
     cf = cf + G @ Q
@@ -820,6 +836,7 @@ def _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forc
     for a, j in enumerate(o0):
         Dm[:, col[("u", j)]] += -cz @ Mi @ Mu[:, j] + czd @ Mi @ E0[:, a]
         cud[:, j] = cud[:, j] - czd @ Mi @ Mu[:, j]
+        size_ud[:, j] += abs_czd @ (np.abs(Mi) @ np.abs(Mu[:, j]))
     for j in o1:
         Dm[:, col[("u", j)]] += -czd @ Mi @ Mu[:, j]
     for j in range(len(forces)):
@@ -834,10 +851,9 @@ def _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forc
     for j in o0:
         Dm[:, col[("u", j)]] += cu[:, j]
     # A derivative of an input the realization does not have: improper.
-    scale = max(np.abs(Cm).max(initial=0.0), np.abs(Dm).max(initial=0.0), 1e-300)
-    for what, coefficient, orders in (("rate", cud, (0,)), ("acceleration", cudd, (0, 1))):
+    for what, coefficient, size, orders in (("rate", cud, size_ud, (0,)), ("acceleration", cudd, size_udd, (0, 1))):
         for j in np.nonzero(np.isin(order, orders))[0]:
-            bad = np.nonzero(np.abs(coefficient[:, j]) > 1e-12 * scale)[0]
+            bad = np.nonzero(np.abs(coefficient[:, j]) > 1e-8 * size[:, j])[0]
             if bad.size:
                 raise InputError(f"{_where(outputs[bad[0]])}: this output follows the {what} of input "
                                  f"{_where(base[j])} (its response is not proper): take the velocity or acceleration "
@@ -873,6 +889,18 @@ def _sensitivities(lin, outputs, velocities) -> dict:
     # At rest (no coordinate moving: ż = 0 and the input motions still) the convective terms
     # vanish; a Linearization alone does not say.
     at_rest = velocities is not None and not np.any(np.asarray(velocities[0].data.xd))
+    nodal = lin.__dict__.get("nodal")
+    if stresses and at_rest and nodal is not None:
+        # δσ = S δe + Dc δė with δe = B DF δz: exact, from the nodal matrices (no differences,
+        # no equations of motion: a model with massless DOFs too).
+        for sig in stresses:
+            c = velocities[0].system.def_class[lin.deformation_labels.index((sig.number, sig.index))]
+            if c not in (_core.DefClass.released, _core.DefClass.dynamic):
+                raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
+                                 "constitutive, σ = S e + D ė); this one is a reaction stress")
+        BDF = nodal.B @ lin.DF
+        out["sigma"], out["sigma_d"] = np.asarray(nodal.S @ BDF), np.asarray(nodal.Dc @ BDF)
+        stresses = []
     needed = stresses + ([] if at_rest else rates) + (positions if k else [])
     if not needed:
         return out

@@ -161,3 +161,33 @@ def test_bad_base_signals_are_refused_by_name():
         spacar.state_space(isolator(), inputs=[("BASEXPP", 1, 1)], outputs=[("OUTR", 3, 1)])
     with pytest.raises(spacar.InputError, match="no modes="):
         spacar.state_space(isolator(), inputs=[("BASEXPP", 1, 1)], outputs=[("OUTX", 3, 1)], modes=1)
+
+
+def test_a_steel_cantilevers_acceleration_under_a_velocity_input_is_refused():
+    # Element masses couple the floor's acceleration straight into the node's (D of BASEXPP is
+    # −0.179 here): under the floor's velocity the node's acceleration follows its derivative.
+    m = spacar.Model()
+    EA, EI, rhoA = 2.1e11 * 1e-4, 2.1e11 * 1e-8 / 12, 7800 * 1e-4
+    for k in range(1, 41):
+        m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
+        m.x(2 * k + 1, k * 0.5 / 40, 0.0)
+        m.estiff(k, EA, EI)
+        m.emass(k, rhoA)
+        m.dyne(k, 1, 2, 3)
+        m.edampp(k, 1e-5 * EA, 1e-5 * EI)
+    m.x(1, 0.0, 0.0)
+    m.inputx(1, 1)
+    m.fix(1, 2)
+    m.fix(2)
+    accel = spacar.state_space(m, inputs=[("BASEXPP", 1, 1)], outputs=[("OUTXPP", 3, 1)])
+    assert abs(accel.D[0, 0]) > 0.1
+    with pytest.raises(spacar.InputError, match="OUTXPP 3 1: this output follows the acceleration of input BASEXP"):
+        spacar.state_space(m, inputs=[("BASEXP", 1, 1)], outputs=[("OUTXPP", 3, 1)])
+
+
+def test_massless_degrees_of_freedom_under_a_moving_support_are_refused():
+    guide = spacar.read("examples/parallel_leaf_guide.dat")
+    guide.mass(9, 0.2)
+    spacar.static(guide)
+    with pytest.raises(spacar.SingularMassError, match="every degree of freedom to carry mass"):
+        spacar.state_space(guide, inputs=[("INPUTF", 9, 1)], outputs=[("OUTXPP", 9, 1)])

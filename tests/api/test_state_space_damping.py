@@ -192,3 +192,65 @@ def test_massless_degrees_of_freedom_with_damping_are_refused():
     spacar.static(guide)
     with pytest.raises(spacar.InputError, match="without mass but with damping"):
         spacar.state_space(guide, inputs=[("INPUTF", 9, 1)], outputs=[("OUTX", 9, 1)])
+
+
+def massless_arm(torque=None):
+    """Two massless BEAMs with a mass and inertia at the tip; a dead moment at the middle (TORQUEG
+    makes the tangent unsymmetric)."""
+    m = spacar.Model()
+    m.beam(1, 1, 2, 3, 4, 0, 1, 0)
+    m.beam(2, 3, 4, 5, 6, 0, 1, 0)
+    m.x(1, 0, 0, 0)
+    m.x(3, 0.5, 0, 0)
+    m.x(5, 1.0, 0, 0)
+    m.fix(1)
+    m.fix(2)
+    for e in (1, 2):
+        m.dyne(e, 1, 2, 3, 4, 5, 6)
+        m.estiff(e, 1e5, 40.0, 60.0, 50.0)
+    m.mass(5, 1.5)
+    m.mass(6, 0.02, 0, 0, 0.03, 0, 0.025)
+    if torque:
+        m.torqueg(4, *torque)
+    spacar.static(m)
+    return m
+
+
+@pytest.mark.parametrize("torque", [None, (0.0, 20.0, 15.0)])
+def test_massless_directions_condensed_with_an_unsymmetric_stiffness(torque):
+    # Against the direct solve of (K − ω²M + iωC) z = Q u, which needs no M⁻¹ (inputs on the
+    # massless middle node and on the tip).
+    m = massless_arm(torque)
+    inputs = [("INPUTF", 3, 2), ("INPUTF", 3, 3), ("INPUTF", 5, 2)]
+    outputs = [("OUTX", 5, 2), ("OUTX", 5, 3), ("OUTX", 3, 2)]
+    lin = spacar.linearize(m)
+    M, C, K = lin.M0, lin.damping, lin.stiffness
+    Q = lin.DF[[lin.coordinate_labels.index((n, i)) for _, n, i in inputs]].T
+    out = lin.DF[[lin.coordinate_labels.index((n, i)) for _, n, i in outputs]]
+    f = np.array([0.0, 0.5, 2.0, 5.0])
+    direct = np.array([out @ np.linalg.solve(K - (2 * np.pi * v) ** 2 * M + 2j * np.pi * v * C, Q) for v in f])
+    ss = spacar.state_space(m, inputs=inputs, outputs=outputs)
+    assert ss.A.shape == (12, 12)     # the tip's six directions with mass
+    assert ss.frequency_response(f) == pytest.approx(direct, rel=1e-12, abs=1e-12 * np.abs(direct).max())
+
+
+def test_stress_outputs_of_massless_leaves_and_an_ill_conditioned_mass_kept():
+    # The stress of a massless leaf under the drive force (from the nodal S, B and DF: no motion
+    # to evaluate), equal to the static stress per unit force.
+    guide = spacar.read("examples/parallel_leaf_guide.dat")
+    guide.mass(9, 0.2)
+    spacar.static(guide)
+    ss = spacar.state_space(guide, inputs=[("INPUTF", 9, 1)], outputs=[("OUTS", 1, 2)])
+    unit = spacar.read("examples/parallel_leaf_guide.dat")       # 1 N on the stage
+    loaded = spacar.static(unit)
+    assert ss.static_gain()[0, 0] == pytest.approx(loaded.stress(1, 2)[-1], rel=1e-3)   # (geometric nonlinearity)
+    # Leaves with their steel mass (light against the stage): every DOF carries mass, however
+    # ill-conditioned M0 is; the model keeps all its states.
+    from spacar import section
+
+    heavy = spacar.read("examples/parallel_leaf_guide.dat")
+    section.rectangle(0.02, 0.5e-3, section.STEEL).apply(heavy, *range(1, 9))
+    heavy.mass(9, 2.0)
+    spacar.static(heavy)
+    full = spacar.state_space(heavy, inputs=[("INPUTF", 9, 1)], outputs=[("OUTX", 9, 1)])
+    assert full.A.shape[0] == 2 * len(spacar.linearize(heavy).z_labels)
