@@ -198,7 +198,8 @@ class Flexure:
         thick as the profile t(x) = thickness + 2 depth (1 − √(1 − (u/radius)²)), u = max(0,
         |x| − length/2), at its middle: its compliance is the midpoint sum of Euler–Bernoulli's
         ∫ dx / E I(x) (for circles Paros and Weisbord's closed form, for corner fillets
-        Lobontiu's), to 1e-5 with the default 40 (docs/flexures.md)."""
+        Lobontiu's): to 1e-5 with the default 40 for circular cuts, 1e-4 for corner fillets
+        (3e-5 with 80; docs/flexures.md)."""
         from .section import Material, rectangle
 
         R = _positive(radius, "radius")
@@ -215,12 +216,16 @@ class Flexure:
             raise InputError("direction must not be zero")
         d = d / np.linalg.norm(d)
         half = flat / 2 + R
-        if flat > 0:  # a quarter of the pieces in each fillet, the rest on the straight part
-            if n < 3:
-                raise InputError(f"a notch hinge with a straight part (length > 0) needs n ≥ 3 pieces, got {n}")
-            fillet = max(1, n // 4)
+        if flat > 0:
+            # A quarter of the pieces in each fillet (where the compliance varies), the straight
+            # part in pieces no shorter than theirs (one at least), the pieces left to the fillets.
+            if n < 5:
+                raise InputError(f"a notch hinge with a straight part (length > 0) needs n ≥ 5 pieces, got {n}")
+            straight = max(1, min(n - 2 * (n // 4), math.ceil(flat / (R / (n // 4)))))
+            fillet = (n - straight) // 2
+            straight = n - 2 * fillet
             edges = np.concatenate([np.linspace(-half, -flat / 2, fillet + 1),
-                                    np.linspace(-flat / 2, flat / 2, n - 2 * fillet + 1)[1:-1],
+                                    np.linspace(-flat / 2, flat / 2, straight + 1)[1:-1],
                                     np.linspace(flat / 2, half, fillet + 1)])
         else:
             edges = np.linspace(-half, half, n + 1)

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from ._util import show
 from .errors import InputError, SpacarError
 from .geometry import Geometry, shapes, frame_coordinates
 from .results import _ARRAYS, STATE_ARRAYS, Results, parse_spec
@@ -356,6 +357,8 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
     from .results import require_results
 
     require_results(res, "view3d")
+    if not isinstance(links, (bool, np.bool_)):
+        raise InputError(f"view3d: links must be True or False, got {show(links)}")
     if frames != 0 and mode is None:
         raise InputError("frames animate a mode: give mode= too (a shape in the nodal coordinates)")
     phases = mode_phases(frames) if frames != 0 else (1.0,)
@@ -386,6 +389,10 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
     fig = go.Figure(data=traces[0])
     fig.update_layout(scene=dict(aspectmode="data"), title=f"t = {time:.4g} s", margin=dict(l=0, r=0, t=30, b=0))
     if len(traces) > 1:
+        for t in traces[1:]:  # a frame moves the vertices; the figure's traces keep the triangles
+            for trace in t:
+                if trace.type == "mesh3d":
+                    trace.i = trace.j = trace.k = None
         fig.frames = [go.Frame(data=t, name=str(j)) for j, t in enumerate(traces)]
         play = dict(frame=dict(duration=1500 // len(traces), redraw=True), fromcurrent=True, mode="immediate")
         fig.update_layout(updatemenus=[dict(type="buttons", showactive=False, x=0.0, y=0.0, buttons=[

@@ -47,13 +47,18 @@ def static_outputs(nb) -> int:
 
 
 _DISPLAY = re.compile(r"\$\$(.+?)\$\$", re.S)
-_INLINE = re.compile(r"(?<![\\$])\$(?!\$)([^$]+?)(?<!\\)\$")
+# Inline $…$ as Pandoc reads it: the opening $ followed by a non-space, the closing one preceded by
+# a non-space and not followed by a digit ("costs $5 and $10" is no equation); no blank line inside.
+_INLINE = re.compile(r"(?<![\\$])\$(?![\s$])((?:[^$\n]|\n(?!\s*\n))+?)(?<![\s\\])\$(?!\d)")
+# Code that keeps its dollars: fenced blocks and code spans.
+_CODE = re.compile(r"(```.*?```|~~~.*?~~~|`[^`\n]*`)", re.S)
 
 
 def mathml_equations(nb) -> int:
     """Replace, in place, the TeX equations of the markdown cells of ``nb`` by MathML (display
-    equations as blocks). Returns the number replaced; 0 without latex2mathml. An equation it
-    cannot convert stays as it was."""
+    equations as blocks), outside code spans and blocks. Returns the number replaced; 0 without
+    latex2mathml. An equation it does not convert fully (a command it does not know comes out as
+    text) stays as it was, for MathJax where there is a network."""
     try:
         from latex2mathml.converter import convert
     except ImportError:
@@ -64,16 +69,24 @@ def mathml_equations(nb) -> int:
         nonlocal count
         try:
             math = convert(match.group(1).strip(), display="block" if display else "inline")
-        except Exception:  # noqa: BLE001 - any TeX it does not know: leave the equation as written
+        except Exception:  # noqa: BLE001 - any TeX it cannot read: leave the equation as written
+            return match.group(0)
+        if "\\" in math or "<mi>&</mi>" in math or "&amp;" in math:  # an unknown command, an alignment
             return match.group(0)
         count += 1
         return math
+
+    def convert_text(text):
+        text = _DISPLAY.sub(lambda m: replace(m, True), text)
+        return _INLINE.sub(lambda m: replace(m, False), text)
     for cell in nb.get("cells", []):
         if cell.get("cell_type") != "markdown":
             continue
-        text = cell.get("source", "")
-        text = _DISPLAY.sub(lambda m: replace(m, True), text)
-        cell["source"] = _INLINE.sub(lambda m: replace(m, False), text)
+        source = cell.get("source", "")
+        if isinstance(source, list):
+            source = "".join(source)
+        parts = _CODE.split(source)   # odd entries: the code, kept as written
+        cell["source"] = "".join(part if k % 2 else convert_text(part) for k, part in enumerate(parts))
     return count
 
 

@@ -317,6 +317,7 @@ class Results:
         self._deformation_labels = state.pop("deformation_labels")
         for old in ("_coord", "_def", "_dof_x", "_dof_e"):  # (older pickles' tables are made again)
             state.pop(old, None)
+        state.setdefault("shapes", None)  # (pickled before the results kept a robot's link shapes)
         self.__dict__.update(state)
         self._lookup = None
         self._set_dofs(labels)
@@ -564,6 +565,7 @@ class Results:
         whole = cls(arrays, first.coordinate_labels, first.deformation_labels, stats,
                     results[-1].geometry or first.geometry, lins, results[-1].settings_linear,
                     first.dof_labels if same_dofs else ())
+        whole.shapes = getattr(results[-1], "shapes", None) or getattr(first, "shapes", None)
         energies = [r.__dict__.get("_energy") for r in results]
         if all(e is not None for e in energies):  # the energy balance of every block: of the whole
             whole._energy = Energy.concatenate(energies)

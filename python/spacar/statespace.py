@@ -461,6 +461,8 @@ def _build(lin: Linearization, inputs, outputs, velocities) -> StateSpace:
     n, k = lin.M0.shape[0], len(getattr(lin, "y_labels", []))
     z_names = [f"{kind}({a},{b})" for kind, a, b in lin.z_labels]
     # Generalized forces of the inputs (nz x m).
+    for sig in outputs:   # each output named by a coordinate or deformation the model has
+        _row(lin, sig)
     Q = np.zeros((n, len(inputs)))
     for j, sig in enumerate(inputs):
         T, r = _row(lin, sig)
@@ -508,7 +510,8 @@ def _massless_directions(M):
     heavy = w > 1e-13 * max(w.max(initial=0.0), 1e-300)
     if heavy.all():
         return None
-    return s[:, None] * basis[:, heavy], s[:, None] * basis[:, ~heavy]
+    # Back to z, and orthonormal again (the spans are what matter; orthonormal keeps them accurate).
+    return np.linalg.qr(s[:, None] * basis[:, heavy])[0], np.linalg.qr(s[:, None] * basis[:, ~heavy])[0]
 
 
 def _build_condensed(lin, inputs, outputs, Q, sens, V, N) -> StateSpace:
@@ -821,8 +824,11 @@ def _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forc
     G = czdd @ Mi
     # The size of the terms that make up the coefficients of u̇ and ü, against which a remainder
     # counts as a real dependence (rather than their rounding) for the properness check below.
-    # (The bounds of the products' rounding: each factor taken by its size.)
-    absG = np.abs(czdd) @ np.abs(Mi)
+    # (The bounds of the products' rounding: each factor taken by its size, M⁻¹ by that of its
+    # Jacobi-scaled inverse, so that a light mass beside heavy ones does not inflate the bound.)
+    dm = np.sqrt(np.abs(np.diag(M)))
+    absMi = np.abs(np.linalg.inv(M / np.outer(dm, dm))) / np.outer(dm, dm)
+    absG = np.abs(czdd) @ absMi
     abs_czd = np.abs(czd) + absG @ np.abs(C)
     size_ud = np.abs(rows["v"]) @ np.abs(U) + absG @ np.abs(Cu)
     size_udd = np.abs(rows["a"]) @ np.abs(U) + absG @ np.abs(Mu)
@@ -836,7 +842,7 @@ def _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forc
     for a, j in enumerate(o0):
         Dm[:, col[("u", j)]] += -cz @ Mi @ Mu[:, j] + czd @ Mi @ E0[:, a]
         cud[:, j] = cud[:, j] - czd @ Mi @ Mu[:, j]
-        size_ud[:, j] += abs_czd @ (np.abs(Mi) @ np.abs(Mu[:, j]))
+        size_ud[:, j] += abs_czd @ (absMi @ np.abs(Mu[:, j]))
     for j in o1:
         Dm[:, col[("u", j)]] += -czd @ Mi @ Mu[:, j]
     for j in range(len(forces)):
@@ -863,8 +869,26 @@ def _realize(M, C, K, Mu, Cu, Ku, Q, Z, U, rows, cf, inputs, outputs, base, forc
         [f"u({s.number},{s.index})" for s in (base[j] for j in o1)] + \
         [f"u({s.number},{s.index})" for s in (base[j] for j in o2)] + \
         [f"ud({s.number},{s.index})" for s in (base[j] for j in o2)]
+    _check_static_gain(A, Bm, Cm, Dm, K, Ku, Z, U, rows["x"], o0, col, base, outputs)
     return StateSpace(A, Bm, Cm, Dm, states, [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in inputs],
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin)
+
+
+def _check_static_gain(A, B, C, D, K, Ku, Z, U, rows_x, o0, col, base, outputs):
+    """The shifted coordinates of a position input cancel large terms (stiff, damped elements):
+    the realization's static response to each position input must be the structure's own,
+    rows_x (Z z + U u) with K z = −K_u u, or the model is refused rather than returned wrong."""
+    if not len(o0) or np.linalg.cond(A) > 1e14 or np.linalg.cond(K) > 1e14:
+        return
+    for j in o0:
+        exact = rows_x @ (Z @ np.linalg.solve(K, -Ku[:, j]) + U[:, j])
+        realized = C @ np.linalg.solve(A, -B[:, col[("u", j)]]) + D[:, col[("u", j)]]
+        scale = max(np.abs(exact).max(initial=0.0), 1e-300)
+        if np.abs(realized - exact).max(initial=0.0) > 1e-6 * scale:
+            raise InputError(f"{_where(base[j])}: the realization of this position input loses its accuracy (its static "
+                             f"response is off by {np.abs(realized - exact).max() / scale:.2g}: large stiffness and "
+                             "damping terms cancel in the shifted coordinates); take the velocity or acceleration "
+                             "of the support as the input (BASEXP, BASEXPP), the same transfer over s or s²")
 
 
 def _sensitivities(lin, outputs, velocities) -> dict:

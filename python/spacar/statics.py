@@ -51,6 +51,7 @@ def _results(arrays: dict, model) -> Results:
     # and spacar.compliance(res, node) takes the loads and elements from it (not pickled).
     res._geometry_source = core = model.core.copy()
     res._static_model = Model._of_core(core)
+    res.shapes = getattr(model, "urdf_shapes", None)  # a URDF robot's link shapes, for spacar.view3d
     # The degrees of freedom of the system the solve compiled, labelled when first asked for.
     system = SimpleNamespace(coord_label=arrays["coord_label"], def_label=arrays["def_label"],
                              x_dyn=arrays["x_dyn"], e_dyn=arrays["e_dyn"])

@@ -189,6 +189,8 @@ class _Reader:
                 else:
                     self.warnings.append(f"{where}: a <{shape.tag}> geometry is not drawn")
                     continue
+                if min(size) < 0:
+                    self.fail(f"{where}: a {shape.tag} of negative size {tuple(float(v) for v in size)}")
                 out.append(Shape(link, role, shape.tag, size, (tuple(xyz), tuple(rpy))))
         return out
 

@@ -62,20 +62,27 @@ class RobotShapes:
         return out
 
     def _drawn(self) -> dict:
+        """{link: shapes drawn}: its readable visual shapes; where a visual cannot be read, the
+        link's readable collision shapes instead (if it has any); a link with collision shapes
+        alone is drawn with them. Every mesh that cannot be read is named in a warning."""
         by_link: dict = {}
         for shape in self.shapes:
             by_link.setdefault(shape.link, {"visual": [], "collision": []})[shape.role].append(shape)
         drawn = {}
         for link, roles in by_link.items():
             visuals = [s for s in roles["visual"] if _readable(s)]
-            if len(visuals) < len(roles["visual"]) or not roles["visual"]:
-                collision = [s for s in roles["collision"] if _readable(s)]
-                if roles["visual"] and collision:
-                    visuals = collision
-            unread = [s.path for s in roles["visual"] + roles["collision"] if s not in visuals and not _readable(s)]
-            if unread and not visuals:
-                warnings.warn(f"link {link!r}: its mesh{'es' if len(unread) > 1 else ''} {', '.join(unread)} cannot be "
-                              "read (pip install trimesh; pycollada for .dae): the link is not drawn", stacklevel=3)
+            collision = [s for s in roles["collision"] if _readable(s)]
+            if (len(visuals) < len(roles["visual"]) or not roles["visual"]) and collision:
+                visuals = collision
+            unread = [s.path for s in roles["visual"] if not _readable(s)]
+            if unread:
+                missing = [p for p in unread if not os.path.isfile(p)]
+                why = (f"no such file: {', '.join(missing)}" if missing else
+                       "cannot be read (pip install trimesh; pycollada for .dae)")
+                instead = "drawn with its collision shapes" if visuals is collision and collision else \
+                    "the rest of the link is drawn" if visuals else "the link is not drawn"
+                warnings.warn(f"link {link!r}: its mesh{'es' if len(unread) > 1 else ''} {', '.join(unread)}: {why}; "
+                              f"{instead}", stacklevel=4)
             if visuals:
                 drawn[link] = visuals
         return drawn
@@ -158,7 +165,9 @@ def resolve(filename: str, urdf_path: str) -> str:
         return filename[len("file://"):]
     if not filename.startswith("package://"):
         return filename if os.path.isabs(filename) else os.path.join(here, filename)
-    package, _, rest = filename[len("package://"):].partition("/")
+    package, _, rest = filename[len("package://"):].lstrip("/").partition("/")
+    if not package:
+        return os.path.join(here, rest)
     d = here
     while True:
         if os.path.basename(d) == package:

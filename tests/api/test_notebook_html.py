@@ -97,7 +97,13 @@ def test_equations_become_mathml_that_needs_no_network():
 
     nb = nbformat.v4.new_notebook()
     nb.cells = [nbformat.v4.new_markdown_cell("costs $5 and $x^2$ and \\$3, $\\unknowncommand{x}$"),
+                nbformat.v4.new_markdown_cell("A ticket costs $5 and a meal $10; `echo $HOME` and $a_1$"),
+                nbformat.v4.new_markdown_cell("$$\\begin{aligned} a &= b \\end{aligned}$$"),
                 nbformat.v4.new_code_cell("s = '$x$'")]
-    assert mathml_equations(nb) >= 1
-    assert "<math" in nb.cells[0].source and "\\$3" in nb.cells[0].source
-    assert nb.cells[1].source == "s = '$x$'"
+    assert mathml_equations(nb) == 2
+    first, second, aligned, code = (c.source for c in nb.cells)
+    assert first.startswith("costs $5 and <math") and "x^2" not in first          # the equation, not "5 and"
+    assert first.endswith("\\$3, $\\unknowncommand{x}$")                           # unknown TeX left for MathJax
+    assert second.startswith("A ticket costs $5 and a meal $10; `echo $HOME` and <math")
+    assert aligned == "$$\\begin{aligned} a &= b \\end{aligned}$$"
+    assert code == "s = '$x$'"

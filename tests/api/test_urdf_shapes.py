@@ -148,10 +148,12 @@ def test_without_a_mesh_reader_the_mesh_is_left_out_with_a_warning(tmp_path, mon
       <visual><geometry><mesh filename="m.stl"/></geometry></visual></link>
       <joint name="j" type="continuous"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/></joint></robot>""")
     res = run(path, 0.1)
-    with pytest.warns(UserWarning, match=r"link 'b': its mesh .*m.stl cannot be read \(pip install trimesh"):
+    with pytest.warns(UserWarning, match=r"link 'b': its mesh .*m.stl: cannot be read \(pip install trimesh.*not drawn"):
         fig = spacar.view3d(res)
     assert not surface(fig, "b")
     assert not surface(spacar.view3d(res, links=False), "b")
+    with pytest.raises(spacar.InputError, match="links must be True or False"):
+        spacar.view3d(res, links="no")
     visuals._mesh.cache_clear()
 
 
@@ -165,15 +167,41 @@ def test_the_ur5_is_drawn_link_by_link():
         pytest.skip("example-robot-data is not installed")
     path = dist.locate_file("cmeel.prefix/share/example-robot-data/robots/ur_description/urdf/ur5_robot.urdf")
     res = run(str(path), 0.1)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")                  # every link readable (visual or collision mesh)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         fig = spacar.view3d(res)
+    # COLLADA visuals need pycollada: without it each such link is drawn with its STL collision mesh
+    # (the end-effector link has a collision box only: drawn with it).
+    assert all("drawn with its collision shapes" in str(w.message) for w in caught)
     names = [t.name for t in fig.data if t.type == "mesh3d"]
     assert names == [f"link {n}" for n in ("base_link", "shoulder_link", "upper_arm_link", "forearm_link",
-                                             "wrist_1_link", "wrist_2_link", "wrist_3_link")]
+                                             "wrist_1_link", "wrist_2_link", "wrist_3_link", "ee_link")]
     # Each mesh on its link: the forearm's vertices near the forearm's frame (within its length).
     coords = frame_coordinates(res.node_columns, res.x[-1])
     fore = next(V for link, _, V, _ in res.shapes.surfaces(coords) if link == "forearm_link")
     origin = coords[res.shapes.frames["forearm_link"][0]]
     assert np.linalg.norm(fore - origin, axis=1).max() < 0.5
     assert math.isfinite(float(np.abs(fore).max()))
+
+
+def test_package_names_with_three_slashes_and_missing_files(tmp_path):
+    # package:///PKG/... (Talos's) is the package PKG; a file that is not there is named as such.
+    from spacar.visuals import resolve
+
+    pkg = tmp_path / "my_robot"
+    (pkg / "urdf").mkdir(parents=True)
+    urdf = pkg / "urdf" / "r.urdf"
+    assert resolve("package:///my_robot/meshes/a.stl", str(urdf)) == str(pkg / "meshes" / "a.stl")
+    assert resolve("package://my_robot/meshes/a.stl", str(urdf)) == str(pkg / "meshes" / "a.stl")
+    urdf.write_text(f"""<robot name="r"><link name="a"/><link name="b">{INERTIA}
+      <visual><geometry><mesh filename="package://my_robot/meshes/gone.stl"/></geometry></visual>
+      <visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
+      <joint name="j" type="continuous"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/></joint></robot>""")
+    res = run(urdf, 0.1)
+    with pytest.warns(UserWarning, match=r"gone.stl: no such file.*the rest of the link is drawn"):
+        fig = spacar.view3d(res)
+    assert len(surface(fig, "b")) == 1
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("""<robot name="r"><link name="a"><visual><geometry><box size="0.1 -1 0.1"/></geometry></visual></link></robot>""")
+    with pytest.raises(spacar.InputError, match="a box of negative size"):
+        spacar.from_urdf(bad)
