@@ -559,6 +559,47 @@ def _build_condensed(lin, inputs, outputs, Q, sens, V, N) -> StateSpace:
                       [f"{_NAMES[s.keyword]}({s.number},{s.index})" for s in outputs], lin.t, lin, (Mr, Cr, Kr, Qr))
 
 
+def _signal_index(sig: Signal, coords: dict, defs: dict) -> int:
+    """The column of the signal's coordinate ({(node, i): column}) or deformation ({(element, i): row})."""
+    on_node = sig.keyword in NODE_SIGNALS
+    table = coords if on_node else defs
+    key = (sig.number, sig.index)
+    if key not in table:
+        what = "node {} has no coordinate {}" if on_node else "element {} has no deformation {}"
+        raise InputError(f"{_where(sig)}: {what.format(*key)}")
+    return table[key]
+
+
+_CONSTITUTIVE = (_core.DefClass.released, _core.DefClass.dynamic)
+
+
+def _require_constitutive(sig: Signal, cls) -> None:
+    """An OUTS output's deformation must carry a constitutive stress (its class DYNE or released)."""
+    if cls not in _CONSTITUTIVE:
+        raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
+                         "constitutive, σ = S e + D ė); this one is a reaction stress")
+
+
+def _input_loads(inputs, index, moves, def_class, b_row, nx: int) -> np.ndarray:
+    """The loads on the coordinates (nx x m) of force and stress inputs: a unit force on a
+    coordinate that moves (``moves``: a mask over the coordinates), or −B_kᵀ of a constitutive
+    deformation (``b_row(k)``: its row of B, dense)."""
+    F = np.zeros((nx, len(inputs)))
+    for j, sig in enumerate(inputs):
+        i = index(sig)
+        if sig.keyword == "INPUTF":
+            if not moves[i]:
+                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
+                                 "input coordinate, or one the constraints hold still)")
+            F[i, j] = 1.0
+        else:
+            if def_class[i] not in _CONSTITUTIVE:
+                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a deformation "
+                                 "that is not DYNE or released)")
+            F[:, j] = -b_row(i)
+    return F
+
+
 def _build_modal(lin: Linearization, inputs, outputs, modes) -> StateSpace:
     """The state space in the lowest undamped modes from the nodal matrices (state_space's
     ``modes``)."""
@@ -583,31 +624,12 @@ def _build_modal(lin: Linearization, inputs, outputs, modes) -> StateSpace:
     defs = {label: i for i, label in enumerate(lin.deformation_labels)}
     coords = {label: i for i, label in enumerate(lin.coordinate_labels)}
     classes = sim.system.def_class
-    constitutive = (_core.DefClass.released, _core.DefClass.dynamic)
 
     def index(sig):
-        on_node = sig.keyword in NODE_SIGNALS
-        table = coords if on_node else defs
-        key = (sig.number, sig.index)
-        if key not in table:
-            what = "node {} has no coordinate {}" if on_node else "element {} has no deformation {}"
-            raise InputError(f"{_where(sig)}: {what.format(*key)}")
-        return table[key]
+        return _signal_index(sig, coords, defs)
 
     # Loads on the coordinates of the inputs (nx x m): a force, or −B_kᵀ for a stress.
-    F = np.zeros((nx, len(inputs)))
-    for j, sig in enumerate(inputs):
-        i = index(sig)
-        if sig.keyword == "INPUTF":
-            if not free[i]:
-                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
-                                 "input coordinate)")
-            F[i, j] = 1.0
-        else:
-            if classes[i] not in constitutive:
-                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a deformation "
-                                 "that is not DYNE or released)")
-            F[:, j] = -nodal.B[i].toarray().ravel()
+    F = _input_loads(inputs, index, free, classes, lambda k: nodal.B[k].toarray().ravel(), nx)
     # Outputs over the coordinates: positions (and the stresses' elastic part) and rates.
     Cx, Cv = np.zeros((len(outputs), nx)), np.zeros((len(outputs), nx))
     for r, sig in enumerate(outputs):
@@ -621,9 +643,7 @@ def _build_modal(lin: Linearization, inputs, outputs, modes) -> StateSpace:
         elif sig.keyword == "OUTEP":
             Cv[r] = nodal.B[i].toarray().ravel()
         else:
-            if classes[i] not in constitutive:
-                raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
-                                 "constitutive, σ = S e + D ė); this one is a reaction stress")
+            _require_constitutive(sig, classes[i])
             Cx[r] = (nodal.S[i] @ nodal.B).toarray().ravel()
             Cv[r] = (nodal.Dc[i] @ nodal.B).toarray().ravel()
     Q = phi.T @ F
@@ -687,29 +707,12 @@ def _build_base(lin, sim, inputs, outputs, ratios, alpha, beta) -> StateSpace:
     B = nodal.B.toarray()
 
     def index(sig):
-        table = coords if sig.keyword in NODE_SIGNALS else defs
-        key = (sig.number, sig.index)
-        if key not in table:
-            what = "node {} has no coordinate {}" if sig.keyword in NODE_SIGNALS else "element {} has no deformation {}"
-            raise InputError(f"{_where(sig)}: {what.format(*key)}")
-        return table[key]
+        return _signal_index(sig, coords, defs)
 
     # The inputs: loads F on the coordinates (forces, stresses), the supports' motion U.
     base = [s for s in inputs if s.keyword in _BASE_ORDER]
     forces = [s for s in inputs if s.keyword not in _BASE_ORDER]
-    F = np.zeros((nx, len(forces)))
-    for j, sig in enumerate(forces):
-        i = index(sig)
-        if sig.keyword == "INPUTF":
-            if not np.any(Z[i]):
-                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a fixed or "
-                                 "input coordinate, or one the constraints hold still)")
-            F[i, j] = 1.0
-        else:
-            if def_class[i] not in (_core.DefClass.released, _core.DefClass.dynamic):
-                raise InputError(f"{_where(sig)}: the input does no work on the degrees of freedom (a deformation "
-                                 "that is not DYNE or released)")
-            F[:, j] = -B[i]
+    F = _input_loads(forces, index, np.any(Z != 0, axis=1), def_class, lambda k: B[k], nx)
     U = np.zeros((nx, len(base)))
     for j, sig in enumerate(base):
         label = ("x", sig.number, sig.index)
@@ -745,9 +748,7 @@ def _build_base(lin, sim, inputs, outputs, ratios, alpha, beta) -> StateSpace:
         elif sig.keyword in ("OUTE", "OUTEP"):
             rows["x" if sig.keyword == "OUTE" else "v"][r] = B[i]
         elif sig.keyword == "OUTS":
-            if def_class[i] not in (_core.DefClass.released, _core.DefClass.dynamic):
-                raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
-                                 "constitutive, σ = S e + D ė); this one is a reaction stress")
+            _require_constitutive(sig, def_class[i])
             rows["x"][r] = nodal.S[i] @ B
             rows["v"][r] = nodal.Dc[i] @ B
         else:  # OUTR
@@ -914,14 +915,13 @@ def _sensitivities(lin, outputs, velocities) -> dict:
     # vanish; a Linearization alone does not say.
     at_rest = velocities is not None and not np.any(np.asarray(velocities[0].data.xd))
     nodal = lin.__dict__.get("nodal")
+    if velocities is not None:
+        classes = velocities[0].system.def_class
+        for sig in stresses:
+            _require_constitutive(sig, classes[lin.deformation_labels.index((sig.number, sig.index))])
     if stresses and at_rest and nodal is not None:
         # δσ = S δe + Dc δė with δe = B DF δz: exact, from the nodal matrices (no differences,
         # no equations of motion: a model with massless DOFs too).
-        for sig in stresses:
-            c = velocities[0].system.def_class[lin.deformation_labels.index((sig.number, sig.index))]
-            if c not in (_core.DefClass.released, _core.DefClass.dynamic):
-                raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
-                                 "constitutive, σ = S e + D ė); this one is a reaction stress")
         BDF = nodal.B @ lin.DF
         out["sigma"], out["sigma_d"] = np.asarray(nodal.S @ BDF), np.asarray(nodal.Dc @ BDF)
         stresses = []
@@ -937,11 +937,6 @@ def _sensitivities(lin, outputs, velocities) -> dict:
                "they are computed for models without LINE parameters only")
         raise InputError(f"{_where(first)}: {what} needs differences of the kinematics or stresses; {why}")
     sim, (t, q, qd) = velocities
-    for sig in stresses:
-        c = sim.system.def_class[lin.deformation_labels.index((sig.number, sig.index))]
-        if c not in (_core.DefClass.released, _core.DefClass.dynamic):
-            raise InputError(f"{_where(sig)}: OUTS needs a DYNE or released deformation (its stress is "
-                             "constitutive, σ = S e + D ė); this one is a reaction stress")
     y_defs = list(sim.system.y_defs)
     y = np.array([sim.data.e_integrated[d] for d in y_defs])
     # The kinematic coordinates' places in y (the integrated deformations, slips among them).

@@ -48,6 +48,7 @@ class RobotShapes:
         {node: coordinates} of its x row: the visual shapes, a link's collision shapes in place
         of visuals that cannot be read."""
         from .geometry import rotation
+        from .urdf import rpy_matrix
 
         out = []
         for link, shapes in self._drawn().items():
@@ -57,7 +58,7 @@ class RobotShapes:
             for shape in shapes:
                 V, F = triangles(shape)
                 xyz, rpy = shape.origin
-                local = V @ _rpy(rpy).T + np.asarray(xyz)
+                local = V @ rpy_matrix(rpy).T + np.asarray(xyz)
                 out.append((link, shape.role, local @ R.T + o, F))
         return out
 
@@ -86,12 +87,6 @@ class RobotShapes:
             if visuals:
                 drawn[link] = visuals
         return drawn
-
-
-def _rpy(rpy) -> np.ndarray:
-    from .urdf import rpy_matrix
-
-    return rpy_matrix(rpy)
 
 
 def _readable(shape: Shape) -> bool:
