@@ -30,7 +30,8 @@ def _widgets():
     try:
         import ipywidgets
     except ImportError:
-        raise ImportError("spacar.explore needs ipywidgets: pip install 'spacar[notebooks]'") from None
+        raise ImportError('spacar.explore needs ipywidgets: pip install ipywidgets (from a clone of spacar: '
+                          'pip install ".[classroom]")') from None
     return ipywidgets
 
 
@@ -386,7 +387,7 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
         coords = frame_coordinates(res.node_columns, x)
         traces.append(_view3d_traces(go, res.geometry, coords, size, beam_points, values, colorscale, stress_kind)
                       + ([] if robot is None else _link_surfaces(go, robot, coords)))
-    fig = go.Figure(data=traces[0])
+    fig = _view3d_class(go)(data=traces[0])
     fig.update_layout(scene=dict(aspectmode="data"), title=f"t = {time:.4g} s", margin=dict(l=0, r=0, t=30, b=0))
     if len(traces) > 1:
         for t in traces[1:]:  # a frame moves the vertices; the figure's traces keep the triangles
@@ -401,6 +402,42 @@ def view3d(res: Results, k: int = -1, *, beam_points: int = 21, stress=None, str
             sliders=[dict(steps=[dict(method="animate", label=str(j), args=[[str(j)], dict(mode="immediate")])
                                  for j in range(len(traces))], x=0.1, len=0.9, currentvalue=dict(prefix="frame "))])
     return fig
+
+
+_VIEW3D_CLASS = None
+_plotly_js_written = False   # whether a figure of this session has carried plotly.js into its HTML
+
+
+def _view3d_class(go):
+    """The class of view3d's figures: a plotly figure whose notebook output carries, beside plotly's
+    own mimetype (which JupyterLab draws), its self-contained HTML, which nbconvert and other
+    viewers that do not know the mimetype keep (nbconvert drops the figure otherwise). plotly.js
+    is written into the first figure of a session only (4.6 MB); ``spacar html`` writes it into
+    every exported page whatever the outputs hold."""
+    global _VIEW3D_CLASS
+    if _VIEW3D_CLASS is None:
+        class View3D(go.Figure):
+            def _repr_mimebundle_(self, include=None, exclude=None, validate=True, **kwargs):
+                global _plotly_js_written
+                import plotly.io
+
+                bundle = super()._repr_mimebundle_(include, exclude, validate, **kwargs)
+                bundle["text/html"] = plotly.io.to_html(self, include_plotlyjs=not _plotly_js_written,
+                                                        full_html=False)
+                _plotly_js_written = True
+                return bundle
+
+            def _ipython_display_(self):   # plotly's displays its renderers' bundle, without the HTML
+                import plotly.io
+
+                bundle = self._repr_mimebundle_() if plotly.io.renderers.render_on_display else {}
+                if "application/vnd.plotly.v1+json" not in bundle:   # no renderer, or an external one
+                    return super()._ipython_display_()
+                from IPython.display import display
+
+                display(bundle, raw=True)
+        _VIEW3D_CLASS = View3D
+    return _VIEW3D_CLASS
 
 
 def _link_surfaces(go, robot, coords) -> list:

@@ -10,7 +10,10 @@ the PNG of its last state beside its widget), and each plotly figure becomes its
 HTML (plotly.js written once into the page, not fetched from a network). The equations of the
 markdown cells ($…$, $$…$$), which nbconvert leaves to MathJax fetched from a network (raw TeX
 offline), become MathML, which browsers draw themselves (with latex2mathml installed; it is in
-the classroom extra). Needs nbconvert (``pip install ".[classroom]"``) and, for figures, plotly.
+the classroom extra). The page then fetches nothing from a network: nbconvert's require.js and
+widget manager are left out (they serve widget views without a picture only), and MathJax too
+unless TeX is left that latex2mathml could not convert. Needs nbconvert (``pip install ".[classroom]"``) and, for
+figures, plotly.
 """
 from __future__ import annotations
 
@@ -27,7 +30,7 @@ STATIC = ("image/png", "image/svg+xml", "text/html")
 def static_outputs(nb) -> int:
     """Replace, in place, the outputs of notebook ``nb`` (an nbformat node) that an HTML page
     cannot show: a widget view with a static picture beside it loses the view; a plotly figure
-    gains its HTML (plotly.js in the first). Returns the number of outputs changed."""
+    gets its HTML (plotly.js in the first). Returns the number of outputs changed."""
     changed, plotly_js = 0, True
     for cell in nb.get("cells", []):
         for output in cell.get("outputs", []) if cell.get("cell_type") == "code" else []:
@@ -37,7 +40,7 @@ def static_outputs(nb) -> int:
             if WIDGET in data and any(kind in data for kind in STATIC):
                 del data[WIDGET]
                 changed += 1
-            if PLOTLY in data and "text/html" not in data:
+            if PLOTLY in data:   # its own HTML, whatever the output held (view3d's has plotly.js once a session)
                 import plotly.io
 
                 data["text/html"] = plotly.io.to_html(data[PLOTLY], include_plotlyjs=plotly_js, full_html=False)
@@ -52,6 +55,51 @@ _DISPLAY = re.compile(r"\$\$(.+?)\$\$", re.S)
 _INLINE = re.compile(r"(?<![\\$])\$(?![\s$])((?:[^$\n]|\n(?!\s*\n))+?)(?<![\s\\])\$(?!\d)")
 # Code that keeps its dollars: fenced blocks and code spans.
 _CODE = re.compile(r"(```.*?```|~~~.*?~~~|`[^`\n]*`)", re.S)
+
+
+# nbconvert's lab page without the scripts it fetches from a network when the page does not need
+# them: require.js and the widget manager (for widget views drawn from saved widget state only;
+# plotly.js is inline) and MathJax (for TeX left after MathML). Mermaid is fetched by the page
+# only where a diagram is.
+_OFFLINE_TEMPLATE = """{%- extends 'index.html.j2' -%}
+{%- block html_head_js_requirejs -%}
+{%- if resources.spacar_widgets -%}{{ super() }}{%- endif -%}
+{%- endblock html_head_js_requirejs -%}
+{%- block jupyter_widgets -%}
+{%- if resources.spacar_widgets -%}{{ super() }}{%- endif -%}
+{%- endblock jupyter_widgets -%}
+{%- block html_head_js_mathjax -%}
+{%- if resources.spacar_mathjax -%}{{ super() }}{%- endif -%}
+{%- endblock html_head_js_mathjax -%}
+"""
+
+
+def _offline_exporter(html_exporter):
+    from jinja2 import DictLoader
+
+    return html_exporter(template_file="spacar_offline.html.j2",
+                         extra_loaders=[DictLoader({"spacar_offline.html.j2": _OFFLINE_TEMPLATE})])
+
+
+def _widget_views_left(nb) -> bool:
+    """Whether widget views remain that the page draws from saved widget state (through
+    require.js and the widget manager, both fetched from a network)."""
+    return "widgets" in nb.get("metadata", {}) and any(
+        WIDGET in output.get("data", {}) for cell in nb.get("cells", []) if cell.get("cell_type") == "code"
+        for output in cell.get("outputs", []))
+
+
+def _tex_left(nb) -> bool:
+    """Whether a markdown cell still holds TeX (outside code), which needs MathJax."""
+    for cell in nb.get("cells", []):
+        if cell.get("cell_type") != "markdown":
+            continue
+        source = cell.get("source", "")
+        source = "".join(source) if isinstance(source, list) else source
+        text = "".join(part for k, part in enumerate(_CODE.split(source)) if k % 2 == 0)
+        if _DISPLAY.search(text) or _INLINE.search(text):
+            return True
+    return False
 
 
 def mathml_equations(nb) -> int:
@@ -107,7 +155,8 @@ def to_html(notebook, path=None) -> str:
         raise InputError(f"{source}: not a readable notebook ({type(err).__name__}: {err})") from None
     static_outputs(nb)
     mathml_equations(nb)
-    html, _ = HTMLExporter().from_notebook_node(nb)
+    html, _ = _offline_exporter(HTMLExporter).from_notebook_node(
+        nb, resources={"spacar_mathjax": _tex_left(nb), "spacar_widgets": _widget_views_left(nb)})
     if path is not None:
         from .io.files import write_replacing
 

@@ -155,7 +155,8 @@ class StateSpace:
         try:
             import control
         except ImportError:
-            raise ImportError("to_control needs python-control: pip install 'spacar[control]'") from None
+            raise ImportError('to_control needs python-control: pip install control (from a clone of spacar: '
+                              'pip install ".[control]")') from None
         return control.ss(self.A, self.B, self.C, self.D, states=self.state_labels,
                           inputs=self.input_labels, outputs=self.output_labels)
 

@@ -1,6 +1,8 @@
 """Notebooks handed out as HTML (issue 41): spacar.notebook.to_html and `spacar html` keep
 spacar.explore's widget as the picture of its last state and spacar.view3d's plotly figure as its
-self-contained HTML, where nbconvert alone gives an empty box and drops the figure."""
+self-contained HTML, where nbconvert alone gives an empty box (and drops a plain plotly figure;
+view3d's output carries its HTML for it). The pages of the shipped notebooks in a browser:
+tests/notebooks/test_notebooks.py."""
 from __future__ import annotations
 
 import base64
@@ -31,8 +33,8 @@ def executed_notebook(tmp_path):
         nbformat.v4.new_code_cell(f"res = spacar.simulate(spacar.read({str(EXAMPLES / 'slidercrank3d.dat')!r}))\n"
                                   "spacar.view3d(res)"),
     ]
-    NotebookClient(nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}},
-                   env=spacar_env()).execute()
+    NotebookClient(nb, timeout=300, kernel_name="python3",
+                   resources={"metadata": {"path": str(tmp_path)}}).execute(env=spacar_env())
     path = tmp_path / "class.ipynb"
     nbformat.write(nb, path)
     return nb, path
@@ -44,20 +46,22 @@ def test_widget_and_3d_view_survive_the_export(tmp_path):
     assert WIDGET in explore_out and "image/png" in explore_out      # the widget and its picture
     png = base64.b64decode(explore_out["image/png"])
     assert png.startswith(b"\x89PNG")
-    assert PLOTLY in nb.cells[1].outputs[-1]["data"]
+    view_out = nb.cells[1].outputs[-1]["data"]
+    assert PLOTLY in view_out and "Plotly.newPlot" in view_out["text/html"]   # the figure and its HTML
+    assert "plotly.js v" in view_out["text/html"]                              # plotly.js: the session's first
 
-    # nbconvert alone: the widget view wins (an empty box without widget state) and the figure is dropped.
+    # nbconvert alone: the widget view wins (an empty box without widget state); view3d's figure is
+    # kept as its HTML (a plain plotly figure is dropped: "not able to be represented").
     from nbconvert import HTMLExporter
 
-    with pytest.warns(UserWarning, match="not able to be represented"):
-        plain, _ = HTMLExporter().from_notebook_node(nbformat.read(path, as_version=4))
-    assert explore_out["image/png"][:200] not in plain and "Plotly.newPlot" not in plain
+    plain, _ = HTMLExporter().from_notebook_node(nbformat.read(path, as_version=4))
+    assert explore_out["image/png"][:200] not in plain and "Plotly.newPlot" in plain
 
     html = to_html(path, tmp_path / "class.html")
     assert (tmp_path / "class.html").read_text(encoding="utf-8") == html
     assert explore_out["image/png"][:200] in html                      # the explore picture
     assert "Plotly.newPlot" in html and html.count("plotly.js v") >= 1  # the figure, plotly.js inline
-    assert not re.search(r"<script[^>]*src=\"https?://[^\"]*plotly", html)
+    assert not re.search(r"<script[^>]*src=\"https?://", html)        # no require.js, no MathJax: no network
 
 
 def test_static_outputs_changes_only_what_html_cannot_show():
