@@ -412,22 +412,13 @@ def _view3d_class(go):
     """The class of view3d's figures: a plotly figure whose notebook output carries, beside plotly's
     own mimetype (which JupyterLab draws), its self-contained HTML, which nbconvert and other
     viewers that do not know the mimetype keep (nbconvert drops the figure otherwise). plotly.js
-    is written into the first figure of a session only (4.6 MB); ``spacar html`` writes it into
-    every exported page whatever the outputs hold."""
+    is written into the first figure displayed in a session only (4.6 MB); ``spacar html``
+    writes it into every exported page whatever the outputs hold."""
     global _VIEW3D_CLASS
     if _VIEW3D_CLASS is None:
         class View3D(go.Figure):
-            def _repr_mimebundle_(self, include=None, exclude=None, validate=True, **kwargs):
-                global _plotly_js_written
-                import plotly.io
-
-                bundle = super()._repr_mimebundle_(include, exclude, validate, **kwargs)
-                bundle["text/html"] = plotly.io.to_html(self, include_plotlyjs=not _plotly_js_written,
-                                                        full_html=False)
-                _plotly_js_written = True
-                return bundle
-
             def _ipython_display_(self):   # plotly's displays its renderers' bundle, without the HTML
+                global _plotly_js_written
                 import plotly.io
 
                 bundle = self._repr_mimebundle_() if plotly.io.renderers.render_on_display else {}
@@ -435,7 +426,13 @@ def _view3d_class(go):
                     return super()._ipython_display_()
                 from IPython.display import display
 
+                bundle["text/html"] = plotly.io.to_html(self, include_plotlyjs=not _plotly_js_written,
+                                                        full_html=False)
+                _plotly_js_written = True
                 display(bundle, raw=True)
+
+            def __reduce__(self):   # pickled as a plain plotly figure (this class is made at run time)
+                return (go.Figure,) + tuple(super().__reduce__()[1:])
         _VIEW3D_CLASS = View3D
     return _VIEW3D_CLASS
 

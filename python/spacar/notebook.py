@@ -89,15 +89,25 @@ def _widget_views_left(nb) -> bool:
         for output in cell.get("outputs", []))
 
 
+_OTHER_TEX = re.compile(r"\\\(|\\\[|\\begin\{")
+
+
 def _tex_left(nb) -> bool:
-    """Whether a markdown cell still holds TeX (outside code), which needs MathJax."""
+    """Whether the page still holds TeX, which needs MathJax: in a markdown cell (outside code,
+    $…$, $$…$$, \\(…\\), \\[…\\], environments) or an output as LaTeX or markdown (IPython's
+    Math, sympy)."""
     for cell in nb.get("cells", []):
+        if cell.get("cell_type") == "code":
+            if any("text/latex" in out.get("data", {}) or "text/markdown" in out.get("data", {})
+                   for out in cell.get("outputs", [])):
+                return True
+            continue
         if cell.get("cell_type") != "markdown":
             continue
         source = cell.get("source", "")
         source = "".join(source) if isinstance(source, list) else source
         text = "".join(part for k, part in enumerate(_CODE.split(source)) if k % 2 == 0)
-        if _DISPLAY.search(text) or _INLINE.search(text):
+        if _DISPLAY.search(text) or _INLINE.search(text) or _OTHER_TEX.search(text):
             return True
     return False
 

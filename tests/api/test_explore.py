@@ -138,7 +138,7 @@ def test_explore_errors(widgets):
 
 def test_explore_without_ipywidgets_says_what_to_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "ipywidgets", None)
-    with pytest.raises(ImportError, match=r"spacar\[notebooks\]"):
+    with pytest.raises(ImportError, match=r"pip install ipywidgets .*\.\[classroom\]"):
         Explorer(fourbar())
 
 

@@ -75,6 +75,24 @@ def test_limit_positions_are_where_the_rocker_reverses(lengths, branch):
         assert at == pytest.approx(psi, abs=1e-12) and fb.freudenstein(theta, psi) == pytest.approx(0.0, abs=1e-12)
 
 
+def test_a_non_grashof_linkage_s_limit_position_found_along_its_input_is_the_closed_form():
+    """Issue 41: the triple-rocker (non-Grashof: no link turns fully) driven by its crank within
+    the toggle positions (±2.373 rad): the rocker reverses once, where the crank and the coupler
+    are in line; spacar's kinematics finds it along the crank's motion as the closed form puts it."""
+    fb = FourBar(0.3, 0.35, 0.30, 0.40)
+    assert fb.grashof().kind == "triple-rocker" and not fb.grashof().grashof
+    theta0 = -2.0
+    assert theta0 > -max(fb.toggle_positions())
+    model = fb.model(theta0=theta0, steps=72)
+    found = limit_positions(model, (9, 1), steps=72, t_end=4.0)     # θ from −2 to 2, inside the toggles
+    (theta, psi), = fb.limit_positions()
+    assert len(found) == 1
+    t, crank, rocker = found[0]
+    psi0 = float(fb.rocker_angle(theta0))
+    assert theta0 + crank - theta == pytest.approx(0.0, abs=1e-10)
+    assert math.remainder(psi0 + rocker - psi, 2 * math.pi) == pytest.approx(0.0, abs=1e-10)
+
+
 def test_a_non_grashof_linkage_s_toggle_positions_end_its_crank_s_range():
     """A triple-rocker: its crank cannot turn fully; at the toggle positions the coupler and the
     rocker are in line (transmission angle 0 or π) and the loop closes there and nowhere beyond."""

@@ -76,7 +76,7 @@ def open_page(page: Path, screenshot: Path, *, width: int = 1280, height: int = 
         raise RuntimeError("no Chromium found (install Debian's chromium or set SPACAR_CHROMIUM)")
     url = Path(page).resolve().as_uri()
     with tempfile.TemporaryDirectory() as profile:
-        common = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+        common = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--no-first-run",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync",
                   "--disable-default-apps", "--host-resolver-rules=MAP * ~NOTFOUND",
                   f"--user-data-dir={profile}", f"--virtual-time-budget={budget_ms}"]
@@ -92,6 +92,9 @@ def _main(argv: list[str]) -> int:
     if len(argv) < 2:
         print(__doc__)
         return 2
+    if chromium() is None:
+        print("browser: no Chromium (Debian's chromium, or SPACAR_CHROMIUM): the pages are not opened")
+        return 0
     out = Path(argv[0])
     out.mkdir(parents=True, exist_ok=True)
     failed = False
