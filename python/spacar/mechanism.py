@@ -8,6 +8,7 @@ and the instant centres of its bodies (docs/mechanisms.md).
     fb.limit_positions()               # crank angles where the rocker reverses
     model = fb.model()                 # the spacar model, crank driven at 1 rad/s
     spacar.mechanism.limit_positions(model, output=(9, 1))   # found along the input, refined
+    spacar.mechanism.dead_positions(model)                   # where the input can drive it no further
     spacar.mechanism.instant_centres(model, [1, 2, 3])       # Aronhold–Kennedy, from the velocities
 
 The four-bar's ground pivots are A = (0, 0) and D = (d, 0); the crank AB turns by θ from the x
@@ -22,12 +23,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _core
 from ._util import show
 from .errors import InputError
 from .model import Model
 from .section import PLANAR_BEAMS
 
-__all__ = ["Grashof", "FourBar", "synthesize", "limit_positions", "instant_centres", "transmission_angle"]
+__all__ = ["Grashof", "FourBar", "synthesize", "limit_positions", "dead_positions", "instant_centres",
+           "transmission_angle"]
 
 
 def _length(value, name) -> float:
@@ -256,6 +259,93 @@ def limit_positions(model, output, steps: int = 360, *, t_end=None, tol: float =
         first, _, row = tf._row(output)
         found.append((float(t), float(tf.q[column]), float((tf.x if first is tf.DF else tf.e)[row])))
     return found
+
+
+def dead_positions(model, steps: int = 360, *, t_end=None, tol: float = 1e-10) -> list:
+    """The dead position of a single-input mechanism along its input's motion (the current block,
+    or to ``t_end``): where the input can drive it no further, the Jacobian of the constraints
+    singular (a toggle: the crank of a non-Grashof four-bar at the end of its range, a
+    slider-crank driven by its slider at a dead centre). Returns [(t, input value)], the first one
+    on the way (the motion cannot pass it), or [] where the input drives the mechanism through
+    the whole motion.
+
+    Found in two stages. The kinematic analysis is stepped along the input's motion in ``steps``
+    samples until it fails. From the last configuration it solves, the coordinate that moves
+    fastest there (the largest velocity ratio) drives the mechanism instead, and the input
+    reverses along that motion: the dead position is that limit position of the input
+    (:func:`limit_positions` of a copy of the model driven by that coordinate), refined to
+    ``tol`` in the driving coordinate; near it the input is stationary, so its value is far more
+    accurate than ``tol``."""
+    from .errors import KinematicsError
+    from .simulate import simulate
+    from .transfer import _labels, _q_labels, _simulation, _transfer_here
+
+    sim = _simulation(model, "dead_positions")
+    system = sim.system
+    labels, is_input = _q_labels(system)
+    coordinate_labels, deformation_labels = _labels(system)
+    t0 = model.current_time
+    t_end = t0 + model.settings.timestep_tp if t_end is None else float(t_end)
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 3:
+        raise InputError(f"dead_positions: steps must be a whole number of at least 3, got {show(steps)}")
+    inputs = [label for label, flag in zip(labels, is_input) if flag]
+    if len(inputs) != 1 or len(labels) != 1:
+        raise InputError(f"a single-input mechanism (one input, no degrees of freedom) is needed; q̂ is {labels}")
+    wrt = inputs[0]
+    q0 = np.zeros(0)
+    good = []                                   # (t, Transfer) of the samples the analysis solves
+    for t in np.linspace(t0, t_end, int(steps) + 1):
+        try:
+            good.append((float(t), _transfer_here(sim, t, q0, labels, is_input, coordinate_labels,
+                                                  deformation_labels)))
+        except KinematicsError:
+            break
+    else:
+        return []
+    if len(good) < 3:
+        raise InputError("dead_positions: the analysis fails within two steps of the start; start the "
+                         "mechanism farther from its dead position or give more steps")
+    t_k, tf = good[-1]
+    column = tf.column(wrt)
+    node, comp = wrt[1], wrt[2]
+    inp = tf.coordinate_labels.index((node, comp))
+    # The driver: the fastest-moving coordinate that is neither the input nor fixed (its DF row not 0).
+    speed = np.abs(tf.DF[:, column])
+    speed[inp] = 0.0
+    driver = tf.coordinate_labels[int(np.argmax(speed))]
+    ratio = float(tf.DF[tf.coordinate_labels.index(driver), column])
+    # The model at the last solved configuration, then driven by that coordinate.
+    at_k = model.copy()
+    at_k.timestep(len(good) - 1, t_k - t0)
+    simulate(at_k)
+    driven = at_k.copy()
+    driven._core.set_coordinate_class(node, [comp], _core.CoordClass.calculable)
+    driven.inputx(*driver)
+    driven.xd(*driver, 1.0 if ratio * (good[-1][1].q[column] - good[-2][1].q[column]) > 0 else -1.0)
+    # The input's remaining travel is at most one step; near the dead position the input moves as
+    # the square of the driver's distance from it, so the driver has about 2 × travel × ratio to go.
+    travel = abs(good[-1][1].q[column] - good[-2][1].q[column])
+    span = 4.0 * travel * abs(ratio)
+    for _ in range(8):
+        try:
+            found = limit_positions(driven, (node, comp), steps=24, t_end=driven.current_time + span, tol=tol)
+        except KinematicsError:
+            found = None
+        if found:
+            value = found[0][2]
+            break
+        span = span / 2 if found is None else span * 2   # past another singularity: shorter; none yet: longer
+    else:
+        raise KinematicsError(f"dead_positions: the analysis stops after t = {t_k:.9g}, but no dead position "
+                              f"was found driving the mechanism by coordinate {driver}")
+    # The time at which the input's motion (constant acceleration at most) reaches the value.
+    ts = np.array([t for t, _ in good[-3:]])
+    qs = np.array([g.q[column] for _, g in good[-3:]])
+    a, b, c = np.polyfit(ts - t_k, qs, 2)
+    roots = np.roots([a, b, c - value]) if abs(a) > 1e-14 * max(abs(b), 1e-300) else np.array([(value - c) / b])
+    roots = roots[np.isreal(roots)].real
+    t_dead = t_k + float(roots[np.argmin(np.abs(roots))])
+    return [(t_dead, float(value))]
 
 
 def instant_centres(model, bodies, at=None) -> dict:

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import spacar
-from spacar.mechanism import FourBar, instant_centres, limit_positions, synthesize, transmission_angle
+from spacar.mechanism import FourBar, dead_positions, instant_centres, limit_positions, synthesize, transmission_angle
 from support.paths import EXAMPLES
 
 
@@ -109,6 +109,39 @@ def test_a_non_grashof_linkage_s_toggle_positions_end_its_crank_s_range():
         assert cross == pytest.approx(0.0, abs=1e-7)
         beyond = theta + 1e-3 * np.sign(theta)
         assert not np.isfinite(fb.points(beyond)[1]).all()  # past the toggle the loop cannot close
+
+
+@pytest.mark.parametrize("lengths, theta0", [((0.3, 0.35, 0.30, 0.40), 0.0), ((0.2, 0.5, 0.2, 0.3), math.pi)])
+@pytest.mark.parametrize("rate", [1.0, -1.0])
+def test_dead_positions_found_along_the_input_are_the_toggle_positions(lengths, theta0, rate):
+    """Issue 41: a non-Grashof crank driven until it can go no further; the kinematics fails past
+    the toggle, and dead_positions locates it: the closed form's toggle position to 1e-10."""
+    fb = FourBar(*lengths)
+    assert not fb.grashof().grashof
+    model = fb.model(theta0=theta0, rate=rate, steps=360)
+    (t, value), = dead_positions(model)
+    ahead = min(fb.toggle_positions(), key=lambda th: ((th - theta0) * rate) % (2 * math.pi))
+    assert math.remainder(theta0 + value - ahead, 2 * math.pi) == pytest.approx(0.0, abs=1e-10)
+    assert t == pytest.approx(value / rate, abs=1e-10)           # the crank's angle is rate × t
+    inside, beyond = theta0 + value - 1e-6 * rate, theta0 + value + 1e-6 * rate
+    assert np.isfinite(fb.points(inside)[1]).all() and not np.isfinite(fb.points(beyond)[1]).all()
+
+
+def test_a_grashof_crank_has_no_dead_position():
+    model, _ = coupler_example()
+    assert dead_positions(model, steps=72) == []
+
+
+def test_a_slider_crank_driven_by_its_slider_stops_at_the_dead_centre():
+    """The slider pushed outwards: the crank and the rod come in line at x = a + b."""
+    m = rigid_slider_crank()
+    m._core.set_coordinate_class(11, [1], spacar._core.CoordClass.calculable)
+    m.apply("INPUTX", 3, 1)
+    m.xd(3, 1, 0.01)
+    x0 = 0.15 * math.cos(0.7) + math.sqrt(0.3**2 - (0.15 * math.sin(0.7)) ** 2)
+    (t, value), = dead_positions(m, steps=100, t_end=10.0)
+    assert value == pytest.approx(0.15 + 0.3, abs=1e-10)
+    assert t == pytest.approx((0.45 - x0) / 0.01, abs=1e-8)
 
 
 def rigid_slider_crank():
