@@ -1,7 +1,8 @@
 """spacar.light (issue 39): SPACAR Light's model, given as spacarlight.m takes it, gives the closed
 forms of flexure design and the same answers as the model built with spacar.flexure: the 3-D
 parallel leaf-spring guide's drive stiffness, support stiffness, eigenfrequency and buckling load,
-the cross-spring pivot's stiffness (Wittrick: 2EI/L for leaves crossing at their middles), a
+the cross-spring pivot's stiffness (Wittrick: 2EI/L for leaves crossing at their middles) and its
+load dependence (Haringx: K = 2EI/L − P L/(6√2) to first order, equal to the builder's pivot), a
 Timoshenko cantilever's compliance P L³/3EI + P L/kGA with one beam, moments fixed in global
 axes (the clamp's reaction is −M at every step), load steps and prescribed displacements, the
 automatic release of a closed loop and the same results with the releases given; results shaped
@@ -97,6 +98,54 @@ def test_cross_spring_pivot_stiffness():
     C = out.step(1).node(3).CMglob
     assert 1 / C[5, 5] == pytest.approx(2 * EI / L, rel=1e-3)           # (shear and axial: 3e-4)
     assert C[5, 5] == pytest.approx(out.step(1).node(4).CMglob[5, 5], rel=1e-9)  # one rigid body
+
+
+def pivot_input(P, nbeams):
+    """The cross-spring pivot of the test above, P down shared by the leaves' upper ends (its line
+    through the crossing point: no moment at θ = 0)."""
+    d1, d2 = np.array([1.0, 1.0, 0.0]) / np.sqrt(2), np.array([-1.0, 1.0, 0.0]) / np.sqrt(2)
+    nodes = [-L / 2 * d1, -L / 2 * d2, L / 2 * d1, L / 2 * d2]
+    load = dict(force=[0.0, -P / 2, 0.0])
+    return (nodes, [[1, 3], [2, 4], [3, 4]], [dict(fix=True), dict(fix=True), load, dict(load)],
+            [leaf_set([1, 2], nbeams=nbeams), dict(elems=3)], dict(loadsteps=2))
+
+
+def builder_pivot(P, nbeams):
+    """The same pivot with spacar.flexure: the body's reference point on the axis, midway between
+    the leaves' upper ends, where the load acts."""
+    d1, d2 = np.array([1.0, 1.0, 0.0]) / np.sqrt(2), np.array([-1.0, 1.0, 0.0]) / np.sqrt(2)
+    fx = flexure.Flexure(spatial=True)
+    top = fx.body(at=(0.0, L / (2 * np.sqrt(2)), 0.0))
+    for d, n in ((d1, d2), (d2, -d1)):        # each leaf thin across itself, in the plane
+        fx.leaf_spring(fx.ground, top, tuple(-L / 2 * d), tuple(L / 2 * d), LEAF, n=nbeams, thickness=tuple(n))
+    m = fx.model()
+    for leaf in fx.flexures:
+        LEAF.apply(m, *leaf.elements, shear=True)
+    m.force(top.node, 0.0, -P, 0.0)
+    return m, top
+
+
+def test_the_loaded_pivot_s_stiffness_is_haringx_s_and_the_builder_s():
+    """A cross-spring pivot carrying a load P along its axis stiffens or softens with it (Haringx's
+    load dependence). To first order in P, for leaves crossing at their middles at 90°: each leaf
+    (axial force N = −P/√2) bends into an arc as the top turns by θ about the crossing point, its
+    geometric stiffness adding N·(−L/4 + L/6)·θ² to the energy (the chord's shortening by the
+    turn, the arc's own by ½∫w′²), and the load's lever lowers it by P·h·θ²/2 with h = L/(2√2) the
+    height of its point of action: K(P) = 2EI/L − P·L/(6√2). The slope dK/dP of spacar.light's
+    pivot, by central differences at P = ±0.1 N and Richardson's extrapolation from 16 and 32 beams
+    per leaf (it converges as h²), equals it to 1e-3; the loaded stiffness equals the builder's."""
+    def stiffness(P, nbeams):
+        return 1.0 / light(*pivot_input(P, nbeams)).step(2).node(3).CMglob[5, 5]
+
+    slopes = [(stiffness(0.1, n) - stiffness(-0.1, n)) / 0.2 for n in (16, 32)]
+    slope = slopes[1] + (slopes[1] - slopes[0]) / 3
+    assert slope == pytest.approx(-L / (6 * np.sqrt(2)), rel=1e-3)
+    P = 2.0
+    m, top = builder_pivot(P, 16)
+    spacar.static(m, steps=2)
+    Cb = spacar.compliance(m, top.node, rotation=top.rotation_node)
+    assert 1.0 / Cb[5, 5] == pytest.approx(stiffness(P, 16), rel=1e-8)
+    assert 1.0 / Cb[5, 5] == pytest.approx(2 * EI / L - P * L / (6 * np.sqrt(2)), rel=2e-4)   # P², mesh
 
 
 def test_timoshenko_cantilever_with_one_beam():
