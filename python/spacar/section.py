@@ -78,6 +78,7 @@ class Section:
         self.Wy, self.Wz, self.Wt = Wy, Wz, Wt
         self.shear_factor = shear_factor
         self._round = round_  # bending about any axis has the same modulus: |M| = hypot(My, Mz)
+        self.principal_angle = 0.0  # from the section's y to its principal y (an angle's legs are not principal)
 
     # --- the element data ---------------------------------------------------------------------
 
@@ -101,6 +102,8 @@ class Section:
             return 10 * (1 + nu) / (12 + 11 * nu)
         if self.shape in ("I-section", "channel"):  # the web carries the shear
             return 1.0 / self.shear_factor
+        if self.shape == "angle":
+            return sum(self.shear_areas()) / (2 * self.A)
         if self.shape == "circle":
             return 6 * (1 + nu) / (7 + 6 * nu)
         m2 = ((self.dims["d"] - 2 * self.dims["t"]) / self.dims["d"]) ** 2
@@ -113,6 +116,11 @@ class Section:
         if self.shape in ("I-section", "channel"):
             d = self.dims
             return (d["h"] - 2 * d["tf"]) * d["tw"], 5.0 / 6.0 * 2 * d["b"] * d["tf"]
+        if self.shape == "angle":   # each leg takes the shear along itself, (5/6) of its area
+            d, a = self.dims, self.principal_angle
+            leg_h, leg_b = 5.0 / 6.0 * d["h"] * d["t"], 5.0 / 6.0 * (d["b"] - d["t"]) * d["t"]
+            c, s = math.cos(a), math.sin(a)
+            return leg_h * c * c + leg_b * s * s, leg_h * s * s + leg_b * c * c
         kA = self.shear_coefficient() * self.A
         return kA, kA
 
@@ -205,6 +213,27 @@ class Section:
             return (d["h"] - d["tf"]) / 2 * max(e, bc - e)
         return {"rectangle": lambda: d["b"] * d["h"] / 4, "I-section": lambda: d["b"] * (d["h"] - d["tf"]) / 4}.get(
             self.shape, lambda: 0.0)()
+
+    def principal_y(self, axis, y) -> tuple:
+        """The direction of the section's principal y-axis for a beam along ``axis`` whose
+        section's own y-axis (an angle's leg h; for the other sections their y, which is
+        principal) points along ``y``: ``y`` made normal to the axis and turned about it by
+        ``principal_angle`` (from y towards z). For a beam's definition line (``Model.beam(...,
+        *sec.principal_y(axis, y))``) or the flexure builder's ``y=``."""
+        x = np.asarray(axis, dtype=float)
+        y = np.asarray(y, dtype=float)
+        if x.shape != (3,) or y.shape != (3,) or not (np.isfinite(x).all() and np.isfinite(y).all()):
+            raise InputError(f"principal_y: axis and y must be 3 finite numbers each, got {show(axis)}, {show(y)}")
+        if not np.linalg.norm(x) > 0:
+            raise InputError("principal_y: the beam's axis has no length")
+        x = x / np.linalg.norm(x)
+        y = y - (y @ x) * x
+        if not np.linalg.norm(y) > 1e-12 * np.linalg.norm(np.asarray(axis, dtype=float)):
+            raise InputError("principal_y: y lies along the beam's axis")
+        y = y / np.linalg.norm(y)
+        z = np.cross(x, y)
+        a = self.principal_angle
+        return tuple(float(v) for v in math.cos(a) * y + math.sin(a) * z)
 
     def __repr__(self):
         dims = ", ".join(f"{k} = {v:g}" for k, v in self.dims.items())
@@ -326,6 +355,49 @@ def channel(h, b, tw, tf, material: Material | None = None) -> Section:
                       Wy=Iy / max(zc, b - zc), Wz=Iz / (h / 2), Wt=J / max(tf, tw), shear_factor=A / (hw * tw),
                       round_=False, Iw=Iw)
     section.shear_centre = 3 * bc**2 * tf / (6 * bc * tf + hc * tw)
+    return section
+
+
+def angle(h, b, t, material: Material | None = None) -> Section:
+    """An angle (L-section, fillets and toe roundings left out): a leg of length ``h`` along y and
+    one of length ``b`` along z from the outer corner, both ``t`` thick. Its principal axes are
+    inclined to the legs: ``Iy``, ``Iz`` are the principal second moments (Iz the larger, about
+    the principal z-axis), ``principal_angle`` α turns the legs' y-axis to the principal y-axis
+    (about the beam's axis, from y towards z; tan 2α = 2 Iyz/(Izz − Iyy) of the moments about the
+    centroid in the legs' axes), and :meth:`Section.principal_y` gives the direction of the
+    principal y-axis for a beam's definition line. ``centroid`` (ȳ, z̄) and ``shear_centre``
+    (the legs' centre lines' crossing, (t/2, t/2)) from the outer corner; spacar's beams keep the
+    shear centre on their axis, so a load through the centroid does not twist the angle as it
+    would. A = t (h + b − t); J = (h + b − t) t³/3; the warping constant of thin legs meeting at
+    the shear centre, (t³/36)(h'³ + b'³) with h' = h − t/2, b' = b − t/2 (secondary warping
+    only); the section moduli from the corners' distances to the principal axes; each leg takes
+    the shear along its length ((5/6) of its area, projected on the principal axes)."""
+    h, b, t = (_positive(v, name) for v, name in ((h, "h"), (b, "b"), (t, "t")))
+    if not (t < h and t < b):
+        raise InputError(f"an angle needs t < h and t < b, got h = {h:g}, b = {b:g}, t = {t:g}")
+    # The legs as two rectangles [y0, y1] × [z0, z1] from the outer corner: their area moments.
+    legs = ((0.0, h, 0.0, t), (0.0, t, t, b))
+    A = sum((y1 - y0) * (z1 - z0) for y0, y1, z0, z1 in legs)
+    yc = sum((y1**2 - y0**2) / 2 * (z1 - z0) for y0, y1, z0, z1 in legs) / A
+    zc = sum((y1 - y0) * (z1**2 - z0**2) / 2 for y0, y1, z0, z1 in legs) / A
+    Syy = sum((y1**3 - y0**3) / 3 * (z1 - z0) for y0, y1, z0, z1 in legs) - A * yc**2     # ∫ y² about the centroid
+    Szz = sum((y1 - y0) * (z1**3 - z0**3) / 3 for y0, y1, z0, z1 in legs) - A * zc**2
+    Syz = sum((y1**2 - y0**2) * (z1**2 - z0**2) / 4 for y0, y1, z0, z1 in legs) - A * yc * zc
+    alpha = 0.5 * math.atan2(2 * Syz, Syy - Szz)      # the principal y': ∫ y'² the largest
+    c, s = math.cos(alpha), math.sin(alpha)
+    Iz = Syy * c * c + 2 * Syz * c * s + Szz * s * s     # ∫ y'² dA: bending about z'
+    Iy = Syy * s * s - 2 * Syz * c * s + Szz * c * c     # ∫ z'² dA
+    corners = np.array([(0, 0), (h, 0), (h, t), (t, t), (t, b), (0, b)], dtype=float) - (yc, zc)
+    yp, zp = corners @ np.array([c, s]), corners @ np.array([-s, c])
+    J = (h + b - t) * t**3 / 3
+    hc, bc = h - t / 2, b - t / 2
+    section = Section("angle", {"h": h, "b": b, "t": t}, material, A=A, Iy=Iy, Iz=Iz, J=J,
+                      Wy=Iy / np.abs(zp).max(), Wz=Iz / np.abs(yp).max(), Wt=J / t, shear_factor=1.0,
+                      round_=False, Iw=t**3 * (hc**3 + bc**3) / 36)
+    section.principal_angle = alpha
+    section.centroid = (yc, zc)
+    section.shear_centre = (t / 2, t / 2)
+    section.shear_factor = 1.5 * A / (t * min(h, b))  # the largest shear stress: 3/2 of the mean in the shorter leg
     return section
 
 

@@ -258,3 +258,50 @@ def test_channel_constants_against_the_sectorial_coordinate_and_its_rectangles()
     with pytest.raises(spacar.InputError, match="h > 2 tf and tw < b"):
         section.channel(0.2, 0.005, 0.0085, 0.0115)
 
+
+
+def test_angle_principal_axes_and_a_cantilever_bent_askew():
+    """An unequal angle 100 x 60 x 8 mm: A, the centroid and the second moments in the legs'
+    axes from the full rectangle less its cut-out corner (not the code's two legs); the principal
+    values are the eigenvalues of that tensor. A cantilever of it, its beam's y along the
+    principal axis (principal_y), pushed along the long leg: the tip moves as unsymmetric bending
+    gives with the legs' tensor, δ = (L³/3E) S⁻¹ F (S = [[∫y², ∫yz], [∫yz, ∫z²]]), askew to the
+    load, to 1e-9 (one beam, shear-rigid, a small load)."""
+    h, b, t = 0.100, 0.060, 0.008
+    s = section.angle(h, b, t, material=section.STEEL)
+    # The bounding rectangle [0, h] × [0, b] less the corner [t, h] × [t, b] (y along h, z along b).
+    parts = [(+1, 0.0, h, 0.0, b), (-1, t, h, t, b)]
+    A = sum(k * (y1 - y0) * (z1 - z0) for k, y0, y1, z0, z1 in parts)
+    yc = sum(k * (y1**2 - y0**2) / 2 * (z1 - z0) for k, y0, y1, z0, z1 in parts) / A
+    zc = sum(k * (y1 - y0) * (z1**2 - z0**2) / 2 for k, y0, y1, z0, z1 in parts) / A
+    Syy = sum(k * (y1**3 - y0**3) / 3 * (z1 - z0) for k, y0, y1, z0, z1 in parts) - A * yc**2
+    Szz = sum(k * (y1 - y0) * (z1**3 - z0**3) / 3 for k, y0, y1, z0, z1 in parts) - A * zc**2
+    Syz = sum(k * (y1**2 - y0**2) * (z1**2 - z0**2) / 4 for k, y0, y1, z0, z1 in parts) - A * yc * zc
+    assert s.A == pytest.approx(A, rel=1e-13) and s.centroid == pytest.approx((yc, zc), rel=1e-13)
+    S = np.array([[Syy, Syz], [Syz, Szz]])
+    assert sorted((s.Iy, s.Iz)) == pytest.approx(np.linalg.eigvalsh(S), rel=1e-12)
+    assert s.Iz > s.Iy and Syz < 0            # the legs point away from the centroid: ∫yz < 0
+    u = np.array([math.cos(s.principal_angle), math.sin(s.principal_angle)])
+    assert S @ u == pytest.approx(s.Iz * u, rel=1e-12)  # the principal y': its spread ∫y'² is Iz
+    assert s.beam_estiff()[2:] == pytest.approx((section.STEEL.E * s.Iy, section.STEEL.E * s.Iz))
+
+    L, F = 1.0, 1e-3
+    m = spacar.Model()
+    m.beam(1, 1, 101, 2, 102, *s.principal_y((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
+    m.x(1, 0.0, 0.0, 0.0)
+    m.x(2, L, 0.0, 0.0)
+    m.fix(1)
+    m.fix(101)
+    m.dyne(1, 2, 3, 4, 5, 6)
+    s.apply(m, 1)
+    m.force(2, 0.0, F, 0.0)
+    m.epskin(1e-13)
+    res = spacar.static(m)
+    tip = np.array([res.coordinate(2, i)[-1] for i in (1, 2, 3)])
+    expected = L**3 / (3 * section.STEEL.E) * np.linalg.solve(S, [F, 0.0])
+    assert tip[1:] == pytest.approx(expected, rel=1e-9, abs=1e-9 * np.abs(expected).max())
+    assert abs(expected[1]) > 0.3 * abs(expected[0])  # askew: the tip leaves the load's plane
+    with pytest.raises(InputError, match="t < h and t < b"):
+        section.angle(0.05, 0.005, 0.008)
+    with pytest.raises(InputError, match="along the beam's axis"):
+        s.principal_y((1.0, 0.0, 0.0), (2.0, 0.0, 0.0))
