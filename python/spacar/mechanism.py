@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _core
 from ._util import show
 from .errors import InputError
 from .model import Model
@@ -319,7 +318,7 @@ def dead_positions(model, steps: int = 360, *, t_end=None, tol: float = 1e-10) -
     at_k.timestep(len(good) - 1, t_k - t0)
     simulate(at_k)
     driven = at_k.copy()
-    driven._core.set_coordinate_class(node, [comp], _core.CoordClass.calculable)
+    driven.calculable(node, comp)
     driven.inputx(*driver)
     driven.xd(*driver, 1.0 if ratio * (good[-1][1].q[column] - good[-2][1].q[column]) > 0 else -1.0)
     # The input's remaining travel is at most one step; near the dead position the input moves as

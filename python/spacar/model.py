@@ -217,6 +217,16 @@ class Model:
         """DYNX n [i...]: node n component(s) i are dynamic degrees of freedom."""
         self._coord_class("DYNX", (n, *components))
 
+    def calculable(self, n, *components):
+        """Node n's component(s) i (all if omitted) calculable again: neither fixed, input nor
+        degree of freedom, what a coordinate is that no FIX, INPUTX or DYNX names (not an input
+        keyword; :func:`spacar.mechanism.dead_positions` drives a copy of a mechanism by another
+        coordinate with it)."""
+        n, comps = self._call("FIX", n, *components)
+        self._core.set_coordinate_class(n, comps, _core.CoordClass.calculable)
+        for key in [k for k in self._prescribed if k[0] == n and (not comps or k[1] in comps or k[1] == 0)]:
+            del self._prescribed[key]
+
     def rlse(self, e, *deformations):
         """RLSE e [i...]: release deformation(s) i of element e (all if omitted)."""
         self._def_class("RLSE", (e, *deformations))

@@ -135,7 +135,7 @@ def test_a_grashof_crank_has_no_dead_position():
 def test_a_slider_crank_driven_by_its_slider_stops_at_the_dead_centre():
     """The slider pushed outwards: the crank and the rod come in line at x = a + b."""
     m = rigid_slider_crank()
-    m._core.set_coordinate_class(11, [1], spacar._core.CoordClass.calculable)
+    m.calculable(11, 1)
     m.apply("INPUTX", 3, 1)
     m.xd(3, 1, 0.01)
     x0 = 0.15 * math.cos(0.7) + math.sqrt(0.3**2 - (0.15 * math.sin(0.7)) ** 2)
