@@ -269,12 +269,16 @@ def dead_positions(model, steps: int = 360, *, t_end=None, tol: float = 1e-10) -
     the whole motion.
 
     Found in two stages. The kinematic analysis is stepped along the input's motion in ``steps``
-    samples until it fails. From the last configuration it solves, the coordinate that moves
-    fastest there (the largest velocity ratio) drives the mechanism instead, and the input
-    reverses along that motion: the dead position is that limit position of the input
-    (:func:`limit_positions` of a copy of the model driven by that coordinate), refined to
-    ``tol`` in the driving coordinate; near it the input is stationary, so its value is far more
-    accurate than ``tol``."""
+    samples until it fails; the failing step is retried in eighths, four times over, so that a
+    step merely too long for Newton is not taken for a dead position (``steps`` must still be
+    fine enough not to jump across the region the input cannot reach). From the last
+    configuration it solves, the coordinate whose velocity ratio to the input grows fastest there
+    (it moves ever faster as the Jacobian turns singular; not an Euler parameter) drives a copy
+    of the model instead, and the input reverses along that motion: the dead position is that
+    limit position of the input (:func:`limit_positions`), refined to ``tol`` in the driving
+    coordinate; near it the input is stationary, so its value is far more accurate than
+    ``tol``. The input must be a coordinate (INPUTX), moving forward in time (``t_end`` after the
+    model's current time)."""
     from .errors import KinematicsError
     from .simulate import simulate
     from .transfer import _labels, _q_labels, _simulation, _transfer_here
@@ -287,53 +291,106 @@ def dead_positions(model, steps: int = 360, *, t_end=None, tol: float = 1e-10) -
     t_end = t0 + model.settings.timestep_tp if t_end is None else float(t_end)
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 3:
         raise InputError(f"dead_positions: steps must be a whole number of at least 3, got {show(steps)}")
+    if not (np.isfinite(t_end) and t_end > t0):
+        raise InputError(f"dead_positions: t_end must be after the model's current time {t0:g}, got {show(t_end)}")
     inputs = [label for label, flag in zip(labels, is_input) if flag]
     if len(inputs) != 1 or len(labels) != 1:
         raise InputError(f"a single-input mechanism (one input, no degrees of freedom) is needed; q̂ is {labels}")
     wrt = inputs[0]
-    q0 = np.zeros(0)
-    good = []                                   # (t, Transfer) of the samples the analysis solves
-    for t in np.linspace(t0, t_end, int(steps) + 1):
-        try:
-            good.append((float(t), _transfer_here(sim, t, q0, labels, is_input, coordinate_labels,
-                                                  deformation_labels)))
-        except KinematicsError:
+    if wrt[0] != "x":
+        raise InputError(f"dead_positions: the input must be a coordinate (INPUTX), not the deformation {wrt[1:]}")
+    node, comp = wrt[1], wrt[2]
+
+    def walk(times):
+        """The samples solved along ``times`` from the start, and the first time that fails."""
+        walker, q0, solved = _simulation(model, "dead_positions"), np.zeros(0), []
+        for t in times:
+            try:
+                solved.append((float(t), _transfer_here(walker, t, q0, labels, is_input, coordinate_labels,
+                                                        deformation_labels)))
+            except KinematicsError:
+                return solved, float(t)
+        return solved, None
+
+    times = list(np.linspace(t0, t_end, int(steps) + 1))
+    good, failed = walk(times)
+    for _ in range(4):                          # the failing step again, in eighths
+        if failed is None or not good:
             break
-    else:
+        times = [t for t, _ in good] + list(np.linspace(good[-1][0], failed, 9)[1:])
+        good, failed = walk(times)
+    if failed is None:
         return []
     if len(good) < 3:
         raise InputError("dead_positions: the analysis fails within two steps of the start; start the "
                          "mechanism farther from its dead position or give more steps")
-    t_k, tf = good[-1]
+    (_, before), (t_k, tf) = good[-2], good[-1]
     column = tf.column(wrt)
-    node, comp = wrt[1], wrt[2]
     inp = tf.coordinate_labels.index((node, comp))
-    # The driver: the fastest-moving coordinate that is neither the input nor fixed (its DF row not 0).
-    speed = np.abs(tf.DF[:, column])
-    speed[inp] = 0.0
+    # The driver: among the coordinates whose ratio to the input grows (those of the motion the
+    # singular Jacobian lets through; a coordinate turning with the input keeps its ratio), the
+    # fastest, positions measured in the mechanism's size against rotations; neither the input
+    # nor an Euler parameter.
+    kinds = {n: data.kind.name for n, data in model.nodes.items()}
+    positions = np.array([tf.x[k] for k, (n, _) in enumerate(tf.coordinate_labels) if kinds[n] in ("XY", "XYZ")])
+    size = float(np.ptp(positions)) if positions.size else 1.0
+    now, then = np.abs(tf.DF[:, column]), np.abs(before.DF[:, column])
+    growth = np.where(now > 0.0, now / np.maximum(then, 1e-300), 0.0)
+    for k, (n, _) in enumerate(tf.coordinate_labels):
+        if k == inp or kinds[n] == "LAMBDA":
+            growth[k] = 0.0
+    weight = np.array([1.0 / (size or 1.0) if kinds[n] in ("XY", "XYZ") else 1.0 for n, _ in tf.coordinate_labels])
+    speed = np.where(growth >= 0.5 * growth.max(), now * weight, 0.0)
     driver = tf.coordinate_labels[int(np.argmax(speed))]
     ratio = float(tf.DF[tf.coordinate_labels.index(driver), column])
-    # The model at the last solved configuration, then driven by that coordinate.
-    at_k = model.copy()
-    at_k.timestep(len(good) - 1, t_k - t0)
-    simulate(at_k)
+    # The model at the last solved configuration, reached in blocks of the walk's step lengths
+    # (finer if its run lands elsewhere: long steps may take another branch).
+    from .transfer import transfer
+
+    spacing = np.diff([t for t, _ in good])
+    for finer in (1, 8, 64):
+        at_k = model.copy()
+        at_k.matasc(0)
+        start = 0
+        while start < len(spacing):
+            end = start + 1
+            while end < len(spacing) and abs(spacing[end] - spacing[start]) <= 1e-9 * spacing[start]:
+                end += 1
+            at_k.timestep(finer * (end - start), float(good[end][0] - good[start][0]))
+            simulate(at_k, progress=False)
+            start = end
+        # The same branch (another one differs by the mechanism's size; near the dead position the
+        # configuration is ill-conditioned, so Newton's tolerance shows magnified).
+        if np.abs(transfer(at_k).x - tf.x).max() <= 1e-3 * max(1.0, np.abs(tf.x).max()):
+            break
+    else:
+        raise KinematicsError(f"dead_positions: the run to t = {t_k:.9g} does not reach the configuration "
+                              "the stepped analysis found there; give more steps")
+    # The copy driven by that coordinate at unit rate, steadily (no acceleration left from the run).
     driven = at_k.copy()
     driven.calculable(node, comp)
     driven.inputx(*driver)
-    driven.xd(*driver, 1.0 if ratio * (good[-1][1].q[column] - good[-2][1].q[column]) > 0 else -1.0)
+    driven.xd(*driver, 1.0 if ratio * (tf.q[column] - before.q[column]) > 0 else -1.0)
+    driven.xdd(*driver, 0.0)
     # The input's remaining travel is at most one step; near the dead position the input moves as
-    # the square of the driver's distance from it, so the driver has about 2 × travel × ratio to go.
-    travel = abs(good[-1][1].q[column] - good[-2][1].q[column])
-    span = 4.0 * travel * abs(ratio)
-    for _ in range(8):
+    # the square of the driver's distance from it, so the driver has about 2 × travel × ratio to
+    # go. The span searched is bracketed: too short finds no reversal, too long fails.
+    travel = abs(tf.q[column] - before.q[column])
+    span, short, long_ = 4.0 * travel * abs(ratio), 0.0, None
+    for _ in range(12):
+        driven.timestep(24, span)
         try:
             found = limit_positions(driven, (node, comp), steps=24, t_end=driven.current_time + span, tol=tol)
-        except KinematicsError:
+        except (KinematicsError, ValueError):   # past another singularity (brentq: no sign change)
             found = None
         if found:
             value = found[0][2]
             break
-        span = span / 2 if found is None else span * 2   # past another singularity: shorter; none yet: longer
+        if found is None:
+            long_ = span
+        else:
+            short = span
+        span = 2.0 * span if long_ is None else 0.5 * (short + long_)
     else:
         raise KinematicsError(f"dead_positions: the analysis stops after t = {t_k:.9g}, but no dead position "
                               f"was found driving the mechanism by coordinate {driver}")
@@ -343,6 +400,8 @@ def dead_positions(model, steps: int = 360, *, t_end=None, tol: float = 1e-10) -
     a, b, c = np.polyfit(ts - t_k, qs, 2)
     roots = np.roots([a, b, c - value]) if abs(a) > 1e-14 * max(abs(b), 1e-300) else np.array([(value - c) / b])
     roots = roots[np.isreal(roots)].real
+    if roots.size == 0:
+        raise KinematicsError(f"dead_positions: the input's motion does not reach its dead value {value:.9g}")
     t_dead = t_k + float(roots[np.argmin(np.abs(roots))])
     return [(t_dead, float(value))]
 

@@ -184,10 +184,15 @@ class Section:
     def normal_stress(self, N, My, Mz):
         """Largest |normal stress| over the section under the axial force N and the bending
         moments My, Mz (arrays broadcast): |N|/A + hypot(My, Mz)/W for round sections, |N|/A +
-        |My|/Wy + |Mz|/Wz (a corner) for the rectangle."""
+        |My|/Wy + |Mz|/Wz (a corner) for the rectangle; for an angle the largest over its corners
+        of |N|/A + |My| |z'|/Iy + |Mz| |y'|/Iz (principal coordinates; an upper bound where the
+        moments' signs would make them cancel there)."""
         N, My, Mz = (np.abs(np.asarray(v, dtype=float)) for v in (N, My, Mz))
         if self._round:
             return N / self.A + np.hypot(My, Mz) / self.Wz
+        if self.shape == "angle":   # the largest at one corner, not the two moduli's corners summed
+            return N / self.A + np.max([My * abs(z) / self.Iy + Mz * abs(y) / self.Iz for y, z in self.corners],
+                                       axis=0)
         return N / self.A + My / self.Wy + Mz / self.Wz
 
     def shear_stress(self, T, Vy, Vz):
@@ -370,8 +375,9 @@ def angle(h, b, t, material: Material | None = None) -> Section:
     shear centre on their axis, so a load through the centroid does not twist the angle as it
     would. A = t (h + b − t); J = (h + b − t) t³/3; the warping constant of thin legs meeting at
     the shear centre, (t³/36)(h'³ + b'³) with h' = h − t/2, b' = b − t/2 (secondary warping
-    only); the section moduli from the corners' distances to the principal axes; each leg takes
-    the shear along its length ((5/6) of its area, projected on the principal axes)."""
+    only); the section moduli from the corners' distances to the principal axes (``corners``:
+    (y', z') of the six); each leg takes the shear along its length ((5/6) of its area, projected
+    on the principal axes, the coupling between the two shear directions left out)."""
     h, b, t = (_positive(v, name) for v, name in ((h, "h"), (b, "b"), (t, "t")))
     if not (t < h and t < b):
         raise InputError(f"an angle needs t < h and t < b, got h = {h:g}, b = {b:g}, t = {t:g}")
@@ -395,6 +401,7 @@ def angle(h, b, t, material: Material | None = None) -> Section:
                       Wy=Iy / np.abs(zp).max(), Wz=Iz / np.abs(yp).max(), Wt=J / t, shear_factor=1.0,
                       round_=False, Iw=t**3 * (hc**3 + bc**3) / 36)
     section.principal_angle = alpha
+    section.corners = tuple(zip(yp.tolist(), zp.tolist()))   # (y', z') in the principal axes
     section.centroid = (yc, zc)
     section.shear_centre = (t / 2, t / 2)
     section.shear_factor = 1.5 * A / (t * min(h, b))  # the largest shear stress: 3/2 of the mean in the shorter leg

@@ -126,8 +126,9 @@ def builder_pivot(P, nbeams):
 
 
 def test_the_loaded_pivot_s_stiffness_is_haringx_s_and_the_builder_s():
-    """A cross-spring pivot carrying a load P along its axis stiffens or softens with it (Haringx's
-    load dependence). To first order in P, for leaves crossing at their middles at 90°: each leaf
+    """A cross-spring pivot carrying a load P along its axis stiffens or softens with it (cf.
+    Haringx 1949; the first-order term is derived here, not taken from his exact result). To first
+    order in P, for leaves crossing at their middles at 90°: each leaf
     (axial force N = −P/√2) bends into an arc as the top turns by θ about the crossing point, its
     geometric stiffness adding N·(−L/4 + L/6)·θ² to the energy (the chord's shortening by the
     turn, the arc's own by ½∫w′²), and the load's lever lowers it by P·h·θ²/2 with h = L/(2√2) the

@@ -127,6 +127,28 @@ def test_dead_positions_found_along_the_input_are_the_toggle_positions(lengths, 
     assert np.isfinite(fb.points(inside)[1]).all() and not np.isfinite(fb.points(beyond)[1]).all()
 
 
+def test_dead_positions_do_not_depend_on_units_or_rates(tmp_path, monkeypatch):
+    """The same linkage in millimetres (positions against rotations in the choice of the driving
+    coordinate), a slider pushed 1000 times faster (the driver's steady rate), MATASC on (no
+    files from the runs inside); a t_end behind is refused by name."""
+    monkeypatch.chdir(tmp_path)
+    fb = FourBar(300.0, 350.0, 300.0, 400.0)
+    model = fb.model(theta0=0.0, steps=36)
+    model.matasc(1)
+    (_, value), = dead_positions(model, steps=36)
+    assert value == pytest.approx(max(fb.toggle_positions()), abs=1e-10)
+    assert list(tmp_path.iterdir()) == []
+    m = rigid_slider_crank()
+    m.calculable(11, 1)
+    m.apply("INPUTX", 3, 1)
+    m.xd(3, 1, 10.0)
+    (t, value), = dead_positions(m, steps=100, t_end=0.01)
+    x0 = 0.15 * math.cos(0.7) + math.sqrt(0.3**2 - (0.15 * math.sin(0.7)) ** 2)
+    assert value == pytest.approx(0.45, abs=1e-10) and t == pytest.approx((0.45 - x0) / 10.0, abs=1e-10)
+    with pytest.raises(spacar.InputError, match="t_end must be after"):
+        dead_positions(FourBar(0.3, 0.35, 0.30, 0.40).model(), t_end=-1.0)
+
+
 def test_a_grashof_crank_has_no_dead_position():
     model, _ = coupler_example()
     assert dead_positions(model, steps=72) == []

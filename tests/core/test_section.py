@@ -284,6 +284,13 @@ def test_angle_principal_axes_and_a_cantilever_bent_askew():
     u = np.array([math.cos(s.principal_angle), math.sin(s.principal_angle)])
     assert S @ u == pytest.approx(s.Iz * u, rel=1e-12)  # the principal y': its spread ∫y'² is Iz
     assert s.beam_estiff()[2:] == pytest.approx((section.STEEL.E * s.Iy, section.STEEL.E * s.Iz))
+    # The largest normal stress under My = Mz = 1 N·m: at one corner (principal coordinates), less
+    # than the two moduli's (different corners) summed.
+    corners = np.array([(0, 0), (h, 0), (h, t), (t, t), (t, b), (0, b)]) - (yc, zc)
+    yp, zp = corners @ u, corners @ np.array([-u[1], u[0]])
+    peak = max(abs(z) / s.Iy + abs(y) / s.Iz for y, z in zip(yp, zp))
+    assert s.normal_stress(0.0, 1.0, 1.0) == pytest.approx(peak, rel=1e-12)
+    assert peak < 1 / s.Wy + 1 / s.Wz
 
     L, F = 1.0, 1e-3
     m = spacar.Model()
