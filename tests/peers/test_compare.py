@@ -74,6 +74,55 @@ def test_planar_chain_absolute_angles():
     np.testing.assert_allclose(T, np.eye(5) - np.eye(5, k=-1), atol=1e-12)
 
 
+@pytest.mark.parametrize("n", [1, 5, 9])
+def test_planar_chain_dynamics_derivatives_match_compute_aba_derivatives(n):
+    """spacar.dynamics_derivatives on a planar tree (issue 37): q̈, ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹
+    of a pendulum chain equal pinocchio.computeABADerivatives at random states and torques, to
+    1e-10 of each matrix's largest entry (relative joint angles: spacar's DOFs are Pinocchio's q
+    up to constant offsets)."""
+    model = models.planar_chain(n, rho_a=1.5, tip_mass=0.3, joint_inertia=0.02, angle=-0.4, epskin=1e-12)
+    pm = sp_pinocchio.build(model)
+    rng = np.random.default_rng(n)
+    states = sp_pinocchio.random_states(model, 4, seed=n, scale_q=1.0, scale_qd=2.0)
+    q = np.array([s[1] for s in states])
+    qd = np.array([s[2] for s in states])
+    tau = rng.uniform(-2.0, 2.0, q.shape)
+    qdd, dq, dqd, dtau = spacar.dynamics_derivatives(model, q, qd, tau)
+    for k, (t, qk, qdk) in enumerate(states):
+        r = pm.spacar_state(t, qk, qdk)
+        np.testing.assert_allclose(r["T"], np.eye(n), atol=1e-12)
+        ref = pin.computeABADerivatives(pm.model, pm.data, r["q_pin"], r["v_pin"], tau[k])
+        expected = pin.aba(pm.model, pm.data, r["q_pin"], r["v_pin"], tau[k])
+        assert np.abs(qdd[k] - expected).max() <= 1e-10 * max(1.0, np.abs(expected).max())
+        minv = np.triu(ref[2]) + np.triu(ref[2], 1).T
+        for ours, theirs in zip((dq[k], dqd[k], dtau[k]), (ref[0], ref[1], minv)):
+            assert np.abs(ours - theirs).max() <= 1e-10 * max(1.0, np.abs(theirs).max())
+
+
+@pytest.mark.parametrize("case", ["springs", "absolute"])
+def test_planar_tree_derivatives_against_differences(case):
+    """What Pinocchio's derivatives do not cover: hinge springs and dampers (their torques depend on
+    q and q̇), a rotated ground, gravity off the axes, and absolute link rotations as DOFs (DYNX on
+    BETA nodes). ∂q̈/∂q and ∂q̈/∂q̇ equal central differences of q̈ (itself Pinocchio's ABA, above
+    and in test_planar_chain_*) to 1e-7."""
+    if case == "springs":
+        model = models.planar_chain(4, rho_a=1.0, tip_mass=0.5, stiffness=3.0, damping=0.2, ground_angle=0.3,
+                                    gravity=(1.0, -models.G), epskin=1e-12)
+    else:
+        model = models.planar_chain(5, rho_a=1.0, tip_mass=0.2, dof="absolute", epskin=1e-12)
+    (_, q, qd), = sp_pinocchio.random_states(model, 1, seed=3, scale_q=1.0, scale_qd=2.0)
+    tau = np.linspace(-1.0, 1.0, q.size)
+    qdd, dq, dqd, _ = spacar.dynamics_derivatives(model, q, qd, tau)
+    h = 1e-6
+    for j in range(q.size):
+        e = np.zeros(q.size)
+        e[j] = h
+        fd_q = (spacar.dynamics_derivatives(model, q + e, qd, tau)[0] - spacar.dynamics_derivatives(model, q - e, qd, tau)[0]) / (2 * h)
+        fd_qd = (spacar.dynamics_derivatives(model, q, qd + e, tau)[0] - spacar.dynamics_derivatives(model, q, qd - e, tau)[0]) / (2 * h)
+        assert np.abs(dq[:, j] - fd_q).max() <= 1e-7 * max(1.0, np.abs(dq).max())
+        assert np.abs(dqd[:, j] - fd_qd).max() <= 1e-7 * max(1.0, np.abs(dqd).max())
+
+
 @pytest.mark.parametrize("n", [1, 3, 6])
 def test_spatial_hinge_chain_matches_crba_and_aba(n):
     """BEAM links with random directions, HINGE joints about random axes (DYNE e1), full inertia

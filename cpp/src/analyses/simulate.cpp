@@ -551,7 +551,8 @@ void Simulation::dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, c
   RecursiveTree* tree = recursive_tree();
   if (!tree) {
     throw InputError("dynamics_derivatives: the model is not a tree of rigid bodies of the recursive path (" +
-                     recursive_refusal() + "); the derivatives are computed on spatial trees (URDF robots)");
+                     recursive_refusal() + "); the derivatives are computed on planar and spatial trees of rigid "
+                     "bodies (URDF robots, pendulums, branched linkages)");
   }
   const int nd = sys_->n_dof();
   if (q.cols() != nd || qd.cols() != nd || tau.cols() != nd || qd.rows() != q.rows() || tau.rows() != q.rows())
@@ -568,8 +569,8 @@ void Simulation::dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, c
     check_thread_deadline("(in dynamics_derivatives)");
     if (!tree->dynamics_derivatives(nd, q.row(k).data(), qd.row(k).data(), tau.row(k).data(), qdd.row(k).data(),
                                     a.data(), b.data(), c.data())) {
-      throw InputError("dynamics_derivatives: the derivatives are computed on spatial trees (URDF robots), not on "
-                       "this (planar) tree, or its mass matrix is not positive definite at state " + std::to_string(k));
+      throw InputError("dynamics_derivatives: the mass matrix is not positive definite at state " +
+                       std::to_string(k) + " (a body that moves no mass)");
     }
     for (int i = 0; i < nd; ++i)
       for (int j = 0; j < nd; ++j) {

@@ -1,6 +1,8 @@
 // Planar rigid trees (planar_tree.hpp): the recognizer, the applied loads, the coordinates moving
 // with the bodies.
 #include "spacar/recursive/planar_tree.hpp"
+#include "spacar/recursive/planar_rnea.hpp"
+#include "spacar/recursive/rnea_derivatives.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -219,6 +221,15 @@ std::unique_ptr<PlanarTree> PlanarTree::detect(const System& sys, const Data& da
 }
 
 // Springs of released hinges and FORCE, subtracted from the bias forces.
+bool PlanarTree::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd,
+                                      double* dq, double* dqd, double* dtau) {
+  if (n != n_bodies()) return false;  // every body turned by one joint, its DOF
+  auto id = [&](const auto* qq, const auto* qqd, const auto* qqdd, auto* out) {
+    rnea::planar_inverse_dynamics(bodies_, base_acceleration_, loads_, springs_, qq, qqd, qqdd, out);
+  };
+  return rnea::forward_dynamics_derivatives(n, q, qd, tau, id, qdd, dq, dqd, dtau);
+}
+
 void PlanarTree::applied_loads() {
   for (const Spring& sp : springs_) {  // torque −σ on node b's body, +σ on node a's
     auto angle = [&](int b, double beta0) { return beta0 + (b == kGround ? 0.0 : work_[b].frame.phi); };

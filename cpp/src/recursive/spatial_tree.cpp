@@ -2,6 +2,7 @@
 // moving with the bodies.
 #include "spacar/recursive/spatial_tree.hpp"
 
+#include "spacar/recursive/rnea_derivatives.hpp"
 #include "spacar/recursive/spatial_rnea.hpp"
 
 #include <algorithm>
@@ -243,59 +244,16 @@ std::unique_ptr<SpatialTree> SpatialTree::detect(const System& sys, const Data& 
   return tree;
 }
 
-// FORCE at body points (world directions), subtracted from the bias forces.
-template <int N>
-void SpatialTree::directional_derivatives(int n, const double* q, const double* qd, const double* qdd,
-                                          Eigen::MatrixXd& dtau_dq, Eigen::MatrixXd& dtau_dqd) const {
-  using Dual = Jet<double, N>;
-  std::vector<Dual> dual_q(q, q + n), dual_qd(qd, qd + n), dual_qdd(qdd, qdd + n), out(n);
-  auto variable = [&](int k) -> Dual& { return k < n ? dual_q[k] : dual_qd[k - n]; };
-  for (int first = 0; first < 2 * n; first += N) {  // directions first … first + N − 1 of (q, q̇)
-    const int last = std::min(2 * n, first + N);
-    for (int k = first; k < last; ++k) variable(k).d[k - first] = 1.0;
-    rnea::inverse_dynamics(bodies_, base_acceleration_, loads_, dual_q.data(), dual_qd.data(), dual_qdd.data(),
-                           out.data());
-    for (int k = first; k < last; ++k) {
-      variable(k).d[k - first] = 0.0;
-      for (int r = 0; r < n; ++r) (k < n ? dtau_dq(r, k) : dtau_dqd(r, k - n)) = out[r].d[k - first];
-    }
-  }
-}
-
 bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd,
                                        double* dq, double* dqd, double* dtau) {
   if (n != n_bodies()) return false;  // every body turned by one joint, its DOF
   auto id = [&](const auto* qq, const auto* qqd, const auto* qqdd, auto* out) {
     rnea::inverse_dynamics(bodies_, base_acceleration_, loads_, qq, qqd, qqdd, out);
   };
-  // M e_j = τ(q, 0, e_j) − τ(q, 0, 0): the inverse dynamics is affine in q̈.
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd rest(n), column(n), unit = zero;
-  Eigen::MatrixXd M(n, n);
-  id(q, zero.data(), zero.data(), rest.data());
-  for (int j = 0; j < n; ++j) {
-    unit[j] = 1.0;
-    id(q, zero.data(), unit.data(), column.data());
-    unit[j] = 0.0;
-    M.col(j) = column - rest;
-  }
-  const Eigen::LLT<Eigen::MatrixXd> llt(0.5 * (M + M.transpose()));
-  if (llt.info() != Eigen::Success) return false;
-  Eigen::Map<Eigen::VectorXd> acc(qdd, n);
-  id(q, qd, zero.data(), column.data());  // the bias forces b(q, q̇)
-  acc = llt.solve(Eigen::Map<const Eigen::VectorXd>(tau, n) - column);
-  // ∂τ/∂q and ∂τ/∂q̇ at (q, q̇, q̈): the 2n directions in as few passes as the dual numbers'
-  // widths allow (one for up to 16 directions: a robot of 8 joints).
-  Eigen::MatrixXd dtau_dq(n, n), dtau_dqd(n, n);
-  if (2 * n <= 8) directional_derivatives<8>(n, q, qd, qdd, dtau_dq, dtau_dqd);
-  else if (2 * n <= 12) directional_derivatives<12>(n, q, qd, qdd, dtau_dq, dtau_dqd);
-  else directional_derivatives<16>(n, q, qd, qdd, dtau_dq, dtau_dqd);
-  Eigen::Map<Eigen::MatrixXd>(dq, n, n) = -llt.solve(dtau_dq);
-  Eigen::Map<Eigen::MatrixXd>(dqd, n, n) = -llt.solve(dtau_dqd);
-  Eigen::Map<Eigen::MatrixXd>(dtau, n, n) = llt.solve(Eigen::MatrixXd::Identity(n, n));
-  return true;
+  return rnea::forward_dynamics_derivatives(n, q, qd, tau, id, qdd, dq, dqd, dtau);
 }
 
+// FORCE at body points (world directions), subtracted from the bias forces.
 void SpatialTree::applied_loads() {
   for (const Load& l : loads_) {
     BodyWork& bd = work_[l.body];

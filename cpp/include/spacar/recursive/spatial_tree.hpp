@@ -194,10 +194,6 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   class Builder;
 
   void applied_loads() override;
-  // ∂τ/∂q and ∂τ/∂q̇ (n × n) at (q, q̇, q̈) by the inverse dynamics on dual numbers of N parts.
-  template <int N>
-  void directional_derivatives(int n, const double* q, const double* qd, const double* qdd, Eigen::MatrixXd& dtau_dq,
-                               Eigen::MatrixXd& dtau_dqd) const;
   void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
 
   std::vector<Follower> followers_;
