@@ -36,7 +36,8 @@ def dynamics_derivatives(model: Model, q, qd, tau, *, time_limit=None):
     Exact: the recursive Newton–Euler algorithm run on dual numbers gives ∂τ/∂q and ∂τ/∂q̇, and
     ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇), in C++ over the whole batch. For planar and spatial trees of
     rigid bodies on the recursive path (URDF robots, pendulums, branched linkages; formulation.md
-    §7); other models raise InputError saying why they are not one. ``time_limit``: wall-clock seconds (:class:`spacar.TimeLimitError`)."""
+    §7); other models raise InputError saying why they are not one. ``time_limit``: wall-clock
+    seconds (:class:`spacar.TimeLimitError`)."""
     if not isinstance(model, Model):
         raise InputError(f"dynamics_derivatives: model must be a spacar.Model, got {show(model)}")
     q, qd, tau = _states("dynamics_derivatives", q=q, qd=qd, tau=tau)

@@ -285,7 +285,7 @@ def test_dynamics_derivatives_match_compute_aba_derivatives(name):
     assert one[1].shape == (nv, nv) and np.abs(one[1] - dq[0]).max() == 0.0
 
 
-def test_dynamics_derivatives_need_a_spatial_tree():
+def test_dynamics_derivatives_need_a_tree_of_the_recursive_path():
     model = spacar.read(EXAMPLES / "slidercrank.dat")  # a closed loop: the general path
     with pytest.raises(spacar.InputError, match="not a tree of rigid bodies of the recursive path"):
         spacar.dynamics_derivatives(model, [0.0] * 5, [0.0] * 5, [0.0] * 5)

@@ -570,7 +570,7 @@ void Simulation::dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, c
     if (!tree->dynamics_derivatives(nd, q.row(k).data(), qd.row(k).data(), tau.row(k).data(), qdd.row(k).data(),
                                     a.data(), b.data(), c.data())) {
       throw InputError("dynamics_derivatives: the mass matrix is not positive definite at state " +
-                       std::to_string(k) + " (a body that moves no mass)");
+                       std::to_string(k) + " (e.g. a body that moves no mass)");
     }
     for (int i = 0; i < nd; ++i)
       for (int j = 0; j < nd; ++j) {

@@ -220,7 +220,6 @@ std::unique_ptr<PlanarTree> PlanarTree::detect(const System& sys, const Data& da
   return tree;
 }
 
-// Springs of released hinges and FORCE, subtracted from the bias forces.
 bool PlanarTree::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd,
                                       double* dq, double* dqd, double* dtau) {
   if (n != n_bodies()) return false;  // every body turned by one joint, its DOF
@@ -230,6 +229,7 @@ bool PlanarTree::dynamics_derivatives(int n, const double* q, const double* qd, 
   return rnea::forward_dynamics_derivatives(n, q, qd, tau, id, qdd, dq, dqd, dtau);
 }
 
+// Springs of released hinges and FORCE, subtracted from the bias forces.
 void PlanarTree::applied_loads() {
   for (const Spring& sp : springs_) {  // torque −σ on node b's body, +σ on node a's
     auto angle = [&](int b, double beta0) { return beta0 + (b == kGround ? 0.0 : work_[b].frame.phi); };

@@ -290,7 +290,8 @@ class Simulation {
   // The forward dynamics and its derivatives at the states in the rows of q, qd under the extra
   // generalized forces tau (spacar.dynamics_derivatives, as pinocchio.computeABADerivatives): the
   // rows of qdd (nd) and of dq, dqd, dtau (nd × nd each, row k the matrix of state k in row-major
-  // order: ∂q̈_i/∂q_j at i·nd + j). On a spatial tree of the recursive path; InputError otherwise.
+  // order: ∂q̈_i/∂q_j at i·nd + j). On a planar or spatial tree of the recursive path; InputError
+  // otherwise.
   void dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, const RowMatrix& tau, RowMatrix& qdd,
                             RowMatrix& dq, RowMatrix& dqd, RowMatrix& dtau);
   // q̈ of the reduced equations (3.1) with transfer functions at the last evaluated state, the
