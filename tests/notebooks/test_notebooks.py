@@ -84,8 +84,10 @@ def test_notebook_page_in_a_browser(path, tmp_path):
 
 
 def test_explore_and_the_3d_view_are_in_the_shipped_notebooks():
-    # The pages above show spacar.explore's picture (notebook 09) and spacar.view3d (notebook 10).
+    # The pages above show spacar.explore's picture (notebook 09) and spacar.view3d: the top of
+    # notebook 04, a spatial mechanism, and the flexure stage of notebook 10.
     sources = {p.name: "".join(c.source for c in nbformat.read(p, as_version=4).cells if c.cell_type == "code")
                for p in NOTEBOOKS}
     assert "spacar.explore(" in sources["09_explore.ipynb"]
     assert "spacar.view3d(" in sources["10_flexure_stage_3d.ipynb"]
+    assert "spacar.view3d(" in sources["04_rigid_body.ipynb"]
