@@ -227,10 +227,11 @@ def synthesize(pairs, d: float = 1.0) -> FourBar:
 
 # --- any single-input mechanism in a model ---------------------------------------------------------
 
-def _single_input(tf) -> tuple:
-    inputs = [label for label, is_input in zip(tf.q_labels, tf.is_input) if is_input]
-    if len(inputs) != 1 or len(tf.q_labels) != 1:
-        raise InputError(f"a single-input mechanism (one input, no degrees of freedom) is needed; q̂ is {tf.q_labels}")
+def _single_input(labels, is_input) -> tuple:
+    """The label of the one input of q̂ (``labels``, ``is_input``), if it has nothing else."""
+    inputs = [label for label, flag in zip(labels, is_input) if flag]
+    if len(inputs) != 1 or len(labels) != 1:
+        raise InputError(f"a single-input mechanism (one input, no degrees of freedom) is needed; q̂ is {labels}")
     return inputs[0]
 
 
@@ -245,11 +246,12 @@ def limit_positions(model, output, steps: int = 360, *, t_end=None, tol: float =
     from .transfer import transfer, transfer_path
 
     path = transfer_path(model, steps, t_end=t_end)
-    wrt = _single_input(path.at(0))
+    first = path.at(0)
+    wrt = _single_input(first.q_labels, first.is_input)
     ratio = path.ratio(output, wrt)
     q0 = np.zeros(0)
     found = []
-    column = path.at(0).column(wrt)
+    column = first.column(wrt)
     rate = (path.q[-1, column] - path.q[0, column]) / (path.t[-1] - path.t[0]) if len(path.t) > 1 else 1.0
     for k in np.nonzero(np.sign(ratio[:-1]) * np.sign(ratio[1:]) < 0)[0]:
         t = brentq(lambda s: transfer(model, at=(s, q0)).ratio(output, wrt), path.t[k], path.t[k + 1],
@@ -293,10 +295,7 @@ def dead_positions(model, steps: int = 360, *, t_end=None, tol: float = 1e-10) -
         raise InputError(f"dead_positions: steps must be a whole number of at least 3, got {show(steps)}")
     if not (np.isfinite(t_end) and t_end > t0):
         raise InputError(f"dead_positions: t_end must be after the model's current time {t0:g}, got {show(t_end)}")
-    inputs = [label for label, flag in zip(labels, is_input) if flag]
-    if len(inputs) != 1 or len(labels) != 1:
-        raise InputError(f"a single-input mechanism (one input, no degrees of freedom) is needed; q̂ is {labels}")
-    wrt = inputs[0]
+    wrt = _single_input(labels, is_input)
     if wrt[0] != "x":
         raise InputError(f"dead_positions: the input must be a coordinate (INPUTX), not the deformation {wrt[1:]}")
     node, comp = wrt[1], wrt[2]

@@ -89,6 +89,13 @@ def _widget_views_left(nb) -> bool:
         for output in cell.get("outputs", []))
 
 
+def _markdown_parts(cell) -> list:
+    """A markdown cell's source split at its code: even entries prose, odd ones code spans and
+    blocks (their dollars are not TeX)."""
+    source = cell.get("source", "")
+    return _CODE.split("".join(source) if isinstance(source, list) else source)
+
+
 _OTHER_TEX = re.compile(r"\\\(|\\\[|\\begin\{")
 
 
@@ -104,9 +111,7 @@ def _tex_left(nb) -> bool:
             continue
         if cell.get("cell_type") != "markdown":
             continue
-        source = cell.get("source", "")
-        source = "".join(source) if isinstance(source, list) else source
-        text = "".join(part for k, part in enumerate(_CODE.split(source)) if k % 2 == 0)
+        text = "".join(_markdown_parts(cell)[::2])
         if _DISPLAY.search(text) or _INLINE.search(text) or _OTHER_TEX.search(text):
             return True
     return False
@@ -140,10 +145,7 @@ def mathml_equations(nb) -> int:
     for cell in nb.get("cells", []):
         if cell.get("cell_type") != "markdown":
             continue
-        source = cell.get("source", "")
-        if isinstance(source, list):
-            source = "".join(source)
-        parts = _CODE.split(source)   # odd entries: the code, kept as written
+        parts = _markdown_parts(cell)   # odd entries: the code, kept as written
         cell["source"] = "".join(part if k % 2 else convert_text(part) for k, part in enumerate(parts))
     return count
 

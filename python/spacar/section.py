@@ -229,11 +229,12 @@ class Section:
         y = np.asarray(y, dtype=float)
         if x.shape != (3,) or y.shape != (3,) or not (np.isfinite(x).all() and np.isfinite(y).all()):
             raise InputError(f"principal_y: axis and y must be 3 finite numbers each, got {show(axis)}, {show(y)}")
-        if not np.linalg.norm(x) > 0:
+        length = np.linalg.norm(x)
+        if not length > 0:
             raise InputError("principal_y: the beam's axis has no length")
-        x = x / np.linalg.norm(x)
+        x = x / length
         y = y - (y @ x) * x
-        if not np.linalg.norm(y) > 1e-12 * np.linalg.norm(np.asarray(axis, dtype=float)):
+        if not np.linalg.norm(y) > 1e-12 * length:
             raise InputError("principal_y: y lies along the beam's axis")
         y = y / np.linalg.norm(y)
         z = np.cross(x, y)
@@ -398,13 +399,13 @@ def angle(h, b, t, material: Material | None = None) -> Section:
     J = (h + b - t) * t**3 / 3
     hc, bc = h - t / 2, b - t / 2
     section = Section("angle", {"h": h, "b": b, "t": t}, material, A=A, Iy=Iy, Iz=Iz, J=J,
-                      Wy=Iy / np.abs(zp).max(), Wz=Iz / np.abs(yp).max(), Wt=J / t, shear_factor=1.0,
+                      Wy=Iy / np.abs(zp).max(), Wz=Iz / np.abs(yp).max(), Wt=J / t,
+                      shear_factor=1.5 * A / (t * min(h, b)),  # the largest shear: 3/2 of the mean in the shorter leg
                       round_=False, Iw=t**3 * (hc**3 + bc**3) / 36)
     section.principal_angle = alpha
     section.corners = tuple(zip(yp.tolist(), zp.tolist()))   # (y', z') in the principal axes
     section.centroid = (yc, zc)
     section.shear_centre = (t / 2, t / 2)
-    section.shear_factor = 1.5 * A / (t * min(h, b))  # the largest shear stress: 3/2 of the mean in the shorter leg
     return section
 
 
