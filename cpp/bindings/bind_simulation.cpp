@@ -283,7 +283,9 @@ void bind_states(py::class_<Simulation>& sim) {
           [](Simulation& s, const RowMatrix& q, const RowMatrix& qd, const RowMatrix& tau) {
             RowMatrix qdd, dq, dqd, dtau;
             s.dynamics_derivatives(q, qd, tau, qdd, dq, dqd, dtau);
-            return py::make_tuple(qdd, dq, dqd, dtau);
+            // Moved into the arrays (a large batch is not copied).
+            return py::make_tuple(py::cast(std::move(qdd)), py::cast(std::move(dq)), py::cast(std::move(dqd)),
+                                  py::cast(std::move(dtau)));
           },
           py::arg("q"), py::arg("qd"), py::arg("tau"),
           "(qdd, dqdd/dq, dqdd/dqd, dqdd/dtau) at the states in the rows of q, qd, tau, each derivative a row of "

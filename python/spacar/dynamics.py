@@ -33,7 +33,8 @@ def dynamics_derivatives(model: Model, q, qd, tau, *, time_limit=None):
     q̈ (n), ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ (n × n). ``q``, ``qd``, ``tau`` may be batches of states,
     one per row: the results then have a leading axis of states.
 
-    Exact: the recursive Newton–Euler algorithm run on dual numbers gives ∂τ/∂q and ∂τ/∂q̇, and
+    Exact: ∂τ/∂q and ∂τ/∂q̇ analytic on spatial trees (passes over the tree in world axes) and
+    from the recursive Newton–Euler algorithm on dual numbers on planar ones, and
     ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇), in C++ over the whole batch. For planar and spatial trees of
     rigid bodies on the recursive path (URDF robots, pendulums, branched linkages; formulation.md
     §7); other models raise InputError saying why they are not one. ``time_limit``: wall-clock

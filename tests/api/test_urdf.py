@@ -264,8 +264,8 @@ def test_inverse_dynamics_matches_rnea(name):
 def test_dynamics_derivatives_match_compute_aba_derivatives(name):
     """spacar.dynamics_derivatives against pinocchio.computeABADerivatives at random states and
     torques, over a batch in one call: q̈, ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ to 1e-10 (relative to
-    each matrix's largest entry). Exact derivatives: the recursive Newton–Euler algorithm on dual
-    numbers (issue 37)."""
+    each matrix's largest entry). Exact derivatives: analytic on the spatial tree
+    (spatial_derivatives.cpp, issue 37)."""
     rng = np.random.default_rng(sum(map(ord, name)) + 2)
     peer = Peer(name)
     nv = peer.pin.nv

@@ -85,8 +85,9 @@ def test_bad_arguments_are_input_errors():
 
 @pytest.mark.parametrize("name", list(MODELS) + ["planar branched tree, a spring between the branches"])
 def test_dynamics_derivatives_agree_with_the_inverse_dynamics_and_differences(name):
-    """spacar.dynamics_derivatives (the recursive Newton–Euler algorithm on dual numbers,
-    spatial_rnea.hpp and planar_rnea.hpp) on every tree above: its q̈ under τ gives back τ through
+    """spacar.dynamics_derivatives (analytic on spatial trees, spatial_derivatives.cpp; the
+    recursive Newton–Euler algorithm on dual numbers on planar ones, planar_rnea.hpp) on every
+    tree above: its q̈ under τ gives back τ through
     spacar.inverse_dynamics (the double recursion of articulated.hpp, checked above against the
     reduced equations), ∂q̈/∂τ is the inverse of the mass matrix that inverse_dynamics implies,
     and ∂q̈/∂q, ∂q̈/∂q̇ equal central differences of q̈ to 1e-6."""

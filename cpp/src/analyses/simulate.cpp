@@ -564,20 +564,13 @@ void Simulation::dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, c
   dq.resize(q.rows(), nd * nd);
   dqd.resize(q.rows(), nd * nd);
   dtau.resize(q.rows(), nd * nd);
-  Eigen::MatrixXd a(nd, nd), b(nd, nd), c(nd, nd);  // column major, transposed into the rows
   for (Eigen::Index k = 0; k < q.rows(); ++k) {
     check_thread_deadline("(in dynamics_derivatives)");
     if (!tree->dynamics_derivatives(nd, q.row(k).data(), qd.row(k).data(), tau.row(k).data(), qdd.row(k).data(),
-                                    a.data(), b.data(), c.data())) {
+                                    dq.row(k).data(), dqd.row(k).data(), dtau.row(k).data())) {
       throw InputError("dynamics_derivatives: the mass matrix is not positive definite at state " +
                        std::to_string(k) + " (e.g. a body that moves no mass)");
     }
-    for (int i = 0; i < nd; ++i)
-      for (int j = 0; j < nd; ++j) {
-        dq(k, i * nd + j) = a(i, j);
-        dqd(k, i * nd + j) = b(i, j);
-        dtau(k, i * nd + j) = c(i, j);
-      }
   }
 }
 

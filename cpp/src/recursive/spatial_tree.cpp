@@ -2,9 +2,6 @@
 // moving with the bodies.
 #include "spacar/recursive/spatial_tree.hpp"
 
-#include "spacar/recursive/rnea_derivatives.hpp"
-#include "spacar/recursive/spatial_rnea.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -242,15 +239,6 @@ std::unique_ptr<SpatialTree> SpatialTree::detect(const System& sys, const Data& 
   if (!tree_detail::build(Builder(sys, data, *tree), why)) return nullptr;
   tree->base_acceleration_.tail<3>() = -sys.gravity;
   return tree;
-}
-
-bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd,
-                                       double* dq, double* dqd, double* dtau) {
-  if (n != n_bodies()) return false;  // every body turned by one joint, its DOF
-  auto id = [&](const auto* qq, const auto* qqd, const auto* qqdd, auto* out) {
-    rnea::inverse_dynamics(bodies_, base_acceleration_, loads_, qq, qqd, qqdd, out);
-  };
-  return rnea::forward_dynamics_derivatives(n, q, qd, tau, id, qdd, dq, dqd, dtau);
 }
 
 // FORCE at body points (world directions), subtracted from the bias forces.

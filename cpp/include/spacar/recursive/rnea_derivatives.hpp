@@ -33,7 +33,8 @@ void directional_derivatives(int n, const double* q, const double* qd, const dou
   }
 }
 
-// q̈ and its derivatives at (q, q̇) under τ; false if the mass matrix is not positive definite.
+// q̈ and its derivatives (n × n, row major) at (q, q̇) under τ; false if the mass matrix is not
+// positive definite.
 template <class Id>
 bool forward_dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, const Id& id,
                                   double* qdd, double* dq, double* dqd, double* dtau) {
@@ -59,9 +60,10 @@ bool forward_dynamics_derivatives(int n, const double* q, const double* qd, cons
   if (2 * n <= 8) directional_derivatives<8>(n, q, qd, qdd, id, dtau_dq, dtau_dqd);
   else if (2 * n <= 12) directional_derivatives<12>(n, q, qd, qdd, id, dtau_dq, dtau_dqd);
   else directional_derivatives<16>(n, q, qd, qdd, id, dtau_dq, dtau_dqd);
-  Eigen::Map<Eigen::MatrixXd>(dq, n, n) = -llt.solve(dtau_dq);
-  Eigen::Map<Eigen::MatrixXd>(dqd, n, n) = -llt.solve(dtau_dqd);
-  Eigen::Map<Eigen::MatrixXd>(dtau, n, n) = llt.solve(Eigen::MatrixXd::Identity(n, n));
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  Eigen::Map<RowMajor>(dq, n, n) = -llt.solve(dtau_dq);
+  Eigen::Map<RowMajor>(dqd, n, n) = -llt.solve(dtau_dqd);
+  Eigen::Map<RowMajor>(dtau, n, n) = llt.solve(Eigen::MatrixXd::Identity(n, n));
   return true;
 }
 

@@ -170,8 +170,8 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   // constraints (a solved state).
   static std::unique_ptr<SpatialTree> detect(const System& sys, const Data& data, std::string* why = nullptr);
 
-  // Exact: the recursive Newton–Euler algorithm on dual numbers (spatial_rnea.hpp) gives ∂τ/∂q and
-  // ∂τ/∂q̇ at (q, q̇, q̈), and ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇), M from the inverse dynamics' columns.
+  // Exact and analytic (spatial_derivatives.cpp): ∂τ/∂q, ∂τ/∂q̇ and M from passes over the tree in
+  // world axes, ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇).
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
 
@@ -198,6 +198,26 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
 
   std::vector<Follower> followers_;
   std::vector<Load> loads_;
+
+  // A body's work in dynamics_derivatives: world axes at the world origin.
+  struct WorldBody {
+    Eigen::Matrix3d R;                     // body → world
+    Eigen::Vector3d p;                     // the pin
+    Eigen::Matrix<double, 6, 1> S, v, a, parent_v, parent_a;
+    Eigen::Matrix<double, 6, 1> u, z;      // S × v_λ and u × v_λ − S × a_λ
+    Eigen::Matrix<double, 6, 1> f, F;      // the body's force, then its subtree's; F: at q̈ = 0
+    Eigen::Matrix<double, 6, 6> I;         // the inertia about the world origin
+    Eigen::Matrix<double, 6, 6> Ic, QmB;   // over the subtree: Σ I and Σ (I (v ×) − B)
+    Eigen::Matrix<double, 6, 3> L;         // over the subtree: the world-direction loads' matrices
+    Eigen::Matrix<double, 6, 1> IS, QmBS;  // Ic S and (Σ (I (v ×) − B))ᵀ S
+    Eigen::Vector3d LS;                    // Lᵀ S
+  };
+  struct DerivativeWork {  // kept between the states of a batch
+    std::vector<WorldBody> bodies;
+    Eigen::VectorXd bias;
+    Eigen::MatrixXd M, Linv, dtau_dq, dtau_dqd;
+  };
+  DerivativeWork derivative_work_;
 };
 
 }  // namespace spacar

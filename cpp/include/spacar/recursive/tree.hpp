@@ -43,7 +43,7 @@ class RecursiveTree {
   virtual void inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) = 0;
   // The forward dynamics at (q, q̇) under the extra generalized forces τ (those inverse_dynamics
   // gives) and its derivatives, as pinocchio.computeABADerivatives: q̈ (n) and ∂q̈/∂q, ∂q̈/∂q̇,
-  // ∂q̈/∂τ = M⁻¹ (n × n, column major), n the DOFs, one per body. False if this tree does not
+  // ∂q̈/∂τ = M⁻¹ (n × n, row major), n the DOFs, one per body. False if this tree does not
   // provide them or its mass matrix is not positive definite.
   virtual bool dynamics_derivatives(int /*n*/, const double* /*q*/, const double* /*qd*/, const double* /*tau*/,
                                     double* /*qdd*/, double* /*dq*/, double* /*dqd*/, double* /*dtau*/) {
