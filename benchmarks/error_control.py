@@ -10,6 +10,8 @@ multiple of the EPSINT asked for, with the step counts:
 
     python benchmarks/error_control.py            # every case (about five minutes)
     python benchmarks/error_control.py 8 32       # the planar cases of some meshes, and the spatial one
+    python benchmarks/error_control.py --all-methods 64 32 64   # DOP853 and Radau5 up to 64 elements
+                                                  # (undamped and damped; minutes per run beyond 16)
 """
 from __future__ import annotations
 
@@ -74,13 +76,20 @@ def table(name, build, meshes, small=16) -> None:
                 print(f"| {name} | {n} | {method} | {eps:.0e} | {err(y) / eps:.3g} | {steps} |", flush=True)
 
 
-def main(meshes) -> None:
+def main(meshes, all_methods=None) -> None:
+    """``all_methods``: DOP853 and Radau5 on the meshes up to this size (default 16 undamped, 8
+    damped, where they take seconds)."""
     print("| case | elements | method | EPSINT | tip error / EPSINT | steps |")
     print("|---|---|---|---|---|---|")
-    table("planar, undamped", lambda n, eps: planar(n, eps, False), meshes)
-    table("planar, damped", lambda n, eps: planar(n, eps, True), meshes, small=8)
-    table("spatial, undamped", spatial, [16], small=0)
+    table("planar, undamped", lambda n, eps: planar(n, eps, False), meshes, small=all_methods or 16)
+    table("planar, damped", lambda n, eps: planar(n, eps, True), meshes, small=all_methods or 8)
+    if all_methods is None:
+        table("spatial, undamped", spatial, [16], small=0)
 
 
 if __name__ == "__main__":
-    main([int(a) for a in sys.argv[1:]] or [8, 16, 32, 64, 128])
+    args = sys.argv[1:]
+    limit = None
+    if args[:1] == ["--all-methods"]:
+        limit, args = int(args[1]), args[2:]
+    main([int(a) for a in args] or [8, 16, 32, 64, 128], limit)
