@@ -24,7 +24,36 @@ MODELS = {
     "spatial chain": lambda: models.spatial_chain(6, seed=3),
     "spatial URDF wrist (joints at one origin, a sliding joint, a body without a beam)":
         lambda: trees.urdf(DATA / "wrist.urdf"),
+    "spatial random tree": lambda: trees.random_tree(7, 2),
+    "spatial sliding joints, forces below them, TORQUEL, a spring-damper, oblique gravity":
+        lambda: loaded_prismatic(),
+    "spatial branched tree, initial hinge angles": lambda: turned_branched_tree(),
 }
+
+
+def loaded_prismatic():
+    """tests/data/prismatic.urdf (a carriage sliding on the ground, an arm, a finger sliding on it)
+    with FORCEs on the finger (two) and the arm (two) below the sliding joints, TORQUELs, a spring
+    and damper on the first joint and gravity off the axes."""
+    m = trees.urdf(DATA / "prismatic.urdf")
+    for node, f in ((17, (0.3, -0.5, 0.7)), (12, (-0.2, 0.4, 0.1)), (15, (0.6, 0.2, -0.3)), (10, (0.1, 0.1, 0.9)),
+                    (13, (-0.4, 0.3, 0.2))):
+        m.force(node, *f)
+    m.torquel(9, 0.1, -0.2, 0.3)
+    m.torquel(6, -0.3, 0.1, 0.2)
+    m.estiff(2, 1.5)
+    m.edampp(2, 0.2)
+    m.gravity(2.0, -3.0, -8.0)
+    return m
+
+
+def turned_branched_tree():
+    """The spatial branched tree with its hinges turned at the start (E: joint angles offset from
+    the reference geometry)."""
+    m = trees.spatial_branched_tree()
+    for hinge, angle in zip((101, 102, 103, 104), (0.4, -0.7, 0.9, 0.3)):
+        m.e(hinge, 1, angle)
+    return m
 
 
 def general_path(model, q, qd, qdd):

@@ -1,7 +1,7 @@
 // The exact derivatives of a spatial tree's forward dynamics (SpatialTree::dynamics_derivatives):
-// analytic, in three O(n) passes and O(n²) dot products over the pairs of joints on one path,
-// in the spirit of Carpentier and Mansard's derivatives of the recursive Newton–Euler algorithm
-// (RSS 2018), derived here in spacar's conventions.
+// analytic, in four O(n) passes (out, in, out again with q̈, in) and O(n²) dot products over the
+// pairs of joints on one path, in the spirit of Carpentier and Mansard's derivatives of the
+// recursive Newton–Euler algorithm (RSS 2018), derived here in spacar's conventions.
 //
 // Everything is in world axes at the world origin, vectors (angular; linear), where the joints'
 // motions add up along the paths of the tree:

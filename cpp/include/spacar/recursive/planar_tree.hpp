@@ -104,8 +104,8 @@ class PlanarTree : public ArticulatedTree<PlanarAlgebra> {
   // constraints (a solved state).
   static std::unique_ptr<PlanarTree> detect(const System& sys, const Data& data, std::string* why = nullptr);
 
-  // Exact: the recursive Newton–Euler algorithm on dual numbers (planar_rnea.hpp), as the spatial
-  // tree's (rnea_derivatives.hpp).
+  // Exact: the recursive Newton–Euler algorithm on dual numbers (planar_rnea.hpp,
+  // rnea_derivatives.hpp).
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
 

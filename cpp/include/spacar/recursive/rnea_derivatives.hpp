@@ -1,5 +1,5 @@
 // The forward dynamics of a tree and its exact derivatives from an inverse dynamics written once
-// on a scalar type (spatial_rnea.hpp, planar_rnea.hpp): M from the inverse dynamics' columns,
+// on a scalar type (planar_rnea.hpp; the spatial tree's are analytic, spatial_derivatives.cpp): M from the inverse dynamics' columns,
 // q̈ = M⁻¹ (τ − b(q, q̇)), and ∂τ/∂q, ∂τ/∂q̇ at (q, q̇, q̈) from the same passes on forward-mode
 // dual numbers, so that ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇) and ∂q̈/∂τ = M⁻¹ (as
 // pinocchio.computeABADerivatives). `id(q, q̇, q̈, τ)` is a generic callable: it is called with
