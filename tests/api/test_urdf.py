@@ -19,7 +19,7 @@ import spacar
 from spacar import _core
 from support.paths import DATA, EXAMPLES
 
-SMALL = ["two_link_arm", "branched_tree", "prismatic", "fixed_joints"]
+SMALL = ["two_link_arm", "branched_tree", "prismatic", "fixed_joints", "pivot"]
 
 
 def robot_file(package: str, name: str, folder: str = "urdf") -> Path:
@@ -34,7 +34,9 @@ def urdf_path(name: str) -> Path:
     return {"ur5": lambda: robot_file("ur_description", "ur5_robot.urdf"),
             "panda": lambda: robot_file("panda_description", "panda.urdf"),
             "xarm7": lambda: robot_file("xarm_description", "xarm7.urdf"),
-            "g1": lambda: robot_file("g1_description", "g1_29dof_rev_1_0.urdf")}.get(name, lambda: DATA / f"{name}.urdf")()
+            "g1": lambda: robot_file("g1_description", "g1_29dof_rev_1_0.urdf"),
+            "simple_humanoid": lambda: robot_file("simple_humanoid_description", "simple_humanoid.urdf"),
+            }.get(name, lambda: DATA / f"{name}.urdf")()
 
 
 def load(path) -> spacar.Model:
@@ -208,7 +210,7 @@ class Peer:
         return err
 
 
-ROBOTS = SMALL + ["ur5", "panda", "xarm7", "g1"]
+ROBOTS = SMALL + ["ur5", "panda", "xarm7", "g1", "simple_humanoid"]
 
 
 @pytest.mark.parametrize("name", ROBOTS)
@@ -463,14 +465,8 @@ def test_a_floating_base_that_moves_no_mass_is_said():
         spacar.simulate(model)
 
 
-# Of the URDFs of example-robot-data that from_urdf reads, those not on the recursive path, and why.
-NOT_TREES = {"simple_humanoid.urdf": "turns a body with no point", "simple_humanoid_classical.urdf":
-             "turns a body with no point"}
-
-
 def test_example_robot_data_takes_the_recursive_path():
-    """Every URDF of example-robot-data that from_urdf accepts is a tree of the recursive path, but
-    the simple humanoid (a link with no point of its own that carries another joint)."""
+    """Every URDF of example-robot-data that from_urdf accepts is a tree of the recursive path."""
     robots = robot_file("ur_description", "ur5_robot.urdf").parents[2]
     seen = 0
     for path in sorted(robots.glob("*/urdf/*.urdf")):
@@ -482,5 +478,5 @@ def test_example_robot_data_takes_the_recursive_path():
             continue  # refused by from_urdf (a missing mesh package, an inertia that is not positive)
         seen += 1
         why = sim.recursive_refusal()
-        assert (NOT_TREES[path.name] in why) if path.name in NOT_TREES else why == "", (path.name, why)
+        assert why == "", (path.name, why)  # the simple humanoid too since its elbows (a link of no point)
     assert seen >= 40

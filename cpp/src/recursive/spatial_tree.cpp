@@ -157,6 +157,10 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     return true;
   }
 
+  // The tree's parent of placed body i, and its pin moved to r from the parent's (TreeBuilder).
+  int parent_index(int i) const { return tree_.bodies_[i].parent; }
+  void set_pin_offset(int i, const Point& r) { tree_.bodies_[i].r = r; }
+
   // Spatial bodies turn only about hinges.
   bool place_rotated(int, std::vector<int>&) { return true; }
 

@@ -76,7 +76,8 @@ Eigen::Matrix<double, N, N> element_inertia(const SystemElement& se, const Eigen
 
 // The steps of recognizing a tree of rigid bodies in a system, shared by the planar and the
 // spatial recognizer (Derived, which adds its own: the hinges it accepts, the joint a hinge
-// makes, the body's inertia, coordinates and loads). Any step may find that the system is not
+// makes, the body's inertia, coordinates and loads; parent_index(i) and set_pin_offset(i, r) read
+// and move a placed body's pin in the tree). Any step may find that the system is not
 // such a tree: it says why (refuse) and returns false.
 template <class Derived, class Algebra>
 class TreeBuilder {
@@ -205,7 +206,6 @@ class TreeBuilder {
       hinges_at[body_of(hinges_[i].a)].push_back(static_cast<int>(i));
       hinges_at[body_of(hinges_[i].b)].push_back(static_cast<int>(i));
     }
-    Derived& self = *static_cast<Derived*>(this);
     std::vector<int> queue = {kGround};
     for (size_t k = 0; k < queue.size(); ++k) {
       const int parent = queue[k];
@@ -220,10 +220,10 @@ class TreeBuilder {
         h.used = true;
         Model bd;
         const Slide slide = h.pa < 0 ? Slide{} : forward ? Slide{h.pb, h.pa} : Slide{h.pa, h.pb};
-        if (!self.hinge_joint(h, forward, child, bd) || !self.place(child, parent, bd, name, slide)) return false;
+        if (!self().hinge_joint(h, forward, child, bd) || !self().place(child, parent, bd, name, slide)) return false;
         queue.push_back(child);
       }
-      if (!self.place_rotated(parent, queue)) return false;
+      if (!self().place_rotated(parent, queue)) return false;
     }
     for (size_t b = 0; b < placed_.size(); ++b)
       if (placed_[b] < 0)
@@ -245,9 +245,12 @@ class TreeBuilder {
     // body's own point of the joint, whose other point is on the parent, and the two share none.
     const int pin = sliding ? slide.pin : pin_of(body);
     if (!sliding && g_.points[body].empty() && parent_body != kGround) {
-      // A body of no point (a rotor's LAMBDA node): it turns about its parent's pin, as good as
-      // any point of the axis for a body whose mass is all rotational inertia.
+      // A body of no point (a rotor's LAMBDA node, a link whose mass is at its joint's origin): it
+      // turns about its parent's pin, as good as any point of the axis for a body whose mass is
+      // all rotational inertia, until a joint of a child shows its pivot (pivot_of).
       placed_[body] = index;
+      body_at_.push_back(body);
+      pivot_found_.push_back(false);
       p0 = pin0_[parent];
       bd.parent = parent;
       bd.r = Point::Zero();
@@ -259,8 +262,12 @@ class TreeBuilder {
         return refuse(joint + " slides a body that is not joined to its parent by that joint alone");
     } else if (pin < 0 || !on_body(pin, parent_body, parent)) {
       return refuse(joint + " turns a body with no point, or more than one, on its parent");
+    } else if (!pivot_of(pin, parent_body, parent, joint)) {
+      return false;
     }
     placed_[body] = index;
+    body_at_.push_back(body);
+    pivot_found_.push_back(true);
     pin_[body] = pin;
     p0 = point(pin);
     bd.parent = parent;
@@ -276,12 +283,44 @@ class TreeBuilder {
 
   // Whether point node id is on the placed body parent_body (index parent in the tree) or the
   // ground. Joints at one origin (two URDF joints at the same point, a spherical wrist) share it
-  // with the parent's own parent, which placed it first.
+  // with the parent's own parent, which placed it first. A body of no point carries its
+  // children's joints at its pivot, a point of its own parent's (or, through further bodies of no
+  // point, of the first ancestor with points).
   bool on_body(int id, int parent_body, int parent) const {
     if (!owner_.count(id)) return false;
-    return owner_.at(id) == parent ||
-           (parent_body != kGround && (g_.points[parent_body].count(id) > 0 || pin_[parent_body] == id));
+    if (owner_.at(id) == parent ||
+        (parent_body != kGround && (g_.points[parent_body].count(id) > 0 || pin_[parent_body] == id)))
+      return true;
+    if (parent_body == kGround || !g_.points[parent_body].empty()) return false;
+    const int grand = self().parent_index(parent);
+    return on_body(id, grand == kGround ? kGround : body_at_[grand], grand);
   }
+
+  // A joint at point `pin` under the body of no point parent_body (index parent) fixes that
+  // body's pivot, and those of its ancestors of no point up to the one with points, at `pin`: they
+  // turn about axes through it (their joints' axes meet there, as at a humanoid's elbow). A second
+  // joint at another point cannot be placed. Nothing to do under a body with points.
+  bool pivot_of(int pin, int parent_body, int parent, const std::string& joint) {
+    std::vector<int> chain;  // tree indices of the bodies of no point, deepest first
+    for (int i = parent; i != kGround && g_.points[body_at_[i]].empty(); i = self().parent_index(i)) chain.push_back(i);
+    if (parent_body == kGround || chain.empty()) return true;
+    const Point p = point(pin);
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {  // from the top, each r from its parent's pivot
+      const int i = *it;
+      if (pivot_found_[i]) {
+        if ((pin0_[i] - p).norm() > 0.0) return refuse(joint + " turns a body at another point than its parent's pivot");
+        continue;
+      }
+      const int up = self().parent_index(i);
+      pin0_[i] = p;
+      self().set_pin_offset(i, up == kGround ? p : Point(p - pin0_[up]));
+      pivot_found_[i] = true;
+    }
+    return true;
+  }
+
+  Derived& self() { return *static_cast<Derived*>(this); }
+  const Derived& self() const { return *static_cast<const Derived*>(this); }
 
   const System& sys_;
   const Eigen::VectorXd& x_;
@@ -295,6 +334,8 @@ class TreeBuilder {
   std::vector<int> pin_;         // body → its pin node, −1: not placed
   std::map<int, int> owner_;     // point node → body (index in the tree) it moves with, kGround
   std::vector<Point> pin0_;      // reference pin of each placed body
+  std::vector<int> body_at_;     // index in the tree → body
+  std::vector<bool> pivot_found_;  // index in the tree → its pin0_ is its pivot (a body of no point: once known)
 };
 
 // Runs a recognizer (a TreeBuilder); false and, if why is given, its reason if the system is not
