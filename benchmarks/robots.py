@@ -10,7 +10,9 @@ target, its model built outside the timing (spacar: ``spacar.simulate`` on a cop
 it, EPSINT = EPSIND = EPS; Pinocchio: ``solve_ivp`` with rtol = EPS, atol = 1e-3 EPS; MuJoCo:
 ``mj_step`` in a loop, which ``mujoco.rollout`` does not beat: 2.05 against 2.12 ms for the UR5's
 200 RK4 steps). The Panda's fingers slide freely (no limits, as in all three models), so its
-motion is fast and the 1e-8 target is out of every program's reach here.
+motion is fast and the 1e-8 target is out of every program's reach here. A floating base: Solo12
+(12 joints on a free base) thrown for 1 s, spacar on its recursive path and on the general path
+against Pinocchio's free flyer integrated by DOP853 (run_floating).
 
     python benchmarks/robots.py [--quick] [--no-write]
 """
@@ -88,6 +90,119 @@ def pinocchio_run(pm, pd, nv, t_end, rtol, atol):
 
     sol = solve_ivp(f, (0.0, t_end), np.zeros(2 * nv), method="DOP853", rtol=rtol, atol=atol)
     return sol.y[:nv, -1]
+
+
+FLOATING = ("solo_description", "solo12.urdf", "robots")  # package, file, folder
+FLOATING_PROGRAMS = ["spacar (tree)", "spacar (general path)", "Pinocchio ABA + DOP853"]
+
+
+def floating_file():
+    import importlib.metadata
+    from pathlib import Path
+
+    dist = importlib.metadata.distribution("example-robot-data")
+    package, name, folder = FLOATING
+    return Path(dist.locate_file(f"cmeel.prefix/share/example-robot-data/robots/{package}/{folder}/{name}"))
+
+
+def floating_state(nj):
+    """Solo12 thrown: the base at 0.5 m, turned by 0.4 rad about a random axis, moving and
+    spinning, the joints turned and moving (seeded)."""
+    rng = np.random.default_rng(2)
+    axis = rng.normal(size=3)
+    lam = np.r_[np.cos(0.2), np.sin(0.2) * axis / np.linalg.norm(axis)]
+    return (np.array([0.0, 0.0, 0.5]), lam, rng.normal(size=3) * 0.5, rng.normal(size=3), rng.normal(size=nj) * 0.3,
+            rng.normal(size=nj))
+
+
+def floating_spacar(path, eps, t_end):
+    import spacar
+    from spacar.geometry import euler_e
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = spacar.from_urdf(path, floating=True)
+    nj = len(m.urdf_joints)
+    p, lam, v, w, qj, qdj = floating_state(nj)
+    m.x(1, *p)
+    m.x(2, *lam)
+    lam_d = 0.5 * euler_e(lam).T @ w
+    for i in range(3):
+        m.xd(1, i + 1, v[i])
+    for i in range(4):
+        m.xd(2, i + 1, lam_d[i])
+    for k in range(nj):
+        m.e(k + 1, 1, qj[k])
+        m.ed(k + 1, 1, qdj[k])
+    m.epsint(eps)
+    m.epsind(eps)
+    m.timestep(1, t_end)
+    return m
+
+
+def floating_pinocchio(pm, pd, t_end, rtol, atol):
+    """Pinocchio's free flyer: its ABA, the base's quaternion and position rates from its twist,
+    integrated by SciPy's DOP853; (base position, Euler parameters (λ0, λ1, λ2, λ3), joints) at the end."""
+    import pinocchio as pin
+    from scipy.integrate import solve_ivp
+
+    from spacar.geometry import rotation
+
+    nq, nv = pm.nq, pm.nv
+    p, lam, v, w, qj, qdj = floating_state(nv - 6)
+    R = rotation(lam)
+    zero = np.zeros(nv)
+
+    def f(t, y):
+        q, vv = y[:nq].copy(), y[nq:]
+        q[3:7] /= np.linalg.norm(q[3:7])
+        x, y_, z, s = q[3:7]
+        wx, wy, wz = vv[3:6]
+        quat_d = 0.5 * np.array([s * wx + y_ * wz - z * wy, s * wy + z * wx - x * wz, s * wz + x * wy - y_ * wx,
+                                 -x * wx - y_ * wy - z * wz])
+        Rq = pin.Quaternion(s, x, y_, z).matrix()
+        return np.r_[Rq @ vv[:3], quat_d, vv[6:], pin.aba(pm, pd, q, vv, zero)]
+
+    y0 = np.r_[p, lam[1:], lam[0], qj, R.T @ v, R.T @ w, qdj]
+    sol = solve_ivp(f, (0.0, t_end), y0, method="DOP853", rtol=rtol, atol=atol)
+    q = sol.y[:nq, -1]
+    quat = q[3:7] / np.linalg.norm(q[3:7])
+    return np.r_[q[:3], quat[3], quat[:3], q[7:]]
+
+
+def floating_result(res):
+    """(base position, Euler parameters, joints) at the end of a spacar run."""
+    return np.r_[res.node(1).x[-1], res.node(2).x[-1], res.q[-1][6:]]
+
+
+def run_floating(quick):
+    """Solo12 with a floating base thrown for 1 s: spacar on the tree and on the general path,
+    Pinocchio's free flyer with DOP853; error: the largest difference of the base position, its
+    Euler parameters and the joints at the end against Pinocchio at rtol = atol = 1e-13."""
+    import pinocchio as pin
+
+    path = floating_file()
+    t_end = QUICK["t_end"] if quick else T_END
+    eps_list = QUICK["eps"] if quick else EPS[:5]
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    pd = pm.createData()
+    ref = floating_pinocchio(pm, pd, t_end, 1e-13, 1e-13)
+    out = {p: [] for p in FLOATING_PROGRAMS}
+    for eps in eps_list:
+        for program, recursive in (("spacar (tree)", True), ("spacar (general path)", False)):
+            res, wall = C.simulate_best(floating_spacar(path, eps, t_end), repeat=REPEAT, budget=BUDGET, min_time=MIN_TIME,
+                                        progress=False, recursive=recursive)
+            err = float(np.abs(floating_result(res) - ref).max())
+            out[program].append((err, wall, eps, res.stats["steps"]))
+            C.log(f"floating Solo12 {program} EPS {eps:g}: {wall * 1e3:.3f} ms, error {err:.1e}, "
+                  f"{res.stats['steps']} steps, {res.stats['path']} path")
+        wall, q = C.best_time(lambda: floating_pinocchio(pm, pd, t_end, eps, 1e-3 * eps), repeat=REPEAT, budget=BUDGET,
+                              min_time=MIN_TIME)
+        err = float(np.abs(q - ref).max())
+        out["Pinocchio ABA + DOP853"].append((err, wall, eps, None))
+        C.log(f"floating Solo12 Pinocchio DOP853 rtol {eps:g}: {wall * 1e3:.3f} ms, error {err:.1e}")
+    out["nv"] = pm.nv
+    return out
 
 
 def series(points, label):
@@ -177,7 +292,7 @@ def derivatives_batch(path, pm, pd, n_states=1000):
 
 def run(a) -> dict:
     return {"quick": a.quick, "t_end": QUICK["t_end"] if a.quick else T_END, "machine": C.machine(peers=True),
-            "robots": {name: run_robot(name, a.quick) for name in ROBOTS}}
+            "robots": {name: run_robot(name, a.quick) for name in ROBOTS}, "floating": run_floating(a.quick)}
 
 
 PROGRAMS = ["spacar", "Pinocchio ABA + DOP853", "MuJoCo RK4", "MuJoCo implicitfast"]
@@ -216,6 +331,20 @@ def section(r: dict, plots=None) -> str:
                          f"{C.fmt_time(d['pinocchio_rnea'])} | {C.fmt_ratio(d['pinocchio_rnea'], d['spacar_id'])} |")
     lines += ["", "Issue 37 target, a batch of 1000 derivative evaluations of the UR5 no slower than 1000 calls of "
               "computeABADerivatives: " + derivatives_verdict(r) + "."]
+    f = r.get("floating")
+    if f:
+        lines += ["", "**A floating base.** " + run_floating.__doc__.replace("\n    ", " ") + " Time to a target: "
+                  "the fastest run that reached it (EPSINT = EPSIND = EPS; Pinocchio: rtol = EPS, atol = 1e-3 EPS):", "",
+                  f"| robot | DOFs | target | " + " | ".join(FLOATING_PROGRAMS) + " | general path / tree | "
+                  "Pinocchio / tree |", "|" + "---|" * (len(FLOATING_PROGRAMS) + 5)]
+        for target in TARGETS:
+            t = {p: C.time_to_accuracy([(e, s) for e, s, *_ in f[p]], target) for p in FLOATING_PROGRAMS}
+            lines.append(f"| Solo12 | {f['nv']} | {target:g} | " + " | ".join(C.fmt_time(t[p]) for p in FLOATING_PROGRAMS) +
+                         f" | {C.fmt_ratio(t['spacar (general path)'], t['spacar (tree)'])} | "
+                         f"{C.fmt_ratio(t['Pinocchio ABA + DOP853'], t['spacar (tree)'])} |")
+        for p in FLOATING_PROGRAMS:
+            runs = ", ".join(f"{s:g} → {e:.1e} in {C.fmt_time(t)}" for e, t, s, *_ in f[p])
+            lines.append(f"* Solo12 floating, {p}: {runs}")
     return "\n".join(lines) + "\n"
 
 

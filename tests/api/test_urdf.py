@@ -430,6 +430,7 @@ def test_floating_base_free_fall_matches_pinocchio_integrated_by_scipy():
     for eps in (model.epsint, model.epsind):
         eps(1e-10)
     res = spacar.simulate(model)
+    assert res.stats["path"] == "tree"
 
     pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
     data = pm.createData()
@@ -454,6 +455,60 @@ def test_floating_base_free_fall_matches_pinocchio_integrated_by_scipy():
     np.testing.assert_allclose(res.node(1).x[-1], qT[:3], rtol=0, atol=1e-9)
     np.testing.assert_allclose(res.node(2).x[-1], np.r_[quat[3], quat[:3]], rtol=0, atol=1e-9)
     np.testing.assert_allclose(res.q[-1][6:], qT[7:], rtol=0, atol=1e-8)
+
+
+def solo12_floating():
+    model = spacar.from_urdf(robot_file("solo_description", "solo12.urdf", "robots"), floating=True)
+    model.epskin(1e-14)
+    return model
+
+
+def test_floating_base_takes_the_recursive_path():
+    """A floating base on the recursive path (issue 37): the free root of the articulated-body
+    algorithm, its DOFs the origin and three Euler parameters. At random states (base pose and
+    twist, joints and rates) the tree's q̈ and its inverse dynamics equal the general path's (the
+    constraint formulation with L2MIN1, itself equal to Pinocchio's free flyer above)."""
+    model = solo12_floating()
+    tree = _core.Simulation(model.copy().core)
+    tree.assemble()
+    assert tree.recursive_refusal() == ""
+    general = _core.Simulation(model.copy().core)
+    general.assemble()
+    nv = general.system.n_dof
+    rng, now = np.random.default_rng(3), np.array(general.system.q0)
+    for _ in range(3):
+        axis = rng.normal(size=3)
+        lam = np.r_[np.cos(0.5), np.sin(0.5) * axis / np.linalg.norm(axis)]
+        q = np.r_[rng.uniform(-0.5, 0.5, 3), lam[1:], rng.uniform(-1.0, 1.0, nv - 6)]
+        qd = rng.uniform(-2.0, 2.0, nv)
+        for s in np.linspace(0.0, 1.0, 9)[1:]:  # by continuation, on the assembled branch
+            general.evaluate(0.0, now + s * (q - now), qd)
+        now = q
+        ref = np.array(general.data.qdd)
+        scale = max(1.0, np.abs(ref).max())
+        assert np.abs(np.array(tree.recursive_state(q, qd)["qdd"]) - ref).max() <= 1e-10 * scale
+        qdd = rng.uniform(-3.0, 3.0, nv)
+        force = np.array(general.data.Mbar) @ (qdd - ref)
+        assert np.abs(spacar.inverse_dynamics(model, q, qd, qdd) - force).max() <= 1e-10 * max(1.0, np.abs(force).max())
+    with pytest.raises(spacar.InputError, match="floating base"):
+        spacar.dynamics_derivatives(model, q, qd, qdd)
+
+
+def test_a_tumbling_floating_base_matches_the_general_path():
+    """Solo12 thrown spinning (6 rad/s) for 2 s: its orientation passes the half turn, where the
+    dependent Euler parameter is exchanged (the tree recognized again in the new partition); the
+    tree's run equals the general path's."""
+    model = solo12_floating()
+    model.xd(2, 2, 3.0)
+    model.xd(1, 1, 0.4)
+    model.timestep(20, 2.0)
+    for eps in (model.epsint, model.epsind):
+        eps(1e-10)
+    tree = spacar.simulate(model.copy())
+    general = spacar.simulate(model.copy(), recursive=False)
+    assert tree.stats["path"] == "tree" and general.stats["path"] == "general"
+    assert tree.node(2).x[:, 0].min() < 0.0  # past the half turn
+    assert np.abs(tree.x - general.x).max() <= 1e-9
 
 
 def test_a_floating_base_that_moves_no_mass_is_said():

@@ -554,6 +554,9 @@ void Simulation::dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, c
                      recursive_refusal() + "); the derivatives are computed on planar and spatial trees of rigid "
                      "bodies (URDF robots, pendulums, branched linkages)");
   }
+  if (const std::string why = tree->derivatives_refusal(); !why.empty())
+    throw InputError("dynamics_derivatives: not yet for " + why + " (its inverse dynamics and forward dynamics are "
+                     "on the recursive path; the derivatives are computed on trees whose every body turns on one joint)");
   const int nd = sys_->n_dof();
   if (q.cols() != nd || qd.cols() != nd || tau.cols() != nd || qd.rows() != q.rows() || tau.rows() != q.rows())
     throw InputError("dynamics_derivatives(): q, qd and tau must have the same number of states (rows) and one "

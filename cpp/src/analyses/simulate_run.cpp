@@ -502,9 +502,10 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   run_.base = run_.anchor = Solved();  // the next evaluation starts from x (q̂ has another meaning)
   run_.base.x = x;
   run_.base.angle_ref = angles;
-  // The chain of the recompiled system (residual_form(): the chain's path; a system with free
-  // rotations is no tree).
-  if (path_->residual_form()) path_ = RhsPath::chain_or_general(*sys_);
+  // The chain of the recompiled system (residual_form(): the chain's path); a floating base's
+  // tree is recognized again below, its DOFs being other Euler parameters now.
+  const bool tree = path_->tree() != nullptr;
+  if (path_->residual_form() || tree) path_ = RhsPath::chain_or_general(*sys_);
   have_transfer_ = false;
   // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;
@@ -517,6 +518,10 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   for (int k : sys.e_dyn) {
     Y[j] = e[k];
     Y[n + ny + j++] = ed[k];
+  }
+  if (tree) {  // at the state solved in the new partition
+    evaluate_state(t, Y);
+    path_ = RhsPath::choose(sys, *data_, true);
   }
 }
 

@@ -92,7 +92,7 @@ bool cholesky_inverse(Eigen::MatrixXd& M, Eigen::MatrixXd& Linv, double* inverse
 bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd,
                                        double* dq, double* dqd, double* dtau) {
   const int nb = n_bodies();
-  if (n != nb) return false;  // every body turned by one joint, its DOF
+  if (n != nb || floating_) return false;  // every body turned by one joint, its DOF
   DerivativeWork& work = derivative_work_;
   std::vector<WorldBody>& world = work.bodies;
   world.resize(nb);

@@ -66,10 +66,60 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
 
   bool supported_classes() {
     if (sys_.n_dof() == 0) return refuse("no degrees of freedom");
-    if (!sys_.x_dyn.empty()) return refuse("DYNX coordinates (free Euler parameters) are not hinge joints");
+    if (!sys_.x_dyn.empty() && !floating_base())
+      return refuse("DYNX coordinates other than a floating base's (an XYZ node and a free LAMBDA node) are not "
+                    "hinge joints");
     if (!sys_.x_input.empty() || !sys_.e_input.empty()) return refuse("prescribed motions (INPUTX, INPUTE)");
     if (!sys_.e_line.empty() || !sys_.e_nonholonomic.empty() || !sys_.e_kinematic.empty() || !sys_.y_defs.empty())
       return refuse("LINE, nonholonomic or kinematic deformations");
+    return true;
+  }
+
+  // The DYNX coordinates of a floating base: an XYZ node's three and a free rotation's three
+  // Euler parameters (FreeRotation), nothing else.
+  bool floating_base() {
+    if (sys_.free_rotations.size() != 1 || sys_.x_dyn.size() != 6) return false;
+    const FreeRotation& fr = sys_.free_rotations.front();
+    int point = -1, n_point = 0;
+    for (int g : sys_.x_dyn) {
+      if (g >= fr.coord && g < fr.coord + 4) continue;
+      if (sys_.coord_node_kind[g] != NodeKind::XYZ) return false;
+      const int id = sys_.coord_label[g][0];
+      if (point != -1 && id != point) return false;
+      point = id;
+      ++n_point;
+    }
+    if (n_point != 3) return false;
+    base_point_ = point;
+    base_orientation_ = fr.node;
+    return true;
+  }
+
+  // The floating base: the body of its LAMBDA node, with its XYZ node as its pin, the root.
+  bool place_free_root(std::vector<int>& queue) {
+    if (base_point_ < 0) return true;
+    const int body = g_.body_of.count(base_orientation_) ? g_.body_of.at(base_orientation_) : -1;
+    if (body < 0 || !g_.points[body].count(base_point_))
+      return refuse("the floating base's nodes " + std::to_string(base_point_) + " and " +
+                    std::to_string(base_orientation_) + " are not on one rigid body");
+    const FreeRotation& fr = sys_.free_rotations.front();
+    SpatialTree::FreeBase& b = tree_.base_;
+    const int xc = nodes_.at(base_point_).coord;
+    b.x_dof = static_cast<int>(std::lower_bound(sys_.x_dyn.begin(), sys_.x_dyn.end(), xc) - sys_.x_dyn.begin());
+    for (int k = 0; k < 3; ++k) b.lambda_dof[k] = fr.dofs[k];
+    b.dependent = fr.dependent;
+    b.lambda0 = lambda(base_orientation_);
+    b.sign = b.lambda0[fr.dependent] < 0.0 ? -1.0 : 1.0;
+    b.R0 = euler_R(b.lambda0);
+    tree_.floating_ = true;
+    Model bd;
+    bd.free = true;
+    bd.dof = b.x_dof;
+    Slide slide;
+    slide.pin = base_point_;
+    slide.free = true;
+    if (!place(body, kGround, bd, "the floating base", slide)) return false;
+    queue.push_back(body);
     return true;
   }
 
@@ -236,6 +286,7 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
   const Eigen::VectorXd& e_;
   SpatialTree& tree_;
   std::map<int, int> lambda_body_;  // first λ coordinate → index in the tree
+  int base_point_ = -1, base_orientation_ = -1;  // a floating base's XYZ and LAMBDA nodes
 };
 
 std::unique_ptr<SpatialTree> SpatialTree::detect(const System& sys, const Data& data, std::string* why) {
@@ -253,6 +304,93 @@ void SpatialTree::applied_loads() {
     bd.pA.head<3>() -= l.b.cross(f);
     bd.pA.tail<3>() -= f;
   }
+}
+
+// The floating base's Euler parameters at q (the dependent one from the unit norm, with its
+// sign at the recognition), and their rates at q̇ (the dependent one from λ · λ̇ = 0).
+Eigen::Vector4d SpatialTree::base_lambda(const double* q) const {
+  Eigen::Vector4d l;
+  double others = 0.0;
+  for (int i = 0, k = 0; i < 4; ++i) {
+    if (i == base_.dependent) continue;
+    l[i] = q[base_.lambda_dof[k++]];
+    others += l[i] * l[i];
+  }
+  l[base_.dependent] = base_.sign * std::sqrt(std::max(0.0, 1.0 - others));
+  return l;
+}
+
+Eigen::Vector4d SpatialTree::base_lambda_rate(const Eigen::Vector4d& l, const double* qd) const {
+  Eigen::Vector4d ld;
+  double dot = 0.0;
+  for (int i = 0, k = 0; i < 4; ++i) {
+    if (i == base_.dependent) continue;
+    ld[i] = qd[base_.lambda_dof[k++]];
+    dot += l[i] * ld[i];
+  }
+  ld[base_.dependent] = -dot / l[base_.dependent];
+  return ld;
+}
+
+// The base's frame: rotated by R(λ) R0ᵀ since the recognition, its pin the XYZ node; its velocity
+// in body coordinates, ω = R0 · 2 G(λ) λ̇ (the angular velocity in the LAMBDA node's axes,
+// turned to the body's) and v = Rᵀ ẋ.
+void SpatialTree::free_body_motion(const double* q, const double* qd, BodyWork& d) {
+  const Eigen::Vector4d l = base_lambda(q), ld = base_lambda_rate(l, qd);
+  const Eigen::Matrix3d R = euler_R(l) * base_.R0.transpose();
+  const Vec3 x(q[base_.x_dof], q[base_.x_dof + 1], q[base_.x_dof + 2]);
+  const Vec3 xd(qd[base_.x_dof], qd[base_.x_dof + 1], qd[base_.x_dof + 2]);
+  d.frame.R = R;
+  d.frame.E = R.transpose();
+  d.frame.r = x;
+  d.frame.lambda = compose(l, Eigen::Vector4d(base_.lambda0[0], -base_.lambda0[1], -base_.lambda0[2], -base_.lambda0[3]));
+  d.pin = x;
+  d.v << base_.R0 * (2.0 * euler_G(l.data()) * ld), R.transpose() * xd;
+}
+
+// q̈ of the base from its acceleration (ω̇; v̇) in body coordinates: ẍ = R (v̇ + ω × v) and
+// λ̈ = ½ G(λ̇)ᵀ ω' + ½ G(λ)ᵀ ω̇' in the LAMBDA node's axes (ω' = R0ᵀ ω).
+void SpatialTree::free_body_qdd(const double* q, const double* qd, const BodyWork& d, const Vector& acc,
+                                double* qdd) {
+  const Eigen::Vector4d l = base_lambda(q), ld = base_lambda_rate(l, qd);
+  const Vec3 w = d.v.head<3>(), v = d.v.tail<3>();
+  const Vec3 xdd = d.frame.R * (acc.tail<3>() + w.cross(v));
+  for (int c = 0; c < 3; ++c) qdd[base_.x_dof + c] = xdd[c];
+  const Eigen::Vector4d ldd = 0.5 * (euler_G(ld.data()).transpose() * (base_.R0.transpose() * w) +
+                                     euler_G(l.data()).transpose() * (base_.R0.transpose() * acc.head<3>()));
+  for (int i = 0, k = 0; i < 4; ++i)
+    if (i != base_.dependent) qdd[base_.lambda_dof[k++]] = ldd[i];
+}
+
+// The inverse: ω̇ = R0 · 2 G(λ) λ̈ (G(λ̇) λ̇ = 0), λ̈ of the dependent parameter from
+// λ · λ̈ + λ̇ · λ̇ = 0; v̇ = Rᵀ ẍ − ω × v.
+SpatialTree::Vector SpatialTree::free_body_acceleration(const double* q, const double* qd, const double* qdd,
+                                                        const BodyWork& d) {
+  const Eigen::Vector4d l = base_lambda(q), ld = base_lambda_rate(l, qd);
+  Eigen::Vector4d ldd;
+  double dot = ld.squaredNorm();
+  for (int i = 0, k = 0; i < 4; ++i) {
+    if (i == base_.dependent) continue;
+    ldd[i] = qdd[base_.lambda_dof[k++]];
+    dot += l[i] * ldd[i];
+  }
+  ldd[base_.dependent] = -dot / l[base_.dependent];
+  const Vec3 xdd(qdd[base_.x_dof], qdd[base_.x_dof + 1], qdd[base_.x_dof + 2]);
+  Vector a;
+  a << base_.R0 * (2.0 * euler_G(l.data()) * ldd), d.frame.R.transpose() * xdd - d.v.head<3>().cross(d.v.tail<3>());
+  return a;
+}
+
+// The generalized forces of the base's DOFs for the wrench f = (moment; force) at its pin in body
+// coordinates, by virtual power: fᵀ (ω; v) with v = Rᵀ ẋ and ω = R0 · 2 G(λ) λ̇, λ̇ of the
+// independent parameters (the dependent one's rate −Σ λ_i λ̇_i / λ_dep).
+void SpatialTree::free_forces(const double* q, const BodyWork& d, const Vector& f, double* force) {
+  const Eigen::Vector4d l = base_lambda(q);
+  const Vec3 fx = d.frame.R * f.tail<3>();
+  for (int c = 0; c < 3; ++c) force[base_.x_dof + c] = fx[c];
+  const Eigen::Vector4d g = 2.0 * euler_G(l.data()).transpose() * (base_.R0.transpose() * f.head<3>());
+  for (int i = 0, k = 0; i < 4; ++i)
+    if (i != base_.dependent) force[base_.lambda_dof[k++]] = g[i] - l[i] / l[base_.dependent] * g[base_.dependent];
 }
 
 // Positions, velocities and accelerations of the coordinates moving with the bodies.

@@ -101,9 +101,11 @@ class TreeBuilder {
   };
 
   // The points of the sliding joint that places a body: its own point (its pin, which slides)
-  // and the parent's point it slides from; −1: a hinge.
+  // and the parent's point it slides from; −1: a hinge. free: the body is a floating base, no
+  // joint, its pin (its own) the point `pin`.
   struct Slide {
     int pin = -1, base = -1;
+    bool free = false;
   };
 
   TreeBuilder(const System& sys, const Data& data, NodeKind point, NodeKind orientation)
@@ -207,6 +209,7 @@ class TreeBuilder {
       hinges_at[body_of(hinges_[i].b)].push_back(static_cast<int>(i));
     }
     std::vector<int> queue = {kGround};
+    if (!self().place_free_root(queue)) return false;
     for (size_t k = 0; k < queue.size(); ++k) {
       const int parent = queue[k];
       for (int i : hinges_at[parent]) {
@@ -234,12 +237,28 @@ class TreeBuilder {
     return true;
   }
 
+  // A floating base, the tree's root before the bodies that hang from the ground (Derived may
+  // place one and add it to the queue).
+  bool place_free_root(std::vector<int>&) { return true; }
+
   // The first step of placing a body under the placed body `parent_body` (or kGround) with its
   // joint `bd`: its pin, its parent and its points; index and p0 are its place in the tree and
   // its pin's reference position.
   bool attach(int body, int parent_body, Model& bd, const std::string& joint, int index, Point& p0,
               const Slide& slide) {
     const int parent = parent_body == kGround ? kGround : placed_[parent_body];
+    if (slide.free) {  // a floating base: it owns every point, its pin too
+      placed_[body] = index;
+      body_at_.push_back(body);
+      pivot_found_.push_back(true);
+      pin_[body] = slide.pin;
+      p0 = point(slide.pin);
+      bd.parent = kGround;
+      bd.r = p0;
+      for (int id : g_.points[body]) owner_[id] = index;
+      pin0_.push_back(p0);
+      return true;
+    }
     const bool sliding = slide.pin >= 0;
     // A hinge's pin is the point the body shares with its parent; a sliding joint's is the
     // body's own point of the joint, whose other point is on the parent, and the two share none.

@@ -39,6 +39,7 @@ struct BodyModel {
   int dof = 0;                  // position of the joint's coordinate in q
   bool absolute = false;        // q is the body's rotation (a planar DYNX), else a hinge's
   bool prismatic = false;       // the joint slides along its axis (spatial), else it turns
+  bool free = false;            // the root of a floating base: no joint, six DOFs (ArticulatedTree's free_* hooks)
   double sign = 1.0;            // hinge: joint angle u = sign · q + offset (the hinge may point to the parent)
   double offset = 0.0;          // absolute: the body's rotation is q − offset
   double stiffness = 0.0, damping = 0.0;  // hinge σ = S e + D ė, joint torque −σ
@@ -83,9 +84,7 @@ class ArticulatedTree : public RecursiveTree {
   bool solve(const double* q, const double* qd, double* qdd) final {
     outward(q, qd);
     applied_loads();
-    if (!articulate()) return false;
-    accelerations(qdd);
-    return true;
+    return articulate() && accelerations(q, qd, qdd);
   }
 
   void inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) final {
@@ -97,7 +96,8 @@ class ArticulatedTree : public RecursiveTree {
       const Model& m = bodies_[i];
       BodyWork& d = work_[i];
       Vector a = Algebra::to_child(m, d.frame, m.parent < 0 ? base_acceleration_ : work_[m.parent].a) + d.bias;
-      Algebra::add_joint_acceleration(m, Algebra::joint_acceleration(m, a, qdd), a);
+      if (m.free) a += free_body_acceleration(q, qd, qdd, d);
+      else Algebra::add_joint_acceleration(m, Algebra::joint_acceleration(m, a, qdd), a);
       d.a = a;
       d.pA += m.inertia * a;
     }
@@ -110,6 +110,10 @@ class ArticulatedTree : public RecursiveTree {
     for (int i = static_cast<int>(bodies_.size()) - 1; i >= 0; --i) {
       const Model& m = bodies_[i];
       BodyWork& d = work_[i];
+      if (m.free) {  // the wrench the base's six DOFs carry
+        free_forces(q, d, d.pA, force);
+        continue;
+      }
       const double torque = Algebra::joint_component(m, d.pA) - d.tau;
       BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
       if (p) p->pA += Algebra::to_parent(m, d.frame, d.pA);
@@ -131,6 +135,16 @@ class ArticulatedTree : public RecursiveTree {
   }
   // The applied loads on the bodies, subtracted from their bias forces.
   virtual void applied_loads() = 0;
+  // A floating base (the root with BodyModel::free): its frame, pin and velocity v (d.frame,
+  // d.pin, d.v) at (q, q̇); q̈ of its DOFs from its acceleration relative to the ground's
+  // (body coordinates, without the ground's fictitious −g); that acceleration from q̈; the
+  // generalized forces of its DOFs from the wrench it carries (body coordinates, at its pin).
+  virtual void free_body_motion(const double*, const double*, BodyWork&) {}
+  virtual void free_body_qdd(const double*, const double*, const BodyWork&, const Vector&, double*) {}
+  virtual Vector free_body_acceleration(const double*, const double*, const double*, const BodyWork&) {
+    return Vector::Zero();
+  }
+  virtual void free_forces(const double*, const BodyWork&, const Vector&, double*) {}
 
   std::vector<Model> bodies_;
   std::vector<BodyWork> work_;
@@ -144,12 +158,19 @@ class ArticulatedTree : public RecursiveTree {
       const Model& m = bodies_[i];
       BodyWork& d = work_[i];
       const BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
-      const double theta = Algebra::joint_angle(m, p, q, qd, d);  // rotation relative to the parent
-      Algebra::place(m, p, theta, d);
-      Vector v = Algebra::joint_motion(m, d.ud);
-      if (p) v += Algebra::to_child(m, d.frame, p->v);
-      d.v = v;
-      d.bias = Algebra::bias(m, v, d.ud);
+      if (m.free) {
+        free_body_motion(q, qd, d);
+        d.ud = d.tau = 0.0;
+        d.bias = Vector::Zero();
+      } else {
+        const double theta = Algebra::joint_angle(m, p, q, qd, d);  // rotation relative to the parent
+        Algebra::place(m, p, theta, d);
+        Vector v = Algebra::joint_motion(m, d.ud);
+        if (p) v += Algebra::to_child(m, d.frame, p->v);
+        d.v = v;
+        d.bias = Algebra::bias(m, v, d.ud);
+      }
+      const Vector& v = d.v;
       d.IA = m.inertia;
       d.pA = Algebra::cross_force(v, m.inertia * v) - m.load;
     }
@@ -161,6 +182,7 @@ class ArticulatedTree : public RecursiveTree {
     for (int i = static_cast<int>(bodies_.size()) - 1; i >= 0; --i) {
       const Model& m = bodies_[i];
       BodyWork& d = work_[i];
+      if (m.free) continue;  // the root: its articulated inertia is solved whole (accelerations)
       d.U = Algebra::joint_column(m, d.IA);
       d.d = Algebra::joint_component(m, d.U);
       // Not positive: a body that moves no mass. Not finite (a trial state out of range): the
@@ -178,17 +200,25 @@ class ArticulatedTree : public RecursiveTree {
   }
 
   // Outwards: joint and body accelerations (relative to the fictitious acceleration −g of the
-  // ground), q̈.
-  void accelerations(double* qdd) {
+  // ground), q̈; false if a floating base's articulated inertia is not positive definite.
+  bool accelerations(const double* q, const double* qd, double* qdd) {
     for (size_t i = 0; i < bodies_.size(); ++i) {
       const Model& m = bodies_[i];
       BodyWork& d = work_[i];
       Vector a = Algebra::to_child(m, d.frame, m.parent < 0 ? base_acceleration_ : work_[m.parent].a) + d.bias;
+      if (m.free) {  // IA a + pA = 0: no joint holds it
+        const Eigen::LLT<Inertia> llt(d.IA);
+        if (llt.info() != Eigen::Success) return false;
+        d.a = -llt.solve(d.pA);
+        free_body_qdd(q, qd, d, d.a - a, qdd);
+        continue;
+      }
       const double udd = (d.u - d.U.dot(a)) / d.d;
       Algebra::add_joint_acceleration(m, udd, a);
       d.a = a;
       qdd[m.dof] = Algebra::dof_acceleration(m, a, udd);
     }
+    return true;
   }
 };
 

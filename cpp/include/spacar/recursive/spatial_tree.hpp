@@ -12,10 +12,12 @@
 // and the joints' ESTIFF and EDAMPP load it. The equations of motion are solved in O(N) by the
 // articulated-body algorithm (articulated.hpp) in spatial algebra, with explicit positions instead
 // of Newton's method: the same equations as the constraint formulation (each body's spatial
-// inertia is the element and nodal mass matrices projected on its rigid motions).
+// inertia is the element and nodal mass matrices projected on its rigid motions). A floating base
+// (an XYZ node and a free LAMBDA node, all DYNX but the dependent Euler parameter, on one body) is
+// the free root: no joint, six DOFs (FreeBase; ArticulatedTree's free_* hooks).
 //
-// Refused (the general path runs, and detect() says why): planar models (planar_tree.hpp), DYNX
-// rotations (free Euler parameters), spherical joints (a shared XYZ node without a DOF hinge),
+// Refused (the general path runs, and detect() says why): planar models (planar_tree.hpp), other
+// DYNX coordinates, spherical joints (a shared XYZ node without a DOF hinge),
 // HINGEs with released or rigid e1, or released e2, e3 (unless all three are released, without
 // stiffness: a measuring hinge), flexible or partly fixed beams, elements other than BEAM, BEAMNL,
 // HINGE, BEARING and L2MIN1, BEARINGs other than prismatic joints, closed loops, prescribed
@@ -24,6 +26,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -174,6 +177,7 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   // world axes, ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇).
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
+  std::string derivatives_refusal() const override { return floating_ ? "a floating base" : ""; }
 
  private:
   using Vec3 = Eigen::Vector3d;
@@ -194,10 +198,28 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   class Builder;
 
   void applied_loads() override;
+  // A floating base (spatial_tree.cpp): the root body's origin (XYZ node, DYNX) and orientation
+  // (LAMBDA node, three Euler parameters DYNX, the dependent one calculable: FreeRotation).
+  struct FreeBase {
+    int x_dof = -1;                  // q index of the origin's x (y, z follow)
+    std::array<int, 3> lambda_dof{};  // q indices of the three independent Euler parameters
+    int dependent = 0;               // 0..3: the calculable one
+    double sign = 1.0;               // of the dependent parameter (it stays away from 0: see repartition)
+    Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();  // R(λ) at the recognition (the body's reference)
+    Eigen::Vector4d lambda0 = Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
+  };
+  Eigen::Vector4d base_lambda(const double* q) const;
+  Eigen::Vector4d base_lambda_rate(const Eigen::Vector4d& l, const double* qd) const;
+  void free_body_motion(const double* q, const double* qd, BodyWork& d) override;
+  void free_body_qdd(const double* q, const double* qd, const BodyWork& d, const Vector& acc, double* qdd) override;
+  Vector free_body_acceleration(const double* q, const double* qd, const double* qdd, const BodyWork& d) override;
+  void free_forces(const double* q, const BodyWork& d, const Vector& f, double* force) override;
   void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
 
   std::vector<Follower> followers_;
   std::vector<Load> loads_;
+  bool floating_ = false;
+  FreeBase base_;
 
   // A body's work in dynamics_derivatives: world axes at the world origin.
   struct WorldBody {

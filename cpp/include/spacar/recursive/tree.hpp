@@ -49,6 +49,8 @@ class RecursiveTree {
                                     double* /*qdd*/, double* /*dq*/, double* /*dqd*/, double* /*dtau*/) {
     return false;
   }
+  // Why dynamics_derivatives is not provided for this tree ("" if it is).
+  virtual std::string derivatives_refusal() const { return ""; }
 
  protected:
   // The coordinates moving with the bodies, after solve().
