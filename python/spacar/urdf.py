@@ -371,13 +371,14 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, max_by
     ``floating=True``: the root link is a free body instead of the ground, as Pinocchio's
     ``buildModelFromUrdf(path, JointModelFreeFlyer())``: its origin (XYZ node 1) and its
     orientation (LAMBDA node 2, Euler parameters with the L2MIN1 constraint) are degrees of
-    freedom, DYNX 1 1 2 3 and DYNX 2 2 3 4 (λ0 calculable: orientations up to, not through, a half
-    turn from the URDF's frame), the first six DOFs: ``res.q`` is (x, y, z, λ1, λ2, λ3, the joints).
+    freedom, DYNX 1 1 2 3 and DYNX 2 2 3 4 (λ0 calculable at the start; when it gets small, past
+    about 120° from the URDF's frame, a run makes another parameter the calculable one), the first
+    six DOFs: ``res.q`` is (x, y, z, λ1, λ2, λ3, the joints).
     ``model.urdf_base`` is (1, 2), None for a fixed base. The model is returned prepared (its
     reference geometry the URDF's zero configuration), so that ``model.x(1, x, y, z)`` and
     ``model.x(2, λ0, λ1, λ2, λ3)`` place the robot and ``model.xd`` set the base's velocity
-    (``λ̇ = ½ E(λ)ᵀ ω``); no elements can be added to it. Such a model takes the general path (an
-    open chain's where it is one), not the recursive path.
+    (``λ̇ = ½ E(λ)ᵀ ω``); no elements can be added to it. Its runs take the recursive path, the
+    base the free root of the articulated-body algorithm (docs/robots.md, "Floating base").
 
     The file must be a regular file (a FIFO or a device
     is refused at once) of at most ``max_bytes`` bytes (default :data:`MAX_URDF_BYTES`, 8 MiB).

@@ -19,7 +19,7 @@ import spacar
 from spacar import _core
 from support.paths import DATA, EXAMPLES
 
-SMALL = ["two_link_arm", "branched_tree", "prismatic", "fixed_joints", "pivot"]
+SMALL = ["two_link_arm", "branched_tree", "prismatic", "fixed_joints", "pivot", "slider_pivot"]
 
 
 def robot_file(package: str, name: str, folder: str = "urdf") -> Path:
@@ -463,12 +463,23 @@ def solo12_floating():
     return model
 
 
-def test_floating_base_takes_the_recursive_path():
+def ur5_floating_loaded():
+    """The UR5 on a floating base with a FORCE on a link and gravity off the axes (other
+    dependent Euler parameters and turned references: the tumbling run below)."""
+    model = spacar.from_urdf(urdf_path("ur5"), floating=True)
+    model.force(model.urdf_links["forearm_link"][0], 0.5, -1.0, 2.0)  # at the forearm's origin
+    model.gravity(2.0, 1.0, -9.0)
+    model.epskin(1e-14)
+    return model
+
+
+@pytest.mark.parametrize("build", [solo12_floating, ur5_floating_loaded], ids=["solo12", "ur5 loaded"])
+def test_floating_base_takes_the_recursive_path(build):
     """A floating base on the recursive path (issue 37): the free root of the articulated-body
     algorithm, its DOFs the origin and three Euler parameters. At random states (base pose and
     twist, joints and rates) the tree's q̈ and its inverse dynamics equal the general path's (the
     constraint formulation with L2MIN1, itself equal to Pinocchio's free flyer above)."""
-    model = solo12_floating()
+    model = build()
     tree = _core.Simulation(model.copy().core)
     tree.assemble()
     assert tree.recursive_refusal() == ""
@@ -476,10 +487,8 @@ def test_floating_base_takes_the_recursive_path():
     general.assemble()
     nv = general.system.n_dof
     rng, now = np.random.default_rng(3), np.array(general.system.q0)
-    for _ in range(3):
-        axis = rng.normal(size=3)
-        lam = np.r_[np.cos(0.5), np.sin(0.5) * axis / np.linalg.norm(axis)]
-        q = np.r_[rng.uniform(-0.5, 0.5, 3), lam[1:], rng.uniform(-1.0, 1.0, nv - 6)]
+    for _ in range(3):  # states a small step away from the assembled one, in its partition
+        q = now + rng.uniform(-0.2, 0.2, nv)
         qd = rng.uniform(-2.0, 2.0, nv)
         for s in np.linspace(0.0, 1.0, 9)[1:]:  # by continuation, on the assembled branch
             general.evaluate(0.0, now + s * (q - now), qd)
@@ -492,6 +501,10 @@ def test_floating_base_takes_the_recursive_path():
         assert np.abs(spacar.inverse_dynamics(model, q, qd, qdd) - force).max() <= 1e-10 * max(1.0, np.abs(force).max())
     with pytest.raises(spacar.InputError, match="floating base"):
         spacar.dynamics_derivatives(model, q, qd, qdd)
+    q[3:6] = 0.7  # three Euler parameters of a norm above 1: no orientation
+    assert tree.recursive_state(q, qd) is None
+    with pytest.raises(spacar.InputError, match="norm of 1"):
+        spacar.inverse_dynamics(model, q, qd, qdd)
 
 
 def test_a_tumbling_floating_base_matches_the_general_path():

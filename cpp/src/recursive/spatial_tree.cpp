@@ -335,8 +335,10 @@ Eigen::Vector4d SpatialTree::base_lambda_rate(const Eigen::Vector4d& l, const do
 // The base's frame: rotated by R(λ) R0ᵀ since the recognition, its pin the XYZ node; its velocity
 // in body coordinates, ω = R0 · 2 G(λ) λ̇ (the angular velocity in the LAMBDA node's axes,
 // turned to the body's) and v = Rᵀ ẋ.
-void SpatialTree::free_body_motion(const double* q, const double* qd, BodyWork& d) {
-  const Eigen::Vector4d l = base_lambda(q), ld = base_lambda_rate(l, qd);
+bool SpatialTree::free_body_motion(const double* q, const double* qd, BodyWork& d) {
+  const Eigen::Vector4d l = base_lambda(q);
+  if (!(std::abs(l[base_.dependent]) > 0.0) || !l.allFinite()) return false;  // |λ_independent| ≥ 1
+  const Eigen::Vector4d ld = base_lambda_rate(l, qd);
   const Eigen::Matrix3d R = euler_R(l) * base_.R0.transpose();
   const Vec3 x(q[base_.x_dof], q[base_.x_dof + 1], q[base_.x_dof + 2]);
   const Vec3 xd(qd[base_.x_dof], qd[base_.x_dof + 1], qd[base_.x_dof + 2]);
@@ -346,6 +348,7 @@ void SpatialTree::free_body_motion(const double* q, const double* qd, BodyWork& 
   d.frame.lambda = compose(l, Eigen::Vector4d(base_.lambda0[0], -base_.lambda0[1], -base_.lambda0[2], -base_.lambda0[3]));
   d.pin = x;
   d.v << base_.R0 * (2.0 * euler_G(l.data()) * ld), R.transpose() * xd;
+  return true;
 }
 
 // q̈ of the base from its acceleration (ω̇; v̇) in body coordinates: ẍ = R (v̇ + ω × v) and

@@ -266,7 +266,8 @@ class TreeBuilder {
     if (!sliding && g_.points[body].empty() && parent_body != kGround) {
       // A body of no point (a rotor's LAMBDA node, a link whose mass is at its joint's origin): it
       // turns about its parent's pin, as good as any point of the axis for a body whose mass is
-      // all rotational inertia, until a joint of a child shows its pivot (pivot_of).
+      // all rotational inertia, until the joint of a child shows its pivot (pivot_of: the child's
+      // pin, or the point a sliding child slides from).
       placed_[body] = index;
       body_at_.push_back(body);
       pivot_found_.push_back(false);
@@ -279,6 +280,7 @@ class TreeBuilder {
     if (sliding) {
       if (!g_.points[body].count(pin) || pin_of(body) != -1 || !on_body(slide.base, parent_body, parent))
         return refuse(joint + " slides a body that is not joined to its parent by that joint alone");
+      if (!pivot_of(slide.base, parent_body, parent, joint)) return false;  // the point it slides from
     } else if (pin < 0 || !on_body(pin, parent_body, parent)) {
       return refuse(joint + " turns a body with no point, or more than one, on its parent");
     } else if (!pivot_of(pin, parent_body, parent, joint)) {
@@ -315,8 +317,8 @@ class TreeBuilder {
     return on_body(id, grand == kGround ? kGround : body_at_[grand], grand);
   }
 
-  // A joint at point `pin` under the body of no point parent_body (index parent) fixes that
-  // body's pivot, and those of its ancestors of no point up to the one with points, at `pin`: they
+  // A joint at point `pin` (a hinge's pin, or the parent's point a sliding joint slides from) under
+  // the body of no point parent_body (index parent) fixes that body's pivot, and those of its ancestors of no point up to the one with points, at `pin`: they
   // turn about axes through it (their joints' axes meet there, as at a humanoid's elbow). A second
   // joint at another point cannot be placed. Nothing to do under a body with points.
   bool pivot_of(int pin, int parent_body, int parent, const std::string& joint) {

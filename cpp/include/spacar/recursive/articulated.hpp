@@ -27,6 +27,7 @@
 
 #include <vector>
 
+#include "spacar/errors.hpp"
 #include "spacar/recursive/tree.hpp"
 
 namespace spacar {
@@ -82,13 +83,14 @@ class ArticulatedTree : public RecursiveTree {
   int n_bodies() const { return static_cast<int>(bodies_.size()); }
 
   bool solve(const double* q, const double* qd, double* qdd) final {
-    outward(q, qd);
+    if (!outward(q, qd)) return false;
     applied_loads();
     return articulate() && accelerations(q, qd, qdd);
   }
 
   void inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) final {
-    outward(q, qd);
+    if (!outward(q, qd))
+      throw InputError("inverse_dynamics: the floating base's three Euler parameters have a norm of 1 or more");
     applied_loads();
     // Outwards: the accelerations the given q̈ make, and each body's force f = I a + pA (its bias
     // forces of inertia less the applied loads).
@@ -136,10 +138,10 @@ class ArticulatedTree : public RecursiveTree {
   // The applied loads on the bodies, subtracted from their bias forces.
   virtual void applied_loads() = 0;
   // A floating base (the root with BodyModel::free): its frame, pin and velocity v (d.frame,
-  // d.pin, d.v) at (q, q̇); q̈ of its DOFs from its acceleration relative to the ground's
+  // d.pin, d.v) at (q, q̇), false if q is no orientation; q̈ of its DOFs from its acceleration relative to the ground's
   // (body coordinates, without the ground's fictitious −g); that acceleration from q̈; the
   // generalized forces of its DOFs from the wrench it carries (body coordinates, at its pin).
-  virtual void free_body_motion(const double*, const double*, BodyWork&) {}
+  virtual bool free_body_motion(const double*, const double*, BodyWork&) { return true; }
   virtual void free_body_qdd(const double*, const double*, const BodyWork&, const Vector&, double*) {}
   virtual Vector free_body_acceleration(const double*, const double*, const double*, const BodyWork&) {
     return Vector::Zero();
@@ -152,14 +154,15 @@ class ArticulatedTree : public RecursiveTree {
 
  private:
   // Outwards: placements, velocities, velocity-product accelerations and the bias forces of the
-  // bodies' inertia, with the joint torques; the articulated inertias start as the bodies'.
-  void outward(const double* q, const double* qd) {
+  // bodies' inertia, with the joint torques; the articulated inertias start as the bodies'. False
+  // if a floating base's q is no orientation.
+  bool outward(const double* q, const double* qd) {
     for (size_t i = 0; i < bodies_.size(); ++i) {
       const Model& m = bodies_[i];
       BodyWork& d = work_[i];
       const BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
       if (m.free) {
-        free_body_motion(q, qd, d);
+        if (!free_body_motion(q, qd, d)) return false;
         d.ud = d.tau = 0.0;
         d.bias = Vector::Zero();
       } else {
@@ -174,6 +177,7 @@ class ArticulatedTree : public RecursiveTree {
       d.IA = m.inertia;
       d.pA = Algebra::cross_force(v, m.inertia * v) - m.load;
     }
+    return true;
   }
 
   // Inwards: articulated inertias and bias forces; false if a joint's articulated inertia is not

@@ -210,7 +210,7 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   };
   Eigen::Vector4d base_lambda(const double* q) const;
   Eigen::Vector4d base_lambda_rate(const Eigen::Vector4d& l, const double* qd) const;
-  void free_body_motion(const double* q, const double* qd, BodyWork& d) override;
+  bool free_body_motion(const double* q, const double* qd, BodyWork& d) override;
   void free_body_qdd(const double* q, const double* qd, const BodyWork& d, const Vector& acc, double* qdd) override;
   Vector free_body_acceleration(const double* q, const double* qd, const double* qdd, const BodyWork& d) override;
   void free_forces(const double* q, const BodyWork& d, const Vector& f, double* force) override;
