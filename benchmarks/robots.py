@@ -143,28 +143,16 @@ def floating_spacar(path, eps, t_end):
 def floating_pinocchio(pm, pd, t_end, rtol, atol):
     """Pinocchio's free flyer: its ABA, the base's quaternion and position rates from its twist,
     integrated by SciPy's DOP853; (base position, Euler parameters (λ0, λ1, λ2, λ3), joints) at the end."""
-    import pinocchio as pin
     from scipy.integrate import solve_ivp
 
+    from spacar.compare.pinocchio import free_flyer_rhs
     from spacar.geometry import rotation
 
     nq, nv = pm.nq, pm.nv
     p, lam, v, w, qj, qdj = floating_state(nv - 6)
     R = rotation(lam)
-    zero = np.zeros(nv)
-
-    def f(t, y):
-        q, vv = y[:nq].copy(), y[nq:]
-        q[3:7] /= np.linalg.norm(q[3:7])
-        x, y_, z, s = q[3:7]
-        wx, wy, wz = vv[3:6]
-        quat_d = 0.5 * np.array([s * wx + y_ * wz - z * wy, s * wy + z * wx - x * wz, s * wz + x * wy - y_ * wx,
-                                 -x * wx - y_ * wy - z * wz])
-        Rq = pin.Quaternion(s, x, y_, z).matrix()
-        return np.r_[Rq @ vv[:3], quat_d, vv[6:], pin.aba(pm, pd, q, vv, zero)]
-
     y0 = np.r_[p, lam[1:], lam[0], qj, R.T @ v, R.T @ w, qdj]
-    sol = solve_ivp(f, (0.0, t_end), y0, method="DOP853", rtol=rtol, atol=atol)
+    sol = solve_ivp(free_flyer_rhs(pm, pd), (0.0, t_end), y0, method="DOP853", rtol=rtol, atol=atol)
     q = sol.y[:nq, -1]
     quat = q[3:7] / np.linalg.norm(q[3:7])
     return np.r_[q[:3], quat[3], quat[:3], q[7:]]

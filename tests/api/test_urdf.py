@@ -406,6 +406,8 @@ def test_floating_base_free_fall_matches_pinocchio_integrated_by_scipy():
     X 2 after from_urdf (the model comes prepared, its geometry the URDF's)."""
     from scipy.integrate import solve_ivp
 
+    from spacar.compare.pinocchio import free_flyer_rhs
+
     from spacar.geometry import euler_e, rotation
 
     path = robot_file("solo_description", "solo12.urdf", "robots")
@@ -436,15 +438,7 @@ def test_floating_base_free_fall_matches_pinocchio_integrated_by_scipy():
     data = pm.createData()
     R = rotation(lam)
 
-    def f(t, y):
-        q, vv = y[:pm.nq].copy(), y[pm.nq:]
-        q[3:7] /= np.linalg.norm(q[3:7])
-        x, y_, z, s = q[3:7]
-        wx, wy, wz = vv[3:6]
-        quat_d = 0.5 * np.array([s * wx + y_ * wz - z * wy, s * wy + z * wx - x * wz, s * wz + x * wy - y_ * wx,
-                                 -x * wx - y_ * wy - z * wz])
-        Rq = pin.Quaternion(s, x, y_, z).matrix()
-        return np.r_[Rq @ vv[:3], quat_d, vv[6:], pin.aba(pm, data, q, vv, np.zeros(pm.nv))]
+    f = free_flyer_rhs(pm, data)
 
     y0 = np.r_[p, lam[1:], lam[0], qj, R.T @ v, R.T @ w, qdj]
     ref = solve_ivp(f, (0.0, 1.0), y0, method="DOP853", rtol=1e-12, atol=1e-12)

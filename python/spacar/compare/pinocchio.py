@@ -349,3 +349,26 @@ def simulate(spacar_model, t_end=None, n_out=None, rtol=None, atol=None, integra
         raise ValueError("integrator must be 'dop853' or 'scipy'")
     n = pm.nq
     return np.array(touts), Y[:, :n], Y[:, n:], stats
+
+
+def free_flyer_rhs(model, data):
+    """The first-order equations y' = f(t, y) of a Pinocchio model whose first joint is a
+    JointModelFreeFlyer, y = (q, v) with q = (position, quaternion (x, y, z, w), joints) and v =
+    (the base's linear and angular velocity in its own axes, the joints' rates), for SciPy's
+    solve_ivp: the position's rate R v, the quaternion's ½ q ⊗ (0, ω) (normalized where it is
+    read), ``pinocchio.aba`` with no joint torques. The reference of the floating-base tests and
+    benchmark (issue 37)."""
+    zero = np.zeros(model.nv)
+
+    def f(t, y):
+        q, v = y[:model.nq].copy(), y[model.nq:]
+        q[3:7] /= np.linalg.norm(q[3:7])
+        x, y_, z, s = q[3:7]
+        wx, wy, wz = v[3:6]
+        quat_d = 0.5 * np.array([s * wx + y_ * wz - z * wy, s * wy + z * wx - x * wz, s * wz + x * wy - y_ * wx,
+                                 -x * wx - y_ * wy - z * wz])
+        R = pin.Quaternion(s, x, y_, z).matrix()
+        return np.r_[R @ v[:3], quat_d, v[6:], pin.aba(model, data, q, v, zero)]
+
+    return f
+
