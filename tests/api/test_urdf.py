@@ -501,6 +501,33 @@ def test_floating_base_takes_the_recursive_path(build):
         spacar.inverse_dynamics(model, q, qd, qdd)
 
 
+FLOATING_ROBOTS = {"go1": ("go1_description", "go1.urdf", "urdf"),
+                   "anymal_c": ("anymal_c_simple_description", "anymal.urdf", "urdf"),
+                   "g1": ("g1_description", "g1_29dof_rev_1_0.urdf", "urdf"),
+                   "talos_reduced": ("talos_data", "talos_reduced.urdf", "robots"),
+                   "simple_humanoid": ("simple_humanoid_description", "simple_humanoid.urdf", "urdf")}
+
+
+@pytest.mark.parametrize("name", FLOATING_ROBOTS)
+def test_floating_robots_take_the_recursive_path(name):
+    """Quadrupeds and humanoids of example-robot-data on a floating base: on the recursive path,
+    the tree's q̈ equal to the general path's at a state near the assembled one (measured 1e-15 to
+    2e-13 relative)."""
+    model = spacar.from_urdf(robot_file(*FLOATING_ROBOTS[name]), floating=True)
+    model.epskin(1e-13)
+    tree, general = (_core.Simulation(model.copy().core) for _ in range(2))
+    for sim in (tree, general):
+        sim.assemble()
+    assert tree.recursive_refusal() == ""
+    nv, rng = general.system.n_dof, np.random.default_rng(1)
+    q0 = np.array(general.system.q0)
+    q, qd = q0 + rng.uniform(-0.05, 0.05, nv), rng.uniform(-1.0, 1.0, nv)
+    for s in np.linspace(0.0, 1.0, 5)[1:]:
+        general.evaluate(0.0, q0 + s * (q - q0), qd)
+    ref = np.array(general.data.qdd)
+    assert np.abs(np.array(tree.recursive_state(q, qd)["qdd"]) - ref).max() <= 1e-10 * max(1.0, np.abs(ref).max())
+
+
 def test_a_tumbling_floating_base_matches_the_general_path():
     """Solo12 thrown spinning (6 rad/s) for 2 s: its orientation passes the half turn, where the
     dependent Euler parameter is exchanged (the tree recognized again in the new partition); the
