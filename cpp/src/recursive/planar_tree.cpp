@@ -83,8 +83,7 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
     return found;
   }
 
-  // The tree's parent of placed body i, and its pin moved to r from the parent's (TreeBuilder).
-  int parent_index(int i) const { return tree_.bodies_[i].parent; }
+  // Placed body i's pin moved to r from its parent's (TreeBuilder).
   void set_pin_offset(int i, const Point& r) { tree_.bodies_[i].r = r; }
 
   // The joint of a DOF hinge, from the parent's end (forward: node a) to the child's.

@@ -45,12 +45,6 @@ Vec6 cross_motion(const Vec6& x, const Vec6& y) {  // x × y
   return out;
 }
 
-Vec6 cross_force(const Vec6& x, const Vec6& f) {  // x ×* f
-  Vec6 out;
-  out << x.head<3>().cross(f.head<3>()) + x.tail<3>().cross(f.tail<3>()), x.head<3>().cross(f.tail<3>());
-  return out;
-}
-
 // M⁻¹ (row major) of a symmetric positive definite M by Cholesky, written out: at a robot's n
 // (6 to 12) Eigen's dynamic-size factorization, triangular solves and products cost more than
 // their arithmetic. M is overwritten by its factor L, Linv by L⁻¹; false if M is not positive
@@ -92,7 +86,7 @@ bool cholesky_inverse(Eigen::MatrixXd& M, Eigen::MatrixXd& Linv, double* inverse
 bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd,
                                        double* dq, double* dqd, double* dtau) {
   const int nb = n_bodies();
-  if (n != nb || floating_) return false;  // every body turned by one joint, its DOF
+  if (n != nb) return false;  // every body turned by one joint, its DOF (not a floating base's six)
   DerivativeWork& work = derivative_work_;
   std::vector<WorldBody>& world = work.bodies;
   world.resize(nb);
@@ -102,20 +96,14 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
     const Model& m = bodies_[i];
     WorldBody& b = world[i];
     const bool root = m.parent < 0;
-    // The placement of SpatialAlgebra::place: turned about (or slid along) the axis k, the same in
-    // the parent's and the body's coordinates.
+    // The placement of SpatialAlgebra::place without its Euler parameters: turned about (or slid
+    // along) the axis k, the same in the parent's and the body's coordinates.
     const double theta = m.sign * q[m.dof] + m.offset;
     const Vec3& k = m.axis;
     Mat3 rel = Mat3::Identity();  // body → parent
     Vec3 r = m.r;
-    if (m.prismatic) {
-      r += theta * k;
-    } else {
-      const double c = std::cos(theta), s = std::sin(theta), one_c = 1.0 - c;
-      rel << c + one_c * k[0] * k[0], one_c * k[0] * k[1] - s * k[2], one_c * k[0] * k[2] + s * k[1],
-             one_c * k[1] * k[0] + s * k[2], c + one_c * k[1] * k[1], one_c * k[1] * k[2] - s * k[0],
-             one_c * k[2] * k[0] - s * k[1], one_c * k[2] * k[1] + s * k[0], c + one_c * k[2] * k[2];
-    }
+    if (m.prismatic) r += theta * k;
+    else rel = SpatialAlgebra::axis_rotation(k, std::cos(theta), std::sin(theta));
     if (root) {
       b.R = rel;
       b.p = r;
@@ -153,7 +141,7 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
   for (int i = 0; i < nb; ++i) {
     WorldBody& b = world[i];
     b.Ic = b.I;
-    b.F = b.f + b.I * b.a + cross_force(b.v, b.I * b.v);
+    b.F = b.f + b.I * b.a + SpatialAlgebra::cross_force(b.v, b.I * b.v);
   }
   for (int i = nb - 1; i >= 0; --i) {
     const Model& m = bodies_[i];
@@ -193,11 +181,11 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
     }
     b.a += b.S * qdd[m.dof];
     const Vec6 h = b.I * b.v;
-    b.f += b.I * b.a + cross_force(b.v, h);
+    b.f += b.I * b.a + SpatialAlgebra::cross_force(b.v, h);
     // I (v ×) − B = −Pᵀ − P − G with P = (v ×*) I (I (v ×) = −Pᵀ, I being symmetric) and
     // G δv = δv ×* h = −(h_ω × δω + h_v × δu; h_v × δω).
     Mat6 P;
-    for (int c = 0; c < 6; ++c) P.col(c) = cross_force(b.v, b.I.col(c));
+    for (int c = 0; c < 6; ++c) P.col(c) = SpatialAlgebra::cross_force(b.v, b.I.col(c));
     b.QmB = -P - P.transpose();
     const Mat3 hw = skew(h.head<3>()), hl = skew(h.tail<3>());
     b.QmB.topLeftCorner<3, 3>() += hw;
@@ -226,7 +214,7 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
   for (int j = 0; j < nb; ++j) {
     const Model& mj = bodies_[j];
     const WorldBody& b = world[j];
-    const Vec6 y_q = cross_force(b.S, b.f) + b.Ic * b.z + b.QmB * b.u + b.L * b.S.head<3>();
+    const Vec6 y_q = SpatialAlgebra::cross_force(b.S, b.f) + b.Ic * b.z + b.QmB * b.u + b.L * b.S.head<3>();
     const Vec6 y_qd = -(b.QmB * b.S) - 2.0 * (b.Ic * b.u);
     for (int r = j; r >= 0; r = bodies_[r].parent) {
       const WorldBody& br = world[r];

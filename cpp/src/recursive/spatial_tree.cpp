@@ -207,8 +207,7 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     return true;
   }
 
-  // The tree's parent of placed body i, and its pin moved to r from the parent's (TreeBuilder).
-  int parent_index(int i) const { return tree_.bodies_[i].parent; }
+  // Placed body i's pin moved to r from its parent's (TreeBuilder).
   void set_pin_offset(int i, const Point& r) { tree_.bodies_[i].r = r; }
 
   // Spatial bodies turn only about hinges.

@@ -76,8 +76,8 @@ Eigen::Matrix<double, N, N> element_inertia(const SystemElement& se, const Eigen
 
 // The steps of recognizing a tree of rigid bodies in a system, shared by the planar and the
 // spatial recognizer (Derived, which adds its own: the hinges it accepts, the joint a hinge
-// makes, the body's inertia, coordinates and loads; parent_index(i) and set_pin_offset(i, r) read
-// and move a placed body's pin in the tree). Any step may find that the system is not
+// makes, the body's inertia, coordinates and loads; set_pin_offset(i, r) moves a placed body's pin
+// in the tree). Any step may find that the system is not
 // such a tree: it says why (refuse) and returns false.
 template <class Derived, class Algebra>
 class TreeBuilder {
@@ -248,9 +248,7 @@ class TreeBuilder {
               const Slide& slide) {
     const int parent = parent_body == kGround ? kGround : placed_[parent_body];
     if (slide.free) {  // a floating base: it owns every point, its pin too
-      placed_[body] = index;
-      body_at_.push_back(body);
-      pivot_found_.push_back(true);
+      mark_placed(body, index, kGround, true);
       pin_[body] = slide.pin;
       p0 = point(slide.pin);
       bd.parent = kGround;
@@ -268,9 +266,7 @@ class TreeBuilder {
       // turns about its parent's pin, as good as any point of the axis for a body whose mass is
       // all rotational inertia, until the joint of a child shows its pivot (pivot_of: the child's
       // pin, or the point a sliding child slides from).
-      placed_[body] = index;
-      body_at_.push_back(body);
-      pivot_found_.push_back(false);
+      mark_placed(body, index, parent, false);
       p0 = pin0_[parent];
       bd.parent = parent;
       bd.r = Point::Zero();
@@ -286,9 +282,7 @@ class TreeBuilder {
     } else if (!pivot_of(pin, parent_body, parent, joint)) {
       return false;
     }
-    placed_[body] = index;
-    body_at_.push_back(body);
-    pivot_found_.push_back(true);
+    mark_placed(body, index, parent, true);
     pin_[body] = pin;
     p0 = point(pin);
     bd.parent = parent;
@@ -297,6 +291,15 @@ class TreeBuilder {
       if (id != pin || sliding) owner_[id] = index;
     pin0_.push_back(p0);
     return true;
+  }
+
+  // Body `body` is index `index` of the tree, under index `parent` (or kGround); pivot_found: its
+  // pin0_ is its pivot (a body of no point: not until a child's joint shows it, pivot_of).
+  void mark_placed(int body, int index, int parent, bool pivot_found) {
+    placed_[body] = index;
+    body_at_.push_back(body);
+    parent_at_.push_back(parent);
+    pivot_found_.push_back(pivot_found);
   }
 
   // Whether a placed body's pin moves with it (a sliding joint's), not with its parent (a hinge's).
@@ -313,17 +316,18 @@ class TreeBuilder {
         (parent_body != kGround && (g_.points[parent_body].count(id) > 0 || pin_[parent_body] == id)))
       return true;
     if (parent_body == kGround || !g_.points[parent_body].empty()) return false;
-    const int grand = self().parent_index(parent);
+    const int grand = parent_at_[parent];
     return on_body(id, grand == kGround ? kGround : body_at_[grand], grand);
   }
 
   // A joint at point `pin` (a hinge's pin, or the parent's point a sliding joint slides from) under
-  // the body of no point parent_body (index parent) fixes that body's pivot, and those of its ancestors of no point up to the one with points, at `pin`: they
-  // turn about axes through it (their joints' axes meet there, as at a humanoid's elbow). A second
-  // joint at another point cannot be placed. Nothing to do under a body with points.
+  // the body of no point parent_body (index parent) fixes that body's pivot, and those of its
+  // ancestors of no point up to the one with points, at `pin`: they turn about axes through it
+  // (their joints' axes meet there, as at a humanoid's elbow). A second joint at another point
+  // cannot be placed. Nothing to do under a body with points.
   bool pivot_of(int pin, int parent_body, int parent, const std::string& joint) {
     std::vector<int> chain;  // tree indices of the bodies of no point, deepest first
-    for (int i = parent; i != kGround && g_.points[body_at_[i]].empty(); i = self().parent_index(i)) chain.push_back(i);
+    for (int i = parent; i != kGround && g_.points[body_at_[i]].empty(); i = parent_at_[i]) chain.push_back(i);
     if (parent_body == kGround || chain.empty()) return true;
     const Point p = point(pin);
     for (auto it = chain.rbegin(); it != chain.rend(); ++it) {  // from the top, each r from its parent's pivot
@@ -332,7 +336,7 @@ class TreeBuilder {
         if ((pin0_[i] - p).norm() > 0.0) return refuse(joint + " turns a body at another point than its parent's pivot");
         continue;
       }
-      const int up = self().parent_index(i);
+      const int up = parent_at_[i];
       pin0_[i] = p;
       self().set_pin_offset(i, up == kGround ? p : Point(p - pin0_[up]));
       pivot_found_[i] = true;
@@ -341,7 +345,6 @@ class TreeBuilder {
   }
 
   Derived& self() { return *static_cast<Derived*>(this); }
-  const Derived& self() const { return *static_cast<const Derived*>(this); }
 
   const System& sys_;
   const Eigen::VectorXd& x_;
@@ -356,7 +359,8 @@ class TreeBuilder {
   std::map<int, int> owner_;     // point node → body (index in the tree) it moves with, kGround
   std::vector<Point> pin0_;      // reference pin of each placed body
   std::vector<int> body_at_;     // index in the tree → body
-  std::vector<bool> pivot_found_;  // index in the tree → its pin0_ is its pivot (a body of no point: once known)
+  std::vector<int> parent_at_;   // index in the tree → its parent's index, kGround
+  std::vector<bool> pivot_found_;  // index in the tree → its pin0_ is its pivot (mark_placed)
 };
 
 // Runs a recognizer (a TreeBuilder); false and, if why is given, its reason if the system is not

@@ -70,6 +70,17 @@ struct SpatialAlgebra {
     return hinge_angle(m, q, qd, d);
   }
 
+  // The rotation by the angle of cosine c and sine s about the unit axis k (Rodrigues), written
+  // out: it runs for every body at every right-hand side and derivative.
+  static Eigen::Matrix3d axis_rotation(const Eigen::Vector3d& k, double c, double s) {
+    const double one_c = 1.0 - c;
+    Eigen::Matrix3d R;
+    R << c + one_c * k[0] * k[0], one_c * k[0] * k[1] - s * k[2], one_c * k[0] * k[2] + s * k[1],
+         one_c * k[1] * k[0] + s * k[2], c + one_c * k[1] * k[1], one_c * k[1] * k[2] - s * k[0],
+         one_c * k[2] * k[0] - s * k[1], one_c * k[2] * k[1] + s * k[0], c + one_c * k[2] * k[2];
+    return R;
+  }
+
   // The body's rotation relative to its parent and its pin: a hinge turns by θ about its axis, a
   // sliding joint moves the pin by θ along its axis without turning.
   static void place(const Model& m, const Work* p, double theta, Work& d) {
@@ -82,9 +93,8 @@ struct SpatialAlgebra {
     } else {
       const double ch = std::cos(0.5 * theta), sh = std::sin(0.5 * theta);  // of the half angle, for λ too
       const double c = 1.0 - 2.0 * sh * sh, s = 2.0 * sh * ch;
-      const Eigen::Vector3d& k = m.axis;
-      rel = c * Eigen::Matrix3d::Identity() + s * skew(k) + (1.0 - c) * k * k.transpose();
-      q_rel << ch, sh * k;
+      rel = axis_rotation(m.axis, c, s);
+      q_rel << ch, sh * m.axis;
     }
     f.E = rel.transpose();
     if (!p) {
@@ -223,7 +233,7 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
 
   // A body's work in dynamics_derivatives: world axes at the world origin.
   struct WorldBody {
-    Eigen::Matrix3d R;                     // body → world
+    Eigen::Matrix3d R;                     // body → world (SpatialAlgebra::place's, without λ)
     Eigen::Vector3d p;                     // the pin
     Eigen::Matrix<double, 6, 1> S, v, a, parent_v, parent_a;
     Eigen::Matrix<double, 6, 1> u, z;      // S × v_λ and u × v_λ − S × a_λ
