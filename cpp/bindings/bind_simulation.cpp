@@ -391,6 +391,48 @@ void bind_run(py::class_<Simulation>& sim) {
           "(benchmarks/newton.py).");
 }
 
+py::dict rollout_results_to_dict(RolloutResults&& r) {
+  py::dict d;
+  d["q"] = std::move(r.q);
+  d["qd"] = std::move(r.qd);
+  d["x"] = r.x.size() ? py::cast(std::move(r.x)) : py::none();
+  d["rhs_evaluations"] = r.rhs_evaluations;
+  d["steps"] = r.steps;
+  d["rejected"] = r.rejected;
+  d["path"] = r.path;
+  d["warnings"] = r.warnings;
+  d["wall_time"] = r.wall_time;
+  d["failed"] = r.failed;
+  return d;
+}
+
+void bind_rollout(py::class_<Simulation>& sim) {
+  sim.def(
+      "rollout",
+      [](Simulation& s, const RowMatrix& q0, const RowMatrix& qd0, const std::vector<double>& times,
+         const std::string& method, bool recursive, double rho_inf, double fixed_step, bool coordinates,
+         double time_limit, double time_spent) {
+        RunOptions opt;
+        opt.method = parse_method(method);
+        opt.recursive = recursive;
+        opt.rho_inf = rho_inf;
+        opt.fixed_step = fixed_step;
+        opt.time_limit = time_limit;
+        opt.time_spent = time_spent;
+        RolloutResults r;
+        const InterruptScope interrupt(python_interrupt_pending);
+        return run_released(r, [&] { s.rollout(q0, qd0, times, opt, coordinates, r); }, rollout_results_to_dict,
+                            [](const std::exception_ptr&) { return true; });
+      },
+      py::arg("q0"), py::arg("qd0"), py::arg("times"), py::arg("method") = method_name(RunOptions().method),
+      py::arg("recursive") = RunOptions().recursive, py::arg("rho_inf") = RunOptions().rho_inf,
+      py::arg("fixed_step") = RunOptions().fixed_step, py::arg("coordinates") = false,
+      py::arg("time_limit") = RunOptions().time_limit, py::arg("time_spent") = RunOptions().time_spent,
+      "Integrate the states in the rows of q0, qd0 through the output times (spacar.Rollout); the model is "
+      "assembled at the first rollout and kept. On failure the exception has the states before the failing one "
+      "as `results` (its `failed` the state's index).");
+}
+
 }  // namespace
 
 void bind_simulation(py::module_& m) {
@@ -403,6 +445,7 @@ void bind_simulation(py::module_& m) {
   bind_linearization(sim);
   bind_states(sim);
   bind_run(sim);
+  bind_rollout(sim);
 }
 
 }  // namespace spacar::bindings

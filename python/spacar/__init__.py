@@ -39,6 +39,7 @@ from .linearize import Linearization, linearize
 from .model import Model
 from .geometry import Geometry
 from .results import Results
+from .rollout import Rollout, RolloutResults
 from .simulate import simulate
 from .spacar_light import LightResults, light, light_model
 from .statics import StaticError, static
@@ -119,6 +120,8 @@ __all__ = [
     "parse",
     "dump",
     "simulate",
+    "Rollout",
+    "RolloutResults",
     "inverse_dynamics",
     "dynamics_derivatives",
     "static",

@@ -161,6 +161,26 @@ def _run_lock(model: Model) -> threading.RLock:
         return lock
 
 
+def check_method_options(method, rho_inf, fixed_step, recursive) -> float:
+    """Refuse what the integration options cannot be (before any work); the fixed step (0: none)."""
+    if not isinstance(method, str):
+        implicit = _core.implicit_methods
+        explicit = [m for m in _core.integration_methods if m not in implicit and m != "auto"]
+        raise InputError(f"method must be {' or '.join(map(repr, explicit))} (explicit), "
+                         f"{' or '.join(map(repr, implicit))} (implicit) or 'auto', got {show(method)}")
+    if rho_inf is not None and (isinstance(rho_inf, (bool, np.bool_))
+                                or not isinstance(rho_inf, (int, float, np.number)) or not 0.0 <= rho_inf <= 1.0):
+        raise InputError(f"rho_inf (the spectral radius of generalized_alpha) must be a number in [0, 1], "
+                         f"got {show(rho_inf)}")
+    step_size = seconds_or_none(fixed_step, "fixed_step") or 0.0
+    for name, given in (("fixed_step", step_size), ("rho_inf", rho_inf is not None)):
+        if given and method != "generalized_alpha":
+            raise InputError(f"{name} is an option of method 'generalized_alpha' only, not of {show(method)}")
+    if not isinstance(recursive, (bool, np.bool_)):
+        raise InputError(f"recursive must be True or False, got {show(recursive)}")
+    return step_size
+
+
 def simulate(model, *, method: str = "auto", on_output=None, progress=None, output_stem=None,
              time_limit=None, recursive: bool = True, forces=None, inputs=None, controller=None,
              energy: bool = False, rho_inf=None, fixed_step=None) -> Results:
@@ -234,21 +254,7 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
     limit = seconds_or_none(time_limit, "time_limit") or 0.0
     if on_output is not None and not callable(on_output):
         raise InputError(f"on_output must be a function on_output(k, state) or None, got {show(on_output)}")
-    if not isinstance(method, str):
-        implicit = _core.implicit_methods
-        explicit = [m for m in _core.integration_methods if m not in implicit and m != "auto"]
-        raise InputError(f"method must be {' or '.join(map(repr, explicit))} (explicit), "
-                         f"{' or '.join(map(repr, implicit))} (implicit) or 'auto', got {show(method)}")
-    if rho_inf is not None and (isinstance(rho_inf, (bool, np.bool_))
-                                or not isinstance(rho_inf, (int, float, np.number)) or not 0.0 <= rho_inf <= 1.0):
-        raise InputError(f"rho_inf (the spectral radius of generalized_alpha) must be a number in [0, 1], "
-                         f"got {show(rho_inf)}")
-    step_size = seconds_or_none(fixed_step, "fixed_step") or 0.0
-    for name, given in (("fixed_step", step_size), ("rho_inf", rho_inf is not None)):
-        if given and method != "generalized_alpha":
-            raise InputError(f"{name} is an option of method 'generalized_alpha' only, not of {show(method)}")
-    if not isinstance(recursive, (bool, np.bool_)):
-        raise InputError(f"recursive must be True or False, got {show(recursive)}")
+    step_size = check_method_options(method, rho_inf, fixed_step, recursive)
     if not isinstance(energy, (bool, np.bool_)):
         raise InputError(f"energy must be True or False, got {show(energy)}")
     if controller is not None and not isinstance(controller, Controller):

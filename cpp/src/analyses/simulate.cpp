@@ -482,6 +482,7 @@ void Simulation::set_time_loads(TimeLoads loads) {
     if (in.table.components() != 1) throw InputError("an input table must have one component (the position)");
   }
   timed_ = std::move(loads);
+  rollout_ = RolloutStart();  // the path a rollout chose may no longer hold
 }
 
 void Simulation::apply_time_loads(double t) {

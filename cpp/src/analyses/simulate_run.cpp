@@ -85,6 +85,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   res = BlockResults();
   res.warnings = sys_->warnings;
+  rollout_ = RolloutStart();  // the run moves the data a rollout prepared
   const BlockPlan plan = plan_block(options, res.warnings);
   run_.n_energy = options.energy ? 2 : 0;
   run_.held.resize(0);
@@ -117,7 +118,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
 }
 
 // Requests that cannot be carried out are refused before any work (formulation.md §8.1).
-Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vector<std::string>& warnings) const {
+void Simulation::check_options(const RunOptions& options) {
   if (!(options.time_limit >= 0.0)) throw InputError("the time limit must not be negative");
   if (!(options.time_spent >= 0.0)) throw InputError("the time spent before the run must not be negative");
   if (options.max_steps < 1) throw InputError("the step limit must be positive");
@@ -133,10 +134,14 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
                      std::to_string(options.fixed_step));
   if (options.fixed_step > 0.0 && options.method != Method::GENERALIZED_ALPHA)
     throw InputError("fixed_step is an option of method generalized_alpha only (the other methods control their error)");
+}
+
+Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vector<std::string>& warnings) const {
+  check_options(options);
   // The system may be recompiled during the run (repartition): keep copies, not references.
   BlockPlan plan;
   plan.st = sys_->settings;
-  Settings& st = plan.st;
+  const Settings& st = plan.st;
   const int n_out = st.timestep_n;
   const double t0 = sys_->t0, t_end = t0 + st.timestep_tp;
   plan.t0 = t0;
@@ -154,27 +159,7 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
   if (options.sample_period > 0.0 && st.timestep_tp / options.sample_period > static_cast<double>(options.max_steps))
     throw InputError("the controller's sample period " + format_number(options.sample_period, 12) + " needs more than " +
                      std::to_string(options.max_steps) + " samples in the block");
-  if (plan.integrate) {
-    refuse_large_massless(*sys_, t0);  // before the assembly, which can take seconds at that size
-    const double h_min = Stepper::min_step(t_end);
-    if (st.timestep_tp < h_min)
-      throw InputError("TIMESTEP: the period Tp = " + format_number(st.timestep_tp, 12) +
-                       " is shorter than the smallest integration step " + format_number(h_min, 12) + " at t = " + format_number(t_end, 12));
-    if (st.hmax < Stepper::min_step(t0))
-      throw InputError("HMAX " + format_number(st.hmax, 12) + " is below the smallest integration step " +
-                       format_number(Stepper::min_step(t0), 12) + " at t = " + format_number(t0, 12));
-    if (st.timestep_tp / st.hmax > static_cast<double>(options.max_steps))
-      throw InputError("HMAX " + format_number(st.hmax, 12) + " needs at least Tp/HMAX = " + format_number(st.timestep_tp / st.hmax, 12) +
-                       " steps, more than the limit of " + std::to_string(options.max_steps) + " steps per block");
-    plan.fixed_step = planned_fixed_step(options, st, t0, n_out, warnings);
-    for (auto [eps, name] : {std::pair<double*, const char*>{&st.epsint, "EPSINT"}, {&st.epsind, "EPSIND"}})
-      if (*eps < kMinTolerance) {
-        warnings.push_back(std::string(name) + " " + format_number(*eps, 12) +
-                           " is below the attainable accuracy in double precision: " + format_number(kMinTolerance, 12) +
-                           " (100 machine epsilons) is used");
-        *eps = kMinTolerance;
-      }
-  }
+  if (plan.integrate) plan_integration(options, plan, st.timestep_tp / n_out, kBlockNames, warnings);
   const int nt = n_out + 1;
   plan.times.resize(nt);
   for (int k = 0; k < nt; ++k) plan.times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
@@ -182,28 +167,55 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
   return plan;
 }
 
-// Generalized-α's fixed step, checked against the block before any work: a step longer than the
-// output interval would interpolate the outputs across whole periods of the motion (cut to the
-// interval, with a warning); one so short that the block needs more steps than the limit, or
-// below the smallest step, is refused as HMAX is.
-double Simulation::planned_fixed_step(const RunOptions& options, const Settings& st, double t0, int n_out,
-                                      std::vector<std::string>& warnings) {
+// The checks of an integration from plan.t0 to plan.t_end with outputs `interval` apart (the
+// shortest interval), before any work; generalized-α's fixed step and the tolerances into plan.
+void Simulation::plan_integration(const RunOptions& options, BlockPlan& plan, double interval,
+                                  const PeriodNames& names, std::vector<std::string>& warnings) const {
+  Settings& st = plan.st;
+  const double t0 = plan.t0, t_end = plan.t_end, tp = t_end - t0;
+  refuse_large_massless(*sys_, t0);  // before the assembly, which can take seconds at that size
+  const double h_min = Stepper::min_step(t_end);
+  if (tp < h_min)
+    throw InputError(std::string(names.period_is) + " " + format_number(tp, 12) +
+                     " is shorter than the smallest integration step " + format_number(h_min, 12) + " at t = " + format_number(t_end, 12));
+  if (st.hmax < Stepper::min_step(t0))
+    throw InputError("HMAX " + format_number(st.hmax, 12) + " is below the smallest integration step " +
+                     format_number(Stepper::min_step(t0), 12) + " at t = " + format_number(t0, 12));
+  if (tp / st.hmax > static_cast<double>(options.max_steps))
+    throw InputError("HMAX " + format_number(st.hmax, 12) + " needs at least " + names.period + "/HMAX = " +
+                     format_number(tp / st.hmax, 12) + " steps, more than the limit of " +
+                     std::to_string(options.max_steps) + " steps per " + names.run);
+  plan.fixed_step = planned_fixed_step(options, t_end, tp, interval, names, warnings);
+  for (auto [eps, name] : {std::pair<double*, const char*>{&st.epsint, "EPSINT"}, {&st.epsind, "EPSIND"}})
+    if (*eps < kMinTolerance) {
+      warnings.push_back(std::string(name) + " " + format_number(*eps, 12) +
+                         " is below the attainable accuracy in double precision: " + format_number(kMinTolerance, 12) +
+                         " (100 machine epsilons) is used");
+      *eps = kMinTolerance;
+    }
+}
+
+// Generalized-α's fixed step, checked against the period tp ending at t_end before any work: a
+// step longer than the output interval would interpolate the outputs across whole periods of the
+// motion (cut to the interval, with a warning); one so short that the period needs more steps
+// than the limit, or below the smallest step, is refused as HMAX is.
+double Simulation::planned_fixed_step(const RunOptions& options, double t_end, double tp, double interval,
+                                      const PeriodNames& names, std::vector<std::string>& warnings) {
   double h = options.fixed_step;
   if (h == 0.0) return h;
-  const double interval = st.timestep_tp / n_out;
   if (h > interval) {
-    warnings.push_back("fixed_step " + format_number(h, 12) + " is longer than the output interval Tp/n = " +
-                       format_number(interval, 12) + ": the steps are cut to the output interval");
+    warnings.push_back("fixed_step " + format_number(h, 12) + " is longer than the output interval " +
+                       names.interval + " = " + format_number(interval, 12) + ": the steps are cut to the output interval");
     h = interval;
   }
-  const double h_min = Stepper::min_step(t0 + st.timestep_tp);
+  const double h_min = Stepper::min_step(t_end);
   if (h < h_min)
     throw InputError("fixed_step " + format_number(h, 12) + " is below the smallest integration step " +
-                     format_number(h_min, 12) + " at the end of the block");
-  if (st.timestep_tp / h > static_cast<double>(options.max_steps))
-    throw InputError("fixed_step " + format_number(h, 12) + " needs Tp/fixed_step = " +
-                     format_number(st.timestep_tp / h, 12) + " steps, more than the limit of " +
-                     std::to_string(options.max_steps) + " steps per block");
+                     format_number(h_min, 12) + " at the end of the " + names.run);
+  if (tp / h > static_cast<double>(options.max_steps))
+    throw InputError("fixed_step " + format_number(h, 12) + " needs " + names.period + "/fixed_step = " +
+                     format_number(tp / h, 12) + " steps, more than the limit of " + std::to_string(options.max_steps) +
+                     " steps per " + names.run);
   return h;
 }
 
@@ -266,6 +278,12 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
     for (double t : plan.times) output(t, Y);
     return;
   }
+  integrate_segments(res, options, plan, Y, k_out, output);
+}
+
+void Simulation::integrate_segments(BlockResults& res, const RunOptions& options, const BlockPlan& plan,
+                                    Eigen::VectorXd& Y, int& k_out, const Stepper::Output& output) {
+  const Settings& st = plan.st;
   // A digital controller: its loads at a sample from the state there, held until the next.
   const bool sampled = options.sample_period > 0.0 && options.on_sample;
   long k_sample = 0;
@@ -490,6 +508,7 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
     if (std::abs(data_->x[fr.coord + i]) > std::abs(data_->x[fr.coord + best])) best = i;
   dependent_[fr.node] = best;
   linearizer_.reset();
+  rollout_ = RolloutStart();
   const Eigen::VectorXd x = data_->x, xd = data_->xd, e = data_->e, ed = data_->ed, angles = data_->angle_ref,
                         integrated = data_->e_integrated;
   const long newton = data_->total_newton_iterations;

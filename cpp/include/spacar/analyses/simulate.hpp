@@ -193,6 +193,17 @@ struct RunState {
   int n_energy = 0;      // 2 with RunOptions::energy: the last states of Y (dissipated, external work)
 };
 
+// The results of Simulation::rollout: the states at the output times, state by state.
+struct RolloutResults {
+  RowMatrix q, qd;  // (states · nt) × nd: row s·nt + k holds state s at output time k
+  RowMatrix x;      // the same rows × nx: the coordinates' positions, when asked for (else empty)
+  std::vector<long> rhs_evaluations, steps, rejected;  // per state integrated
+  const char* path = "general";  // the right-hand-side path (RhsPath::name)
+  std::vector<std::string> warnings;
+  double wall_time = 0.0;  // seconds of the whole rollout
+  long failed = -1;        // the state whose integration failed (rows from it cut), or −1
+};
+
 class Simulation {
  public:
   // Prepares (first END) and compiles the model; the model must outlive the simulation.
@@ -315,6 +326,20 @@ class Simulation {
   // Write the state reached into the model (coordinates, rates, deformation values, time).
   void store_state();
 
+  // Runs from many initial states over the same output times (spacar.Rollout): the rows of q0
+  // and qd0 (one state each, one column per DOF; the integrated deformations start from the
+  // model's) integrated from times.front() through the increasing `times` by options' method,
+  // its tolerances EPSINT and EPSIND. The model is assembled and its right-hand-side path chosen
+  // (the recursive path of a tree of rigid bodies, when options.recursive) at the first rollout
+  // and kept for the next: a rollout then costs its states' integrations alone. On the general
+  // path each state's positions are solved by Newton from the assembled ones. `coordinates`: the
+  // positions of every coordinate at the output times too. The model is not changed. If a state
+  // fails, res holds the states before it and res.failed its index, and the error is rethrown.
+  // Not for free rotations (a floating base changes its dependent Euler parameter in a run) nor
+  // a controller or the energy balance (RunOptions' sample_period, on_sample, energy).
+  void rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::vector<double>& times,
+               const RunOptions& options, bool coordinates, RolloutResults& res);
+
  private:
   using Solved = RunState::Solved;
   // A block's run in three stages: plan (the requests checked before any work, the output
@@ -328,12 +353,30 @@ class Simulation {
     std::vector<double> times;   // the output times, the last exactly t_end
     double fixed_step = 0.0;     // generalized-α's fixed step (planned_fixed_step), 0: error control
   };
+  static void check_options(const RunOptions& options);
   BlockPlan plan_block(const RunOptions& options, std::vector<std::string>& warnings) const;
-  static double planned_fixed_step(const RunOptions& options, const Settings& st, double t0, int n_out,
-                                   std::vector<std::string>& warnings);
+  // How the checks of an integration's period name it: a block's (TIMESTEP's Tp, Tp/n) or a
+  // rollout's (the span of its output times).
+  struct PeriodNames {
+    const char* period_is;  // "TIMESTEP: the period Tp ="
+    const char* period;     // "Tp"
+    const char* interval;   // "Tp/n"
+    const char* run;        // "block"
+  };
+  static constexpr PeriodNames kBlockNames{"TIMESTEP: the period Tp =", "Tp", "Tp/n", "block"};
+  static constexpr PeriodNames kRolloutNames{"the span of the output times T =", "T", "(the shortest)", "state"};
+  void plan_integration(const RunOptions& options, BlockPlan& plan, double interval, const PeriodNames& names,
+                        std::vector<std::string>& warnings) const;
+  static double planned_fixed_step(const RunOptions& options, double t_end, double tp, double interval,
+                                   const PeriodNames& names, std::vector<std::string>& warnings);
   void allocate_results(BlockResults& res, const BlockPlan& plan) const;
   // k_out: the output times recorded (also when it throws).
   void integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out);
+  // The integration of the state Y from plan.t0 through the output times plan.times[k_out…]
+  // (output(t, Y) at each) to plan.t_end: segment by segment, for the controller's samples, the
+  // repartitions of free rotations and AUTO's switches of method. Counters to res.
+  void integrate_segments(BlockResults& res, const RunOptions& options, const BlockPlan& plan, Eigen::VectorXd& Y,
+                          int& k_out, const Stepper::Output& output);
   // How a segment ended: the time reached (t_end, or earlier for a repartition or a switch) and
   // whether the integrator asks to hand over to the other one (method AUTO).
   struct SegmentEnd {
@@ -402,6 +445,18 @@ class Simulation {
   void check_time(double t);       // TimeLimitError past the deadline of the running block
   void require_finite_state(double t) const;  // SpacarError if an output would hold inf or NaN
   TimeLoads timed_;
+  // What the first rollout prepared and the next reuse: the assembled positions (Newton's start
+  // of every state on the general path, with its data) and the path chosen (swapped into path_
+  // while a rollout runs). Dropped by a run, a repartition and new time loads.
+  struct RolloutStart {
+    bool ready = false;
+    bool recursive = true;  // RunOptions::recursive it was chosen with
+    Solved assembled;
+    std::unique_ptr<Data> data;  // the assembled data (general path), or nullptr (the tree's)
+    std::unique_ptr<RhsPath> path;
+  } rollout_;
+  BlockPlan plan_rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::vector<double>& times,
+                         const RunOptions& options, std::vector<std::string>& warnings) const;
   // The time-dependent loads and inputs at t into data (after set_inputs): input tables replace
   // the inputs' constant-acceleration motion, loads go to Data::time_load.
   void apply_time_loads(double t);

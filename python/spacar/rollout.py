@@ -1,0 +1,171 @@
+"""Many short runs of one model from different initial states (:class:`Rollout`), for
+optimizations, Monte Carlo studies, shooting methods and learning: compiled, assembled and its
+right-hand-side path chosen once, then every batch of states integrated in one call into C++."""
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+
+from . import _core
+from ._util import seconds_or_none, show
+from .errors import InputError, SpacarError
+from .model import Model
+from .results import dof_labels
+from .simulate import check_method_options
+
+
+class RolloutResults:
+    """The states of a rollout at its output times.
+
+    ``t`` (nt): the output times, the first the start of every state's run. ``q``, ``qd``: the
+    DOFs and their rates, (states, nt, n) for a batch of initial states, (nt, n) for one.
+    ``x``: the positions of every coordinate, (states, nt, nx) or (nt, nx), when asked for
+    (``coordinates=True``), else None. ``stats``: ``path`` ("tree", "chain" or "general"),
+    ``wall_time`` (seconds of the call in C++), ``rhs_evaluations``, ``steps`` and ``rejected``
+    (one per state), ``method``. ``dof_labels``, ``coordinate_labels`` name the columns."""
+
+    def __init__(self, arrays: dict, t, batch: bool, rollout: "Rollout"):
+        nt, n = len(t), rollout.n_dof
+        self.t = t
+        shape = (-1, nt) if batch else (nt,)
+        self.q = np.asarray(arrays["q"]).reshape(shape + (n,))
+        self.qd = np.asarray(arrays["qd"]).reshape(shape + (n,))
+        x = arrays["x"]
+        self.x = None if x is None else np.asarray(x).reshape(shape + (-1,))
+        self.stats = {"path": arrays["path"], "wall_time": arrays["wall_time"], "method": rollout.method}
+        for key in ("rhs_evaluations", "steps", "rejected"):
+            self.stats[key] = np.asarray(arrays[key], dtype=np.int64)
+        self.warnings = list(arrays["warnings"])
+        self.dof_labels = rollout.dof_labels
+        self.coordinate_labels = rollout.coordinate_labels
+
+    def __repr__(self) -> str:
+        return (f"<spacar.RolloutResults: q {self.q.shape}, path {self.stats['path']!r}, "
+                f"{int(self.stats['rhs_evaluations'].sum())} right-hand sides in {self.stats['wall_time']:.3g} s>")
+
+
+class Rollout:
+    """Runs of ``model`` from many initial states over the same output times, its set-up paid once.
+
+    ::
+
+        roll = spacar.Rollout(model)              # compiled now; assembled at the first call
+        res = roll(q0, qd0)                       # q0, qd0: (n,) or (states, n); TIMESTEP's times
+        res = roll(q0, qd0, t=np.linspace(0, 0.3, 31))
+        res.q, res.qd                             # (states, nt, n)
+
+    ``spacar.simulate`` pays for every block its set-up: the model compiled, assembled by Newton's
+    method, the tree of a robot recognized, the complete state (coordinates, velocities,
+    accelerations, stresses) solved at every output time and handed to Python. A rollout does that
+    once: each call integrates its states (one per row of ``q0``, ``qd0``) in C++ from ``t[0]``
+    through the output times ``t`` (default: the model's TIMESTEP times from its current time) and
+    records the DOFs and their rates there, the positions of every coordinate too with
+    ``coordinates=True``. The integration is :func:`spacar.simulate`'s: the same ``method``
+    (default ``"auto"``), error control (EPSINT, EPSIND), ``recursive`` path (the articulated-body
+    algorithm on a tree of rigid bodies), ``rho_inf`` and ``fixed_step``; each state gives what a
+    block run from it gives. ``q0`` or ``qd0`` None: the model's initial DOFs or rates (for every
+    state). On the general path each state's positions are found by Newton's method from the
+    assembled ones (as the first step of a block from there), so states far from the model's
+    initial one may reach another assembly of a closed loop.
+
+    The model as it is when the Rollout is made is used: later changes to it are not seen (make
+    a new Rollout). The model itself is not changed. A failure names the state; the exception
+    carries the states before it as ``err.results``. Not for floating bases yet (their dependent
+    Euler parameter changes during a run), nor with time-dependent loads, controllers or the
+    energy balance (:func:`spacar.simulate` has them). One call at a time per Rollout (calls from
+    several threads wait for each other)."""
+
+    def __init__(self, model: Model, *, method: str = "auto", recursive: bool = True, rho_inf=None,
+                 fixed_step=None):
+        if not isinstance(model, Model):
+            raise InputError(f"Rollout: model must be a spacar.Model, got {show(model)}")
+        self._fixed_step = check_method_options(method, rho_inf, fixed_step, recursive)
+        if method not in _core.integration_methods:
+            raise InputError(f"Rollout: method must be one of {', '.join(map(repr, _core.integration_methods))}, "
+                             f"got {show(method)}")
+        self.method = method
+        self._recursive = bool(recursive)
+        self._rho_inf = _core.run_defaults["rho_inf"] if rho_inf is None else float(rho_inf)
+        self._sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
+        system = self._sim.system
+        self.n_dof = system.n_dof
+        if self.n_dof == 0:
+            raise InputError("Rollout: the model has no degrees of freedom to integrate")
+        self._q0, self._qd0 = np.array(system.q0, dtype=float), np.array(system.qd0, dtype=float)
+        settings = model.core.settings
+        n_out = settings.timestep_n
+        self._times = model.current_time + settings.timestep_tp * np.arange(n_out + 1) / max(n_out, 1)
+        coords = system.coord_label
+        self.coordinate_labels = [tuple(c) for c in coords]
+        self.dof_labels = dof_labels(system, model.core, coords)
+        self._lock = threading.Lock()
+
+    def __call__(self, q0=None, qd0=None, t=None, *, coordinates: bool = False, time_limit=None) -> RolloutResults:
+        q0, qd0, batch = self._initial_states(q0, qd0)
+        times = self._output_times(t)
+        if not isinstance(coordinates, (bool, np.bool_)):
+            raise InputError(f"Rollout: coordinates must be True or False, got {show(coordinates)}")
+        limit = seconds_or_none(time_limit, "time_limit") or 0.0
+        with self._lock:
+            try:
+                arrays = self._sim.rollout(q0, qd0, times, method=self.method, recursive=self._recursive,
+                                           rho_inf=self._rho_inf, fixed_step=self._fixed_step,
+                                           coordinates=bool(coordinates), time_limit=limit)
+            except SpacarError as err:
+                partial = getattr(err, "results", None)
+                if not isinstance(partial, dict) or partial["failed"] < 0:
+                    raise
+                failed = type(err)(f"rollout, state {partial['failed']} (q0 = {_short(q0[partial['failed']])}): {err}")
+                failed.results = RolloutResults(partial, times, True, self)
+                raise failed from err
+        return RolloutResults(arrays, times, batch, self)
+
+    def _initial_states(self, q0, qd0):
+        """q0, qd0 as (states, n) float arrays (a missing one the model's, broadcast), and whether
+        a batch was given."""
+        given = []
+        for name, value, default in (("q0", q0, self._q0), ("qd0", qd0, self._qd0)):
+            if value is None:
+                given.append(None)
+                continue
+            try:
+                a = np.array(value, dtype=float)
+            except (TypeError, ValueError, OverflowError):
+                raise InputError(f"Rollout: {name} must be an array of numbers, got {show(value)}") from None
+            if a.ndim not in (1, 2) or a.shape[-1] != self.n_dof or not np.isfinite(a).all():
+                raise InputError(f"Rollout: {name} must be finite, {self.n_dof} values (one per DOF, in the order of "
+                                 f"dof_labels) or a matrix of states with {self.n_dof} columns, got shape {a.shape}")
+            given.append(a)
+        batch = any(a is not None and a.ndim == 2 for a in given)
+        rows = max((a.shape[0] for a in given if a is not None and a.ndim == 2), default=1)
+        out = []
+        for a, default in zip(given, (self._q0, self._qd0)):
+            a = default if a is None else a
+            a = np.atleast_2d(a)
+            if a.shape[0] == 1 and rows > 1:
+                a = np.repeat(a, rows, axis=0)
+            elif a.shape[0] != rows:
+                raise InputError(f"Rollout: q0 and qd0 must have the same number of states (rows), got "
+                                 f"{given[0].shape[0]} and {given[1].shape[0]}")
+            out.append(np.ascontiguousarray(a))
+        return out[0], out[1], batch
+
+    def _output_times(self, t) -> np.ndarray:
+        if t is None:
+            return self._times
+        try:
+            times = np.array(t, dtype=float).reshape(-1)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError(f"Rollout: t must be an array of output times, got {show(t)}") from None
+        if times.size == 0 or not np.isfinite(times).all() or (np.diff(times) <= 0).any():
+            raise InputError("Rollout: t must be finite, increasing output times (the first the start of every state)")
+        return times
+
+    def __repr__(self) -> str:
+        return f"<spacar.Rollout: {self.n_dof} DOFs, method {self.method!r}, {len(self._times)} TIMESTEP output times>"
+
+
+def _short(values) -> str:
+    shown = ", ".join(f"{v:.6g}" for v in values[:6])
+    return f"[{shown}{', …' if len(values) > 6 else ''}]"

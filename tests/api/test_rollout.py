@@ -1,0 +1,173 @@
+"""spacar.Rollout: many initial states integrated with one set-up, against spacar.simulate from
+each state (the same integration, so to rounding) and against Pinocchio's ABA integrated by
+SciPy (an independent reference)."""
+import numpy as np
+import pytest
+
+import spacar
+from spacar.compare import models
+
+EXAMPLE = "examples/slidercrank.dat"
+
+
+def _dof_elements(roll):
+    """The element of each DOF of a model whose DOFs are HINGE rotations ("e(k,1) HINGE")."""
+    out = []
+    for label in roll.dof_labels:
+        assert label.startswith("e(") and label.endswith("HINGE")
+        out.append(int(label[2:label.index(",")]))
+    return out
+
+
+def _simulated_from(model, roll, q0, qd0, **kw):
+    """spacar.simulate of a copy of the model started at (q0, qd0)."""
+    m = model.copy()
+    for k, q, qd in zip(_dof_elements(roll), q0, qd0):
+        m.e(k, 1, q)
+        m.ed(k, 1, qd)
+    return spacar.simulate(m, **kw)
+
+
+@pytest.fixture(scope="module")
+def chain():
+    return models.spatial_chain(6, seed=6, t_end=0.3, n_out=6, eps=1e-8, epskin=1e-11)
+
+
+def test_rollout_of_the_initial_state_is_the_block(chain):
+    roll = spacar.Rollout(chain)
+    res = roll(coordinates=True)
+    ref = spacar.simulate(chain.copy())
+    assert res.stats["path"] == "tree" == ref.stats["path"]
+    np.testing.assert_allclose(res.t, ref.t, rtol=0, atol=1e-15)
+    for a, b in ((res.q, ref.q), (res.qd, ref.qd), (res.x, ref.x)):
+        assert a.shape == b.shape
+        assert np.abs(a - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+    assert res.stats["rhs_evaluations"][0] == ref.stats["rhs_evaluations"]
+    assert res.dof_labels == ref.dof_labels
+
+
+def test_a_batch_equals_a_block_from_each_state(chain):
+    roll = spacar.Rollout(chain)
+    rng = np.random.default_rng(1)
+    base = roll()
+    q0 = base.q[0] + 0.2 * rng.standard_normal((4, roll.n_dof))
+    qd0 = 0.5 * rng.standard_normal((4, roll.n_dof))
+    res = roll(q0, qd0, t=np.linspace(0.0, 0.3, 7))
+    assert res.q.shape == res.qd.shape == (4, 7, roll.n_dof)
+    for s in range(4):
+        ref = _simulated_from(chain, roll, q0[s], qd0[s])
+        assert np.abs(res.q[s] - ref.q).max() < 1e-12
+        assert np.abs(res.qd[s] - ref.qd).max() < 1e-11
+    # the set-up is kept: the same batch again gives the same numbers
+    again = roll(q0, qd0, t=np.linspace(0.0, 0.3, 7))
+    assert np.array_equal(again.q, res.q)
+
+
+def test_against_pinocchio_aba_integrated_by_scipy(chain):
+    pytest.importorskip("pinocchio")
+    from scipy.integrate import solve_ivp
+
+    from spacar.compare import pinocchio as sp
+
+    model = models.spatial_chain(6, seed=6, t_end=0.5, n_out=5, eps=1e-11, epskin=1e-13)
+    roll = spacar.Rollout(model)
+    rng = np.random.default_rng(2)
+    q0 = roll().q[0] + 0.3 * rng.standard_normal((3, roll.n_dof))
+    qd0 = rng.standard_normal((3, roll.n_dof))
+    t = np.linspace(0.0, 0.5, 6)
+    res = roll(q0, qd0, t=t)
+    f = sp.build(model).rhs()
+    for s in range(3):
+        ref = solve_ivp(f, (0.0, 0.5), np.concatenate((q0[s], qd0[s])), method="DOP853", t_eval=t,
+                        rtol=1e-13, atol=1e-15)
+        assert np.abs(res.q[s] - ref.y[:6].T).max() < 1e-8
+        assert np.abs(res.qd[s] - ref.y[6:].T).max() < 1e-7
+
+
+def test_general_path_and_closed_loop():
+    model = spacar.read(EXAMPLE)
+    roll = spacar.Rollout(model)
+    res = roll(coordinates=True)
+    ref = spacar.simulate(model.copy())
+    assert res.stats["path"] == ref.stats["path"] != "tree"
+    assert np.abs(res.q - ref.q).max() < 1e-12
+    assert np.abs(res.qd - ref.qd).max() < 1e-10
+    assert np.abs(res.x - ref.x).max() < 1e-12
+    # Without the coordinates no state is solved at the output times, where a block's next
+    # Newton iteration would start: the same solution to the tolerances (EPSINT 1e-3, EPSKIN 1e-5).
+    plain = roll()
+    assert np.abs(plain.q - ref.q).max() < 1e-5
+    # a batch of rates (the manual's slider-crank: a flexible coupler whose bending deformations
+    # are the DOFs, the crank an input): each row as if rolled out alone
+    qd0 = np.array([plain.qd[0] + 0.01, plain.qd[0]])
+    both = roll(qd0=qd0)
+    assert both.q.shape == (2, len(ref.t), 4)
+    assert np.array_equal(both.q[1], plain.q)
+    assert np.array_equal(both.q[0], roll(qd0=qd0[0]).q)
+    assert np.abs(both.q[0] - plain.q).max() > 1e-6
+
+
+def test_forced_general_path_equals_the_tree(chain):
+    tree = spacar.Rollout(chain)(t=[0.0, 0.1, 0.3])
+    general = spacar.Rollout(chain, recursive=False)(t=[0.0, 0.1, 0.3])
+    assert general.stats["path"] != "tree"
+    assert np.abs(tree.q - general.q).max() < 1e-6  # two integrations at EPSINT 1e-8
+
+
+def test_the_model_is_not_changed(chain):
+    m = chain.copy()
+    before = spacar.dump(m)
+    spacar.Rollout(m)(np.zeros((2, 6)))
+    assert spacar.dump(m) == before
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda r: r(np.zeros(5)), "one per DOF"),
+    (lambda r: r(np.zeros((3, 6)), np.zeros((2, 6))), "same number of states"),
+    (lambda r: r(t=[0.0, 0.2, 0.1]), "increasing"),
+    (lambda r: r(t=[]), "increasing"),
+    (lambda r: r(np.full(6, np.nan)), "finite"),
+    (lambda r: r(coordinates=1), "True or False"),
+])
+def test_bad_requests_are_refused(chain, call, message):
+    with pytest.raises(spacar.InputError, match=message):
+        call(spacar.Rollout(chain))
+
+
+def test_options_are_checked(chain):
+    with pytest.raises(spacar.InputError, match="'generalized_alpha' only"):
+        spacar.Rollout(chain, fixed_step=1e-3)
+    with pytest.raises(spacar.InputError, match="method must be"):
+        spacar.Rollout(chain, method="euler")
+    with pytest.raises(spacar.InputError, match="no degrees of freedom"):
+        spacar.Rollout(spacar.read_string("PLBEAM 1 1 2 3 4\nX 3 1 0\nFIX 1\nFIX 2\nFIX 3\nFIX 4\nEND\nEND\n"))
+
+
+@pytest.mark.filterwarnings("ignore:.*joint limits")
+def test_floating_base_refused_with_the_reason():
+    from pathlib import Path
+
+    model = spacar.from_urdf(Path(__file__).parents[1] / "data" / "two_link_arm.urdf", floating=True)
+    with pytest.raises(spacar.InputError, match="free rotation"):
+        spacar.Rollout(model)()
+
+
+def test_a_failure_names_the_state_and_keeps_the_states_before(chain):
+    roll = spacar.Rollout(chain)
+    q0 = np.repeat(roll().q[:1], 3, axis=0)
+    with pytest.raises(spacar.TimeLimitError) as info:
+        roll(q0, t=np.linspace(0.0, 300.0, 3), time_limit=0.05)
+    assert "rollout, state" in str(info.value)
+    partial = info.value.results
+    assert isinstance(partial, spacar.RolloutResults)
+    assert partial.q.shape[1:] == (3, 6)
+
+
+def test_generalized_alpha_on_a_flexible_arm():
+    """A flexible model with the options of generalized-α: the rollout equals simulate's block."""
+    model = spacar.read("examples/flexible_arm.dat")
+    kw = dict(method="generalized_alpha", fixed_step=1e-4)
+    res = spacar.Rollout(model, **kw)()
+    ref = spacar.simulate(model.copy(), **kw)
+    assert np.abs(res.q - ref.q).max() < 1e-12
+    assert np.abs(res.qd - ref.qd).max() < 1e-9
