@@ -71,10 +71,10 @@ class Rollout:
 
     The model as it is when the Rollout is made is used: later changes to it are not seen (make
     a new Rollout). The model itself is not changed. A failure names the state; the exception
-    carries the states before it as ``err.results``. Not for floating bases yet (their dependent
-    Euler parameter changes during a run), nor with time-dependent loads, controllers or the
-    energy balance (:func:`spacar.simulate` has them). One call at a time per Rollout (calls from
-    several threads wait for each other)."""
+    carries the states before it as ``err.results``. A floating base whose run exchanges its
+    dependent Euler parameter is recorded in the DOFs it started with all the same. Time-dependent
+    loads, controllers and the energy balance are :func:`spacar.simulate`'s. One call at a time
+    per Rollout (calls from several threads wait for each other)."""
 
     def __init__(self, model: Model, *, method: str = "auto", recursive: bool = True, rho_inf=None,
                  fixed_step=None):

@@ -143,13 +143,37 @@ def test_options_are_checked(chain):
         spacar.Rollout(spacar.read_string("PLBEAM 1 1 2 3 4\nX 3 1 0\nFIX 1\nFIX 2\nFIX 3\nFIX 4\nEND\nEND\n"))
 
 
-@pytest.mark.filterwarnings("ignore:.*joint limits")
-def test_floating_base_refused_with_the_reason():
-    from pathlib import Path
+@pytest.mark.filterwarnings("ignore:.*(joint limits|collision)")
+def test_a_tumbling_floating_base_keeps_its_dofs():
+    """Solo12 thrown spinning (6 rad/s) for 2 s: past the half turn the run exchanges the dependent
+    Euler parameter; the rollout still records the DOFs it started with (x, λ1, λ2, λ3, joints),
+    equal to simulate's coordinates, and the next state of the batch starts in the first partition."""
+    from test_urdf import solo12_floating
 
-    model = spacar.from_urdf(Path(__file__).parents[1] / "data" / "two_link_arm.urdf", floating=True)
-    with pytest.raises(spacar.InputError, match="free rotation"):
-        spacar.Rollout(model)()
+    model = solo12_floating()
+    model.xd(2, 2, 3.0)
+    model.xd(1, 1, 0.4)
+    model.timestep(20, 2.0)
+    for eps in (model.epsint, model.epsind):
+        eps(1e-10)
+    roll = spacar.Rollout(model)
+    assert roll.dof_labels[:6] == ["x(1,1)", "x(1,2)", "x(1,3)", "x(2,2)", "x(2,3)", "x(2,4)"]
+    ref = spacar.simulate(model.copy())
+    assert ref.node(2).x[:, 0].min() < 0.0  # past the half turn: λ0 is no longer the dependent one
+    res = roll(coordinates=True)
+    assert res.stats["path"] == "tree"
+    cols = [roll.coordinate_labels.index((1, i)) for i in (1, 2, 3)] + \
+        [roll.coordinate_labels.index((2, i)) for i in (2, 3, 4)]
+    assert np.abs(res.q[:, :6] - ref.x[:, cols]).max() < 1e-12
+    assert np.abs(res.qd[:, :6] - ref.xd[:, cols]).max() < 1e-11
+    assert np.abs(res.q[:, 6:] - ref.q[:, 6:]).max() < 1e-12
+    assert np.abs(res.x - ref.x).max() < 1e-12
+    # a batch: the tumbling state, then one at rest, which starts in the first partition again
+    q0 = np.repeat(res.q[:1], 2, axis=0)
+    qd0 = np.array([res.qd[0], np.zeros(roll.n_dof)])
+    batch = roll(q0, qd0)
+    assert np.array_equal(batch.q[0], res.q)
+    assert np.array_equal(batch.q[1], roll(q0[1], qd0[1]).q)
 
 
 def test_a_failure_names_the_state_and_keeps_the_states_before(chain):

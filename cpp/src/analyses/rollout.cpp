@@ -21,9 +21,6 @@ Simulation::BlockPlan Simulation::plan_rollout(const RowMatrix& q0, const RowMat
   const System& sys = *sys_;
   const int nd = sys.n_dof();
   if (nd == 0) throw InputError("rollout: the model has no degrees of freedom to integrate");
-  if (!sys.free_rotations.empty())
-    throw InputError("rollout: not yet for a free rotation (a floating base's Euler parameters: a run changes which one "
-                     "is dependent, and with it the meaning of q); spacar.simulate runs such a model");
   if (q0.cols() != nd || qd0.cols() != nd || qd0.rows() != q0.rows())
     throw InputError("rollout: q0 and qd0 must have the same number of states (rows) and one column per degree of "
                      "freedom (" + std::to_string(nd) + ")");
@@ -54,29 +51,32 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
   const auto start = std::chrono::steady_clock::now();
   res = RolloutResults();
   const BlockPlan plan = plan_rollout(q0, qd0, times, options, res.warnings);
-  const System& sys = *sys_;
-  const int nd = sys.n_dof(), ny = static_cast<int>(sys.y_defs.size()), nt = static_cast<int>(times.size());
+  // sys_ and data_ are recompiled where a state's run exchanges a dependent Euler parameter: no
+  // references to them are held across a state.
+  const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size()), nt = static_cast<int>(times.size());
   const Eigen::Index states = q0.rows();
-  require_memory(8.0 * double(states) * nt * (2.0 * nd + (coordinates ? sys.nx : 0)),
+  require_memory(8.0 * double(states) * nt * (2.0 * nd + (coordinates ? sys_->nx : 0)),
                  "the rollout's " + std::to_string(states) + " states at " + std::to_string(nt) + " output times",
                  "roll out fewer states at a time");
   res.q.resize(states * nt, nd);
   res.qd.resize(states * nt, nd);
-  if (coordinates) res.x.resize(states * nt, sys.nx);
+  if (coordinates) res.x.resize(states * nt, sys_->nx);
   run_.n_energy = 0;
   run_.held.resize(0);
   run_.predictor_order = options.predictor_order;
   run_.chord = options.chord;
   run_.fixed_step = plan.fixed_step;
   const DeadlineScope deadline(options.time_limit, options.time_spent);
+  const bool recursive = plan.integrate && options.recursive && timed_.empty();  // the tree knows no time loads
   if (!rollout_.ready || rollout_.recursive != options.recursive) {
     assemble();
-    // The recursive and explicit-chain paths know no time-dependent loads.
-    rollout_.path = RhsPath::choose(sys, *data_, plan.integrate && options.recursive && timed_.empty());
+    rollout_.path = RhsPath::choose(*sys_, *data_, recursive);
     rollout_.assembled = run_.base;
     // Every state starts from the assembly's data, its factorizations included (Newton's chord
     // iterations reuse them): a state's run does not depend on the states rolled out before it.
-    rollout_.data = rollout_.path->tree() ? nullptr : std::make_unique<Data>(*data_);
+    rollout_.data = std::make_unique<Data>(*data_);
+    rollout_.dependent = dependent_;
+    rollout_.x_dyn = sys_->x_dyn;
     rollout_.recursive = options.recursive;
     rollout_.ready = true;
   }
@@ -88,29 +88,42 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
     ~Swap() { std::swap(a, b); }
   } swap(path_, rollout_.path);
   res.path = path_->name();
-  const bool tree = path_->tree() != nullptr;
   Eigen::VectorXd Y(2 * nd + ny);
   for (Eigen::Index s = 0; s < states; ++s) {
+    if (dependent_ != rollout_.dependent) restore_rollout_partition(recursive);
+    const bool tree = path_->tree() != nullptr;
     run_.base = rollout_.assembled;  // Newton's start on the general path: the assembly
-    if (rollout_.data) *data_ = *rollout_.data;
     run_.anchor = Solved();
     run_.kinematic_failure.clear();
+    if (!tree) *data_ = *rollout_.data;
     if (tree) {
-      run_.base.xd = run_.base.xdd = Eigen::VectorXd::Zero(sys.nx);
+      run_.base.xd = run_.base.xdd = Eigen::VectorXd::Zero(sys_->nx);
       run_.base.t = plan.t0;
     }
-    Y << q0.row(s).transpose(), sys.y0, qd0.row(s).transpose();
+    Y << q0.row(s).transpose(), sys_->y0, qd0.row(s).transpose();
     int k = 0;
     auto output = [&](double t, const Eigen::VectorXd& y) {
       check_time(t);
       const Eigen::Index row = s * nt + k;
       res.q.row(row) = y.head(nd).transpose();
       res.qd.row(row) = y.segment(nd + ny, nd).transpose();
-      if (coordinates) {  // the tree's explicit positions, else the general path's solved state
-        if (tree && tree_state(t, y, run_.tree_qdd)) res.x.row(row) = run_.base.x.transpose();
-        else {
+      // The coordinates of every node, when asked for or when the state's DOFs are no longer
+      // those it started with (another dependent Euler parameter): the tree's explicit
+      // positions, else the general path's solved state.
+      const bool repartitioned = dependent_ != rollout_.dependent;
+      if (coordinates || repartitioned) {
+        const Eigen::VectorXd* x = &data_->x;
+        const Eigen::VectorXd* xd = &data_->xd;
+        if (path_->tree() && tree_state(t, y, run_.tree_qdd)) {
+          x = &run_.base.x;
+          xd = &run_.base.xd;
+        } else {
           evaluate_state(t, y);
-          res.x.row(row) = data_->x.transpose();
+        }
+        if (coordinates) res.x.row(row) = x->transpose();
+        for (size_t j = 0; j < rollout_.x_dyn.size() && repartitioned; ++j) {
+          res.q(row, static_cast<Eigen::Index>(j)) = (*x)[rollout_.x_dyn[j]];
+          res.qd(row, static_cast<Eigen::Index>(j)) = (*xd)[rollout_.x_dyn[j]];
         }
       }
       if (!res.q.row(row).allFinite() || !res.qd.row(row).allFinite())
@@ -129,14 +142,30 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
         if (m->size()) m->conservativeResize(s * nt, m->cols());
       res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       run_.fixed_step = 0.0;
+      if (dependent_ != rollout_.dependent) restore_rollout_partition(recursive);
       throw;
     }
     res.rhs_evaluations.push_back(counters.rhs_evaluations);
     res.steps.push_back(counters.steps);
     res.rejected.push_back(counters.rejected);
   }
+  if (dependent_ != rollout_.dependent) restore_rollout_partition(recursive);
   run_.fixed_step = 0.0;
   res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Simulation::restore_rollout_partition(bool recursive) {
+  dependent_ = rollout_.dependent;
+  sys_ = compile(model_, dependent_);
+  data_ = std::make_unique<Data>(*sys_);
+  *data_ = *rollout_.data;
+  linearizer_.reset();
+  have_transfer_ = false;
+  run_.newton_data.reset();
+  run_.newton_system.reset();
+  // The tree of this partition, recognized again at the assembled state (repartition() left
+  // the other partition's).
+  path_ = RhsPath::choose(*sys_, *data_, recursive);
 }
 
 }  // namespace spacar

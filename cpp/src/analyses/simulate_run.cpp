@@ -508,7 +508,6 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
     if (std::abs(data_->x[fr.coord + i]) > std::abs(data_->x[fr.coord + best])) best = i;
   dependent_[fr.node] = best;
   linearizer_.reset();
-  rollout_ = RolloutStart();
   const Eigen::VectorXd x = data_->x, xd = data_->xd, e = data_->e, ed = data_->ed, angles = data_->angle_ref,
                         integrated = data_->e_integrated;
   const long newton = data_->total_newton_iterations;

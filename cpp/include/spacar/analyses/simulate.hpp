@@ -335,8 +335,9 @@ class Simulation {
   // path each state's positions are solved by Newton from the assembled ones. `coordinates`: the
   // positions of every coordinate at the output times too. The model is not changed. If a state
   // fails, res holds the states before it and res.failed its index, and the error is rethrown.
-  // Not for free rotations (a floating base changes its dependent Euler parameter in a run) nor
-  // a controller or the energy balance (RunOptions' sample_period, on_sample, energy).
+  // A free rotation (a floating base) may exchange its dependent Euler parameter within a state's
+  // run: the state is recorded in the DOFs it started with all the same. Not with a controller or
+  // the energy balance (RunOptions' sample_period, on_sample, energy).
   void rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::vector<double>& times,
                const RunOptions& options, bool coordinates, RolloutResults& res);
 
@@ -447,14 +448,22 @@ class Simulation {
   TimeLoads timed_;
   // What the first rollout prepared and the next reuse: the assembled positions (Newton's start
   // of every state on the general path, with its data) and the path chosen (swapped into path_
-  // while a rollout runs). Dropped by a run, a repartition and new time loads.
+  // while a rollout runs). Dropped by a run and new time loads.
   struct RolloutStart {
     bool ready = false;
     bool recursive = true;  // RunOptions::recursive it was chosen with
     Solved assembled;
-    std::unique_ptr<Data> data;  // the assembled data (general path), or nullptr (the tree's)
+    std::unique_ptr<Data> data;  // the assembled data
     std::unique_ptr<RhsPath> path;
+    // The partition of the free rotations every state starts in (a state's run may exchange a
+    // dependent Euler parameter: the next state starts again in this one), and its DOFs'
+    // coordinates (global indices), in which the states are recorded.
+    std::map<int, int> dependent;
+    std::vector<int> x_dyn;
   } rollout_;
+  // After a state whose run exchanged a dependent Euler parameter: the system, data and path of
+  // the rollout's partition again.
+  void restore_rollout_partition(bool recursive);
   BlockPlan plan_rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::vector<double>& times,
                          const RunOptions& options, std::vector<std::string>& warnings) const;
   // The time-dependent loads and inputs at t into data (after set_inputs): input tables replace
