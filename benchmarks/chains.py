@@ -180,7 +180,7 @@ def per_rhs(n, t_end, quick, build=chain):
     st = em.settings(0.0, steps * h, "rk44", None, None, h)
     wall, _ = C.best_time(lambda: em.mbs.SolveDynamic(st, solverType=exu.DynamicSolverType.RK44), repeat=3)
     t_exu = wall / (4 * steps)
-    t_mujoco = t_long = t_loop = t_fixed = t_rollout_fixed = t_simulate_fixed = None
+    t_mujoco = t_long = t_loop = t_fixed = t_rollout_fixed = t_simulate_fixed = t_batch_one = t_batch_all = None
     if build is spatial_chain:  # the same, over a run 10 times as long: the fixed costs spread thinner
         t_long, long_stats = C.in_run_per_rhs(build(n, 10 * t_end, 1e-6), min_time=0.1 if quick else 0.5)
         # The block's time as fixed costs (assembly, recognition of the tree, output times) plus
@@ -190,10 +190,21 @@ def per_rhs(n, t_end, quick, build=chain):
         t_fixed = t_run * rhs_short - t_loop * rhs_short
         # spacar.Rollout: the set-up made once (its first call), each call from Python then
         # integrates alone; its fixed cost per call is the call's time beyond the loop's.
-        roll = spacar.Rollout(build(n, t_end, 1e-6))
-        rhs_roll = int(roll().stats["rhs_evaluations"][0])
-        t_roll_call = C.per_call(roll, min_time=0.1 if quick else 0.5)
-        t_rollout_fixed = t_roll_call - t_loop * rhs_roll
+        # The same line through a short and a 10× longer rollout of one Rollout, from Python.
+        roll = spacar.Rollout(build(n, t_end, 1e-6), threads=1)
+        short, long = np.array([0.0, t_end]), np.array([0.0, 10 * t_end])
+        rhs_roll = [int(roll(t=t).stats["rhs_evaluations"][0]) for t in (short, long)]
+        t_roll = [C.per_call(lambda: roll(t=t), min_time=0.1 if quick else 0.5) for t in (short, long)]
+        slope = (t_roll[1] - t_roll[0]) / (rhs_roll[1] - rhs_roll[0])
+        t_rollout_fixed = t_roll[0] - slope * rhs_roll[0]
+        # A batch of 64 states from random joint angles and rates: one thread against all cores.
+        rng = np.random.default_rng(n)
+        q_batch = np.array(roll().q[0]) + 0.2 * rng.standard_normal((64, n))
+        qd_batch = rng.standard_normal((64, n))
+        roll_threads = spacar.Rollout(build(n, t_end, 1e-6), threads=None)
+        roll_threads(q_batch, qd_batch)  # each thread's copy assembled
+        t_batch_one, _ = C.best_time(lambda: roll(q_batch, qd_batch), repeat=5, min_time=0.1 if quick else 0.5)
+        t_batch_all, _ = C.best_time(lambda: roll_threads(q_batch, qd_batch), repeat=5, min_time=0.1 if quick else 0.5)
         t_simulate_call, _ = C.best_time(spacar.simulate, repeat=20, min_time=0.1 if quick else 0.5,
                                          setup=build(n, t_end, 1e-6).copy)  # each call on a fresh copy
         t_simulate_fixed = t_simulate_call - t_loop * rhs_short
@@ -204,7 +215,7 @@ def per_rhs(n, t_end, quick, build=chain):
         md = mujoco.MjData(mm)
         md.qpos[:], md.qvel[:] = q0, qd0
         t_mujoco = C.per_call(lambda: mujoco.mj_forward(mm, md), min_time=0.1 if quick else 0.5)
-    return {"rollout_fixed": t_rollout_fixed, "simulate_fixed": t_simulate_fixed, "mujoco_forward": t_mujoco, "spacar_in_long_run": t_long, "spacar_loop": t_loop, "spacar_fixed": t_fixed, "spacar_in_run": t_run, "spacar_recursive": run_stats["recursive"], "spacar_general_in_run": t_general,
+    return {"rollout_batch_one_thread": t_batch_one, "rollout_batch_threads": t_batch_all, "rollout_fixed": t_rollout_fixed, "simulate_fixed": t_simulate_fixed, "mujoco_forward": t_mujoco, "spacar_in_long_run": t_long, "spacar_loop": t_loop, "spacar_fixed": t_fixed, "spacar_in_run": t_run, "spacar_recursive": run_stats["recursive"], "spacar_general_in_run": t_general,
             "spacar_newton_per_rhs": general_stats["newton_iterations"] / general_stats["rhs_evaluations"],
             "spacar_evaluate": t_eval, "pinocchio_aba": t_aba, "pinocchio_rhs_python": t_rhs_py, "exudyn_tree_rk44": t_exu}
 
@@ -447,7 +458,8 @@ def spatial_section(r: dict, quick: bool) -> list:
                       f"N = {n}: {C.fmt_time(r['rhs'][n]['spacar_fixed'])} + {C.fmt_time(r['rhs'][n]['spacar_loop'])} "
                       "per right-hand side" for n in sizes if r["rhs"][n].get("spacar_loop")) + ".",
                   "", "The fixed costs of a call from Python (its time beyond the loop's right-hand sides, the "
-                  "model's copy, compilation and results included): " + "; ".join(
+                  "model's copy, compilation and results included; a Rollout's from the line through its own short "
+                  "and long calls): " + "; ".join(
                       f"N = {n}: `spacar.simulate` {C.fmt_time(r['rhs'][n]['simulate_fixed'])}, a `spacar.Rollout` "
                       f"made before {C.fmt_time(r['rhs'][n]['rollout_fixed'])}" for n in sizes
                       if r["rhs"][n].get("rollout_fixed") is not None) + ". Issue #37 target, fixed costs per run of "
@@ -458,6 +470,12 @@ def spatial_section(r: dict, quick: bool) -> list:
                       "every call compiles, assembles, recognizes the tree and solves the complete state at the "
                       "output times)"
                       if r["rhs"].get(6, {}).get("rollout_fixed") is not None else "not measured") + ".",
+                  "", f"A batch of 64 states (random joint angles and rates) in one `spacar.Rollout` call, one thread "
+                  f"against `threads=None` (cores: {r['machine'].get('cores', '?')}): " + "; ".join(
+                      f"N = {n}: {C.fmt_time(r['rhs'][n]['rollout_batch_one_thread'])} against "
+                      f"{C.fmt_time(r['rhs'][n]['rollout_batch_threads'])} "
+                      f"({r['rhs'][n]['rollout_batch_threads'] / r['rhs'][n]['rollout_batch_one_thread']:.2f}×)"
+                      for n in sizes if r["rhs"][n].get("rollout_batch_threads")) + ".",
                   "", f"Issue #21 target, time per right-hand side of the 20-link spatial chain inside a run no more "
                   f"than `pinocchio.aba` per call: in the integration loop **{'met' if ratio <= 1 else 'NOT met'}** "
                   f"({C.fmt_time(x['spacar_loop'])} against {C.fmt_time(x['pinocchio_aba'])}: {ratio:.2f}×); as the "

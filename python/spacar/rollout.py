@@ -3,7 +3,9 @@ optimizations, Monte Carlo studies, shooting methods and learning: compiled, ass
 right-hand-side path chosen once, then every batch of states integrated in one call into C++."""
 from __future__ import annotations
 
+import os
 import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -73,11 +75,16 @@ class Rollout:
     a new Rollout). The model itself is not changed. A failure names the state; the exception
     carries the states before it as ``err.results``. A floating base whose run exchanges its
     dependent Euler parameter is recorded in the DOFs it started with all the same. Time-dependent
-    loads, controllers and the energy balance are :func:`spacar.simulate`'s. One call at a time
-    per Rollout (calls from several threads wait for each other)."""
+    loads, controllers and the energy balance are :func:`spacar.simulate`'s.
+
+    ``threads``: a batch is split into this many contiguous parts, integrated in parallel, each by
+    its own compiled copy of the model (made when first needed; its first call assembles); None
+    (default): the machine's cores for batches of at least 8 states per core, else one. A state's
+    result does not depend on the thread or the states before it. One call at a time per Rollout
+    (calls from several threads wait for each other)."""
 
     def __init__(self, model: Model, *, method: str = "auto", recursive: bool = True, rho_inf=None,
-                 fixed_step=None):
+                 fixed_step=None, threads=None):
         if not isinstance(model, Model):
             raise InputError(f"Rollout: model must be a spacar.Model, got {show(model)}")
         self._fixed_step = check_method_options(method, rho_inf, fixed_step, recursive)
@@ -87,12 +94,20 @@ class Rollout:
         self.method = method
         self._recursive = bool(recursive)
         self._rho_inf = _core.run_defaults["rho_inf"] if rho_inf is None else float(rho_inf)
-        self._sim = _core.Simulation(model.core)  # prepares the model (the first END) and compiles it
-        system = self._sim.system
+        if threads is not None and (isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer))
+                                    or threads < 1):
+            raise InputError(f"Rollout: threads must be a positive whole number or None, got {show(threads)}")
+        self._threads = None if threads is None else int(threads)
+        # The model as it is now, in a copy of the Rollout's own: every thread's simulation is
+        # compiled from it, whatever the user's model becomes.
+        self._core = model.core.copy()
+        self._sims = [_core.Simulation(self._core)]  # prepares the copy (the first END) and compiles it
+        system = self._sims[0].system
         self.n_dof = system.n_dof
         if self.n_dof == 0:
             raise InputError("Rollout: the model has no degrees of freedom to integrate")
         self._q0, self._qd0 = np.array(system.q0, dtype=float), np.array(system.qd0, dtype=float)
+        self._initial = (self._q0.reshape(1, -1), self._qd0.reshape(1, -1))
         settings = model.core.settings
         n_out = settings.timestep_n
         self._times = model.current_time + settings.timestep_tp * np.arange(n_out + 1) / max(n_out, 1)
@@ -108,22 +123,50 @@ class Rollout:
             raise InputError(f"Rollout: coordinates must be True or False, got {show(coordinates)}")
         limit = seconds_or_none(time_limit, "time_limit") or 0.0
         with self._lock:
-            try:
-                arrays = self._sim.rollout(q0, qd0, times, method=self.method, recursive=self._recursive,
-                                           rho_inf=self._rho_inf, fixed_step=self._fixed_step,
-                                           coordinates=bool(coordinates), time_limit=limit)
-            except SpacarError as err:
-                partial = getattr(err, "results", None)
-                if not isinstance(partial, dict) or partial["failed"] < 0:
-                    raise
-                failed = type(err)(f"rollout, state {partial['failed']} (q0 = {_short(q0[partial['failed']])}): {err}")
-                failed.results = RolloutResults(partial, times, True, self)
-                raise failed from err
+            parts = self._parts(q0.shape[0])
+            while len(self._sims) < len(parts):
+                self._sims.append(_core.Simulation(self._core))
+
+            def run(k):
+                a, b = parts[k]
+                try:
+                    return self._sims[k].rollout(q0[a:b], qd0[a:b], times, method=self.method,
+                                                 recursive=self._recursive, rho_inf=self._rho_inf,
+                                                 fixed_step=self._fixed_step, coordinates=bool(coordinates),
+                                                 time_limit=limit)
+                except SpacarError as err:
+                    return err
+
+            if len(parts) == 1:
+                outcomes = [run(0)]
+            else:
+                with ThreadPoolExecutor(len(parts)) as pool:  # the core releases the GIL
+                    outcomes = list(pool.map(run, range(len(parts))))
+        arrays = _joined(outcomes, parts)
+        if isinstance(arrays, SpacarError):
+            err = arrays
+            partial = getattr(err, "results", None)
+            if not isinstance(partial, dict) or partial["failed"] < 0:
+                raise err
+            failed = type(err)(f"rollout, state {partial['failed']} (q0 = {_short(q0[partial['failed']])}): {err}")
+            failed.results = RolloutResults(partial, times, True, self)
+            raise failed from err
         return RolloutResults(arrays, times, batch, self)
+
+    def _parts(self, states: int) -> list:
+        """The batch's contiguous parts [(first, end)], one per thread."""
+        threads = self._threads
+        if threads is None:
+            cores = os.cpu_count() or 1
+            threads = cores if states >= 8 * cores else 1
+        threads = max(1, min(threads, states))
+        return [(k * states // threads, (k + 1) * states // threads) for k in range(threads)]
 
     def _initial_states(self, q0, qd0):
         """q0, qd0 as (states, n) float arrays (a missing one the model's, broadcast), and whether
         a batch was given."""
+        if q0 is None and qd0 is None:
+            return self._initial[0], self._initial[1], False
         given = []
         for name, value, default in (("q0", q0, self._q0), ("qd0", qd0, self._qd0)):
             if value is None:
@@ -152,18 +195,47 @@ class Rollout:
         return out[0], out[1], batch
 
     def _output_times(self, t) -> np.ndarray:
+        """The output times as a float array (the core refuses times that are not finite or do not
+        increase, naming the time)."""
         if t is None:
             return self._times
         try:
-            times = np.array(t, dtype=float).reshape(-1)
+            return np.asarray(t, dtype=float).reshape(-1)
         except (TypeError, ValueError, OverflowError):
             raise InputError(f"Rollout: t must be an array of output times, got {show(t)}") from None
-        if times.size == 0 or not np.isfinite(times).all() or (np.diff(times) <= 0).any():
-            raise InputError("Rollout: t must be finite, increasing output times (the first the start of every state)")
-        return times
 
     def __repr__(self) -> str:
         return f"<spacar.Rollout: {self.n_dof} DOFs, method {self.method!r}, {len(self._times)} TIMESTEP output times>"
+
+
+def _joined(outcomes: list, parts: list):
+    """The parts' results as one (their rows and per-state counters in order), or the error of
+    the first part that failed, its partial results joined to the parts before it and its failed
+    state numbered in the whole batch."""
+    keys = ("q", "qd", "x")
+    done = []
+    for (a, _), out in zip(parts, outcomes):
+        if isinstance(out, SpacarError):
+            partial = getattr(out, "results", None)
+            if isinstance(partial, dict) and partial["failed"] >= 0:
+                partial["failed"] += a
+                out.results = _concatenated(done + [partial], keys)
+            return out
+        done.append(out)
+    return _concatenated(done, keys)
+
+
+def _concatenated(parts: list, keys) -> dict:
+    if len(parts) == 1:
+        return parts[0]
+    out = dict(parts[-1])
+    for key in keys:
+        out[key] = None if parts[0][key] is None else np.concatenate([np.asarray(p[key]) for p in parts])
+    for key in ("rhs_evaluations", "steps", "rejected"):
+        out[key] = [n for p in parts for n in p[key]]
+    out["wall_time"] = max(p["wall_time"] for p in parts)
+    out["warnings"] = list(dict.fromkeys(w for p in parts for w in p["warnings"]))
+    return out
 
 
 def _short(values) -> str:

@@ -124,8 +124,9 @@ def test_the_model_is_not_changed(chain):
 @pytest.mark.parametrize("call, message", [
     (lambda r: r(np.zeros(5)), "one per DOF"),
     (lambda r: r(np.zeros((3, 6)), np.zeros((2, 6))), "same number of states"),
-    (lambda r: r(t=[0.0, 0.2, 0.1]), "increasing"),
-    (lambda r: r(t=[]), "increasing"),
+    (lambda r: r(t=[0.0, 0.2, 0.1]), r"must increase \(time 2 = 0.1 follows 0.2\)"),
+    (lambda r: r(t=[0.0, np.inf]), "output time 1 is not finite"),
+    (lambda r: r(t=[]), "no output times"),
     (lambda r: r(np.full(6, np.nan)), "finite"),
     (lambda r: r(coordinates=1), "True or False"),
 ])
@@ -195,3 +196,30 @@ def test_generalized_alpha_on_a_flexible_arm():
     ref = spacar.simulate(model.copy(), **kw)
     assert np.abs(res.q - ref.q).max() < 1e-12
     assert np.abs(res.qd - ref.qd).max() < 1e-9
+
+
+def test_threads_give_the_same_states(chain):
+    """A batch split over threads (each its own compiled copy) gives the states of one thread;
+    a failure in the second part is numbered in the whole batch, the states before it kept."""
+    one, two = spacar.Rollout(chain, threads=1), spacar.Rollout(chain, threads=2)
+    rng = np.random.default_rng(3)
+    q0 = one().q[0] + 0.2 * rng.standard_normal((6, one.n_dof))
+    qd0 = rng.standard_normal((6, one.n_dof))
+    a, b = one(q0, qd0), two(q0, qd0)
+    assert np.array_equal(a.q, b.q) and np.array_equal(a.qd, b.qd)
+    assert np.array_equal(a.stats["rhs_evaluations"], b.stats["rhs_evaluations"])
+    qd0[4] = 1e200  # its right-hand side overflows
+    with pytest.raises(spacar.IntegrationError, match="rollout, state 4") as info:
+        two(q0, qd0)
+    assert np.array_equal(info.value.results.q, a.q[:4])
+    with pytest.raises(spacar.InputError, match="threads"):
+        spacar.Rollout(chain, threads=0)
+
+
+def test_later_changes_of_the_model_are_not_seen(chain):
+    m = chain.copy()
+    roll = spacar.Rollout(m, threads=2)
+    before = roll(np.zeros(6)).q  # one state: one simulation
+    m.gravity(0.0, 0.0, -100.0)
+    after = roll(np.zeros((4, 6))).q  # two parts: the second simulation is compiled now
+    assert np.array_equal(after[0], before) and np.array_equal(after[-1], before)
