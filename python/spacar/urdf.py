@@ -308,6 +308,7 @@ class _Builder:
         self.tol = _SAME_POINT * scale
         self.next_node = 1
         self.node_mass: dict = {}
+        self.ground_lam = None  # the ground's LAMBDA node (a fixed base), else None
 
     def node(self):
         n = self.next_node
@@ -321,21 +322,30 @@ class _Builder:
             self.m.fix(n)
         return n
 
-    def point(self, body: _Body, p, ground: bool, next_element):
+    def point(self, body: _Body, p, next_element):
         """The XYZ node of body at p (an existing one if it is there already)."""
-        for q, n in body.points:
-            if np.abs(q - p).max() <= self.tol:
-                return n, next_element
+        n = self.at(body, p)
+        if n is not None:
+            return n, next_element
         n = self.node()
         self.m.xyz(n, *p)
-        if ground:
-            self.m.fix(n)
-        else:  # a rigid BEAM from the body's origin, with its own end orientation node
+        return n, self.attach(body, n, p, next_element)
+
+    def attach(self, body: _Body, node: int, p, next_element):
+        """Make the XYZ node at p a point of body: fixed on the ground, else held by a rigid BEAM
+        from the body's origin (with its own end orientation node)."""
+        if body.lam == self.ground_lam:
+            self.m.fix(node)
+        else:
             o, origin = body.points[0][1], body.points[0][0]
-            self.m.beam(next_element, o, body.lam, n, self.lambda_node(), *_perpendicular(p - origin))
+            self.m.beam(next_element, o, body.lam, node, self.lambda_node(), *_perpendicular(p - origin))
             next_element += 1
-        body.points.append((p, n))
-        return n, next_element
+        body.points.append((p, node))
+        return next_element
+
+    def at(self, body: _Body, p):
+        """The node of body at p, or None."""
+        return next((n for q, n in body.points if np.abs(q - p).max() <= self.tol), None)
 
 
 def _perpendicular(d) -> np.ndarray:
@@ -344,12 +354,108 @@ def _perpendicular(d) -> np.ndarray:
     return np.cross(d, np.eye(3)[k])
 
 
+def _close_loop(b: _Builder, loop: dict, body_of: dict, frame: dict, next_element: int) -> int:
+    """A loop joint: one XYZ node at its point, a point of both bodies (rigid BEAMs from their
+    origins, or fixed on the ground); a revolute one also a HINGE between their LAMBDA nodes about
+    its axis, its rotation released and its misalignments fixed."""
+    parent, child = body_of[loop["parent"]], body_of[loop["child"]]
+    if parent is child:
+        raise InputError(f"{loop['name']}: {loop['parent']!r} and {loop['child']!r} are one rigid body (fixed joints)")
+    R, o = frame[loop["parent"]]
+    p = o + R @ loop["xyz"]
+    on_parent, on_child = b.at(parent, p), b.at(child, p)
+    if on_parent is not None and on_parent == on_child:
+        raise InputError(f"{loop['name']}: its point is already a joint of {loop['parent']!r} and {loop['child']!r}")
+    if on_parent is not None and on_child is not None:
+        raise InputError(f"{loop['name']}: both links already have a point there (joints at one origin): close the "
+                         f"loop at another point")
+    if on_parent is not None:
+        next_element = b.attach(child, on_parent, p, next_element)
+    elif on_child is not None:
+        next_element = b.attach(parent, on_child, p, next_element)
+    else:
+        node, next_element = b.point(parent, p, next_element)
+        next_element = b.attach(child, node, p, next_element)
+    if loop["type"] == "revolute":
+        b.m.hinge(next_element, parent.lam, child.lam, *(R @ loop["axis"]))
+        b.m.rlse(next_element, 1)
+        next_element += 1
+    return next_element
+
+
 # The largest URDF of example-robot-data has 0.2 MB; parsing takes about 20 bytes of memory and
 # 0.5 µs per byte of the file (a 20 MB file: 454 MB, 11 s).
 MAX_URDF_BYTES = 8 * 2**20
 
 
-def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, max_bytes: int | None = None) -> Model:
+_LOOP_KEYS = {"parent", "child", "xyz", "type", "axis", "name"}
+LOOP_TYPES = ("spherical", "revolute")
+
+
+def _loop_joints(loops, dependent, links, moving, path) -> tuple:
+    """The loop joints (dicts with parent, child, xyz, type, axis, name) and the set of dependent
+    joint names, checked against the URDF's links and moving joints (InputError naming the file)."""
+    def fail(text):
+        raise InputError(f"{path}: {text}")
+
+    if isinstance(loops, dict) or not hasattr(loops, "__iter__"):
+        fail(f"loops must be a list of loop joints (dicts), got {show(loops)}")
+    out = []
+    for k, loop in enumerate(loops):
+        where = f"loop joint {k}"
+        if not isinstance(loop, dict):
+            fail(f"{where} must be a dict with 'parent', 'child', 'xyz' (in the parent link's frame) and 'type', "
+                 f"got {show(loop)}")
+        unknown = set(loop) - _LOOP_KEYS
+        if unknown:
+            fail(f"{where} has unknown keys {sorted(unknown)} (known: {sorted(_LOOP_KEYS)})")
+        name = str(loop.get("name", where))
+        for key in ("parent", "child"):
+            if loop.get(key) not in links:
+                fail(f"{name}: {key} {show(loop.get(key))} is not a link of the URDF")
+        if loop["parent"] == loop["child"]:
+            fail(f"{name}: parent and child are the same link {loop['parent']!r}")
+        kind = loop.get("type", "spherical")
+        if kind not in LOOP_TYPES:
+            fail(f"{name}: type must be one of {', '.join(map(repr, LOOP_TYPES))}, got {show(kind)}")
+        values = {}
+        for key, default in (("xyz", (0.0, 0.0, 0.0)), ("axis", None)):
+            value = loop.get(key, default)
+            if value is None:
+                values[key] = None
+                continue
+            try:
+                v = np.array([float(x) for x in value])
+            except (TypeError, ValueError, OverflowError):
+                v = np.array([])
+            if v.shape != (3,) or not np.isfinite(v).all():
+                fail(f"{name}: {key} must be three finite numbers, got {show(value)}")
+            values[key] = v
+        if kind == "revolute":
+            if values["axis"] is None or not np.any(values["axis"]):
+                fail(f"{name}: a revolute loop joint needs a nonzero axis (in the parent link's frame)")
+            values["axis"] = values["axis"] / np.linalg.norm(values["axis"])
+        elif values["axis"] is not None:
+            fail(f"{name}: a spherical loop joint has no axis")
+        out.append({"name": name, "parent": loop["parent"], "child": loop["child"], "type": kind, **values})
+    if isinstance(dependent, str) or not hasattr(dependent, "__iter__"):
+        fail(f"dependent must be a list of joint names, got {show(dependent)}")
+    names = {j.name for j in moving}
+    dependent = list(dependent)
+    for j in dependent:
+        if j not in names:
+            fail(f"dependent joint {show(j)} is not a moving joint of the URDF")
+    if dependent and not out:
+        fail("dependent joints need loop joints that determine them (loops=...)")
+    constraints = sum(3 if loop["type"] == "spherical" else 5 for loop in out)
+    if len(dependent) > constraints:
+        fail(f"{len(dependent)} dependent joints for the {constraints} constraints of the loop joints: the loops cannot "
+             "determine them")
+    return out, set(dependent), constraints
+
+
+def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, loops=(), dependent=(),
+              max_bytes: int | None = None) -> Model:
     """A spacar :class:`Model` of the fixed-base robot described by the URDF file ``path``: its
     revolute, continuous, prismatic and fixed joints, branches, link inertias (mass, centre of
     mass, inertia tensor with the origin's rpy), joint origins (xyz, rpy) and axes, in the URDF's
@@ -380,6 +486,18 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, max_by
     (``λ̇ = ½ E(λ)ᵀ ω``); no elements can be added to it. Its runs take the recursive path, the
     base the free root of the articulated-body algorithm (docs/robots.md, "Floating base").
 
+    ``loops``: loop joints beside the URDF's tree, which URDF cannot describe (a four-bar knee, a
+    parallel arm): dicts ``{"parent": link, "child": link, "xyz": (x, y, z), "type": "spherical"}``
+    (the point ``xyz`` of the parent link's frame is a point of the child link too: a ball joint,
+    three constraints) or ``"type": "revolute"`` with ``"axis"`` (in the parent link's frame; the
+    links also keep that axis in common: five constraints), optionally a ``"name"``. The point
+    must be where the child's link puts it in the zero configuration too (the loop closed there;
+    otherwise the assembly closes it and warns of the nodes it moved). ``dependent``: the names
+    of the moving joints whose coordinates the loops determine: their rotations (or slides) are
+    released (RLSE) instead of DOFs, so that the DOFs are the other joints, in the same order;
+    element k is still joint k (``model.urdf_joints``). Such a model takes the general path
+    (constraint formulation, exact loops; docs/robots.md, "Closed loops").
+
     The file must be a regular file (a FIFO or a device
     is refused at once) of at most ``max_bytes`` bytes (default :data:`MAX_URDF_BYTES`, 8 MiB).
     """
@@ -408,6 +526,11 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, max_by
     m = Model()
     b = _Builder(m, scale)
     moving = [j for j in order if j.type in MOVING]
+    loop_joints, dependent, constraints = _loop_joints(loops, dependent, links, moving, reader.path)
+    if len(dependent) < constraints:
+        reader.warnings.append(f"the loop joints add {constraints} constraints and {len(dependent)} joints are dependent: "
+                               f"unless {constraints - len(dependent)} of the constraints are redundant (a planar loop "
+                               "closed by a ball joint), the mechanism is over-constrained (name more dependent joints)")
     element_of = {j.name: k for k, j in enumerate(moving, start=1)}
     next_element = len(moving) + 1  # elements 1..n are the joints: the DOFs in their order
     if not isinstance(floating, bool):
@@ -427,32 +550,34 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, max_by
         link_nodes = {root: (n_origin, base.lam)}
     else:
         ground = _Body(np.zeros(3))
-        ground.lam = b.lambda_node(fixed=True)
+        ground.lam = b.ground_lam = b.lambda_node(fixed=True)
         body_of = {root: ground}
         bodies = []
-        n_origin, next_element = b.point(ground, np.zeros(3), True, next_element)
+        n_origin, next_element = b.point(ground, np.zeros(3), next_element)
         link_nodes = {root: (n_origin, ground.lam)}  # (the ground's inertia does not matter)
     for j in order:
         parent = body_of[j.parent]
         R, o = frame[j.child]
-        on_ground = parent is ground
         if j.type == "fixed":
             body_of[j.child] = parent
-            n, next_element = b.point(parent, o, on_ground, next_element)
+            n, next_element = b.point(parent, o, next_element)
         else:
             k = element_of[j.name]
             child = _Body(o)
             child.lam = b.lambda_node()
             axis = R @ j.axis
             if j.type == "prismatic":
-                p, next_element = b.point(parent, o, on_ground, next_element)
+                p, next_element = b.point(parent, o, next_element)
                 n = b.node()
                 m.xyz(n, *o)
                 m.bearing(k, p, parent.lam, n, child.lam, *axis)  # e2..e6 stay fixed
             else:
-                n, next_element = b.point(parent, o, on_ground, next_element)
+                n, next_element = b.point(parent, o, next_element)
                 m.hinge(k, parent.lam, child.lam, *axis)
-            m.dyne(k, 1)
+            if j.name in dependent:
+                m.rlse(k, 1)  # determined by the loops
+            else:
+                m.dyne(k, 1)
             child.points.append((o, n))
             body_of[j.child] = child
             bodies.append(child)
@@ -460,10 +585,13 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, max_by
         if body_of[j.child] is not ground:
             body_of[j.child].add(links[j.child], R, o)
 
+    for loop in loop_joints:
+        next_element = _close_loop(b, loop, body_of, frame, next_element)
+
     for body in bodies:
         c, J = body.centre_and_inertia()
         if c is not None:
-            n, next_element = b.point(body, c, False, next_element)
+            n, next_element = b.point(body, c, next_element)
             b.node_mass[n] = b.node_mass.get(n, 0.0) + body.mass
         if np.any(J):
             m.mass(body.lam, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
