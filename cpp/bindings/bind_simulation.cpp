@@ -395,7 +395,7 @@ py::dict rollout_results_to_dict(RolloutResults&& r) {
   py::dict d;
   d["q"] = std::move(r.q);
   d["qd"] = std::move(r.qd);
-  d["x"] = r.x.size() ? py::cast(std::move(r.x)) : py::none();
+  d["x"] = r.x.cols() ? py::cast(std::move(r.x)) : py::none();  // asked for: (rows × nx), rows maybe 0
   d["rhs_evaluations"] = r.rhs_evaluations;
   d["steps"] = r.steps;
   d["rejected"] = r.rejected;

@@ -34,7 +34,7 @@ class RolloutResults:
         self.q = np.asarray(arrays["q"]).reshape(shape + (n,))
         self.qd = np.asarray(arrays["qd"]).reshape(shape + (n,))
         x = arrays["x"]
-        self.x = None if x is None else np.asarray(x).reshape(shape + (-1,))
+        self.x = None if x is None else np.asarray(x).reshape(shape + (len(rollout.coordinate_labels),))
         self.stats = {"path": arrays["path"], "wall_time": arrays["wall_time"], "method": rollout.method}
         for key in ("rhs_evaluations", "steps", "rejected"):
             self.stats[key] = np.asarray(arrays[key], dtype=np.int64)
@@ -98,10 +98,12 @@ class Rollout:
                                     or threads < 1):
             raise InputError(f"Rollout: threads must be a positive whole number or None, got {show(threads)}")
         self._threads = None if threads is None else int(threads)
-        # The model as it is now, in a copy of the Rollout's own: every thread's simulation is
-        # compiled from it, whatever the user's model becomes.
-        self._core = model.core.copy()
-        self._sims = [_core.Simulation(self._core)]  # prepares the copy (the first END) and compiles it
+        # The model as it is now, in a copy of the Rollout's own, whatever the user's model
+        # becomes. Every thread's simulation prepares (the first END: its Euler parameters
+        # normalized) and compiles a copy of its own of that one, so that all see the same model.
+        self._pristine = model.core.copy()
+        self._cores = [self._pristine.copy()]
+        self._sims = [_core.Simulation(self._cores[0])]
         system = self._sims[0].system
         self.n_dof = system.n_dof
         if self.n_dof == 0:
@@ -111,6 +113,7 @@ class Rollout:
         settings = model.core.settings
         n_out = settings.timestep_n
         self._times = model.current_time + settings.timestep_tp * np.arange(n_out + 1) / max(n_out, 1)
+        self._times[-1] = model.current_time + settings.timestep_tp  # the block's end exactly
         coords = system.coord_label
         self.coordinate_labels = [tuple(c) for c in coords]
         self.dof_labels = dof_labels(system, model.core, coords)
@@ -125,23 +128,33 @@ class Rollout:
         with self._lock:
             parts = self._parts(q0.shape[0])
             while len(self._sims) < len(parts):
-                self._sims.append(_core.Simulation(self._core))
+                self._cores.append(self._pristine.copy())
+                self._sims.append(_core.Simulation(self._cores[-1]))
+            cancel = _core.Cancellation()
 
             def run(k):
                 a, b = parts[k]
                 try:
-                    return self._sims[k].rollout(q0[a:b], qd0[a:b], times, method=self.method,
-                                                 recursive=self._recursive, rho_inf=self._rho_inf,
-                                                 fixed_step=self._fixed_step, coordinates=bool(coordinates),
-                                                 time_limit=limit)
+                    with cancel.watch():  # Ctrl-C (the main thread's) stops the other threads too
+                        return self._sims[k].rollout(q0[a:b], qd0[a:b], times, method=self.method,
+                                                     recursive=self._recursive, rho_inf=self._rho_inf,
+                                                     fixed_step=self._fixed_step, coordinates=bool(coordinates),
+                                                     time_limit=limit)
                 except SpacarError as err:
                     return err
 
             if len(parts) == 1:
                 outcomes = [run(0)]
             else:
-                with ThreadPoolExecutor(len(parts)) as pool:  # the core releases the GIL
-                    outcomes = list(pool.map(run, range(len(parts))))
+                pool = ThreadPoolExecutor(len(parts))  # the core releases the GIL
+                try:
+                    futures = [pool.submit(run, k) for k in range(len(parts))]
+                    outcomes = [f.result() for f in futures]
+                except KeyboardInterrupt:
+                    cancel.cancel()
+                    raise
+                finally:
+                    pool.shutdown(wait=True, cancel_futures=True)
         arrays = _joined(outcomes, parts)
         if isinstance(arrays, SpacarError):
             err = arrays
@@ -157,7 +170,7 @@ class Rollout:
         """The batch's contiguous parts [(first, end)], one per thread."""
         threads = self._threads
         if threads is None:
-            cores = os.cpu_count() or 1
+            cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
             threads = cores if states >= 8 * cores else 1
         threads = max(1, min(threads, states))
         return [(k * states // threads, (k + 1) * states // threads) for k in range(threads)]
@@ -184,13 +197,12 @@ class Rollout:
         rows = max((a.shape[0] for a in given if a is not None and a.ndim == 2), default=1)
         out = []
         for a, default in zip(given, (self._q0, self._qd0)):
-            a = default if a is None else a
-            a = np.atleast_2d(a)
-            if a.shape[0] == 1 and rows > 1:
-                a = np.repeat(a, rows, axis=0)
-            elif a.shape[0] != rows:
+            a = np.atleast_2d(default if a is None else a)
+            if a.shape[0] != rows and a.shape[0] != 1:
                 raise InputError(f"Rollout: q0 and qd0 must have the same number of states (rows), got "
                                  f"{given[0].shape[0]} and {given[1].shape[0]}")
+            if a.shape[0] != rows:  # one state for all (a vector, or the model's)
+                a = np.repeat(a, rows, axis=0)
             out.append(np.ascontiguousarray(a))
         return out[0], out[1], batch
 

@@ -42,7 +42,7 @@ Simulation::BlockPlan Simulation::plan_rollout(const RowMatrix& q0, const RowMat
   plan.t_end = times.back();
   plan.times = times;
   plan.integrate = times.size() > 1;
-  if (plan.integrate) plan_integration(options, plan, interval, kRolloutNames, warnings);
+  if (plan.integrate) plan_integration(options, plan, times.back() - times.front(), interval, kRolloutNames, warnings);
   return plan;
 }
 
@@ -67,7 +67,8 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
   run_.chord = options.chord;
   run_.fixed_step = plan.fixed_step;
   const DeadlineScope deadline(options.time_limit, options.time_spent);
-  const bool recursive = plan.integrate && options.recursive && timed_.empty();  // the tree knows no time loads
+  // The path of the rollouts to come, whatever this one's times: the tree knows no time loads.
+  const bool recursive = options.recursive && timed_.empty();
   if (!rollout_.ready || rollout_.recursive != options.recursive) {
     assemble();
     rollout_.path = RhsPath::choose(*sys_, *data_, recursive);
@@ -77,6 +78,10 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
     rollout_.data = std::make_unique<Data>(*data_);
     rollout_.dependent = dependent_;
     rollout_.x_dyn = sys_->x_dyn;
+    rollout_.sign_of.assign(sys_->x_dyn.size(), -1);
+    for (const FreeRotation& fr : sys_->free_rotations)
+      for (size_t j = 0; j < sys_->x_dyn.size(); ++j)
+        if (sys_->x_dyn[j] >= fr.coord && sys_->x_dyn[j] < fr.coord + 4) rollout_.sign_of[j] = fr.coord + fr.dependent;
     rollout_.recursive = options.recursive;
     rollout_.ready = true;
   }
@@ -89,8 +94,10 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
   } swap(path_, rollout_.path);
   res.path = path_->name();
   Eigen::VectorXd Y(2 * nd + ny);
+  long repartitions = repartitions_;  // a state whose run repartitioned leaves another system
   for (Eigen::Index s = 0; s < states; ++s) {
-    if (dependent_ != rollout_.dependent) restore_rollout_partition(recursive);
+    if (repartitions_ != repartitions) restore_rollout_partition(recursive);
+    repartitions = repartitions_;
     const bool tree = path_->tree() != nullptr;
     run_.base = rollout_.assembled;  // Newton's start on the general path: the assembly
     run_.anchor = Solved();
@@ -110,7 +117,7 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
       // The coordinates of every node, when asked for or when the state's DOFs are no longer
       // those it started with (another dependent Euler parameter): the tree's explicit
       // positions, else the general path's solved state.
-      const bool repartitioned = dependent_ != rollout_.dependent;
+      const bool repartitioned = repartitions_ != repartitions;
       if (coordinates || repartitioned) {
         const Eigen::VectorXd* x = &data_->x;
         const Eigen::VectorXd* xd = &data_->xd;
@@ -122,8 +129,10 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
         }
         if (coordinates) res.x.row(row) = x->transpose();
         for (size_t j = 0; j < rollout_.x_dyn.size() && repartitioned; ++j) {
-          res.q(row, static_cast<Eigen::Index>(j)) = (*x)[rollout_.x_dyn[j]];
-          res.qd(row, static_cast<Eigen::Index>(j)) = (*xd)[rollout_.x_dyn[j]];
+          const int dep = rollout_.sign_of[j];
+          const double sign = dep >= 0 && (*x)[dep] < 0.0 ? -1.0 : 1.0;
+          res.q(row, static_cast<Eigen::Index>(j)) = sign * (*x)[rollout_.x_dyn[j]];
+          res.qd(row, static_cast<Eigen::Index>(j)) = sign * (*xd)[rollout_.x_dyn[j]];
         }
       }
       if (!res.q.row(row).allFinite() || !res.qd.row(row).allFinite())
@@ -142,14 +151,14 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
         if (m->size()) m->conservativeResize(s * nt, m->cols());
       res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       run_.fixed_step = 0.0;
-      if (dependent_ != rollout_.dependent) restore_rollout_partition(recursive);
+      if (repartitions_ != repartitions) restore_rollout_partition(recursive);
       throw;
     }
     res.rhs_evaluations.push_back(counters.rhs_evaluations);
     res.steps.push_back(counters.steps);
     res.rejected.push_back(counters.rejected);
   }
-  if (dependent_ != rollout_.dependent) restore_rollout_partition(recursive);
+  if (repartitions_ != repartitions) restore_rollout_partition(recursive);
   run_.fixed_step = 0.0;
   res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

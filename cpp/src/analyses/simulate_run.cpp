@@ -159,7 +159,7 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
   if (options.sample_period > 0.0 && st.timestep_tp / options.sample_period > static_cast<double>(options.max_steps))
     throw InputError("the controller's sample period " + format_number(options.sample_period, 12) + " needs more than " +
                      std::to_string(options.max_steps) + " samples in the block");
-  if (plan.integrate) plan_integration(options, plan, st.timestep_tp / n_out, kBlockNames, warnings);
+  if (plan.integrate) plan_integration(options, plan, st.timestep_tp, st.timestep_tp / n_out, kBlockNames, warnings);
   const int nt = n_out + 1;
   plan.times.resize(nt);
   for (int k = 0; k < nt; ++k) plan.times[k] = n_out ? t0 + st.timestep_tp * k / n_out : t0;
@@ -169,10 +169,10 @@ Simulation::BlockPlan Simulation::plan_block(const RunOptions& options, std::vec
 
 // The checks of an integration from plan.t0 to plan.t_end with outputs `interval` apart (the
 // shortest interval), before any work; generalized-α's fixed step and the tolerances into plan.
-void Simulation::plan_integration(const RunOptions& options, BlockPlan& plan, double interval,
+void Simulation::plan_integration(const RunOptions& options, BlockPlan& plan, double tp, double interval,
                                   const PeriodNames& names, std::vector<std::string>& warnings) const {
   Settings& st = plan.st;
-  const double t0 = plan.t0, t_end = plan.t_end, tp = t_end - t0;
+  const double t0 = plan.t0, t_end = plan.t_end;
   refuse_large_massless(*sys_, t0);  // before the assembly, which can take seconds at that size
   const double h_min = Stepper::min_step(t_end);
   if (tp < h_min)
@@ -507,6 +507,7 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   for (int i = 1; i < 4; ++i)
     if (std::abs(data_->x[fr.coord + i]) > std::abs(data_->x[fr.coord + best])) best = i;
   dependent_[fr.node] = best;
+  ++repartitions_;
   linearizer_.reset();
   const Eigen::VectorXd x = data_->x, xd = data_->xd, e = data_->e, ed = data_->ed, angles = data_->angle_ref,
                         integrated = data_->e_integrated;

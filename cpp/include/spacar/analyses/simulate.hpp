@@ -365,9 +365,10 @@ class Simulation {
     const char* run;        // "block"
   };
   static constexpr PeriodNames kBlockNames{"TIMESTEP: the period Tp =", "Tp", "Tp/n", "block"};
-  static constexpr PeriodNames kRolloutNames{"the span of the output times T =", "T", "(the shortest)", "state"};
-  void plan_integration(const RunOptions& options, BlockPlan& plan, double interval, const PeriodNames& names,
-                        std::vector<std::string>& warnings) const;
+  static constexpr PeriodNames kRolloutNames{"the span of the output times T =", "T", "Δt", "state"};
+  // tp: the period as given (TIMESTEP's Tp; not t_end − t0, rounded).
+  void plan_integration(const RunOptions& options, BlockPlan& plan, double tp, double interval,
+                        const PeriodNames& names, std::vector<std::string>& warnings) const;
   static double planned_fixed_step(const RunOptions& options, double t_end, double tp, double interval,
                                    const PeriodNames& names, std::vector<std::string>& warnings);
   void allocate_results(BlockResults& res, const BlockPlan& plan) const;
@@ -460,7 +461,13 @@ class Simulation {
     // coordinates (global indices), in which the states are recorded.
     std::map<int, int> dependent;
     std::vector<int> x_dyn;
+    // Per DOF coordinate of x_dyn: the coordinate of its free rotation's dependent Euler parameter
+    // in that partition (−1: not an Euler parameter). Where that parameter has become negative,
+    // the state is recorded with the opposite Euler parameters (the same orientation), so that the
+    // recorded q restarts a run in the same orientation.
+    std::vector<int> sign_of;
   } rollout_;
+  long repartitions_ = 0;  // repartition() calls: a rollout restores its partition after any
   // After a state whose run exchanged a dependent Euler parameter: the system, data and path of
   // the rollout's partition again.
   void restore_rollout_partition(bool recursive);
