@@ -275,7 +275,20 @@ def derivatives_batch(path, pm, pd, n_states=1000):
                             repeat=REPEAT, budget=BUDGET, min_time=MIN_TIME)
     C.log(f"derivatives of {n_states} states: spacar {t_ours * 1e3:.2f} ms, Pinocchio {t_pin * 1e3:.2f} ms; "
           f"inverse dynamics: spacar {t_id * 1e3:.2f} ms, Pinocchio rnea {t_rnea * 1e3:.2f} ms")
-    return {"states": n_states, "spacar": t_ours, "pinocchio": t_pin, "spacar_id": t_id, "pinocchio_rnea": t_rnea}
+    # One state per call, as a controller or an optimizer's step calls them: the functions (their
+    # set-up at every call) and a spacar.Dynamics made once, against Pinocchio's calls.
+    dyn = spacar.Dynamics(model)
+    assert np.abs(dyn.dynamics_derivatives(q[0], qd[0], tau[0])[1] - ours[1][0]).max() == 0.0
+    one = {"function": lambda: spacar.dynamics_derivatives(model, q[0], qd[0], tau[0]),
+           "handle": lambda: dyn.dynamics_derivatives(q[0], qd[0], tau[0]),
+           "function_id": lambda: spacar.inverse_dynamics(model, q[0], qd[0], tau[0]),
+           "handle_id": lambda: dyn.inverse_dynamics(q[0], qd[0], tau[0]),
+           "pinocchio": lambda: pin.computeABADerivatives(pm, pd, pin_q[0], qd[0], tau[0]),
+           "pinocchio_rnea": lambda: pin.rnea(pm, pd, pin_q[0], qd[0], tau[0])}
+    per_call = {k: C.per_call(f, min_time=0.2) for k, f in one.items()}
+    C.log("one state per call: " + ", ".join(f"{k} {v * 1e6:.1f} µs" for k, v in per_call.items()))
+    return {"states": n_states, "spacar": t_ours, "pinocchio": t_pin, "spacar_id": t_id, "pinocchio_rnea": t_rnea,
+            "per_call": per_call}
 
 
 def run(a) -> dict:
@@ -319,6 +332,19 @@ def section(r: dict, plots=None) -> str:
                          f"{C.fmt_time(d['pinocchio_rnea'])} | {C.fmt_ratio(d['pinocchio_rnea'], d['spacar_id'])} |")
     lines += ["", "Issue 37 target, a batch of 1000 derivative evaluations of the UR5 no slower than 1000 calls of "
               "computeABADerivatives: " + derivatives_verdict(r) + "."]
+    if any("per_call" in (x.get("derivatives") or {}) for x in r["robots"].values()):
+        lines += ["", "**One state per call** (as a controller's or an optimizer's step calls them): the functions "
+                  "`spacar.dynamics_derivatives` and `spacar.inverse_dynamics`, which compile and assemble the model "
+                  "at every call, a `spacar.Dynamics` made once, and Pinocchio's calls:", "",
+                  "| robot | derivatives: function | `Dynamics` | Pinocchio | Pinocchio / `Dynamics` | inverse "
+                  "dynamics: function | `Dynamics` | `rnea` | `rnea` / `Dynamics` |", "|---|---|---|---|---|---|---|---|---|"]
+        for name, x in r["robots"].items():
+            c = (x.get("derivatives") or {}).get("per_call")
+            if c:
+                lines.append(f"| {name} | {C.fmt_time(c['function'])} | {C.fmt_time(c['handle'])} | "
+                             f"{C.fmt_time(c['pinocchio'])} | {C.fmt_ratio(c['pinocchio'], c['handle'])} | "
+                             f"{C.fmt_time(c['function_id'])} | {C.fmt_time(c['handle_id'])} | "
+                             f"{C.fmt_time(c['pinocchio_rnea'])} | {C.fmt_ratio(c['pinocchio_rnea'], c['handle_id'])} |")
     f = r.get("floating")
     if f:
         lines += ["", "**A floating base.** " + run_floating.__doc__.replace("\n    ", " ") + " Time to a target: "

@@ -21,7 +21,7 @@ from . import flexure, mechanism, notebook, section, sensitivity
 from .check import Check, Diagnosis, Summary, check, summary
 from .compliance import compliance, support_stiffness
 from .control import Controller
-from .dynamics import dynamics_derivatives, inverse_dynamics
+from .dynamics import Dynamics, dynamics_derivatives, inverse_dynamics
 from .energy import Energy
 from .table import Table
 from .errors import (
@@ -124,6 +124,7 @@ __all__ = [
     "RolloutResults",
     "inverse_dynamics",
     "dynamics_derivatives",
+    "Dynamics",
     "static",
     "StaticError",
     "compliance",

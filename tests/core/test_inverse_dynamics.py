@@ -13,7 +13,7 @@ import spacar
 from spacar import InputError, _core
 from spacar.compare import models
 from support import trees
-from support.paths import DATA
+from support.paths import DATA, EXAMPLES
 
 MODELS = {
     "planar branched tree, springs": lambda: trees.planar_branched_tree(spring=False),
@@ -142,3 +142,40 @@ def test_dynamics_derivatives_agree_with_the_inverse_dynamics_and_differences(na
                  - spacar.dynamics_derivatives(model, q, qd - e, tau)[0]) / (2 * h)
         assert np.abs(dq[:, j] - fd_q).max() <= 1e-6 * max(1.0, np.abs(dq).max())
         assert np.abs(dqd[:, j] - fd_qd).max() <= 1e-6 * max(1.0, np.abs(dqd).max())
+
+
+@pytest.mark.parametrize("name", ["spatial chain", "planar chain, absolute rotations, springs"])
+def test_a_dynamics_handle_equals_the_functions(name):
+    """spacar.Dynamics (set up once) gives the functions' numbers, call after call, on a copy of
+    the model (a later change of the model is not seen)."""
+    model = MODELS[name]()
+    dyn = spacar.Dynamics(model)
+    assert dyn.path == "tree"
+    rng = np.random.default_rng(4)
+    n = dyn.n_dof
+    q, qd, qdd = (rng.uniform(-1.0, 1.0, (3, n)) for _ in range(3))
+    tau = spacar.inverse_dynamics(model, q, qd, qdd)
+    for _ in range(2):
+        assert np.array_equal(dyn.inverse_dynamics(q, qd, qdd), tau)
+        for ours, theirs in zip(dyn.dynamics_derivatives(q, qd, tau), spacar.dynamics_derivatives(model, q, qd, tau)):
+            assert np.array_equal(ours, theirs)
+    np.testing.assert_allclose(dyn.dynamics_derivatives(q[0], qd[0], tau[0])[0], qdd[0], rtol=0, atol=1e-10)
+    model.gravity(*([0.0] * (3 if "spatial" in name else 2)))
+    assert np.array_equal(dyn.inverse_dynamics(q, qd, qdd), tau)
+    assert len(dyn.dof_labels) == n
+
+
+def test_a_dynamics_handle_on_the_general_path_forgets_its_calls():
+    """On the general path each call starts Newton's iterations from the assembled positions: a
+    call's forces do not depend on the calls before it."""
+    model = spacar.read(EXAMPLES / "slidercrank.dat")
+    dyn = spacar.Dynamics(model)
+    assert dyn.path == "general"
+    n = dyn.n_dof
+    q = np.linspace(0.0, 1e-3, 3 * n).reshape(3, n)
+    qd = np.zeros((3, n))
+    qdd = np.ones((3, n))
+    first = dyn.inverse_dynamics(q[2], qd[2], qdd[2])
+    dyn.inverse_dynamics(q, qd, qdd)
+    assert np.array_equal(dyn.inverse_dynamics(q[2], qd[2], qdd[2]), first)
+    np.testing.assert_allclose(first, spacar.inverse_dynamics(model, q[2], qd[2], qdd[2]), rtol=1e-9, atol=1e-12)
