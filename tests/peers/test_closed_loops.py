@@ -19,6 +19,7 @@ import pytest
 
 import spacar
 from spacar.compare import models
+from support.constraints import constrained
 from support.spatial_models import RSSR, rssr_model, unit
 
 pin = pytest.importorskip("pinocchio")
@@ -34,25 +35,6 @@ def rod(mass_per_length, p0, p1, origin):
     u = d / length
     m = mass_per_length * length
     return pin.Inertia(m, (p0 + p1) / 2 - origin, m * length**2 / 12 * (np.eye(3) - np.outer(u, u)))
-
-
-def constrained(model, joint1, point1, joint2, point2):
-    """Pinocchio's data and a solver of its constrained dynamics with a 3-D point constraint
-    between point1 (in joint1's frame) and point2 (in joint2's)."""
-    data = model.createData()
-    cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, model, joint1, pin.SE3(np.eye(3), point1),
-                                  joint2, pin.SE3(np.eye(3), point2), pin.ReferenceFrame.LOCAL)
-    cms = pin.StdVec_RigidConstraintModel()
-    cms.append(cm)
-    cds = pin.StdVec_RigidConstraintData()
-    cds.append(cm.createData())
-    pin.initConstraintDynamics(model, data, cms, cds)
-    settings = pin.ProximalSettings(1e-14, 1e-12, 100)
-
-    def accelerations(q, v):
-        return pin.constraintDynamics(model, data, q, v, np.zeros(model.nv), cms, cds, settings)
-
-    return accelerations
 
 
 def tight(model):
