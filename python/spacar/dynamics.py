@@ -63,8 +63,8 @@ class Dynamics:
     def __init__(self, model: Model, *, _copy: bool = True):
         if not isinstance(model, Model):
             raise InputError(f"Dynamics: model must be a spacar.Model, got {show(model)}")
-        self._core = model.core.copy() if _copy else model.core
-        self._sim = _core.Simulation(self._core)  # prepares the model (the first END) and compiles it
+        self._model_core = model.core.copy() if _copy else model.core
+        self._sim = _core.Simulation(self._model_core)  # prepares the model (the first END) and compiles it
         self._sim.assemble()
         self._assembled = True
         self.n_dof = self._sim.system.n_dof
@@ -81,7 +81,7 @@ class Dynamics:
 
     @property
     def dof_labels(self) -> list:
-        return dof_labels(self._sim.system, self._core)
+        return dof_labels(self._sim.system, self._model_core)
 
     def inverse_dynamics(self, q, qd, qdd, *, time_limit=None) -> np.ndarray:
         """:func:`inverse_dynamics` at these states."""
@@ -105,7 +105,7 @@ class Dynamics:
         """After a general-path call (its Newton iterations moved the positions): the simulation
         made and assembled again, as at the start."""
         if not self._assembled:
-            self._sim = _core.Simulation(self._core)
+            self._sim = _core.Simulation(self._model_core)
             self._sim.assemble()
             self._assembled = True
 
