@@ -95,6 +95,12 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
   res.path = path_->name();
   Eigen::VectorXd Y(2 * nd + ny);
   long repartitions = repartitions_;  // a state whose run repartitioned leaves another system
+  // After the last state, or a failed one: the rollout's partition again, the run's fixed step off.
+  auto finish = [&]() {
+    if (repartitions_ != repartitions) restore_rollout_partition(recursive);
+    run_.fixed_step = 0.0;
+    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   for (Eigen::Index s = 0; s < states; ++s) {
     if (repartitions_ != repartitions) restore_rollout_partition(recursive);
     repartitions = repartitions_;
@@ -102,10 +108,11 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
     run_.base = rollout_.assembled;  // Newton's start on the general path: the assembly
     run_.anchor = Solved();
     run_.kinematic_failure.clear();
-    if (!tree) *data_ = *rollout_.data;
     if (tree) {
       run_.base.xd = run_.base.xdd = Eigen::VectorXd::Zero(sys_->nx);
       run_.base.t = plan.t0;
+    } else {
+      *data_ = *rollout_.data;
     }
     Y << q0.row(s).transpose(), sys_->y0, qd0.row(s).transpose();
     int k = 0;
@@ -149,29 +156,20 @@ void Simulation::rollout(const RowMatrix& q0, const RowMatrix& qd0, const std::v
       res.failed = static_cast<long>(s);
       for (RowMatrix* m : {&res.q, &res.qd, &res.x})
         if (m->size()) m->conservativeResize(s * nt, m->cols());
-      res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      run_.fixed_step = 0.0;
-      if (repartitions_ != repartitions) restore_rollout_partition(recursive);
+      finish();
       throw;
     }
     res.rhs_evaluations.push_back(counters.rhs_evaluations);
     res.steps.push_back(counters.steps);
     res.rejected.push_back(counters.rejected);
   }
-  if (repartitions_ != repartitions) restore_rollout_partition(recursive);
-  run_.fixed_step = 0.0;
-  res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  finish();
 }
 
 void Simulation::restore_rollout_partition(bool recursive) {
   dependent_ = rollout_.dependent;
-  sys_ = compile(model_, dependent_);
-  data_ = std::make_unique<Data>(*sys_);
+  recompile();
   *data_ = *rollout_.data;
-  linearizer_.reset();
-  have_transfer_ = false;
-  run_.newton_data.reset();
-  run_.newton_system.reset();
   // The tree of this partition, recognized again at the assembled state (repartition() left
   // the other partition's).
   path_ = RhsPath::choose(*sys_, *data_, recursive);

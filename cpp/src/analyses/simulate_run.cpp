@@ -500,6 +500,13 @@ int Simulation::rotation_to_repartition(const Eigen::VectorXd& Y) const {
   return -1;
 }
 
+void Simulation::recompile() {
+  sys_ = compile(model_, dependent_);
+  data_ = std::make_unique<Data>(*sys_);
+  linearizer_.reset();
+  have_transfer_ = false;
+}
+
 void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   evaluate_state(t, Y);
   const FreeRotation fr = sys_->free_rotations[which];
@@ -508,12 +515,10 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
     if (std::abs(data_->x[fr.coord + i]) > std::abs(data_->x[fr.coord + best])) best = i;
   dependent_[fr.node] = best;
   ++repartitions_;
-  linearizer_.reset();
   const Eigen::VectorXd x = data_->x, xd = data_->xd, e = data_->e, ed = data_->ed, angles = data_->angle_ref,
                         integrated = data_->e_integrated;
   const long newton = data_->total_newton_iterations;
-  sys_ = compile(model_, dependent_);
-  data_ = std::make_unique<Data>(*sys_);
+  recompile();
   data_->x = x;
   data_->angle_ref = angles;
   data_->e_integrated = integrated;
@@ -525,7 +530,6 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
   // tree is recognized again below, its DOFs being other Euler parameters now.
   const bool tree = path_->tree() != nullptr;
   if (path_->residual_form() || tree) path_ = RhsPath::chain_or_general(*sys_);
-  have_transfer_ = false;
   // Same sizes: the new partition only exchanges which Euler parameter is calculable.
   const System& sys = *sys_;
   const int n = sys.n_dof(), ny = static_cast<int>(sys.y_defs.size());

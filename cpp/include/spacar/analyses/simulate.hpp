@@ -407,6 +407,9 @@ class Simulation {
   // The tree of rigid bodies of the system, detected at the current state on the first call
   // and kept until the next run; nullptr if the system is not one.
   RecursiveTree* recursive_tree();
+  // The system of the partition dependent_ compiled again, with fresh data; the linearizer and
+  // the transfer functions of the old one dropped.
+  void recompile();
   // Make the largest Euler parameter of that node the dependent one: recompile the system and
   // map the state (t, Y) to the new degrees of freedom.
   void repartition(int which, double t, Eigen::VectorXd& Y);
