@@ -108,8 +108,8 @@ class Rollout:
         self.n_dof = system.n_dof
         if self.n_dof == 0:
             raise InputError("Rollout: the model has no degrees of freedom to integrate")
-        self._q0, self._qd0 = np.array(system.q0, dtype=float), np.array(system.qd0, dtype=float)
-        self._initial = (self._q0.reshape(1, -1), self._qd0.reshape(1, -1))
+        # The model's initial DOFs and rates, one state each (2-D).
+        self._initial = (np.array(system.q0, dtype=float).reshape(1, -1), np.array(system.qd0, dtype=float).reshape(1, -1))
         settings = model.core.settings
         n_out = settings.timestep_n
         self._times = model.current_time + settings.timestep_tp * np.arange(n_out + 1) / max(n_out, 1)
@@ -181,7 +181,7 @@ class Rollout:
         if q0 is None and qd0 is None:
             return self._initial[0], self._initial[1], False
         given = []
-        for name, value, default in (("q0", q0, self._q0), ("qd0", qd0, self._qd0)):
+        for name, value in (("q0", q0), ("qd0", qd0)):
             if value is None:
                 given.append(None)
                 continue
@@ -196,7 +196,7 @@ class Rollout:
         batch = any(a is not None and a.ndim == 2 for a in given)
         rows = max((a.shape[0] for a in given if a is not None and a.ndim == 2), default=1)
         out = []
-        for a, default in zip(given, (self._q0, self._qd0)):
+        for a, default in zip(given, self._initial):
             a = np.atleast_2d(default if a is None else a)
             if a.shape[0] != rows and a.shape[0] != 1:
                 raise InputError(f"Rollout: q0 and qd0 must have the same number of states (rows), got "
@@ -224,24 +224,24 @@ def _joined(outcomes: list, parts: list):
     """The parts' results as one (their rows and per-state counters in order), or the error of
     the first part that failed, its partial results joined to the parts before it and its failed
     state numbered in the whole batch."""
-    keys = ("q", "qd", "x")
     done = []
     for (a, _), out in zip(parts, outcomes):
         if isinstance(out, SpacarError):
             partial = getattr(out, "results", None)
             if isinstance(partial, dict) and partial["failed"] >= 0:
                 partial["failed"] += a
-                out.results = _concatenated(done + [partial], keys)
+                out.results = _concatenated(done + [partial])
             return out
         done.append(out)
-    return _concatenated(done, keys)
+    return _concatenated(done)
 
 
-def _concatenated(parts: list, keys) -> dict:
+def _concatenated(parts: list) -> dict:
+    """The parts' results (dicts of the core's rollout) as one: rows and counters in order."""
     if len(parts) == 1:
         return parts[0]
     out = dict(parts[-1])
-    for key in keys:
+    for key in ("q", "qd", "x"):
         out[key] = None if parts[0][key] is None else np.concatenate([np.asarray(p[key]) for p in parts])
     for key in ("rhs_evaluations", "steps", "rejected"):
         out[key] = [n for p in parts for n in p[key]]

@@ -388,6 +388,15 @@ def _close_loop(b: _Builder, loop: dict, body_of: dict, frame: dict, next_elemen
 MAX_URDF_BYTES = 8 * 2**20
 
 
+def _three_numbers(value):
+    """value as an array of three finite floats, or None."""
+    try:
+        v = np.array([float(x) for x in value])
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer beyond double
+        return None
+    return v if v.shape == (3,) and np.isfinite(v).all() else None
+
+
 _LOOP_KEYS = {"parent", "child", "xyz", "type", "axis", "name"}
 LOOP_TYPES = ("spherical", "revolute")
 
@@ -424,11 +433,8 @@ def _loop_joints(loops, dependent, links, moving, path) -> tuple:
             if value is None:
                 values[key] = None
                 continue
-            try:
-                v = np.array([float(x) for x in value])
-            except (TypeError, ValueError, OverflowError):
-                v = np.array([])
-            if v.shape != (3,) or not np.isfinite(v).all():
+            v = _three_numbers(value)
+            if v is None:
                 fail(f"{name}: {key} must be three finite numbers, got {show(value)}")
             values[key] = v
         if kind == "revolute":
@@ -503,11 +509,8 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, loops=
     """
     if not isinstance(path, (str, os.PathLike)) or "\x00" in os.fspath(path):
         raise InputError(f"from_urdf needs the path of a URDF file, got {show(path)}")
-    try:
-        g = np.array([float(v) for v in gravity])
-    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer beyond double
-        g = np.array([])
-    if g.shape != (3,) or not np.isfinite(g).all():
+    g = _three_numbers(gravity)
+    if g is None:
         raise InputError(f"gravity must be three finite numbers (gx, gy, gz), got {show(gravity)}")
     limit = MAX_URDF_BYTES if max_bytes is None else max_bytes
     if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
