@@ -37,9 +37,8 @@ namespace spacar {
 class GeneralizedAlpha : public Stepper {
  public:
   // n states, of which the first m are positions with rates at rate_offset .. rate_offset + m − 1
-  // (m ≤ rate_offset ≤ n − m); rho_inf in [0, 1]. The tolerances (Stepper::set_tolerances) are
-  // not mapped: sc = atol + rtol |y|; the method has order 2 and the global error follows rtol
-  // roughly in proportion.
+  // (m ≤ rate_offset ≤ n − m); rho_inf in [0, 1]. Below kProportionalFrom the tolerances
+  // (Stepper::set_tolerances) are tightened for tolerance proportionality (tolerances_set).
   GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf);
   // The stepper of GENERALIZED_ALPHA for a run (the method table, stepper.cpp).
   static std::unique_ptr<Stepper> make(Method method, const StepperSetup& setup);
@@ -69,6 +68,8 @@ class GeneralizedAlpha : public Stepper {
 
   // The hooks of Stepper::integrate.
   void check_ready() const override;
+  void tolerances_set() override;
+  void map_tolerances();
   void begin() override;
   bool start(const Rhs& f, double t0, const Eigen::VectorXd& y) override;
   double first_step(const Rhs& f, double t0, double t_end, const Eigen::VectorXd& y) override;
@@ -95,6 +96,7 @@ class GeneralizedAlpha : public Stepper {
   int m_, r0_, nz_;
   double alpha_m_, alpha_f_, gamma_, beta_, gamma_d_, beta_d_;
   double h_fixed_ = 0.0;
+  Eigen::VectorXd rtol_asked_, atol_asked_;  // the tolerances as set, before tolerances_set's map
   std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)> position_error_;  // StepperSetup's
   Eigen::VectorXd dq_, dx_;  // its argument and result
   Residual residual_;
