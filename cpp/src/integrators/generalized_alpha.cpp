@@ -133,10 +133,14 @@ void GeneralizedAlpha::factorize(double h) {
     system_.factorize(gh, bh2);
     return;
   }
+  const int r = r0_ - m_;
   N_ = -gh * J_.bottomRightCorner(nz_, nz_);
   N_.diagonal().array() += 1.0;
-  N_.middleCols(r0_ - m_, m_) -= bh2 * J_.bottomLeftCorner(nz_, m_);
-  if (in_residual_form_) N_.middleRows(r0_ - m_, m_) = (W_ * N_.middleRows(r0_ - m_, m_)).eval();
+  N_.middleCols(r, m_) -= bh2 * J_.bottomLeftCorner(nz_, m_);
+  if (in_residual_form_) {  // the rates' rows W_v (I − γ′h ∂f/∂Z − β′h² ∂f/∂q) from the products kept
+    N_.middleRows(r, m_) = -gh * WJz_;
+    N_.block(r, r, m_, m_) += W_ - bh2 * WJq_;
+  }
   lu_.compute(N_);
 }
 
@@ -347,6 +351,9 @@ GeneralizedAlpha::Attempt GeneralizedAlpha::attempt(const Rhs& f, double t, doub
       if (W_.rows() != m_ || W_.cols() != m_ || !W_.allFinite())
         throw IntegrationError("GeneralizedAlpha: the residual's weight is not a finite " + std::to_string(m_) + " x " +
                                std::to_string(m_) + " matrix at " + describe_step(t, h_try));
+      const int r = r0_ - m_;
+      WJz_.noalias() = W_ * J_.bottomRightCorner(nz_, nz_).middleRows(r, m_);
+      WJq_.noalias() = W_ * J_.bottomLeftCorner(nz_, m_).middleRows(r, m_);
     }
     need_jacobian_ = false;
     jacobian_fresh_ = true;

@@ -116,6 +116,9 @@ class GeneralizedAlpha : public Stepper {
 
   // Work space, allocated once. d_: D at the step start, a_: A there; d_new_, a_new_: at its end.
   Eigen::MatrixXd J_, N_, W_;  // W_: W_v at the Jacobian's state (residual form)
+  // The rates' rows of W_v ∂f_Z/∂Z and W_v ∂f_Z/∂q (m × nz, m × m), formed once per Jacobian: the
+  // residual form's Newton matrix for a step h is then a sum, not a product (factorize).
+  Eigen::MatrixXd WJz_, WJq_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   Eigen::VectorXd d_, a_, a_use_, d_new_, a_new_, d_prev_, dd_, y_new_, fy_, res_, scale_, y_out_, wv_;
 };
