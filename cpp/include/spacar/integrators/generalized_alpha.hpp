@@ -96,6 +96,8 @@ class GeneralizedAlpha : public Stepper {
   int m_, r0_, nz_;
   double alpha_m_, alpha_f_, gamma_, beta_, gamma_d_, beta_d_;
   double h_fixed_ = 0.0;
+  double h_refused_ = 0.0;    // the last step the kinematics or Newton refused (0: none yet)
+  double newton_tol_ = 0.02;  // Newton's stop, in units of the tolerance (map_tolerances)
   Eigen::VectorXd rtol_asked_, atol_asked_;  // the tolerances as set, before tolerances_set's map
   std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)> position_error_;  // StepperSetup's
   Eigen::VectorXd dq_, dx_;  // its argument and result
