@@ -163,7 +163,7 @@ def test_a_loose_tolerance_on_a_fine_mesh_takes_few_steps(eps):
     # unresolved modes made states the kinematics refused, and the step grew back at once to the
     # one refused: 18 533 steps, 10 882 refused, 14 s (EPS 0.01: 106 steps). Newton now stops at
     # no looser a relative tolerance than 2e-4, and after a refused step the steps grow back
-    # slowly: about 70 steps.
+    # slowly: about 60 steps.
     res = spacar.simulate(models.cantilever(128, ei=175.0, rho_a=0.785, t_end=0.2, eps=eps),
                           method="generalized_alpha", progress=False, time_limit=20)
     assert res.t[-1] == pytest.approx(0.2) and np.isfinite(res.x).all()

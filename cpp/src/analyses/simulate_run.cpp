@@ -342,8 +342,9 @@ void Simulation::integrate_segments(BlockResults& res, const RunOptions& options
 
 bool Simulation::auto_takes_generalized_alpha() const {
   const System& sys = *sys_;
-  // Below 1e-6 generalized-α's steps grow as EPS^(-1/3) and its error stops following EPS
-  // (docs/stiff-integration.md): radau5 and dop853 are the methods for tight tolerances.
+  // Below 1e-6 generalized-α's steps grow as EPS^(-1/2) for its error to follow EPS (its
+  // tolerance proportionality, docs/stiff-integration.md): radau5 and dop853 are the methods for
+  // tight tolerances.
   if (std::min(sys.settings.epsint, sys.settings.epsind) < 1e-6) return false;
   bool elastic = false;
   for (const SystemElement& se : sys.elements) {

@@ -24,6 +24,9 @@ constexpr double kResidualDrift = 1e-3;
 // Above it, and wherever unresolved modes set the step (the undamped beams: 0.2 r), the
 // tolerance stays as asked. Radau5 maps its tolerances for the same reason (Hairer's r^(2/3)).
 constexpr double kProportionalFrom = 1e-5;
+// ... but not below this (or the tolerance asked for, if smaller): Newton's stop, 2 % of it,
+// would sink into round-off.
+constexpr double kTightest = 1e-12;
 // Newton stops at kNewtonTolerance of the tolerance, but at no looser a relative tolerance than
 // this one's: at EPSINT 0.1 the iterates it left unconverged carried the unresolved modes of a
 // 128-element cantilever into states the kinematics refused, step after step (18 533 steps, 10 882
@@ -87,14 +90,21 @@ void GeneralizedAlpha::map_tolerances() {
   if (rtol_asked_.size() != n_) return;  // not set yet (set_fixed_step before set_tolerances)
   rtol_ = rtol_asked_;
   atol_ = atol_asked_;
-  newton_tol_ = kNewtonTolerance * std::min(1.0, kLoosestNewton / std::max(rtol_.maxCoeff(), kRound));
-  if (h_fixed_ > 0) return;
-  for (int i = 0; i < n_; ++i) {
-    if (!(rtol_[i] > 0 && rtol_[i] < kProportionalFrom)) continue;
-    const double tighten = std::sqrt(rtol_[i] / kProportionalFrom);
-    rtol_[i] *= tighten;
-    atol_[i] *= tighten;
+  if (h_fixed_ == 0) {
+    for (int i = 0; i < n_; ++i) {
+      if (!(rtol_[i] > 0 && rtol_[i] < kProportionalFrom)) continue;
+      const double mapped = std::max(rtol_[i] * std::sqrt(rtol_[i] / kProportionalFrom), std::min(rtol_[i], kTightest));
+      atol_[i] *= mapped / rtol_[i];
+      rtol_[i] = mapped;
+    }
   }
+  // Newton's stop, in units of the tolerance: above round-off (as Radau5's) and below kLoosestNewton.
+  double rmin = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n_; ++i)
+    if (rtol_[i] > 0) rmin = std::min(rmin, rtol_[i]);
+  const double rmax = std::max(rtol_.maxCoeff(), kRound);
+  newton_tol_ = kNewtonTolerance * std::min(1.0, kLoosestNewton / rmax);
+  if (std::isfinite(rmin)) newton_tol_ = std::max(newton_tol_, 10.0 * kRound / rmin);
 }
 
 void GeneralizedAlpha::set_newton_system(NewtonSystem system) {
@@ -412,7 +422,9 @@ Stepper::Outcome GeneralizedAlpha::step(const Rhs& f, double t, double h_try, do
       return Outcome::Retry;
     }
     rejected_ = true;
-    if (result != Attempt::ErrorTooLarge) h_refused_ = h_try;
+    // The step size is the likely cause where the kinematics refused the state, or Newton failed
+    // with a fresh Jacobian (with an old one a new Jacobian is the remedy, below).
+    if (result == Attempt::Rejected || (result != Attempt::ErrorTooLarge && jacobian_fresh_)) h_refused_ = h_try;
     if (result == Attempt::ErrorTooLarge) h = h_try / quot;
     else if (result == Attempt::SlowNewton) h = h_try * slow_factor_;
     else h = 0.5 * h_try;
