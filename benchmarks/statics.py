@@ -48,7 +48,9 @@ QUICK = {"sizes": [4, 8], "targets": [1e-2, 1e-3], "memory": [8], "probe": 8, "f
          "repeat": 3, "budget": 0.3, "min_time": 0.02, "max_n": 64, "passes": 1}
 SOLVERS = ("spacar", "ge", "ancf")
 ARC = "spacar_arc"                   # PLBEAMC: in the time to accuracy only
-NAMES = {"spacar": "spacar PLBEAM", "ge": "exudyn GE beam", "ancf": "exudyn ANCF cable", ARC: "spacar PLBEAMC"}
+PREPARED = "spacar_solver"           # spacar.StaticSolver, set up outside the timing: in the meshes' table only
+NAMES = {"spacar": "spacar PLBEAM", "ge": "exudyn GE beam", "ancf": "exudyn ANCF cable", ARC: "spacar PLBEAMC",
+         PREPARED: "spacar StaticSolver"}
 STEP_CHOICES = (1, 2, 5, 10, 20)   # load steps tried, the fewest first
 TOL, TIGHT = 1e-8, 1e-10           # exudyn's Newton increment tolerance: timed, answer check
 SANE = 0.05                        # a tip farther than this from the elastica (/ L) is no answer
@@ -102,17 +104,20 @@ def cantilever(n, element="plbeam"):
 
 
 class SpacarRunner:
-    """spacar.static on n PLBEAMs (or PLBEAMCs); ``solve`` copies the model outside the timing."""
+    """spacar.static on n PLBEAMs (or PLBEAMCs); ``solve`` copies the model outside the timing.
+    PREPARED: a spacar.StaticSolver of the PLBEAM model, made once outside the timing (as exudyn's
+    model is built and assembled once), called for each solve."""
 
     def __init__(self, n, kind="spacar"):
         self.n, self.kind = n, kind
         self.model = cantilever(n, "plbeamc" if kind == ARC else "plbeam")
+        self.solver = spacar.StaticSolver(self.model) if kind == PREPARED else None
 
     def solve(self, steps, tolerance=None):
-        m = self.model.copy()
+        m = self.model.copy() if self.solver is None else None
         start = time.perf_counter()
         try:
-            res = spacar.static(m, steps=steps)
+            res = spacar.static(m, steps=steps) if self.solver is None else self.solver(steps=steps)
         except spacar.StaticError:
             return {"ok": False, "tip": None, "iterations": None, "steps": None, "wall": None}
         wall = time.perf_counter() - start
@@ -140,7 +145,7 @@ def runner(kind, n):
 
 
 def _spacar(kind):
-    return kind in ("spacar", ARC)
+    return kind in ("spacar", ARC, PREPARED)
 
 
 def _fewest_steps(run, ref):
@@ -390,7 +395,7 @@ def run(a) -> dict:
     out = {"quick": a.quick, "cfg": cfg, "machine": C.machine(peers=True),
            "reference": {"tip": [float(v) for v in ref], "shooting_difference": shooting},
            "exudyn_settings": {"tolerance": TOL, "check_tolerance": TIGHT, "ea_factor": X.EA_FACTOR},
-           "runs": {k: [] for k in SOLVERS}}
+           "runs": {k: [] for k in SOLVERS + (PREPARED,)}}
     least = {}   # target: {kind: (the smallest mesh reaching it, the meshes tried)}
     accuracy = SOLVERS + (ARC,)
     out["accuracy"] = {k: [] for k in accuracy}
@@ -398,7 +403,7 @@ def run(a) -> dict:
     out["runs"][ARC] = list(measure([(ARC, n) for n in cfg["sizes"][:2]], ref, cfg, timed=False).values())
     for p in range(cfg["passes"]):   # two passes over everything timed: a quiet spell for each figure
         for n in cfg["sizes"]:
-            for (kind, _), row in measure([(k, n) for k in SOLVERS], ref, cfg).items():
+            for (kind, _), row in measure([(k, n) for k in SOLVERS + (PREPARED,)], ref, cfg).items():
                 _keep_faster(out["runs"][kind], row)
             C.log(f"pass {p + 1}, n={n}: " + ", ".join(f"{k} {C.fmt_time(_row(out['runs'][k], n)['wall'])} "
                                                       f"({C.fmt_err(_row(out['runs'][k], n)['error'])})" for k in SOLVERS))
@@ -482,6 +487,11 @@ def _words(r) -> list:
                          f"(of {sizes[0]}…{sizes[-1]}).")
         else:
             lines.append(f"* Per mesh, spacar is faster than {NAMES[k]} at every n of {sizes[0]}…{sizes[-1]}.")
+    prepared = [(n, _row(runs["ge"], n)["wall"] / _row(runs[PREPARED], n)["wall"]) for n in sizes
+                if (_row(runs.get(PREPARED, []), n) or {}).get("wall") and _row(runs["ge"], n)["wall"]]
+    if prepared:
+        lines.append(f"* A `spacar.StaticSolver` (set up once, as exudyn's model is) against {NAMES['ge']}: "
+                     + ", ".join(f"{v:.3g}× at {n}" for n, v in prepared) + " (exudyn's time / spacar's).")
     for t_i, target in enumerate(cfg["targets"]):
         acc = {k: r["accuracy"][k][t_i] for k in r["accuracy"]}
         s = acc["spacar"]
@@ -540,7 +550,9 @@ def section(r: dict, plots: dict | None = None) -> str:
              f"under a dead tip load P L²/EI = {ALPHA:g} along y ([static analysis](statics.md); the tip turns by "
              f"{turn:.1f}°), n elements, each solver from the straight beam in the fewest load steps that converge "
              f"(tried {', '.join(map(str, STEP_CHOICES))}: {fewest}). **spacar**: n PLBEAMs, axially rigid, `spacar.static` "
-             "(the whole call, the model copied outside the timing). **exudyn GE beam**: n "
+             "(the whole call, the model copied outside the timing); **spacar StaticSolver**: the same model in a "
+             "`spacar.StaticSolver` made once outside the timing (compiled, its chain recognized, its tangent's "
+             "pattern ordered, as exudyn's model is assembled once), each solve a call of it. **exudyn GE beam**: n "
              "`ObjectBeamGeometricallyExact2D` (the model of `spacar.compare.exudyn_static`, EA = "
              f"{st['ea_factor']:g} EI/l² with l = L/n, but shear stiffness GA = EA instead of its 100 EA). "
              "**exudyn ANCF cable**: n `ObjectANCFCable2D` on `NodePoint2DSlope1` nodes, EA = "
@@ -557,12 +569,15 @@ def section(r: dict, plots: dict | None = None) -> str:
              f"equal to a shooting solution within {r['reference']['shooting_difference']:.0e}) over the length.",
              "", *C.machine_table(r["machine"]), "",
              "**Each mesh**: wall time (Newton iterations, load steps) / tip error (/ L)", "",
-             "| n | spacar | exudyn GE beam | exudyn ANCF cable | GE / spacar | ANCF / spacar |",
-             "|---|---|---|---|---|---|"]
+             "| n | spacar | exudyn GE beam | exudyn ANCF cable | GE / spacar | ANCF / spacar | spacar StaticSolver | "
+             "GE / StaticSolver | ANCF / StaticSolver |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for n in cfg["sizes"]:
         s, g, a = (_row(runs[k], n) for k in SOLVERS)
+        p = _row(runs.get(PREPARED, []), n) or {"wall": None}
         lines.append(f"| {n} | {_cell(s)} | {_cell(g)} | {_cell(a)} | {C.fmt_ratio(g['wall'], s['wall'])} | "
-                     f"{C.fmt_ratio(a['wall'], s['wall'])} |")
+                     f"{C.fmt_ratio(a['wall'], s['wall'])} | {C.fmt_time(p['wall'])} | "
+                     f"{C.fmt_ratio(g['wall'], p['wall'])} | {C.fmt_ratio(a['wall'], p['wall'])} |")
     lo = cfg["fit_from"]
     exps = {k: _exponent(runs[k], lo) for k in SOLVERS}
     orders = {k: _order(runs[k]) for k in SOLVERS}

@@ -45,6 +45,43 @@ py::dict static_results_to_dict(StaticResults&& r) {
   return d;
 }
 
+StaticOptions static_options(int steps, int max_iterations, int max_cuts, double tolerance, bool arc_length,
+                             int max_steps, double time_limit) {
+  StaticOptions opt;
+  opt.steps = steps;
+  opt.max_iterations = max_iterations;
+  opt.max_cuts = max_cuts;
+  opt.tolerance = tolerance;
+  opt.arc_length = arc_length;
+  opt.max_steps = max_steps;
+  opt.time_limit = time_limit;
+  return opt;
+}
+
+// A static analysis without the GIL; a StaticError carries the converged steps as `results`, a
+// TimeLimitError too once the rows exist (not in the set-up).
+template <class Work>
+py::dict run_static(StaticResults& r, Work&& work) {
+  return run_released(r, std::forward<Work>(work), static_results_to_dict, [&r](const std::exception_ptr& failure) {
+    try {
+      std::rethrow_exception(failure);
+    } catch (const StaticError&) {
+      return true;
+    } catch (const TimeLimitError&) {
+      return r.x.cols() > 0;
+    } catch (...) {
+      return false;
+    }
+  });
+}
+
+// spacar.StaticSolver's core: a copy of the model, and the solver set up on it.
+struct PreparedStatics {
+  explicit PreparedStatics(const Model& m) : model(m), solver(model) {}
+  Model model;
+  StaticSolver solver;
+};
+
 }  // namespace
 
 void bind_statics(py::module_& m) {
@@ -52,34 +89,44 @@ void bind_statics(py::module_& m) {
       "solve_static",
       [](Model& model, int steps, int max_iterations, int max_cuts, double tolerance, bool arc_length,
          int max_steps, double time_limit) {
-        StaticOptions opt;
-        opt.steps = steps;
-        opt.max_iterations = max_iterations;
-        opt.max_cuts = max_cuts;
-        opt.tolerance = tolerance;
-        opt.arc_length = arc_length;
-        opt.max_steps = max_steps;
-        opt.time_limit = time_limit;
+        const StaticOptions opt = static_options(steps, max_iterations, max_cuts, tolerance, arc_length, max_steps,
+                                                 time_limit);
         StaticResults r;
-        return run_released(
-            r, [&] { solve_static(model, r, opt); }, static_results_to_dict,
-            [&r](const std::exception_ptr& failure) {
-              try {
-                std::rethrow_exception(failure);
-              } catch (const StaticError&) {  // with the converged steps
-                return true;
-              } catch (const TimeLimitError&) {
-                return r.x.cols() > 0;  // with the converged steps once the rows exist, not in the set-up
-              } catch (...) {
-                return false;
-              }
-            });
+        return run_static(r, [&] { solve_static(model, r, opt); });
       },
       py::arg("model"), py::arg("steps") = 10, py::arg("max_iterations") = 30, py::arg("max_cuts") = 12,
       py::arg("tolerance") = 1e-10, py::arg("arc_length") = false, py::arg("max_steps") = 200,
       py::arg("time_limit") = 0.0,
       "Static equilibrium of the model's block in load steps (or by the arc-length method past limit "
       "points); StaticError (with `results`, the converged steps) if no equilibrium is found.");
+
+  py::class_<PreparedStatics>(m, "StaticSolver",
+                              "The static analysis of a copy of a model set up once (spacar.StaticSolver): "
+                              "compiled, its open chain recognized, the tangent's pattern ordered.")
+      .def(py::init<const Model&>(), py::arg("model"))
+      .def(
+          "solve",
+          [](PreparedStatics& p, std::optional<Eigen::VectorXd> force, int steps, int max_iterations, int max_cuts,
+             double tolerance, bool arc_length, int max_steps, double time_limit) {
+            const StaticOptions opt = static_options(steps, max_iterations, max_cuts, tolerance, arc_length,
+                                                     max_steps, time_limit);
+            StaticResults r;
+            return run_static(r, [&] { p.solver.solve(r, opt, force ? &*force : nullptr); });
+          },
+          py::arg("force") = py::none(), py::arg("steps") = 10, py::arg("max_iterations") = 30,
+          py::arg("max_cuts") = 12, py::arg("tolerance") = 1e-10, py::arg("arc_length") = false,
+          py::arg("max_steps") = 200, py::arg("time_limit") = 0.0,
+          "solve_static's analysis from the model's state when the solver was made; force: the FORCE loads on "
+          "every nodal coordinate in place of the model's (None: the model's).")
+      .def_property_readonly(
+          "model", [](PreparedStatics& p) -> const Model& { return p.model; },
+          "The solver's copy of the model, prepared, at the state every solve starts from (not to be changed).")
+      .def_property_readonly(
+          "force", [](const PreparedStatics& p) { return Eigen::VectorXd(p.solver.system().force); },
+          "The model's FORCE loads on every nodal coordinate (in the order of coordinate_labels).")
+      .def_property_readonly(
+          "coordinate_labels", [](const PreparedStatics& p) { return label_array(p.solver.system().coord_label); },
+          "(node, component) of every nodal coordinate.");
 
   m.def(
       "static_compliance",

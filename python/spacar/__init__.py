@@ -42,7 +42,7 @@ from .results import Results
 from .rollout import Rollout, RolloutResults
 from .simulate import simulate
 from .spacar_light import LightResults, light, light_model
-from .statics import StaticError, static
+from .statics import StaticError, StaticSolver, static
 from .statespace import StateSpace, state_space
 from .sweep import SweepError, SweepResult, sweep
 from .periodic import PeriodicOrbit, floquet, periodic_orbit
@@ -126,6 +126,7 @@ __all__ = [
     "dynamics_derivatives",
     "Dynamics",
     "static",
+    "StaticSolver",
     "StaticError",
     "compliance",
     "support_stiffness",

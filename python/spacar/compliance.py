@@ -64,6 +64,8 @@ def compliance(model, node, rotation=None, *, results=None, k: int = -1, time_li
             raise InputError("give the static results once: compliance(results, node) or compliance(model, node, results=...)")
         results = model
         model = getattr(results, "_static_model", None)
+        if callable(model):  # a StaticSolver's load case: its model made when first needed
+            model = results._static_model = model()
         if model is None:
             raise InputError("these results do not carry their model (only spacar.static's do, and not through a "
                              "pickle): call compliance(model, node, results=res)")

@@ -16,6 +16,7 @@ limit points::
 from __future__ import annotations
 
 import numbers
+import threading
 from functools import partial
 from types import SimpleNamespace
 
@@ -28,7 +29,7 @@ from .model import Model
 from .results import Results, dof_labels
 
 
-def _results(arrays: dict, model) -> Results:
+def _results(arrays: dict, model, *, end_model=None) -> Results:
     load = np.asarray(arrays["load"], dtype=float)
     x, e = arrays["x"], arrays["e"]
     rest_x, rest_e = np.zeros_like(x), np.zeros_like(e)
@@ -48,9 +49,15 @@ def _results(arrays: dict, model) -> Results:
     }
     res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
     # A copy of the model at the end of the solve: res.geometry is built from it when first used,
-    # and spacar.compliance(res, node) takes the loads and elements from it (not pickled).
-    res._geometry_source = core = model.core.copy()
-    res._static_model = Model._of_core(core)
+    # and spacar.compliance(res, node) takes the loads and elements from it (not pickled); a
+    # StaticSolver's results share its model instead (`end_model`: the model with the solve's
+    # loads, or a function that makes it).
+    if end_model is None:
+        res._geometry_source = core = model.core.copy()
+        res._static_model = Model._of_core(core)
+    else:
+        res._geometry_source = core = model.core
+        res._static_model = end_model
     res.shapes = getattr(model, "urdf_shapes", None)  # a URDF robot's link shapes, for spacar.view3d
     # The degrees of freedom of the system the solve compiled, labelled when first asked for.
     system = SimpleNamespace(coord_label=arrays["coord_label"], def_label=arrays["def_label"],
@@ -110,6 +117,13 @@ def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int =
     """
     if not isinstance(model, Model):
         raise InputError(f"static: model must be a spacar.Model, got {show(model)}")
+    options = _options(steps, arc_length, max_steps, max_iterations, max_cuts, tolerance, time_limit)
+    # The core prepares the model (the first END) as a simulation does.
+    return _solved(lambda: _core.solve_static(model.core, *options), model.warnings, partial(_results, model=model))
+
+
+def _options(steps, arc_length, max_steps, max_iterations, max_cuts, tolerance, time_limit) -> tuple:
+    """static's options checked, in the order of the core's arguments."""
     steps = _count(steps, "steps", 1, 10**7)
     max_iterations = _count(max_iterations, "max_iterations", 1, 1000)
     max_cuts = _count(max_cuts, "max_cuts", 0, 50)
@@ -119,17 +133,100 @@ def static(model, steps: int = 10, *, arc_length: bool = False, max_steps: int =
     if isinstance(tolerance, bool) or not isinstance(tolerance, numbers.Real) or not 0 < tolerance < 1:
         raise InputError(f"tolerance must be a number between 0 and 1, got {show(tolerance)}")
     limit = seconds_or_none(time_limit, "time_limit") or 0.0
-    try:  # the core prepares the model (the first END) as a simulation does
-        arrays = _core.solve_static(model.core, steps, max_iterations, max_cuts, float(tolerance), arc_length,
-                                    max_steps, limit)
+    return steps, max_iterations, max_cuts, float(tolerance), arc_length, max_steps, limit
+
+
+def _solved(solve, warnings: list, results) -> Results:
+    """The results of ``solve()`` (the core's arrays), its warnings added to ``warnings``; a
+    failure's converged steps as its ``results``."""
+    try:
+        arrays = solve()
     except SpacarError as err:
-        partial = getattr(err, "results", None)
-        if isinstance(partial, dict):
-            model.warnings.extend(w for w in partial["warnings"] if w not in model.warnings)
-            err.results = _results(partial, model)
+        partial_arrays = getattr(err, "results", None)
+        if isinstance(partial_arrays, dict):
+            warnings.extend(w for w in partial_arrays["warnings"] if w not in warnings)
+            err.results = results(partial_arrays)
         raise
-    model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-    return _results(arrays, model)
+    warnings.extend(w for w in arrays["warnings"] if w not in warnings)
+    return results(arrays)
+
+
+class StaticSolver:
+    """The static analysis of one model, its set-up paid once, solved for many load cases::
+
+        solver = spacar.StaticSolver(model)        # prepared, compiled and set up now
+        res = solver(steps=1)                       # spacar.static(model, steps=1), the model unchanged
+        f = solver.force.copy()                     # the model's FORCE on every nodal coordinate
+        f[solver.coordinate(21, 2)] = 2.5           # another load case: FORCE on node 21, y
+        res = solver(f, steps=1)
+
+    :func:`spacar.static` compiles the model, recognizes an open chain and orders the sparse
+    tangent stiffness at every call: a third of the time of a one-step solve of a few hundred
+    beams. A solver does that once, on a copy of the model as it is when the solver is made (later
+    changes to the model are not seen: make a new solver). Each call is :func:`spacar.static`'s
+    analysis with its options (``steps``, ``arc_length``, ``max_steps``, ``max_iterations``,
+    ``max_cuts``, ``tolerance``, ``time_limit``; the time limit covers the call), from the
+    model's state when the solver was made, and gives the same results to the last digit; the
+    model is not changed. ``force`` (nx values, in the order of :attr:`coordinate_labels`): the
+    FORCE loads on the nodal coordinates in place of the model's, applied with the load factor as
+    the model's are (torques, gravity and prescribed inputs stay the model's). The results share
+    the solver's copy of the model for ``res.geometry``, and ``spacar.compliance(res, node)``
+    takes the loads of their call. One call at a time per solver (calls from several threads wait
+    for each other)."""
+
+    def __init__(self, model: Model):
+        if not isinstance(model, Model):
+            raise InputError(f"StaticSolver: model must be a spacar.Model, got {show(model)}")
+        self._solver = _core.StaticSolver(model.core)
+        self._model = Model._of_core(self._solver.model)
+        self._model.urdf_shapes = getattr(model, "urdf_shapes", None)
+        self.warnings: list[str] = []
+        self._labels = np.asarray(self._solver.coordinate_labels)
+        self._lock = threading.Lock()
+
+    @property
+    def force(self) -> np.ndarray:
+        """The model's FORCE loads on every nodal coordinate (a copy, in the order of
+        :attr:`coordinate_labels`)."""
+        return np.asarray(self._solver.force)
+
+    @property
+    def coordinate_labels(self) -> np.ndarray:
+        """(node, component) of every nodal coordinate, components from 1 (nx × 2)."""
+        return self._labels.copy()
+
+    def coordinate(self, node: int, component: int) -> int:
+        """The index of coordinate ``component`` (from 1) of ``node`` in :attr:`force`."""
+        hits = np.flatnonzero((self._labels[:, 0] == node) & (self._labels[:, 1] == component))
+        if len(hits) == 0:
+            raise InputError(f"StaticSolver: the model has no coordinate {show(component)} of node {show(node)}")
+        return int(hits[0])
+
+    def __call__(self, force=None, *, steps: int = 10, arc_length: bool = False, max_steps: int = 200,
+                 max_iterations: int = 30, max_cuts: int = 12, tolerance: float = 1e-10, time_limit=None) -> Results:
+        options = _options(steps, arc_length, max_steps, max_iterations, max_cuts, tolerance, time_limit)
+        end_model = self._model
+        if force is not None:
+            force = np.array(force, dtype=float)
+            if force.shape != (len(self._labels),):
+                raise InputError(f"StaticSolver: force must have one value per nodal coordinate "
+                                 f"({len(self._labels)}), got shape {force.shape}")
+            end_model = partial(_loaded_model, self._model, self._labels, force)
+        with self._lock:
+            return _solved(lambda: self._solver.solve(force, *options), self.warnings,
+                           partial(_results, model=self._model, end_model=end_model))
+
+    def __repr__(self) -> str:
+        return f"<spacar.StaticSolver: {len(self._labels)} nodal coordinates>"
+
+
+def _loaded_model(model: Model, labels: np.ndarray, force: np.ndarray) -> Model:
+    """A copy of ``model`` with the FORCE loads ``force`` (one per coordinate of ``labels``)."""
+    copy = Model._of_core(model.core.copy())
+    for node in np.unique(labels[:, 0]):
+        values = force[labels[:, 0] == node]
+        copy.force(int(node), *(float(v) for v in values))
+    return copy
 
 
 def static_blocks(model, **kwargs):

@@ -28,11 +28,12 @@ namespace {
 // represented on the coordinates and the solution read back in q.
 class EquilibriumPath {
  public:
+  // `reduced`: the saddle-point system of sys and data (its pattern and ordering made once);
   // `chain`: the system's open chain (ExplicitChain::detect), or nullptr.
-  EquilibriumPath(const System& sys, Data& data, const StaticOptions& opt, StaticResults& res,
-                  std::unique_ptr<ExplicitChain> chain)
-      : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()), reduced_(sys, data), tangent_(reduced_.saddle()),
-        chain_(std::move(chain)), scale_(dof_scale(sys)) {
+  EquilibriumPath(const System& sys, Data& data, const StaticOptions& opt, StaticResults& res, ReducedSystem& reduced,
+                  ExplicitChain* chain)
+      : sys_(sys), data_(data), opt_(opt), res_(res), nd_(sys.n_dof()), reduced_(reduced), tangent_(reduced.saddle()),
+        chain_(chain), scale_(dof_scale(sys)) {
     // Inputs at the block start (λ = 0) and end (λ = 1), ordered as input_cols.
     const double tp = sys.settings.timestep_tp;
     p0_ = sys.p0;
@@ -52,7 +53,7 @@ class EquilibriumPath {
   // for an unloaded stress-free start, the equilibrium of the block before otherwise. The path
   // solves R(q, λ) − (1 − λ) R0 = 0: it begins exactly at the current state, and from one block
   // to the next the loads change gradually instead of being released and applied again.
-  void start() { static_forces(sys_, data_, 0.0, R0_, nullptr, nullptr, chain_.get()); }
+  void start() { static_forces(sys_, data_, 0.0, R0_, nullptr, nullptr, chain_); }
 
   // Equilibrium at load factor λ, starting from the current state. The sign of det K must stay
   // that of the start: a change during the iterations means that the step crosses a limit or
@@ -257,7 +258,7 @@ class EquilibriumPath {
     return force;
   }
   double forces_here(double lambda, Eigen::VectorXd& R, Eigen::VectorXd* full_load = nullptr) {
-    const double force = static_forces(sys_, data_, lambda, R, nullptr, full_load, chain_.get());
+    const double force = static_forces(sys_, data_, lambda, R, nullptr, full_load, chain_);
     R -= (1.0 - lambda) * R0_;
     return force;
   }
@@ -305,9 +306,9 @@ class EquilibriumPath {
   const StaticOptions& opt_;
   StaticResults& res_;
   const int nd_;
-  ReducedSystem reduced_;
+  ReducedSystem& reduced_;
   SaddlePoint& tangent_;   // reduced_'s saddle-point system
-  std::unique_ptr<ExplicitChain> chain_;  // the kinematics of an open chain; nullptr otherwise
+  ExplicitChain* chain_;   // the kinematics of an open chain; nullptr otherwise
   bool factorized_ = false;
   Eigen::VectorXd scale_;        // characteristic size of each DOF: lengths vs angles
   Eigen::VectorXd p0_, p1_;
@@ -722,14 +723,37 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
 
 }  // namespace
 
-void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
+StaticSolver::StaticSolver(Model& model) : sim_(model) {
+  const System& sys = sim_.system();
+  require_memory(Data::estimate_dense_bytes(sys),
+                 "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
+                     std::to_string(sys.ne) + " deformations",
+                 "");
+  chain_ = ExplicitChain::detect(sys);
+  check_thread_deadline("(in the recognition of an open chain)");
+  reduced_ = std::make_unique<ReducedSystem>(sys, sim_.data());
+  check_thread_deadline("(in the set-up of the tangent stiffness)");
+  x0_ = sim_.data().x;
+}
+
+StaticSolver::~StaticSolver() = default;
+
+void StaticSolver::solve(StaticResults& res, const StaticOptions& opt, const Eigen::VectorXd* force) {
+  const Clock::time_point start = Clock::now();
   check_options(opt);
-  const DeadlineScope deadline(opt.time_limit);  // the set-up included
+  const DeadlineScope deadline(opt.time_limit);
+  run(res, opt, force, start);
+}
+
+void StaticSolver::run(StaticResults& res, const StaticOptions& opt, const Eigen::VectorXd* force,
+                       Clock::time_point start) {
   res = StaticResults();
-  Simulation sim(model);
-  const System& sys = sim.system();
-  Data& data = sim.data();
+  const System& sys = sim_.system();
+  Data& data = sim_.data();
+  if (force && force->size() != sys.nx)
+    throw InputError("static: the loads must have one value per nodal coordinate (" + std::to_string(sys.nx) +
+                     "), got " + std::to_string(force->size()));
+  if (force && !force->allFinite()) throw InputError("static: the loads must be finite numbers");
   res.warnings = sys.warnings;
   res.coord_label = sys.coord_label;
   res.def_label = sys.def_label;
@@ -740,10 +764,18 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
                  "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
                      std::to_string(sys.ne) + " deformations in " + std::to_string(n) + " load steps",
                  opt.arc_length ? "allow fewer steps (max_steps)" : "use fewer load steps");
-  std::unique_ptr<ExplicitChain> chain = ExplicitChain::detect(sys);
-  sim.assemble(chain.get());
+  if (!fresh_) {  // the state of a solve before: back to the model's
+    data.reset_state(sys);
+    data.x = x0_;
+    reduced_->forget_pivots();
+  }
+  fresh_ = false;
+  sim_.assemble(chain_.get());
+  // The loads of this solve: time_load is added to FORCE (compute_inertia_and_loads) and scaled
+  // by λ with it; nothing else sets it in a static analysis.
+  if (force) data.time_load = *force - sys.force;
   data.t = sys.t0;
-  EquilibriumPath path(sys, data, opt, res, std::move(chain));
+  EquilibriumPath path(sys, data, opt, res, *reduced_, chain_.get());
   path.start();
   Rows rows(sys, data, path, res, n);
   try {
@@ -753,12 +785,21 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
       follow_load_steps(sys, path, opt, res, rows);
   } catch (const Error&) {
     rows.finish();
-    res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    res.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
     throw;
   }
   rows.finish();
-  res.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  sim.store_state();
+  res.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  check_options(opt);
+  const DeadlineScope deadline(opt.time_limit);  // the set-up included
+  res = StaticResults();
+  StaticSolver solver(model);
+  solver.run(res, opt, nullptr, start);
+  solver.store_state();
 }
 
 }  // namespace spacar

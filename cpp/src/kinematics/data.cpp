@@ -12,32 +12,54 @@ Data::Data(const System& sys) {
   const int nx = sys.nx, ne = sys.ne, nq = sys.n_qhat(), nd = sys.n_dof();
   const int nP = static_cast<int>(sys.defs_P.size()), nV = static_cast<int>(sys.defs_V.size());
   const int nc = static_cast<int>(sys.x_calc.size());
-  x = xd = xdd = Eigen::VectorXd::Zero(nx);
-  e = ed = edd = sigma = conv = Eigen::VectorXd::Zero(ne);
-  qhat = qhat_d = qhat_dd = Eigen::VectorXd::Zero(nq);
+  for (Eigen::VectorXd* v : {&x, &xd, &xdd, &acc0, &h, &f, &inertia_residual, &reaction, &acc_known, &residual_load})
+    v->resize(nx);
+  for (Eigen::VectorXd* v : {&e, &ed, &edd, &sigma, &conv, &angle_ref, &sigma_equilibrium}) v->resize(ne);
+  for (Eigen::VectorXd* v : {&qhat, &qhat_d, &qhat_dd, &qhat_load}) v->resize(nq);
+  for (Eigen::VectorXd* v : {&rhs, &qdd}) v->resize(nd);
+  target.resize(nP);
+  residual.resize(nP);
+  step.resize(std::max(nc, std::max(nP, nV)));
+  rhs_V.resize(nV);
+  sol_V.resize(nc);
   work.resize(sys.elements.size());
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const int n = static_cast<int>(sys.elements[i].coords.size()), m = sys.elements[i].nd;
     ElementWork& w = work[i];
-    w.x = w.v = w.a = w.h = w.f = Eigen::VectorXd::Zero(n);
-    w.B = Eigen::MatrixXd::Zero(m, n);
-    w.c = Eigen::VectorXd::Zero(m);
-    w.M = Eigen::MatrixXd::Zero(n, n);
+    for (Eigen::VectorXd* v : {&w.x, &w.v, &w.a, &w.h, &w.f}) v->resize(n);
+    w.B.resize(m, n);
+    w.c.resize(m);
+    w.M.resize(n, n);
   }
-  target = residual = Eigen::VectorXd::Zero(nP);
-  e_integrated = sys.e_target;
-  angle_ref = Eigen::VectorXd::Constant(ne, std::numeric_limits<double>::quiet_NaN());
-  acc0 = Eigen::VectorXd::Zero(nx);
-  step = Eigen::VectorXd::Zero(std::max(nc, std::max(nP, nV)));
-  rhs_V = Eigen::VectorXd::Zero(nV);
-  sol_V = Eigen::VectorXd::Zero(nc);
-  h = f = inertia_residual = reaction = acc_known = residual_load = Eigen::VectorXd::Zero(nx);
-  sigma_equilibrium = Eigen::VectorXd::Zero(ne);
-  qhat_load = Eigen::VectorXd::Zero(sys.n_qhat());
-  rhs = qdd = Eigen::VectorXd::Zero(nd);
-  body_M.assign(sys.bodies.size(), Eigen::Matrix4d::Zero());
-  body_h.assign(sys.bodies.size(), Eigen::Vector4d::Zero());
+  body_M.resize(sys.bodies.size());
+  body_h.resize(sys.bodies.size());
+  reset_state(sys);
   number_equations_of_motion(sys);
+}
+
+void Data::reset_state(const System& sys) {
+  t = 0.0;
+  for (Eigen::VectorXd* v : {&x, &xd, &xdd, &e, &ed, &edd, &sigma, &conv, &qhat, &qhat_d, &qhat_dd, &target, &residual,
+                             &acc0, &step, &rhs_V, &sol_V, &h, &f, &inertia_residual, &reaction, &acc_known,
+                             &residual_load, &sigma_equilibrium, &qhat_load, &rhs, &qdd})
+    v->setZero();
+  for (ElementWork& w : work) {
+    for (Eigen::VectorXd* v : {&w.x, &w.v, &w.a, &w.h, &w.f, &w.c}) v->setZero();
+    w.B.setZero();
+    w.M.setZero();
+  }
+  e_integrated = sys.e_target;
+  angle_ref.setConstant(std::numeric_limits<double>::quiet_NaN());
+  for (Eigen::Matrix4d& m : body_M) m.setZero();
+  for (Eigen::Vector4d& v : body_h) v.setZero();
+  time_load.resize(0);
+  jacobian_reusable = false;
+  newton_iterations = 0;
+  total_newton_iterations = 0;
+  // The sparse LUs forget their pivot sequences (replayed from one factorization to the next),
+  // so that a solve from here gives the same digits whatever was solved before.
+  if (constraint_blocks_ready) analyze_constraint_blocks(sys);
+  if (equations_ready) luK.analyze(KKT.matrix());
 }
 
 void Data::ensure_constraint_blocks(const System& sys) {
@@ -64,6 +86,11 @@ void Data::build_constraint_blocks(const System& sys) {
   }
   AP.finalize();
   AV.finalize();
+  analyze_constraint_blocks(sys);
+}
+
+void Data::analyze_constraint_blocks(const System& sys) {
+  const int nc = static_cast<int>(sys.x_calc.size());
   if (AP.rows() == nc) luP.analyze(AP.matrix());
   if (AV.rows() == nc) luV.analyze(AV.matrix());
 }

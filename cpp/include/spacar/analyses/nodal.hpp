@@ -100,6 +100,11 @@ class SaddlePoint {
   void solve_free(const double* r, double* dx, bool refine = true);
 
   bool symmetric() const { return symmetric_; }
+  // The LU's pivot sequence forgotten (it is replayed from one factorization to the next): the
+  // next factorization chooses its pivots, as the first did.
+  void forget_pivots() {
+    if (!symmetric_) lu_.analyze(kkt_.matrix());
+  }
   // Of the reduced matrix Zᵀ H Z: singular to working precision (a tiny pivot), the sign of
   // its determinant, and its negative eigenvalues (−1 when unknown: the unsymmetric case).
   bool singular() const { return singular_; }
@@ -170,6 +175,7 @@ class ReducedSystem {
   Eigen::VectorXd motion(const Eigen::VectorXd& q);        // Z q (nx)
 
   SaddlePoint& saddle() { return saddle_; }
+  void forget_pivots() { saddle_.forget_pivots(); }
   const NodalLayout& layout() const { return layout_; }
   static constexpr int kRefinements = 3;
 

@@ -18,6 +18,8 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <chrono>
+#include <memory>
 #include <limits>
 #include <string>
 #include <vector>
@@ -83,6 +85,42 @@ std::string dof_directions(const System& sys, const Eigen::MatrixXd& V);
 // λ = 1 and store it in the model (at rest, at the block's start time). On failure StaticError
 // with `res` holding the rows converged before it; the model is then not changed.
 void solve_static(Model& model, StaticResults& res, const StaticOptions& options = {});
+
+class ReducedSystem;
+
+// The static analysis of one model set up once and solved many times (spacar.StaticSolver): the
+// model prepared and compiled, its open chain recognized and the pattern and ordering of the
+// tangent's saddle-point system made when the solver is made, a third of a single solve of a few
+// hundred beams. Each solve starts again from the state the model had then, with the model's
+// loads or others on its nodal coordinates (a load case). solve_static is one solve of a solver.
+class StaticSolver {
+ public:
+  // The model (prepared here: the first END) must outlive the solver.
+  explicit StaticSolver(Model& model);
+  ~StaticSolver();
+  StaticSolver(const StaticSolver&) = delete;
+  StaticSolver& operator=(const StaticSolver&) = delete;
+
+  // solve_static's path of equilibria from the model's state when the solver was made, within
+  // opt.time_limit. `force`: the FORCE loads on the nodal coordinates (nx, in the order of
+  // system().coord_label) in place of the model's, applied with the load factor as they are;
+  // nullptr: the model's.
+  void solve(StaticResults& res, const StaticOptions& opt, const Eigen::VectorXd* force = nullptr);
+  // The model's state set to the end of the last solve, as spacar.static leaves it.
+  void store_state() { sim_.store_state(); }
+  const System& system() const { return sim_.system(); }
+
+ private:
+  friend void solve_static(Model& model, StaticResults& res, const StaticOptions& options);
+  using Clock = std::chrono::steady_clock;
+  void run(StaticResults& res, const StaticOptions& opt, const Eigen::VectorXd* force, Clock::time_point start);
+
+  Simulation sim_;
+  std::unique_ptr<ExplicitChain> chain_;    // nullptr: not an open chain
+  std::unique_ptr<ReducedSystem> reduced_;  // the tangent's saddle-point system
+  Eigen::VectorXd x0_;                      // the model's positions: each solve's assembly starts there
+  bool fresh_ = true;                       // no solve yet: the work arrays as constructed
+};
 
 // The rows T (m x nx) of the displacements of the nodes: a position node's coordinates, a BETA
 // node's angle, a LAMBDA node's small rotation vector in global axes, δθ = 2 E(λ) δλ.

@@ -23,6 +23,10 @@ struct ElementWork {
 
 struct Data {
   explicit Data(const System& sys);
+  // Every value back to the constructor's (zeros, the integrated deformations at their targets,
+  // no angle branches, no reusable Jacobian), the sizes and the patterns built on first use
+  // kept: a prepared analysis (StaticSolver) starts each solve from here.
+  void reset_state(const System& sys);
   // Allocate the dense matrices of the full path (transfer functions, reduced mass matrix).
   void ensure_dense(const System& sys);
   bool dense_ready = false;
@@ -43,6 +47,7 @@ struct Data {
 
  private:
   void build_constraint_blocks(const System& sys);
+  void analyze_constraint_blocks(const System& sys);  // the LUs of AP and AV, when square
   // The places of the free coordinates and constraint rows in the equations of motion.
   void number_equations_of_motion(const System& sys);
 
