@@ -171,8 +171,9 @@ class StaticSolver:
     FORCE loads on the nodal coordinates in place of the model's, applied with the load factor as
     the model's are (torques, gravity and prescribed inputs stay the model's). The results share
     the solver's copy of the model for ``res.geometry``, and ``spacar.compliance(res, node)``
-    takes the loads of their call. One call at a time per solver (calls from several threads wait
-    for each other)."""
+    takes the loads of their call. The warnings of the calls are collected in ``solver.warnings``
+    (each once), not in the model's. The set-up runs when the solver is made, without a time
+    limit. One call at a time per solver (calls from several threads wait for each other)."""
 
     def __init__(self, model: Model):
         if not isinstance(model, Model):
@@ -205,13 +206,16 @@ class StaticSolver:
     def __call__(self, force=None, *, steps: int = 10, arc_length: bool = False, max_steps: int = 200,
                  max_iterations: int = 30, max_cuts: int = 12, tolerance: float = 1e-10, time_limit=None) -> Results:
         options = _options(steps, arc_length, max_steps, max_iterations, max_cuts, tolerance, time_limit)
-        end_model = self._model
         if force is not None:
-            force = np.array(force, dtype=float)
+            try:
+                force = np.array(force, dtype=float)
+            except (TypeError, ValueError):
+                raise InputError(f"StaticSolver: force must be numbers, got {show(force)}") from None
             if force.shape != (len(self._labels),):
                 raise InputError(f"StaticSolver: force must have one value per nodal coordinate "
                                  f"({len(self._labels)}), got shape {force.shape}")
-            end_model = partial(_loaded_model, self._model, self._labels, force)
+        # spacar.compliance(res, ...) prepares the model it is given: a copy, made when first needed.
+        end_model = partial(_loaded_model, self._model, self._labels, force)
         with self._lock:
             return _solved(lambda: self._solver.solve(force, *options), self.warnings,
                            partial(_results, model=self._model, end_model=end_model))
@@ -220,9 +224,12 @@ class StaticSolver:
         return f"<spacar.StaticSolver: {len(self._labels)} nodal coordinates>"
 
 
-def _loaded_model(model: Model, labels: np.ndarray, force: np.ndarray) -> Model:
-    """A copy of ``model`` with the FORCE loads ``force`` (one per coordinate of ``labels``)."""
+def _loaded_model(model: Model, labels: np.ndarray, force) -> Model:
+    """A copy of ``model``, with the FORCE loads ``force`` (one per coordinate of ``labels``) if
+    given."""
     copy = Model._of_core(model.core.copy())
+    if force is None:
+        return copy
     for node in np.unique(labels[:, 0]):
         values = force[labels[:, 0] == node]
         copy.force(int(node), *(float(v) for v in values))

@@ -64,14 +64,14 @@ def test_a_load_case_is_the_model_with_those_loads():
     tip = solver.coordinate(2 * n + 1, 2)
     assert f[tip] == 3.0 and np.count_nonzero(f) == 1
     f[solver.coordinate(2 * n + 1, 1)] = -1.0
+    f[tip] = 0.1                              # the model's 3 replaced (not 3 + (0.1 − 3))
     f[solver.coordinate(2 * n + 2, 1)] = 0.7  # a moment on the tip's BETA node
     f[solver.coordinate(n + 1, 2)] = 2.0      # a load on the middle node
     res = solver(f, steps=3)
-    loaded = plbeam_cantilever(n, force=(-1.0, 3.0), moment=0.7)
+    loaded = plbeam_cantilever(n, force=(-1.0, 0.1), moment=0.7)
     loaded.force(n + 1, 0.0, 2.0)
     reference = spacar.static(loaded, steps=3)
-    for key in ARRAYS:
-        np.testing.assert_allclose(getattr(res, key), getattr(reference, key), rtol=0, atol=1e-13, err_msg=key)
+    assert_same(res, reference)
     # The model's loads again, after the load case.
     assert_same(solver(steps=3), spacar.static(plbeam_cantilever(n, force=(0.0, 3.0)), steps=3))
     # The compliance of a load case's results takes that case's loads (its geometric stiffness).
@@ -102,7 +102,7 @@ def test_spatial_load_case_and_results():
     res = solver(f, steps=4)
     loaded = beam_cantilever(6, EIy=1.0, EIz=1.0, GIp=1.0, rhoA=0.0)
     loaded.force(7, 0.0, 1.5, 0.0)
-    np.testing.assert_allclose(res.x, spacar.static(loaded, steps=4).x, rtol=0, atol=1e-13)
+    assert_same(res, spacar.static(loaded, steps=4))
     assert res.node(7).x[-1][1] > 0.3
     assert res.geometry.elements[0].type == "BEAM"  # the solver's model, shared
 
@@ -115,8 +115,18 @@ def test_bad_input():
         solver(np.zeros(3))
     with pytest.raises(spacar.InputError, match="finite"):
         solver(np.full(len(solver.force), np.nan))
+    with pytest.raises(spacar.InputError, match="numbers"):
+        solver(["a"] * len(solver.force))
     with pytest.raises(spacar.InputError, match="steps"):
         solver(steps=0)
     with pytest.raises(spacar.InputError, match="no coordinate 3 of node 5"):
         solver.coordinate(5, 3)
     assert "nodal coordinates" in repr(solver)
+
+
+def test_a_call_stopped_by_its_time_limit_keeps_its_steps_and_the_next_starts_afresh():
+    solver = spacar.StaticSolver(plbeam_cantilever(3, force=(0.0, 1e-3)))
+    with pytest.raises(spacar.TimeLimitError, match=r"\(in the static analysis\)") as err:
+        solver(steps=10**6, time_limit=0.2)   # several seconds of load steps
+    assert 0 < len(err.value.results.t) < 10**6
+    assert_same(solver(steps=2), spacar.static(plbeam_cantilever(3, force=(0.0, 1e-3)), steps=2))

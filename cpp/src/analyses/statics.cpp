@@ -723,12 +723,24 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
 
 }  // namespace
 
-StaticSolver::StaticSolver(Model& model) : sim_(model) {
+namespace {
+
+// The memory of a static analysis checked before it is set up or run: the dense arrays its
+// checks may need, and with `opt` the rows of its results.
+void require_static_memory(const System& sys, const StaticOptions* opt) {
+  const int n = !opt ? 0 : opt->arc_length ? opt->max_steps + 1 : opt->steps;  // arc length: the last row at λ = 1
+  std::string what = "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
+                     std::to_string(sys.ne) + " deformations";
+  if (opt) what += " in " + std::to_string(n) + " load steps";
+  require_memory(Data::estimate_dense_bytes(sys) + 8.0 * n * (2.0 * sys.nx + 2.0 * sys.ne + 2.0), what,
+                 !opt ? "" : opt->arc_length ? "allow fewer steps (max_steps)" : "use fewer load steps");
+}
+
+}  // namespace
+
+StaticSolver::StaticSolver(Model& model, const StaticOptions* first) : sim_(model) {
   const System& sys = sim_.system();
-  require_memory(Data::estimate_dense_bytes(sys),
-                 "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
-                     std::to_string(sys.ne) + " deformations",
-                 "");
+  require_static_memory(sys, first);
   chain_ = ExplicitChain::detect(sys);
   check_thread_deadline("(in the recognition of an open chain)");
   reduced_ = std::make_unique<ReducedSystem>(sys, sim_.data());
@@ -760,10 +772,7 @@ void StaticSolver::run(StaticResults& res, const StaticOptions& opt, const Eigen
   res.x_dyn = sys.x_dyn;
   res.e_dyn = sys.e_dyn;
   const int n = opt.arc_length ? opt.max_steps + 1 : opt.steps;  // arc length: the last row at λ = 1
-  require_memory(Data::estimate_dense_bytes(sys) + 8.0 * n * (2.0 * sys.nx + 2.0 * sys.ne + 2.0),
-                 "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
-                     std::to_string(sys.ne) + " deformations in " + std::to_string(n) + " load steps",
-                 opt.arc_length ? "allow fewer steps (max_steps)" : "use fewer load steps");
+  require_static_memory(sys, &opt);
   if (!fresh_) {  // the state of a solve before: back to the model's
     data.reset_state(sys);
     data.x = x0_;
@@ -771,9 +780,7 @@ void StaticSolver::run(StaticResults& res, const StaticOptions& opt, const Eigen
   }
   fresh_ = false;
   sim_.assemble(chain_.get());
-  // The loads of this solve: time_load is added to FORCE (compute_inertia_and_loads) and scaled
-  // by λ with it; nothing else sets it in a static analysis.
-  if (force) data.time_load = *force - sys.force;
+  if (force) data.constant_load = *force;  // in place of FORCE, scaled by λ with it (compute_inertia_and_loads)
   data.t = sys.t0;
   EquilibriumPath path(sys, data, opt, res, *reduced_, chain_.get());
   path.start();
@@ -797,7 +804,7 @@ void solve_static(Model& model, StaticResults& res, const StaticOptions& opt) {
   check_options(opt);
   const DeadlineScope deadline(opt.time_limit);  // the set-up included
   res = StaticResults();
-  StaticSolver solver(model);
+  StaticSolver solver(model, &opt);  // the memory of the rows checked before the set-up
   solver.run(res, opt, nullptr, start);
   solver.store_state();
 }

@@ -53,6 +53,7 @@ void Data::reset_state(const System& sys) {
   for (Eigen::Matrix4d& m : body_M) m.setZero();
   for (Eigen::Vector4d& v : body_h) v.setZero();
   time_load.resize(0);
+  constant_load.resize(0);
   jacobian_reusable = false;
   newton_iterations = 0;
   total_newton_iterations = 0;

@@ -48,7 +48,7 @@ void constitutive_stresses(const System& sys, Data& data) {
 
 void compute_inertia_and_loads(const System& sys, Data& data) {
   data.h.setZero();
-  data.f = sys.force;
+  data.f = data.constant_load.size() ? data.constant_load : sys.force;
   if (data.time_load.size()) data.f += data.time_load;
   const bool gravity = sys.gravity.squaredNorm() > 0.0;
   if (gravity) {  // on point masses (position coordinates only)

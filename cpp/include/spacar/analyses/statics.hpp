@@ -96,7 +96,7 @@ class ReducedSystem;
 class StaticSolver {
  public:
   // The model (prepared here: the first END) must outlive the solver.
-  explicit StaticSolver(Model& model);
+  explicit StaticSolver(Model& model) : StaticSolver(model, nullptr) {}
   ~StaticSolver();
   StaticSolver(const StaticSolver&) = delete;
   StaticSolver& operator=(const StaticSolver&) = delete;
@@ -113,6 +113,8 @@ class StaticSolver {
  private:
   friend void solve_static(Model& model, StaticResults& res, const StaticOptions& options);
   using Clock = std::chrono::steady_clock;
+  // `first`: the options of the first solve, whose memory is checked before the set-up.
+  StaticSolver(Model& model, const StaticOptions* first);
   void run(StaticResults& res, const StaticOptions& opt, const Eigen::VectorXd* force, Clock::time_point start);
 
   Simulation sim_;

@@ -23,9 +23,10 @@ struct ElementWork {
 
 struct Data {
   explicit Data(const System& sys);
-  // Every value back to the constructor's (zeros, the integrated deformations at their targets,
-  // no angle branches, no reusable Jacobian), the sizes and the patterns built on first use
-  // kept: a prepared analysis (StaticSolver) starts each solve from here.
+  // The state back to the constructor's (zeros, the integrated deformations at their targets,
+  // no angle branches, no reusable Jacobian, no load case, the LUs' pivots forgotten), the sizes
+  // and the patterns built on first use kept: a prepared analysis (StaticSolver) starts each
+  // solve from here. The dense arrays of ensure_dense are not reset (no static solve reads them).
   void reset_state(const System& sys);
   // Allocate the dense matrices of the full path (transfer functions, reduced mass matrix).
   void ensure_dense(const System& sys);
@@ -98,6 +99,7 @@ struct Data {
   Eigen::MatrixXd M;            // global mass matrix (nx x nx)
   Eigen::VectorXd h, f;         // convective inertia and applied forces (nx)
   Eigen::VectorXd time_load;    // time-dependent loads at t added to FORCE (nx; empty: none)
+  Eigen::VectorXd constant_load;  // FORCE in place of the system's (nx; empty: sys.force): a StaticSolver's load case
   Eigen::MatrixXd DFq;          // DF restricted to the DOF columns (nx x n_dof)
   Eigen::MatrixXd Mbar;         // reduced mass matrix (n_dof x n_dof)
   Eigen::VectorXd rhs;          // reduced force (n_dof)
