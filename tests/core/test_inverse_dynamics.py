@@ -108,6 +108,11 @@ def test_bad_arguments_are_input_errors():
         spacar.inverse_dynamics(model, np.zeros(3), np.zeros(3), np.zeros(3))
     with pytest.raises(InputError, match="finite"):
         spacar.inverse_dynamics(model, [np.nan, 0.0], np.zeros(2), np.zeros(2))
+    dyn = spacar.Dynamics(model)  # the finiteness checked in the core
+    with pytest.raises(InputError, match="inverse_dynamics: qdd must be finite"):
+        dyn.inverse_dynamics(np.zeros(2), np.zeros(2), [0.0, np.inf])
+    with pytest.raises(InputError, match="dynamics_derivatives: q must be finite"):
+        dyn.dynamics_derivatives(np.array([[0.0, 0.0], [np.nan, 0.0]]), np.zeros((2, 2)), np.zeros((2, 2)))
     with pytest.raises(InputError, match="spacar.Model"):
         spacar.inverse_dynamics("model", np.zeros(2), np.zeros(2), np.zeros(2))
 
@@ -160,6 +165,12 @@ def test_a_dynamics_handle_equals_the_functions(name):
         for ours, theirs in zip(dyn.dynamics_derivatives(q, qd, tau), spacar.dynamics_derivatives(model, q, qd, tau)):
             assert np.array_equal(ours, theirs)
     np.testing.assert_allclose(dyn.dynamics_derivatives(q[0], qd[0], tau[0])[0], qdd[0], rtol=0, atol=1e-10)
+    # Arrays of any layout (passed to the core without a contiguous copy): a Fortran-ordered batch,
+    # a strided vector.
+    assert np.array_equal(dyn.inverse_dynamics(np.asfortranarray(q), qd, qdd), tau)
+    wide = np.repeat(q[1], 2)[::2]
+    assert not wide.flags.c_contiguous
+    assert np.array_equal(dyn.inverse_dynamics(wide, qd[1], qdd[1]), tau[1])
     model.gravity(*([0.0] * (3 if "spatial" in name else 2)))
     assert np.array_equal(dyn.inverse_dynamics(q, qd, qdd), tau)
     assert len(dyn.dof_labels) == n
