@@ -41,6 +41,16 @@ def _states(what, finite=True, **arrays):
     return rows, shape
 
 
+def _one_state(a, b, c):
+    """_states' answer (finiteness left to the core) for the call of a controller: three float
+    vectors of one length, passed on as views; None for anything else."""
+    F = np.float64
+    if (type(a) is np.ndarray and type(b) is np.ndarray and type(c) is np.ndarray and a.ndim == 1
+            and a.dtype == F and b.dtype == F and c.dtype == F and a.shape == b.shape == c.shape):
+        return [a[None], b[None], c[None]], a.shape
+    return None
+
+
 def _limited(time_limit, where):
     """time_limited, or nothing to enter when there is no limit (a call per state stays cheap)."""
     return contextlib.nullcontext() if time_limit is None else time_limited(time_limit, where)
@@ -88,7 +98,7 @@ class Dynamics:
 
     def inverse_dynamics(self, q, qd, qdd, *, time_limit=None) -> np.ndarray:
         """:func:`inverse_dynamics` at these states."""
-        rows, shape = _states("inverse_dynamics", False, q=q, qd=qd, qdd=qdd)
+        rows, shape = _one_state(q, qd, qdd) or _states("inverse_dynamics", False, q=q, qd=qd, qdd=qdd)
         with self._lock, _limited(time_limit, "in inverse_dynamics"):
             self._reassemble()
             force, path = self._sim.inverse_dynamics(*rows)
@@ -97,7 +107,7 @@ class Dynamics:
 
     def dynamics_derivatives(self, q, qd, tau, *, time_limit=None):
         """:func:`dynamics_derivatives` at these states."""
-        rows, shape = _states("dynamics_derivatives", False, q=q, qd=qd, tau=tau)
+        rows, shape = _one_state(q, qd, tau) or _states("dynamics_derivatives", False, q=q, qd=qd, tau=tau)
         with self._lock, _limited(time_limit, "in dynamics_derivatives"):
             self._reassemble()
             qdd, dq, dqd, dtau = self._sim.dynamics_derivatives(*rows)
