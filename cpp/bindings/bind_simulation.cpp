@@ -270,7 +270,7 @@ void bind_states(py::class_<Simulation>& sim) {
           "solve_state() and move_to().")
       .def(
           "inverse_dynamics",
-          [](Simulation& s, const RowMatrix& q, const RowMatrix& qd, const RowMatrix& qdd) {
+          [](Simulation& s, const StateRows& q, const StateRows& qd, const StateRows& qdd) {
             std::string path;
             RowMatrix force = s.inverse_dynamics(q, qd, qdd, path);
             return py::make_tuple(force, path);
@@ -280,7 +280,7 @@ void bind_states(py::class_<Simulation>& sim) {
           "the model's own loads, 'tree' or 'general'), spacar.inverse_dynamics.")
       .def(
           "dynamics_derivatives",
-          [](Simulation& s, const RowMatrix& q, const RowMatrix& qd, const RowMatrix& tau) {
+          [](Simulation& s, const StateRows& q, const StateRows& qd, const StateRows& tau) {
             RowMatrix qdd, dq, dqd, dtau;
             s.dynamics_derivatives(q, qd, tau, qdd, dq, dqd, dtau);
             // Moved into the arrays (a large batch is not copied).

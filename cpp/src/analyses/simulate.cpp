@@ -529,7 +529,7 @@ namespace {
 
 // The states given to inverse_dynamics and dynamics_derivatives: finite (checked here, where it
 // costs nanoseconds; in Python a check per array took a third of a call for one state).
-void require_finite_states(const char* what, std::initializer_list<std::pair<const char*, const RowMatrix*>> arrays) {
+void require_finite_states(const char* what, std::initializer_list<std::pair<const char*, const StateRows*>> arrays) {
   for (const auto& [name, a] : arrays)
     if (!a->allFinite())
       throw InputError(std::string(what) + ": " + name + " must be finite (NaN and infinity are not states)");
@@ -537,7 +537,7 @@ void require_finite_states(const char* what, std::initializer_list<std::pair<con
 
 }  // namespace
 
-RowMatrix Simulation::inverse_dynamics(const RowMatrix& q, const RowMatrix& qd, const RowMatrix& qdd,
+RowMatrix Simulation::inverse_dynamics(const StateRows& q, const StateRows& qd, const StateRows& qdd,
                                        std::string& path) {
   const int nd = sys_->n_dof();
   if (q.cols() != nd || qd.cols() != nd || qdd.cols() != nd || qd.rows() != q.rows() || qdd.rows() != q.rows())
@@ -562,7 +562,7 @@ RowMatrix Simulation::inverse_dynamics(const RowMatrix& q, const RowMatrix& qd, 
   return force;
 }
 
-void Simulation::dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, const RowMatrix& tau, RowMatrix& qdd,
+void Simulation::dynamics_derivatives(const StateRows& q, const StateRows& qd, const StateRows& tau, RowMatrix& qdd,
                                       RowMatrix& dq, RowMatrix& dqd, RowMatrix& dtau) {
   RecursiveTree* tree = recursive_tree();
   if (!tree) {

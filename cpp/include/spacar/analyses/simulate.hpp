@@ -297,13 +297,13 @@ class Simulation {
   // iteration; any other system by its reduced equations, M̄ (q̈ − q̈₀), q̈₀ its accelerations
   // under its own loads, each state's positions solved by Newton from the previous state's (so
   // successive rows should be near each other). `path` is set to "tree" or "general".
-  RowMatrix inverse_dynamics(const RowMatrix& q, const RowMatrix& qd, const RowMatrix& qdd, std::string& path);
+  RowMatrix inverse_dynamics(const StateRows& q, const StateRows& qd, const StateRows& qdd, std::string& path);
   // The forward dynamics and its derivatives at the states in the rows of q, qd under the extra
   // generalized forces tau (spacar.dynamics_derivatives, as pinocchio.computeABADerivatives): the
   // rows of qdd (nd) and of dq, dqd, dtau (nd × nd each, row k the matrix of state k in row-major
   // order: ∂q̈_i/∂q_j at i·nd + j). On a planar or spatial tree of the recursive path; InputError
   // otherwise.
-  void dynamics_derivatives(const RowMatrix& q, const RowMatrix& qd, const RowMatrix& tau, RowMatrix& qdd,
+  void dynamics_derivatives(const StateRows& q, const StateRows& qd, const StateRows& tau, RowMatrix& qdd,
                             RowMatrix& dq, RowMatrix& dqd, RowMatrix& dtau);
   // q̈ of the reduced equations (3.1) with transfer functions at the last evaluated state, the
   // state left as it was: an independent check of the integration path's sparse solve.

@@ -12,6 +12,9 @@ namespace spacar {
 
 // Row-major results, one row per state (the output arrays, Python's layout).
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// States given one per row (q, q̇, ... of a batch), read in place: from NumPy without a copy when
+// they are float rows of unit stride.
+using StateRows = Eigen::Ref<const RowMatrix>;
 
 struct ElementWork {
   Eigen::VectorXd x, v, a;      // local coordinates, velocities, accelerations (nc)
