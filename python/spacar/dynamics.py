@@ -16,7 +16,7 @@ from .results import dof_labels
 
 
 def _states(what, finite=True, **arrays):
-    """The arrays (q, qd, ...) as C-contiguous float matrices of states (one per row), and the
+    """The arrays (q, qd, ...) as float matrices of states (one per row; views where they can be), and the
     shape they were given in (a vector: one state). Written for a call per state: a few µs.
     ``finite=False``: their finiteness left to the core (Simulation.inverse_dynamics and
     dynamics_derivatives check it in nanoseconds, where a sum per array here costs microseconds)."""

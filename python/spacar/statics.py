@@ -209,7 +209,7 @@ class StaticSolver:
         if force is not None:
             try:
                 force = np.array(force, dtype=float)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 raise InputError(f"StaticSolver: force must be numbers, got {show(force)}") from None
             if force.shape != (len(self._labels),):
                 raise InputError(f"StaticSolver: force must have one value per nodal coordinate "

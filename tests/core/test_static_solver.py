@@ -117,6 +117,8 @@ def test_bad_input():
         solver(np.full(len(solver.force), np.nan))
     with pytest.raises(spacar.InputError, match="numbers"):
         solver(["a"] * len(solver.force))
+    with pytest.raises(spacar.InputError, match="numbers"):
+        solver([10**400] * len(solver.force))
     with pytest.raises(spacar.InputError, match="steps"):
         solver(steps=0)
     with pytest.raises(spacar.InputError, match="no coordinate 3 of node 5"):
