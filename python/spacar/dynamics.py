@@ -36,7 +36,7 @@ def _states(what, finite=True, **arrays):
     if any(a.shape != shape for a in out):
         raise InputError(f"{what}: {', '.join(list(arrays)[:-1])} and {list(arrays)[-1]} must have the same shape, got "
                          f"{', '.join(str(a.shape) for a in out)}")
-    # Any strides: the binding copies each into a matrix of the core.
+    # Any strides: the core reads float rows of unit stride in place, the binding copies others.
     rows = [a.reshape(1, -1) if a.ndim == 1 else a for a in out]
     return rows, shape
 

@@ -50,8 +50,8 @@ def _results(arrays: dict, model, *, end_model=None) -> Results:
     res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
     # A copy of the model at the end of the solve: res.geometry is built from it when first used,
     # and spacar.compliance(res, node) takes the loads and elements from it (not pickled); a
-    # StaticSolver's results share its model instead (`end_model`: the model with the solve's
-    # loads, or a function that makes it).
+    # StaticSolver's results share its model for the geometry instead, and `end_model` makes
+    # compliance's copy with the solve's loads when first needed.
     if end_model is None:
         res._geometry_source = core = model.core.copy()
         res._static_model = Model._of_core(core)
@@ -156,7 +156,7 @@ class StaticSolver:
 
         solver = spacar.StaticSolver(model)        # prepared, compiled and set up now
         res = solver(steps=1)                       # spacar.static(model, steps=1), the model unchanged
-        f = solver.force.copy()                     # the model's FORCE on every nodal coordinate
+        f = solver.force                            # the model's FORCE on every nodal coordinate (a copy)
         f[solver.coordinate(21, 2)] = 2.5           # another load case: FORCE on node 21, y
         res = solver(f, steps=1)
 

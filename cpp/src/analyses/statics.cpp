@@ -725,10 +725,13 @@ void follow_arc_length(const System& sys, EquilibriumPath& path, const StaticOpt
 
 namespace {
 
+// The rows of the results: one per load step; arc length: at most one per step and the last at λ = 1.
+int result_rows(const StaticOptions& opt) { return opt.arc_length ? opt.max_steps + 1 : opt.steps; }
+
 // The memory of a static analysis checked before it is set up or run: the dense arrays its
 // checks may need, and with `opt` the rows of its results.
 void require_static_memory(const System& sys, const StaticOptions* opt) {
-  const int n = !opt ? 0 : opt->arc_length ? opt->max_steps + 1 : opt->steps;  // arc length: the last row at λ = 1
+  const int n = opt ? result_rows(*opt) : 0;
   std::string what = "the static analysis of " + std::to_string(sys.nx) + " nodal coordinates and " +
                      std::to_string(sys.ne) + " deformations";
   if (opt) what += " in " + std::to_string(n) + " load steps";
@@ -771,7 +774,7 @@ void StaticSolver::run(StaticResults& res, const StaticOptions& opt, const Eigen
   res.def_label = sys.def_label;
   res.x_dyn = sys.x_dyn;
   res.e_dyn = sys.e_dyn;
-  const int n = opt.arc_length ? opt.max_steps + 1 : opt.steps;  // arc length: the last row at λ = 1
+  const int n = result_rows(opt);
   require_static_memory(sys, &opt);
   if (!fresh_) {  // the state of a solve before: back to the model's
     data.reset_state(sys);
