@@ -25,9 +25,24 @@
 // ∂τ_r/∂q_j = S_rᵀ c_r(j). In the rates, ∂v_i/∂q̇_j = S_j and ∂a_i/∂q̇_j = S_j × v_i − 2u give
 // Σ_m ∂f/∂q̇_j = (Bc − Q) S_j − 2 Ic u, and M_rj = S_rᵀ Ic S_j, each with the composites of the
 // deeper of r and j. Then q̈ = M⁻¹ (τ − b) and ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇) at that q̈.
+//
+// A floating base is a joint of six world-fixed axes S_k = e_k (unit twists) with the base's
+// twist ν = (ω; v at the world origin) as its rates and the wrench at the origin as its forces;
+// a pose change δ (a world twist) moves the whole tree rigidly. Its axes do not move with each
+// other, and its twist holds under δ, so the formulas above hold with v_λ = ν and a_λ = the
+// base's acceleration (u_k = e_k × ν, w_k = e_k × a_base), with the "above" form for both
+// orders of two base axes, and with one u, not two, in ∂a/∂ν_k = e_k × v_i − u_k (no v × S ν̇
+// term: the axes are fixed). The results in (δ, ν) are taken to spacar's DOFs of the base (the
+// origin x and three Euler parameters μ) by the chain rule through ν = T(p) ṗ, δ = T(p) δp,
+// the wrench from the generalized forces (τ = Tᵀ wrench) and p̈ from ν̇, whose derivatives are
+// exact by forward-mode dual numbers (BaseMaps).
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
+#include "spacar/autodiff.hpp"
+#include "spacar/errors.hpp"
 #include "spacar/recursive/spatial_tree.hpp"
 
 namespace spacar {
@@ -81,40 +96,261 @@ bool cholesky_inverse(Eigen::MatrixXd& M, Eigen::MatrixXd& Linv, double* inverse
   return true;
 }
 
+// The floating base's coordinates p = (x, μ) (the origin and the three independent Euler
+// parameters) and rates, as functions on any scalar (double or Jet), for their exact derivatives.
+struct BaseMaps {
+  int dependent = 0;
+  double sign = 1.0;
+
+  template <class T>
+  void lambda(const T* mu, T* l) const {  // the dependent parameter from the unit norm
+    T others(0.0);
+    for (int i = 0, k = 0; i < 4; ++i) {
+      if (i == dependent) continue;
+      l[i] = mu[k++];
+      others = others + l[i] * l[i];
+    }
+    l[dependent] = sign * sqrt(T(1.0) - others);
+  }
+  template <class T>
+  void lambda_rate(const T* l, const T* mud, T* ld) const {  // λ · λ̇ = 0
+    T dot(0.0);
+    for (int i = 0, k = 0; i < 4; ++i) {
+      if (i == dependent) continue;
+      ld[i] = mud[k++];
+      dot = dot + l[i] * ld[i];
+    }
+    ld[dependent] = -dot / l[dependent];
+  }
+  template <class T>
+  static void omega(const T* l, const T* ld, T* w) {  // ω = 2 E(λ) λ̇, world axes
+    w[0] = 2.0 * (-l[1] * ld[0] + l[0] * ld[1] - l[3] * ld[2] + l[2] * ld[3]);
+    w[1] = 2.0 * (-l[2] * ld[0] + l[3] * ld[1] + l[0] * ld[2] - l[1] * ld[3]);
+    w[2] = 2.0 * (-l[3] * ld[0] - l[2] * ld[1] + l[1] * ld[2] + l[0] * ld[3]);
+  }
+  template <class T>
+  static void e_transpose_times(const T* l, const T* w, T* out) {  // E(λ)ᵀ w
+    out[0] = -(w[0] * l[1] + w[1] * l[2] + w[2] * l[3]);
+    out[1] = l[0] * w[0] + w[1] * l[3] - w[2] * l[2];
+    out[2] = l[0] * w[1] + w[2] * l[1] - w[0] * l[3];
+    out[3] = l[0] * w[2] + w[0] * l[2] - w[1] * l[1];
+  }
+  template <class T>
+  static void cross(const T* a, const T* b, T* out) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+  }
+  // ν = (ω; ẋ − ω × x): the base's twist at the world origin (also δ from δp).
+  template <class T>
+  void twist(const T* p, const T* pd, T* nu) const {
+    T l[4], ld[4], xw[3];
+    lambda(p + 3, l);
+    lambda_rate(l, pd + 3, ld);
+    omega(l, ld, nu);
+    cross(nu, p, xw);
+    for (int c = 0; c < 3; ++c) nu[3 + c] = pd[c] - xw[c];
+  }
+  // The wrench (n; f) at the world origin whose power on ν is that of the generalized forces
+  // τ_p on ṗ: f = τ_x, n = x × f + A⁻ᵀ τ_μ with ω = A μ̇.
+  template <class T>
+  void wrench(const T* p, const T* tau, T* out) const {
+    T l[4], A[3][3];
+    lambda(p + 3, l);
+    for (int m = 0; m < 3; ++m) {
+      T e[3] = {T(0.0), T(0.0), T(0.0)}, ld[4], w[3];
+      e[m] = T(1.0);
+      lambda_rate(l, e, ld);
+      omega(l, ld, w);
+      for (int r = 0; r < 3; ++r) A[r][m] = w[r];
+    }
+    // Aᵀ y = τ_μ by Cramer's rule: y = adj(Aᵀ) τ_μ / det A, adj(Aᵀ) = cof(A).
+    T cof[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        cof[r][c] = A[(r + 1) % 3][(c + 1) % 3] * A[(r + 2) % 3][(c + 2) % 3] -
+                    A[(r + 1) % 3][(c + 2) % 3] * A[(r + 2) % 3][(c + 1) % 3];
+    const T det = A[0][0] * cof[0][0] + A[0][1] * cof[0][1] + A[0][2] * cof[0][2];
+    T xf[3];
+    cross(p, tau, xf);
+    for (int r = 0; r < 3; ++r) {
+      out[r] = xf[r] + (cof[r][0] * tau[3] + cof[r][1] * tau[4] + cof[r][2] * tau[5]) / det;
+      out[3 + r] = tau[r];
+    }
+  }
+  // p̈ from ν̇ = (α; a_O): ẍ = a_O + α × x + ω × ẋ, λ̈ = ½ E(λ̇)ᵀ ω + ½ E(λ)ᵀ α.
+  template <class T>
+  void acceleration(const T* p, const T* pd, const T* nud, T* pdd) const {
+    T l[4], ld[4], w[3], ax[3], wx[3], a[4], b[4];
+    lambda(p + 3, l);
+    lambda_rate(l, pd + 3, ld);
+    omega(l, ld, w);
+    cross(nud, p, ax);
+    cross(w, pd, wx);
+    for (int c = 0; c < 3; ++c) pdd[c] = nud[3 + c] + ax[c] + wx[c];
+    e_transpose_times(ld, w, a);
+    e_transpose_times(l, nud, b);
+    for (int i = 0, k = 0; i < 4; ++i)
+      if (i != dependent) pdd[3 + k++] = 0.5 * (a[i] + b[i]);
+  }
+};
+
+// f's value (out, m) and its m × 6 Jacobians in each of its arguments (J[a], row major), at
+// double arguments args[a] (6 each), by one pass on dual numbers over all of them.
+template <int A, class F>
+void jacobians(const F& f, const std::array<const double*, A>& args, int m, double* out, double* const* J) {
+  using J6 = Jet<double, 6 * A>;
+  std::array<std::array<J6, 6>, A> in;
+  for (int a = 0; a < A; ++a)
+    for (int c = 0; c < 6; ++c) in[a][c] = J6::variable(args[a][c], 6 * a + c);
+  std::array<J6, 6> res;
+  f(in, res.data());
+  for (int r = 0; r < m; ++r) {
+    out[r] = res[r].a;
+    for (int a = 0; a < A; ++a)
+      for (int c = 0; c < 6; ++c) J[a][r * 6 + c] = res[r].d[6 * a + c];
+  }
+}
+
+// The floating base's results in (ν, joints) taken to q by the chain rule: a column of the base's
+// coordinates p_m gathers the columns of δ (through δ = T δp), of ν (ν = T(p) ṗ depends on p) and
+// of the wrench (w = T⁻ᵀ(p) τ_p); q̇'s through T, τ's through T⁻ᵀ. A row of p̈ is P(p, ṗ, ν̇),
+// with its explicit derivatives in p and ṗ beside ∂P/∂ν̇ times the rows of ν̇.
+// qdd_t, Aq, Aqd, At: q̈ and the derivatives in (ν, joints) (Aq, Aqd, At overwritten).
+void base_to_coordinates(int n, const BaseMaps& maps, const std::array<int, 6>& bidx, const std::array<int, 6>& tidx,
+                         const double* p, const double* pd, const double* taub, const double* qdd_t, double* Aq,
+                         double* Aqd, double* At, double* qdd, double* dq, double* dqd, double* dtau) {
+  double nu[6], T[36], Np[36], wrench[6], Wp[36], Wt[36];
+  {
+    double* J[2] = {Np, T};
+    jacobians<2>([&](const auto& in, auto* out) { maps.twist(in[0].data(), in[1].data(), out); },
+                 {p, pd}, 6, nu, J);
+    double* K[2] = {Wp, Wt};
+    jacobians<2>([&](const auto& in, auto* out) { maps.wrench(in[0].data(), in[1].data(), out); },
+                 {p, taub}, 6, wrench, K);
+  }
+  double nud[6], pdd[6], Pp[36], Ppd[36], Pn[36];
+  for (int k = 0; k < 6; ++k) nud[k] = qdd_t[tidx[k]];
+  {
+    double* J[3] = {Pp, Ppd, Pn};
+    jacobians<3>([&](const auto& in, auto* out) { maps.acceleration(in[0].data(), in[1].data(), in[2].data(), out); },
+                 {p, pd, nud}, 6, pdd, J);
+  }
+  // Columns, in place (At: ∂/∂w, Aq: ∂/∂δ, Aqd: ∂/∂ν).
+  for (int i = 0; i < n; ++i) {
+    double aq[6], aqd[6], at[6];
+    for (int k = 0; k < 6; ++k) {
+      aq[k] = Aq[i * n + tidx[k]];
+      aqd[k] = Aqd[i * n + tidx[k]];
+      at[k] = At[i * n + tidx[k]];
+    }
+    for (int m = 0; m < 6; ++m) {
+      double cq = 0.0, cqd = 0.0, ct = 0.0;
+      for (int k = 0; k < 6; ++k) {
+        cq += aq[k] * T[k * 6 + m] + aqd[k] * Np[k * 6 + m] + at[k] * Wp[k * 6 + m];
+        cqd += aqd[k] * T[k * 6 + m];
+        ct += at[k] * Wt[k * 6 + m];
+      }
+      Aq[i * n + bidx[m]] = cq;
+      Aqd[i * n + bidx[m]] = cqd;
+      At[i * n + bidx[m]] = ct;
+    }
+  }
+  // Rows: the joints' as they are, the base's through P.
+  std::copy(qdd_t, qdd_t + n, qdd);
+  std::copy(Aq, Aq + n * n, dq);
+  std::copy(Aqd, Aqd + n * n, dqd);
+  std::copy(At, At + n * n, dtau);
+  for (int r = 0; r < 6; ++r) {
+    const int row = bidx[r];
+    qdd[row] = pdd[r];
+    for (int c = 0; c < n; ++c) {
+      double sq = 0.0, sqd = 0.0, st = 0.0;
+      for (int k = 0; k < 6; ++k) {
+        const double w = Pn[r * 6 + k];
+        sq += w * Aq[tidx[k] * n + c];
+        sqd += w * Aqd[tidx[k] * n + c];
+        st += w * At[tidx[k] * n + c];
+      }
+      dq[row * n + c] = sq;
+      dqd[row * n + c] = sqd;
+      dtau[row * n + c] = st;
+    }
+    for (int m = 0; m < 6; ++m) {
+      dq[row * n + bidx[m]] += Pp[r * 6 + m];
+      dqd[row * n + bidx[m]] += Ppd[r * 6 + m];
+    }
+  }
+}
+
 }  // namespace
 
 bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd,
                                        double* dq, double* dqd, double* dtau) {
   const int nb = n_bodies();
-  if (n != nb) return false;  // every body turned by one joint, its DOF (not a floating base's six)
+  if (n != (floating_ ? nb + 5 : nb)) return false;  // a DOF per joint, a floating root's six
   DerivativeWork& work = derivative_work_;
   std::vector<WorldBody>& world = work.bodies;
   world.resize(nb);
+  // A floating base: where its DOFs are in q, as p = (x, μ) (bidx) and as the slots of its twist
+  // ν = (ω; v at the origin) and wrench (tidx) in the passes; ν, and the wrench of tau's forces
+  // on p. The passes then run in (ν, joints), their results taken to q at the end.
+  BaseMaps maps{base_.dependent, base_.sign};
+  std::array<int, 6> bidx{}, tidx{};
+  double base_p[6] = {}, base_pd[6] = {}, base_tau[6] = {};
+  Vec6 nu = Vec6::Zero(), wrench = Vec6::Zero();
+  Eigen::Vector4d base_l = Eigen::Vector4d::Zero();
+  const double* tau_t = tau;
+  if (floating_) {
+    for (int c = 0; c < 3; ++c) {
+      bidx[c] = tidx[3 + c] = base_.x_dof + c;
+      bidx[3 + c] = tidx[c] = base_.lambda_dof[c];
+    }
+    for (int m = 0; m < 6; ++m) {
+      base_p[m] = q[bidx[m]];
+      base_pd[m] = qd[bidx[m]];
+      base_tau[m] = tau[bidx[m]];
+    }
+    maps.lambda(base_p + 3, base_l.data());
+    if (!(std::abs(base_l[base_.dependent]) > 0.0) || !std::isfinite(base_l[base_.dependent]))
+      throw InputError("dynamics_derivatives: the floating base's three Euler parameters have a norm of 1 or more");
+    maps.twist(base_p, base_pd, nu.data());
+    maps.wrench(base_p, base_tau, wrench.data());
+    work.tau_t = Eigen::Map<const Eigen::VectorXd>(tau, n);
+    for (int k = 0; k < 6; ++k) work.tau_t[tidx[k]] = wrench[k];
+    tau_t = work.tau_t.data();
+  }
   // Outwards: placements, joint axes, inertias, velocities, the accelerations without q̈, the
   // external loads and their matrices.
   for (int i = 0; i < nb; ++i) {
     const Model& m = bodies_[i];
     WorldBody& b = world[i];
     const bool root = m.parent < 0;
-    // The placement of SpatialAlgebra::place without its Euler parameters: turned about (or slid
-    // along) the axis k, the same in the parent's and the body's coordinates.
-    const double theta = m.sign * q[m.dof] + m.offset;
-    const Vec3& k = m.axis;
-    Mat3 rel = Mat3::Identity();  // body → parent
-    Vec3 r = m.r;
-    if (m.prismatic) r += theta * k;
-    else rel = SpatialAlgebra::axis_rotation(k, std::cos(theta), std::sin(theta));
-    if (root) {
-      b.R = rel;
-      b.p = r;
+    if (m.free) {  // the floating base: its frame R(λ) R0ᵀ at its origin, no joint
+      b.R = euler_E(base_l) * euler_G(base_l.data()).transpose() * base_.R0.transpose();
+      b.p = Vec3(base_p[0], base_p[1], base_p[2]);
+      b.S.setZero();
     } else {
-      const WorldBody& parent = world[m.parent];
-      b.R.noalias() = parent.R * rel;
-      b.p.noalias() = parent.p + parent.R * r;
+      // The placement of SpatialAlgebra::place without its Euler parameters: turned about (or
+      // slid along) the axis k, the same in the parent's and the body's coordinates.
+      const double theta = m.sign * q[m.dof] + m.offset;
+      const Vec3& k = m.axis;
+      Mat3 rel = Mat3::Identity();  // body → parent
+      Vec3 r = m.r;
+      if (m.prismatic) r += theta * k;
+      else rel = SpatialAlgebra::axis_rotation(k, std::cos(theta), std::sin(theta));
+      if (root) {
+        b.R = rel;
+        b.p = r;
+      } else {
+        const WorldBody& parent = world[m.parent];
+        b.R.noalias() = parent.R * rel;
+        b.p.noalias() = parent.p + parent.R * r;
+      }
+      const Vec3 axis = b.R * k;
+      if (m.prismatic) b.S << Vec3::Zero(), m.sign * axis;
+      else b.S << m.sign * axis, m.sign * b.p.cross(axis);
     }
-    const Vec3 axis = b.R * k;
-    if (m.prismatic) b.S << Vec3::Zero(), m.sign * axis;
-    else b.S << m.sign * axis, m.sign * b.p.cross(axis);
     SpatialAlgebra::Frame to_world;  // world → body coordinates at the pin, as a child's frame
     to_world.E = b.R.transpose();
     to_world.r = b.p;
@@ -122,8 +358,13 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
     SpatialAlgebra::add_inertia_to_parent(m, to_world, m.inertia, b.I);
     b.parent_v = root ? Vec6::Zero() : world[m.parent].v;
     b.parent_a = root ? base_acceleration_ : world[m.parent].a;
-    b.v = b.parent_v + b.S * qd[m.dof];
-    b.a = b.parent_a + cross_motion(b.v, b.S) * qd[m.dof];
+    if (m.free) {
+      b.v = nu;
+      b.a = b.parent_a;
+    } else {
+      b.v = b.parent_v + b.S * qd[m.dof];
+      b.a = b.parent_a + cross_motion(b.v, b.S) * qd[m.dof];
+    }
     b.f = -SpatialAlgebra::to_parent(m, to_world, m.load);  // −f^ext, the body-fixed load
     b.L.setZero();
   }
@@ -146,28 +387,52 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
   for (int i = nb - 1; i >= 0; --i) {
     const Model& m = bodies_[i];
     WorldBody& b = world[i];
-    bias[m.dof] = b.S.dot(b.F) + m.stiffness * q[m.dof] + m.damping * qd[m.dof];
+    if (m.free)
+      for (int k = 0; k < 6; ++k) bias[tidx[k]] = b.F[k];
+    else
+      bias[m.dof] = b.S.dot(b.F) + m.stiffness * q[m.dof] + m.damping * qd[m.dof];
     b.IS = b.Ic * b.S;
     if (m.parent >= 0) {
       world[m.parent].Ic += b.Ic;
       world[m.parent].F += b.F;
     }
   }
-  // M_rj = S_rᵀ Ic_j S_j for r on the path from j to the root.
+  // M_rj = S_rᵀ Ic_j S_j for r on the path from j to the root (the base's axes: Ic_j S_j).
   Eigen::MatrixXd& M = work.M;
   M.setZero(n, n);
-  for (int j = 0; j < nb; ++j)
-    for (int r = j; r >= 0; r = bodies_[r].parent) {
-      const double value = world[r].S.dot(world[j].IS);
-      M(bodies_[r].dof, bodies_[j].dof) = value;
-      M(bodies_[j].dof, bodies_[r].dof) = value;
+  for (int j = 0; j < nb; ++j) {
+    if (bodies_[j].free) {
+      for (int a = 0; a < 6; ++a)
+        for (int c = 0; c < 6; ++c) M(tidx[a], tidx[c]) = world[j].Ic(a, c);
+      continue;
     }
-  double* inverse = dtau;  // ∂q̈/∂τ = M⁻¹
+    const int dj = bodies_[j].dof;
+    for (int r = j; r >= 0; r = bodies_[r].parent) {
+      if (bodies_[r].free) {
+        for (int k = 0; k < 6; ++k) M(tidx[k], dj) = M(dj, tidx[k]) = world[j].IS[k];
+        break;
+      }
+      const double value = world[r].S.dot(world[j].IS);
+      M(bodies_[r].dof, dj) = value;
+      M(dj, bodies_[r].dof) = value;
+    }
+  }
+  // In (ν, joints) for a floating base (taken to q below), else straight into the results.
+  if (floating_) {
+    work.inverse.resize(n * n);
+    work.qdd_t.resize(n);
+    work.dq_t.resize(n * n);
+    work.dqd_t.resize(n * n);
+  }
+  double* inverse = floating_ ? work.inverse.data() : dtau;  // ∂q̈/∂τ = M⁻¹
+  double* acc = floating_ ? work.qdd_t.data() : qdd;
+  double* acc_q = floating_ ? work.dq_t.data() : dq;
+  double* acc_qd = floating_ ? work.dqd_t.data() : dqd;
   if (!cholesky_inverse(M, work.Linv, inverse)) return false;
   for (int i = 0; i < n; ++i) {
     double s = 0.0;
-    for (int j = 0; j < n; ++j) s += inverse[i * n + j] * (tau[j] - bias[j]);
-    qdd[i] = s;
+    for (int j = 0; j < n; ++j) s += inverse[i * n + j] * (tau_t[j] - bias[j]);
+    acc[i] = s;
   }
   // Outwards again with q̈: the accelerations and the body forces; then inwards the composites
   // of the derivatives.
@@ -179,7 +444,10 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
       b.parent_a += change;
       b.a += change;
     }
-    b.a += b.S * qdd[m.dof];
+    if (m.free)
+      for (int k = 0; k < 6; ++k) b.a[k] += acc[tidx[k]];
+    else
+      b.a += b.S * acc[m.dof];
     const Vec6 h = b.I * b.v;
     b.f += b.I * b.a + SpatialAlgebra::cross_force(b.v, h);
     // I (v ×) − B = −Pᵀ − P − G with P = (v ×*) I (I (v ×) = −Pᵀ, I being symmetric) and
@@ -206,6 +474,17 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
       parent.L += b.L;
     }
   }
+  // The base's axes e_k: u_k = e_k × ν and z_k = u_k × ν − e_k × a_base.
+  std::array<Vec6, 6> base_u, base_z;
+  int base_body = -1;
+  for (int i = 0; i < nb && floating_; ++i)
+    if (bodies_[i].free) base_body = i;
+  if (base_body >= 0)
+    for (int k = 0; k < 6; ++k) {
+      const Vec6 e = Vec6::Unit(k);
+      base_u[k] = cross_motion(e, nu);
+      base_z[k] = cross_motion(base_u[k], nu) - cross_motion(e, world[base_body].a);
+    }
   // The pairs (r, j), r on the path from j to the root: ∂τ_r/∂(q_j, q̇_j) from j's composites,
   // and for r above j, ∂τ_j/∂(q_r, q̇_r) from j's composites.
   Eigen::MatrixXd &dtau_dq = work.dtau_dq, &dtau_dqd = work.dtau_dqd;
@@ -214,9 +493,31 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
   for (int j = 0; j < nb; ++j) {
     const Model& mj = bodies_[j];
     const WorldBody& b = world[j];
+    if (mj.free) {  // the base's axes among themselves: each in the "above" form
+      for (int c = 0; c < 6; ++c) {
+        const Vec6 e = Vec6::Unit(c);
+        Vec6 y_q = SpatialAlgebra::cross_force(e, b.f) + b.Ic * base_z[c] + b.QmB * base_u[c];
+        if (c < 3) y_q += b.L.col(c);
+        const Vec6 y_qd = -(b.QmB * e) - b.Ic * base_u[c];
+        for (int a = 0; a < 6; ++a) {
+          dtau_dq(tidx[a], tidx[c]) = y_q[a];
+          dtau_dqd(tidx[a], tidx[c]) = y_qd[a];
+        }
+      }
+      continue;
+    }
     const Vec6 y_q = SpatialAlgebra::cross_force(b.S, b.f) + b.Ic * b.z + b.QmB * b.u + b.L * b.S.head<3>();
     const Vec6 y_qd = -(b.QmB * b.S) - 2.0 * (b.Ic * b.u);
     for (int r = j; r >= 0; r = bodies_[r].parent) {
+      if (bodies_[r].free) {  // the base above j: its axes stay, j's subtree moves with them
+        for (int k = 0; k < 6; ++k) {
+          dtau_dq(tidx[k], mj.dof) = y_q[k];
+          dtau_dqd(tidx[k], mj.dof) = y_qd[k];
+          dtau_dq(mj.dof, tidx[k]) = b.IS.dot(base_z[k]) + b.QmBS.dot(base_u[k]) + (k < 3 ? b.LS[k] : 0.0);
+          dtau_dqd(mj.dof, tidx[k]) = -b.QmBS[k] - b.IS.dot(base_u[k]);
+        }
+        break;
+      }
       const WorldBody& br = world[r];
       const int dr = bodies_[r].dof;
       dtau_dq(dr, mj.dof) = br.S.dot(y_q);
@@ -236,9 +537,12 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
         sq += inverse[i * n + k] * dtau_dq(k, j);
         sqd += inverse[i * n + k] * dtau_dqd(k, j);
       }
-      dq[i * n + j] = -sq;
-      dqd[i * n + j] = -sqd;
+      acc_q[i * n + j] = -sq;
+      acc_qd[i * n + j] = -sqd;
     }
+  if (floating_)
+    base_to_coordinates(n, maps, bidx, tidx, base_p, base_pd, base_tau, acc, acc_q, acc_qd, inverse, qdd, dq, dqd,
+                        dtau);
   return true;
 }
 

@@ -187,7 +187,7 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   // world axes, ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇).
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
-  std::string derivatives_refusal() const override { return floating_ ? "a floating base" : ""; }
+
 
  private:
   using Vec3 = Eigen::Vector3d;
@@ -246,8 +246,9 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   };
   struct DerivativeWork {  // kept between the states of a batch
     std::vector<WorldBody> bodies;
-    Eigen::VectorXd bias;
+    Eigen::VectorXd bias, tau_t;
     Eigen::MatrixXd M, Linv, dtau_dq, dtau_dqd;
+    std::vector<double> inverse, qdd_t, dq_t, dqd_t;  // a floating base's results in (ν, joints)
   };
   DerivativeWork derivative_work_;
 };
