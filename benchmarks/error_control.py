@@ -12,6 +12,9 @@ multiple of the EPSINT asked for, with the step counts:
     python benchmarks/error_control.py 8 32       # the planar cases of some meshes, and the spatial one
     python benchmarks/error_control.py --all-methods 64 32 64   # DOP853 and Radau5 up to 64 elements
                                                   # (undamped and damped; minutes per run beyond 16)
+    python benchmarks/error_control.py --case damped --methods radau5 16 32 64 128 256
+                                                  # one case, the methods named, on every mesh given
+                                                  # (case: undamped, damped or spatial)
 """
 from __future__ import annotations
 
@@ -66,11 +69,12 @@ def error(build, n: int):
     return lambda y: float(abs(y - reference).max())
 
 
-def table(name, build, meshes, small=16) -> None:
+def table(name, build, meshes, small=16, methods=None) -> None:
+    """``methods``: these on every mesh; None: generalized-α, and DOP853 and Radau5 up to ``small``."""
     for n in meshes:
         err = error(build, n)
-        methods = ("generalized_alpha", "dop853", "radau5") if n <= small else ("generalized_alpha",)
-        for method in methods:
+        on_mesh = methods or (("generalized_alpha", "dop853", "radau5") if n <= small else ("generalized_alpha",))
+        for method in on_mesh:
             for eps in TOLERANCES:
                 y, steps = tip(build, n, method, eps)
                 print(f"| {name} | {n} | {method} | {eps:.0e} | {err(y) / eps:.3g} | {steps} |", flush=True)
@@ -87,9 +91,23 @@ def main(meshes, all_methods=None) -> None:
         table("spatial, undamped", spatial, [16], small=0)
 
 
+CASES = {"undamped": ("planar, undamped", lambda n, eps: planar(n, eps, False)),
+         "damped": ("planar, damped", lambda n, eps: planar(n, eps, True)),
+         "spatial": ("spatial, undamped", spatial)}
+
+
 if __name__ == "__main__":
     args = sys.argv[1:]
     limit = None
+    if args[:1] == ["--case"]:
+        case, args = CASES[args[1]], args[2:]
+        methods = None
+        if args[:1] == ["--methods"]:
+            methods, args = tuple(args[1].split(",")), args[2:]
+        print("| case | elements | method | EPSINT | tip error / EPSINT | steps |")
+        print("|---|---|---|---|---|---|")
+        table(*case, [int(a) for a in args] or [16], methods=methods)
+        sys.exit()
     if args[:1] == ["--all-methods"]:
         limit, args = int(args[1]), args[2:]
     main([int(a) for a in args] or [8, 16, 32, 64, 128], limit)
