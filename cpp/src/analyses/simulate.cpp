@@ -570,9 +570,6 @@ void Simulation::dynamics_derivatives(const StateRows& q, const StateRows& qd, c
                      recursive_refusal() + "); the derivatives are computed on planar and spatial trees of rigid "
                      "bodies (URDF robots, pendulums, branched linkages)");
   }
-  if (const std::string why = tree->derivatives_refusal(); !why.empty())
-    throw InputError("dynamics_derivatives: not yet for " + why + " (its inverse dynamics and forward dynamics are "
-                     "on the recursive path; the derivatives are computed on trees whose every body turns on one joint)");
   const int nd = sys_->n_dof();
   if (q.cols() != nd || qd.cols() != nd || tau.cols() != nd || qd.rows() != q.rows() || tau.rows() != q.rows())
     throw InputError("dynamics_derivatives(): q, qd and tau must have the same number of states (rows) and one "
@@ -586,8 +583,14 @@ void Simulation::dynamics_derivatives(const StateRows& q, const StateRows& qd, c
   dtau.resize(q.rows(), nd * nd);
   for (Eigen::Index k = 0; k < q.rows(); ++k) {
     check_thread_deadline("(in dynamics_derivatives)");
-    if (!tree->dynamics_derivatives(nd, q.row(k).data(), qd.row(k).data(), tau.row(k).data(), qdd.row(k).data(),
-                                    dq.row(k).data(), dqd.row(k).data(), dtau.row(k).data())) {
+    bool ok = false;
+    try {
+      ok = tree->dynamics_derivatives(nd, q.row(k).data(), qd.row(k).data(), tau.row(k).data(), qdd.row(k).data(),
+                                      dq.row(k).data(), dqd.row(k).data(), dtau.row(k).data());
+    } catch (const InputError& e) {  // the state itself (a floating base's Euler parameters): say which
+      throw InputError(std::string(e.what()) + " at state " + std::to_string(k));
+    }
+    if (!ok) {
       throw InputError("dynamics_derivatives: the mass matrix is not positive definite at state " +
                        std::to_string(k) + " (e.g. a body that moves no mass)");
     }

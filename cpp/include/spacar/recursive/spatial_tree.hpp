@@ -188,7 +188,6 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
 
-
  private:
   using Vec3 = Eigen::Vector3d;
   using Quat = Eigen::Vector4d;

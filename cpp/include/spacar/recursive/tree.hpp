@@ -43,14 +43,12 @@ class RecursiveTree {
   virtual void inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) = 0;
   // The forward dynamics at (q, q̇) under the extra generalized forces τ (those inverse_dynamics
   // gives) and its derivatives, as pinocchio.computeABADerivatives: q̈ (n) and ∂q̈/∂q, ∂q̈/∂q̇,
-  // ∂q̈/∂τ = M⁻¹ (n × n, row major), n the DOFs, one per body. False if this tree does not
-  // provide them or its mass matrix is not positive definite.
+  // ∂q̈/∂τ = M⁻¹ (n × n, row major), n the DOFs (one per joint, a floating base's six). False if
+  // this tree does not provide them or its mass matrix is not positive definite.
   virtual bool dynamics_derivatives(int /*n*/, const double* /*q*/, const double* /*qd*/, const double* /*tau*/,
                                     double* /*qdd*/, double* /*dq*/, double* /*dqd*/, double* /*dtau*/) {
     return false;
   }
-  // Why dynamics_derivatives is not provided for this tree ("" if it is).
-  virtual std::string derivatives_refusal() const { return ""; }
 
  protected:
   // The coordinates moving with the bodies, after solve().
