@@ -190,7 +190,50 @@ def run_floating(quick):
         out["Pinocchio ABA + DOP853"].append((err, wall, eps, None))
         C.log(f"floating Solo12 Pinocchio DOP853 rtol {eps:g}: {wall * 1e3:.3f} ms, error {err:.1e}")
     out["nv"] = pm.nv
+    out["derivatives"] = floating_derivatives(path, pm, pd)
     return out
+
+
+def floating_derivatives(path, pm, pd, n_states=1000):
+    """Seconds for the dynamics derivatives of n_states random Solo12 states on a floating base:
+    one spacar.dynamics_derivatives call on the batch against as many calls of
+    pinocchio.computeABADerivatives on its free flyer, and one state per call (a spacar.Dynamics
+    made once). The coordinates differ (spacar: origin and three Euler parameters; Pinocchio: the
+    free flyer's tangent), so each is checked against itself before it is timed: spacar's q̈ gives
+    back tau through its inverse dynamics (equal to Pinocchio's free flyer in the tests; the
+    derivatives are checked there against the inverse dynamics' differences), Pinocchio's q̈ is
+    its aba's."""
+    import pinocchio as pin
+    import spacar
+    from spacar import _core
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = spacar.from_urdf(path, floating=True)
+    dyn = spacar.Dynamics(model)
+    assembled = _core.Simulation(model.copy().core)
+    assembled.assemble()
+    rng = np.random.default_rng(4)
+    nv = pm.nv
+    q = np.array(assembled.system.q0) + rng.uniform(-0.1, 0.1, (n_states, nv))
+    qd, tau = rng.uniform(-1.0, 1.0, (n_states, nv)), rng.uniform(-1.0, 1.0, (n_states, nv))
+    ours = spacar.dynamics_derivatives(model, q, qd, tau)
+    for k in range(0, n_states, 97):
+        assert np.abs(dyn.inverse_dynamics(q[k], qd[k], ours[0][k]) - tau[k]).max() <= 1e-9
+    pin_q = [pin.integrate(pm, pin.neutral(pm), rng.uniform(-1.0, 1.0, nv)) for _ in range(n_states)]
+    for k in range(0, n_states, 97):
+        pin.computeABADerivatives(pm, pd, pin_q[k], qd[k], tau[k])
+        assert np.abs(pd.ddq - pin.aba(pm, pd, pin_q[k], qd[k], tau[k])).max() <= 1e-9 * max(1.0, np.abs(pd.ddq).max())
+    t_ours, _ = C.best_time(lambda: spacar.dynamics_derivatives(model, q, qd, tau), repeat=REPEAT, budget=BUDGET,
+                            min_time=MIN_TIME)
+    t_pin, _ = C.best_time(lambda: [pin.computeABADerivatives(pm, pd, pin_q[k], qd[k], tau[k])
+                                    for k in range(n_states)], repeat=REPEAT, budget=BUDGET, min_time=MIN_TIME)
+    one = {"handle": C.per_call(lambda: dyn.dynamics_derivatives(q[0], qd[0], tau[0]), min_time=0.2),
+           "pinocchio": C.per_call(lambda: pin.computeABADerivatives(pm, pd, pin_q[0], qd[0], tau[0]), min_time=0.2)}
+    C.log(f"floating Solo12 derivatives of {n_states} states: spacar {t_ours * 1e3:.2f} ms, Pinocchio "
+          f"{t_pin * 1e3:.2f} ms; one state per call: Dynamics {one['handle'] * 1e6:.1f} µs, Pinocchio "
+          f"{one['pinocchio'] * 1e6:.1f} µs")
+    return {"states": n_states, "spacar": t_ours, "pinocchio": t_pin, "per_call": one}
 
 
 def series(points, label):
@@ -359,6 +402,15 @@ def section(r: dict, plots=None) -> str:
         for p in FLOATING_PROGRAMS:
             runs = ", ".join(f"{s:g} → {e:.1e} in {C.fmt_time(t)}" for e, t, s, *_ in f[p])
             lines.append(f"* Solo12 floating, {p}: {runs}")
+        d = f.get("derivatives")
+        if d:
+            lines += ["", "**Derivatives on the floating base.** " + floating_derivatives.__doc__.replace("\n    ", " "),
+                      "", "| robot | states | spacar batch | Pinocchio calls | Pinocchio / spacar | one state: "
+                      "`Dynamics` | one state: Pinocchio | Pinocchio / `Dynamics` |", "|---|---|---|---|---|---|---|---|",
+                      f"| Solo12 floating | {d['states']} | {C.fmt_time(d['spacar'])} | {C.fmt_time(d['pinocchio'])} | "
+                      f"{C.fmt_ratio(d['pinocchio'], d['spacar'])} | {C.fmt_time(d['per_call']['handle'])} | "
+                      f"{C.fmt_time(d['per_call']['pinocchio'])} | "
+                      f"{C.fmt_ratio(d['per_call']['pinocchio'], d['per_call']['handle'])} |"]
     return "\n".join(lines) + "\n"
 
 
