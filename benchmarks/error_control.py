@@ -13,8 +13,10 @@ multiple of the EPSINT asked for, with the step counts:
     python benchmarks/error_control.py --all-methods 64 32 64   # DOP853 and Radau5 up to 64 elements
                                                   # (undamped and damped; minutes per run beyond 16)
     python benchmarks/error_control.py --case damped --methods radau5 16 32 64 128 256
-                                                  # one case, the methods named, on every mesh given
-                                                  # (case: undamped, damped or spatial)
+                                                  # one case (undamped, damped or spatial) on the
+                                                  # meshes given (default 16); --methods (comma-
+                                                  # separated, after the case) on every mesh, else
+                                                  # the methods main() runs on that case
 """
 from __future__ import annotations
 
@@ -91,22 +93,29 @@ def main(meshes, all_methods=None) -> None:
         table("spatial, undamped", spatial, [16], small=0)
 
 
-CASES = {"undamped": ("planar, undamped", lambda n, eps: planar(n, eps, False)),
-         "damped": ("planar, damped", lambda n, eps: planar(n, eps, True)),
-         "spatial": ("spatial, undamped", spatial)}
+# name: (label, model builder, the largest mesh on which main() runs DOP853 and Radau5)
+CASES = {"undamped": ("planar, undamped", lambda n, eps: planar(n, eps, False), 16),
+         "damped": ("planar, damped", lambda n, eps: planar(n, eps, True), 8),
+         "spatial": ("spatial, undamped", spatial, 0)}
+METHODS = ("generalized_alpha", "dop853", "radau5")
 
 
 if __name__ == "__main__":
     args = sys.argv[1:]
     limit = None
     if args[:1] == ["--case"]:
-        case, args = CASES[args[1]], args[2:]
+        if len(args) < 2 or args[1] not in CASES:
+            sys.exit(f"--case needs one of {', '.join(CASES)}")
+        (label, build, small), args = CASES[args[1]], args[2:]
         methods = None
         if args[:1] == ["--methods"]:
-            methods, args = tuple(args[1].split(",")), args[2:]
+            methods = tuple(args[1].split(",")) if len(args) > 1 else ()
+            if not methods or any(m not in METHODS for m in methods):
+                sys.exit(f"--methods needs a comma-separated list of {', '.join(METHODS)}")
+            args = args[2:]
         print("| case | elements | method | EPSINT | tip error / EPSINT | steps |")
         print("|---|---|---|---|---|---|")
-        table(*case, [int(a) for a in args] or [16], methods=methods)
+        table(label, build, [int(a) for a in args] or [16], small=small, methods=methods)
         sys.exit()
     if args[:1] == ["--all-methods"]:
         limit, args = int(args[1]), args[2:]

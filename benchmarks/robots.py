@@ -196,13 +196,13 @@ def run_floating(quick):
 
 def floating_derivatives(path, pm, pd, n_states=1000):
     """Seconds for the dynamics derivatives of n_states random Solo12 states on a floating base:
-    one spacar.dynamics_derivatives call on the batch against as many calls of
-    pinocchio.computeABADerivatives on its free flyer, and one state per call (a spacar.Dynamics
-    made once). The coordinates differ (spacar: origin and three Euler parameters; Pinocchio: the
-    free flyer's tangent), so each is checked against itself before it is timed: spacar's q̈ gives
-    back tau through its inverse dynamics (equal to Pinocchio's free flyer in the tests; the
-    derivatives are checked there against the inverse dynamics' differences), Pinocchio's q̈ is
-    its aba's."""
+    one call of a spacar.Dynamics (made outside the timing, as Pinocchio's model is) on the batch
+    against as many calls of pinocchio.computeABADerivatives on its free flyer, and one state per
+    call. The coordinates differ (spacar: origin and three Euler parameters; Pinocchio: the free
+    flyer's tangent), so each is checked against itself before it is timed: spacar's q̈ gives
+    back tau through its inverse dynamics (the derivatives are checked against the inverse
+    dynamics' differences in tests/api/test_urdf.py), one state per call equals the batch's, and
+    Pinocchio's q̈ is its aba's."""
     import pinocchio as pin
     import spacar
     from spacar import _core
@@ -217,14 +217,17 @@ def floating_derivatives(path, pm, pd, n_states=1000):
     nv = pm.nv
     q = np.array(assembled.system.q0) + rng.uniform(-0.1, 0.1, (n_states, nv))
     qd, tau = rng.uniform(-1.0, 1.0, (n_states, nv)), rng.uniform(-1.0, 1.0, (n_states, nv))
-    ours = spacar.dynamics_derivatives(model, q, qd, tau)
+    ours = dyn.dynamics_derivatives(q, qd, tau)
     for k in range(0, n_states, 97):
         assert np.abs(dyn.inverse_dynamics(q[k], qd[k], ours[0][k]) - tau[k]).max() <= 1e-9
+    assert np.array_equal(dyn.dynamics_derivatives(q[0], qd[0], tau[0])[1], ours[1][0])
     pin_q = [pin.integrate(pm, pin.neutral(pm), rng.uniform(-1.0, 1.0, nv)) for _ in range(n_states)]
     for k in range(0, n_states, 97):
         pin.computeABADerivatives(pm, pd, pin_q[k], qd[k], tau[k])
-        assert np.abs(pd.ddq - pin.aba(pm, pd, pin_q[k], qd[k], tau[k])).max() <= 1e-9 * max(1.0, np.abs(pd.ddq).max())
-    t_ours, _ = C.best_time(lambda: spacar.dynamics_derivatives(model, q, qd, tau), repeat=REPEAT, budget=BUDGET,
+        ddq = pd.ddq.copy()  # a view of Pinocchio's data, which aba overwrites
+        expected = pin.aba(pm, pd, pin_q[k], qd[k], tau[k]).copy()
+        assert np.abs(ddq - expected).max() <= 1e-9 * max(1.0, np.abs(expected).max())
+    t_ours, _ = C.best_time(lambda: dyn.dynamics_derivatives(q, qd, tau), repeat=REPEAT, budget=BUDGET,
                             min_time=MIN_TIME)
     t_pin, _ = C.best_time(lambda: [pin.computeABADerivatives(pm, pd, pin_q[k], qd[k], tau[k])
                                     for k in range(n_states)], repeat=REPEAT, budget=BUDGET, min_time=MIN_TIME)
@@ -404,7 +407,13 @@ def section(r: dict, plots=None) -> str:
             lines.append(f"* Solo12 floating, {p}: {runs}")
         d = f.get("derivatives")
         if d:
-            lines += ["", "**Derivatives on the floating base.** " + floating_derivatives.__doc__.replace("\n    ", " "),
+            lines += ["", "**Derivatives on the floating base.** Solo12 on a floating base, 1000 random states: one "
+                      "call of a `spacar.Dynamics` (made outside the timing) on the batch against as many calls of "
+                      "`pinocchio.computeABADerivatives` on its free flyer, and one state per call. The coordinates "
+                      "differ (spacar: the origin and three Euler parameters; Pinocchio: the free flyer's tangent), "
+                      "so each is checked against itself before it is timed (spacar's q̈ gives back τ through its "
+                      "inverse dynamics, and its derivatives are checked against the inverse dynamics' differences "
+                      "in tests/api/test_urdf.py; Pinocchio's q̈ is its `aba`'s).",
                       "", "| robot | states | spacar batch | Pinocchio calls | Pinocchio / spacar | one state: "
                       "`Dynamics` | one state: Pinocchio | Pinocchio / `Dynamics` |", "|---|---|---|---|---|---|---|---|",
                       f"| Solo12 floating | {d['states']} | {C.fmt_time(d['spacar'])} | {C.fmt_time(d['pinocchio'])} | "
