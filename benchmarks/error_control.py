@@ -71,11 +71,19 @@ def error(build, n: int):
     return lambda y: float(abs(y - reference).max())
 
 
+# name: (label, model builder, the largest mesh on which main() runs DOP853 and Radau5)
+CASES = {"undamped": ("planar, undamped", lambda n, eps: planar(n, eps, False), 16),
+         "damped": ("planar, damped", lambda n, eps: planar(n, eps, True), 8),
+         "spatial": ("spatial, undamped", spatial, 0)}
+METHODS = ("generalized_alpha", "dop853", "radau5")
+HEADER = "| case | elements | method | EPSINT | tip error / EPSINT | steps |\n|---|---|---|---|---|---|"
+
+
 def table(name, build, meshes, small=16, methods=None) -> None:
     """``methods``: these on every mesh; None: generalized-α, and DOP853 and Radau5 up to ``small``."""
     for n in meshes:
         err = error(build, n)
-        on_mesh = methods or (("generalized_alpha", "dop853", "radau5") if n <= small else ("generalized_alpha",))
+        on_mesh = methods or (METHODS if n <= small else METHODS[:1])
         for method in on_mesh:
             for eps in TOLERANCES:
                 y, steps = tip(build, n, method, eps)
@@ -85,19 +93,13 @@ def table(name, build, meshes, small=16, methods=None) -> None:
 def main(meshes, all_methods=None) -> None:
     """``all_methods``: DOP853 and Radau5 on the meshes up to this size (default 16 undamped, 8
     damped, where they take seconds)."""
-    print("| case | elements | method | EPSINT | tip error / EPSINT | steps |")
-    print("|---|---|---|---|---|---|")
-    table("planar, undamped", lambda n, eps: planar(n, eps, False), meshes, small=all_methods or 16)
-    table("planar, damped", lambda n, eps: planar(n, eps, True), meshes, small=all_methods or 8)
+    print(HEADER)
+    for case in ("undamped", "damped"):
+        label, build, small = CASES[case]
+        table(label, build, meshes, small=all_methods or small)
     if all_methods is None:
-        table("spatial, undamped", spatial, [16], small=0)
-
-
-# name: (label, model builder, the largest mesh on which main() runs DOP853 and Radau5)
-CASES = {"undamped": ("planar, undamped", lambda n, eps: planar(n, eps, False), 16),
-         "damped": ("planar, damped", lambda n, eps: planar(n, eps, True), 8),
-         "spatial": ("spatial, undamped", spatial, 0)}
-METHODS = ("generalized_alpha", "dop853", "radau5")
+        label, build, small = CASES["spatial"]
+        table(label, build, [16], small=small)
 
 
 if __name__ == "__main__":
@@ -113,8 +115,7 @@ if __name__ == "__main__":
             if not methods or any(m not in METHODS for m in methods):
                 sys.exit(f"--methods needs a comma-separated list of {', '.join(METHODS)}")
             args = args[2:]
-        print("| case | elements | method | EPSINT | tip error / EPSINT | steps |")
-        print("|---|---|---|---|---|---|")
+        print(HEADER)
         table(label, build, [int(a) for a in args] or [16], small=small, methods=methods)
         sys.exit()
     if args[:1] == ["--all-methods"]:

@@ -77,6 +77,8 @@ Eigen::Matrix<double, 3, 4> euler_E(const Eigen::Vector4d& l) {
   return E;
 }
 
+Eigen::Matrix3d euler_R(const Eigen::Vector4d& l) { return euler_E(l) * euler_G(l.data()).transpose(); }
+
 void add_rotational_inertia(int n, const double* x, const double* v, const int* lam, int nblocks,
                             const Eigen::Matrix3d* A, double* M, double* h) {
   Eigen::Map<Eigen::MatrixXd> Mm(M, n, n);

@@ -35,10 +35,10 @@
 // term: the axes are fixed). The results in (δ, ν) are taken to spacar's DOFs of the base (the
 // origin x and three Euler parameters μ) by the chain rule through ν = T(p) ṗ, δ = T(p) δp,
 // the wrench from the generalized forces (τ = Tᵀ wrench) and p̈ from ν̇, whose derivatives are
-// exact by forward-mode dual numbers (BaseMaps).
-#include <algorithm>
+// exact by forward-mode dual numbers (FreeBaseMaps, free_base.hpp).
 #include <array>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "spacar/autodiff.hpp"
@@ -96,105 +96,6 @@ bool cholesky_inverse(Eigen::MatrixXd& M, Eigen::MatrixXd& Linv, double* inverse
   return true;
 }
 
-// The floating base's coordinates p = (x, μ) (the origin and the three independent Euler
-// parameters) and rates, as functions on any scalar (double or Jet), for their exact derivatives.
-struct BaseMaps {
-  int dependent = 0;
-  double sign = 1.0;
-
-  template <class T>
-  void lambda(const T* mu, T* l) const {  // the dependent parameter from the unit norm
-    T others(0.0);
-    for (int i = 0, k = 0; i < 4; ++i) {
-      if (i == dependent) continue;
-      l[i] = mu[k++];
-      others = others + l[i] * l[i];
-    }
-    l[dependent] = sign * sqrt(T(1.0) - others);
-  }
-  template <class T>
-  void lambda_rate(const T* l, const T* mud, T* ld) const {  // λ · λ̇ = 0
-    T dot(0.0);
-    for (int i = 0, k = 0; i < 4; ++i) {
-      if (i == dependent) continue;
-      ld[i] = mud[k++];
-      dot = dot + l[i] * ld[i];
-    }
-    ld[dependent] = -dot / l[dependent];
-  }
-  template <class T>
-  static void omega(const T* l, const T* ld, T* w) {  // ω = 2 E(λ) λ̇, world axes
-    w[0] = 2.0 * (-l[1] * ld[0] + l[0] * ld[1] - l[3] * ld[2] + l[2] * ld[3]);
-    w[1] = 2.0 * (-l[2] * ld[0] + l[3] * ld[1] + l[0] * ld[2] - l[1] * ld[3]);
-    w[2] = 2.0 * (-l[3] * ld[0] - l[2] * ld[1] + l[1] * ld[2] + l[0] * ld[3]);
-  }
-  template <class T>
-  static void e_transpose_times(const T* l, const T* w, T* out) {  // E(λ)ᵀ w
-    out[0] = -(w[0] * l[1] + w[1] * l[2] + w[2] * l[3]);
-    out[1] = l[0] * w[0] + w[1] * l[3] - w[2] * l[2];
-    out[2] = l[0] * w[1] + w[2] * l[1] - w[0] * l[3];
-    out[3] = l[0] * w[2] + w[0] * l[2] - w[1] * l[1];
-  }
-  template <class T>
-  static void cross(const T* a, const T* b, T* out) {
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-  }
-  // ν = (ω; ẋ − ω × x): the base's twist at the world origin (also δ from δp).
-  template <class T>
-  void twist(const T* p, const T* pd, T* nu) const {
-    T l[4], ld[4], xw[3];
-    lambda(p + 3, l);
-    lambda_rate(l, pd + 3, ld);
-    omega(l, ld, nu);
-    cross(nu, p, xw);
-    for (int c = 0; c < 3; ++c) nu[3 + c] = pd[c] - xw[c];
-  }
-  // The wrench (n; f) at the world origin whose power on ν is that of the generalized forces
-  // τ_p on ṗ: f = τ_x, n = x × f + A⁻ᵀ τ_μ with ω = A μ̇.
-  template <class T>
-  void wrench(const T* p, const T* tau, T* out) const {
-    T l[4], A[3][3];
-    lambda(p + 3, l);
-    for (int m = 0; m < 3; ++m) {
-      T e[3] = {T(0.0), T(0.0), T(0.0)}, ld[4], w[3];
-      e[m] = T(1.0);
-      lambda_rate(l, e, ld);
-      omega(l, ld, w);
-      for (int r = 0; r < 3; ++r) A[r][m] = w[r];
-    }
-    // Aᵀ y = τ_μ by Cramer's rule: y = adj(Aᵀ) τ_μ / det A, adj(Aᵀ) = cof(A).
-    T cof[3][3];
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c)
-        cof[r][c] = A[(r + 1) % 3][(c + 1) % 3] * A[(r + 2) % 3][(c + 2) % 3] -
-                    A[(r + 1) % 3][(c + 2) % 3] * A[(r + 2) % 3][(c + 1) % 3];
-    const T det = A[0][0] * cof[0][0] + A[0][1] * cof[0][1] + A[0][2] * cof[0][2];
-    T xf[3];
-    cross(p, tau, xf);
-    for (int r = 0; r < 3; ++r) {
-      out[r] = xf[r] + (cof[r][0] * tau[3] + cof[r][1] * tau[4] + cof[r][2] * tau[5]) / det;
-      out[3 + r] = tau[r];
-    }
-  }
-  // p̈ from ν̇ = (α; a_O): ẍ = a_O + α × x + ω × ẋ, λ̈ = ½ E(λ̇)ᵀ ω + ½ E(λ)ᵀ α.
-  template <class T>
-  void acceleration(const T* p, const T* pd, const T* nud, T* pdd) const {
-    T l[4], ld[4], w[3], ax[3], wx[3], a[4], b[4];
-    lambda(p + 3, l);
-    lambda_rate(l, pd + 3, ld);
-    omega(l, ld, w);
-    cross(nud, p, ax);
-    cross(w, pd, wx);
-    for (int c = 0; c < 3; ++c) pdd[c] = nud[3 + c] + ax[c] + wx[c];
-    e_transpose_times(ld, w, a);
-    e_transpose_times(l, nud, b);
-    for (int i = 0, k = 0; i < 4; ++i)
-      if (i != dependent) pdd[3 + k++] = 0.5 * (a[i] + b[i]);
-  }
-};
-
 // f's value (out, m) and its m × 6 Jacobians in each of its arguments (J[a], row major), at
 // double arguments args[a] (6 each), by one pass on dual numbers over all of them.
 template <int A, class F>
@@ -212,23 +113,32 @@ void jacobians(const F& f, const std::array<const double*, A>& args, int m, doub
   }
 }
 
+// A floating base's state in the passes' terms at p = (x, μ), ṗ and its generalized forces τ_p:
+// its twist ν = T(p) ṗ and the wrench w = T⁻ᵀ(p) τ_p, with their Jacobians (row major, 6 × 6):
+// T = ∂ν/∂ṗ (also δ = T δp), Np = ∂ν/∂p, Wp = ∂w/∂p, Wt = ∂w/∂τ_p = T⁻ᵀ.
+struct BaseState {
+  Eigen::Matrix<double, 6, 1> nu, wrench;
+  double T[36], Np[36], Wp[36], Wt[36];
+
+  BaseState(const FreeBaseMaps& maps, const double* p, const double* pd, const double* tau) {
+    double* J[2] = {Np, T};
+    jacobians<2>([&](const auto& in, auto* out) { maps.twist(in[0].data(), in[1].data(), out); },
+                 {p, pd}, 6, nu.data(), J);
+    double* K[2] = {Wp, Wt};
+    jacobians<2>([&](const auto& in, auto* out) { maps.wrench(in[0].data(), in[1].data(), out); },
+                 {p, tau}, 6, wrench.data(), K);
+  }
+};
+
 // The floating base's results in (ν, joints) taken to q by the chain rule: a column of the base's
 // coordinates p_m gathers the columns of δ (through δ = T δp), of ν (ν = T(p) ṗ depends on p) and
 // of the wrench (w = T⁻ᵀ(p) τ_p); q̇'s through T, τ's through T⁻ᵀ. A row of p̈ is P(p, ṗ, ν̇),
 // with its explicit derivatives in p and ṗ beside ∂P/∂ν̇ times the rows of ν̇.
 // qdd_t, Aq, Aqd, At: q̈ and the derivatives in (ν, joints) (Aq, Aqd, At overwritten).
-void base_to_coordinates(int n, const BaseMaps& maps, const std::array<int, 6>& bidx, const std::array<int, 6>& tidx,
-                         const double* p, const double* pd, const double* taub, const double* qdd_t, double* Aq,
-                         double* Aqd, double* At, double* qdd, double* dq, double* dqd, double* dtau) {
-  double nu[6], T[36], Np[36], wrench[6], Wp[36], Wt[36];
-  {
-    double* J[2] = {Np, T};
-    jacobians<2>([&](const auto& in, auto* out) { maps.twist(in[0].data(), in[1].data(), out); },
-                 {p, pd}, 6, nu, J);
-    double* K[2] = {Wp, Wt};
-    jacobians<2>([&](const auto& in, auto* out) { maps.wrench(in[0].data(), in[1].data(), out); },
-                 {p, taub}, 6, wrench, K);
-  }
+void base_to_coordinates(int n, const FreeBaseMaps& maps, const BaseState& base, const std::array<int, 6>& bidx,
+                         const std::array<int, 6>& tidx, const double* p, const double* pd, const double* qdd_t,
+                         double* Aq, double* Aqd, double* At, double* qdd, double* dq, double* dqd, double* dtau) {
+  const double *T = base.T, *Np = base.Np, *Wp = base.Wp, *Wt = base.Wt;
   double nud[6], pdd[6], Pp[36], Ppd[36], Pn[36];
   for (int k = 0; k < 6; ++k) nud[k] = qdd_t[tidx[k]];
   {
@@ -257,10 +167,12 @@ void base_to_coordinates(int n, const BaseMaps& maps, const std::array<int, 6>& 
     }
   }
   // Rows: the joints' as they are, the base's through P.
-  std::copy(qdd_t, qdd_t + n, qdd);
-  std::copy(Aq, Aq + n * n, dq);
-  std::copy(Aqd, Aqd + n * n, dqd);
-  std::copy(At, At + n * n, dtau);
+  using Values = Eigen::Map<Eigen::VectorXd>;
+  using ConstValues = Eigen::Map<const Eigen::VectorXd>;
+  Values(qdd, n) = ConstValues(qdd_t, n);
+  Values(dq, n * n) = ConstValues(Aq, n * n);
+  Values(dqd, n * n) = ConstValues(Aqd, n * n);
+  Values(dtau, n * n) = ConstValues(At, n * n);
   for (int r = 0; r < 6; ++r) {
     const int row = bidx[r];
     qdd[row] = pdd[r];
@@ -295,10 +207,10 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
   // A floating base: where its DOFs are in q, as p = (x, μ) (bidx) and as the slots of its twist
   // ν = (ω; v at the origin) and wrench (tidx) in the passes; ν, and the wrench of tau's forces
   // on p. The passes then run in (ν, joints), their results taken to q at the end.
-  BaseMaps maps{base_.dependent, base_.sign};
   std::array<int, 6> bidx{}, tidx{};
   double base_p[6] = {}, base_pd[6] = {}, base_tau[6] = {};
-  Vec6 nu = Vec6::Zero(), wrench = Vec6::Zero();
+  std::optional<BaseState> base;
+  Vec6 nu = Vec6::Zero();
   Eigen::Vector4d base_l = Eigen::Vector4d::Zero();
   const double* tau_t = tau;
   if (floating_) {
@@ -311,23 +223,25 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
       base_pd[m] = qd[bidx[m]];
       base_tau[m] = tau[bidx[m]];
     }
-    maps.lambda(base_p + 3, base_l.data());
-    if (!(std::abs(base_l[base_.dependent]) > 0.0) || !std::isfinite(base_l[base_.dependent]))
+    base_l = base_lambda(q);
+    if (!(std::abs(base_l[base_.dependent]) > 0.0) || !base_l.allFinite())
       throw InputError("dynamics_derivatives: the floating base's three Euler parameters have a norm of 1 or more");
-    maps.twist(base_p, base_pd, nu.data());
-    maps.wrench(base_p, base_tau, wrench.data());
+    base.emplace(base_, base_p, base_pd, base_tau);
+    nu = base->nu;
     work.tau_t = Eigen::Map<const Eigen::VectorXd>(tau, n);
-    for (int k = 0; k < 6; ++k) work.tau_t[tidx[k]] = wrench[k];
+    for (int k = 0; k < 6; ++k) work.tau_t[tidx[k]] = base->wrench[k];
     tau_t = work.tau_t.data();
   }
   // Outwards: placements, joint axes, inertias, velocities, the accelerations without q̈, the
   // external loads and their matrices.
+  int base_body = -1;  // the floating base's body
   for (int i = 0; i < nb; ++i) {
     const Model& m = bodies_[i];
     WorldBody& b = world[i];
     const bool root = m.parent < 0;
     if (m.free) {  // the floating base: its frame R(λ) R0ᵀ at its origin, no joint
-      b.R = euler_E(base_l) * euler_G(base_l.data()).transpose() * base_.R0.transpose();
+      base_body = i;
+      b.R = euler_R(base_l) * base_.R0.transpose();
       b.p = Vec3(base_p[0], base_p[1], base_p[2]);
       b.S.setZero();
     } else {
@@ -476,9 +390,6 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
   }
   // The base's axes e_k: u_k = e_k × ν and z_k = u_k × ν − e_k × a_base.
   std::array<Vec6, 6> base_u, base_z;
-  int base_body = -1;
-  for (int i = 0; i < nb && floating_; ++i)
-    if (bodies_[i].free) base_body = i;
   if (base_body >= 0)
     for (int k = 0; k < 6; ++k) {
       const Vec6 e = Vec6::Unit(k);
@@ -541,8 +452,7 @@ bool SpatialTree::dynamics_derivatives(int n, const double* q, const double* qd,
       acc_qd[i * n + j] = -sqd;
     }
   if (floating_)
-    base_to_coordinates(n, maps, bidx, tidx, base_p, base_pd, base_tau, acc, acc_q, acc_qd, inverse, qdd, dq, dqd,
-                        dtau);
+    base_to_coordinates(n, base_, *base, bidx, tidx, base_p, base_pd, acc, acc_q, acc_qd, inverse, qdd, dq, dqd, dtau);
   return true;
 }
 

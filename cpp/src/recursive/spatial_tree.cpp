@@ -23,13 +23,9 @@ using tree_detail::compose;
 // E(λ)ᵀ ω = (0, ω) ⊗ λ.
 Eigen::Vector4d euler_E_transpose_times(const Eigen::Vector4d& l, const Eigen::Vector3d& w) {
   Eigen::Vector4d out;
-  out[0] = -w.dot(l.tail<3>());
-  out.tail<3>() = l[0] * w + w.cross(l.tail<3>());
+  FreeBaseMaps::e_transpose_times(l.data(), w.data(), out.data());
   return out;
 }
-
-// R(λ) = E(λ) G(λ)ᵀ, body → global.
-Eigen::Matrix3d euler_R(const Eigen::Vector4d& l) { return euler_E(l) * euler_G(l.data()).transpose(); }
 
 // Rigid-motion row of a coordinate: its rate for the body twist (ω, v) at the pin (world axes
 // at the reference state); b is an XYZ node's position relative to the pin, lambda a LAMBDA
@@ -308,26 +304,16 @@ void SpatialTree::applied_loads() {
 // The floating base's Euler parameters at q (the dependent one from the unit norm, with its
 // sign at the recognition), and their rates at q̇ (the dependent one from λ · λ̇ = 0).
 Eigen::Vector4d SpatialTree::base_lambda(const double* q) const {
+  const double mu[3] = {q[base_.lambda_dof[0]], q[base_.lambda_dof[1]], q[base_.lambda_dof[2]]};
   Eigen::Vector4d l;
-  double others = 0.0;
-  for (int i = 0, k = 0; i < 4; ++i) {
-    if (i == base_.dependent) continue;
-    l[i] = q[base_.lambda_dof[k++]];
-    others += l[i] * l[i];
-  }
-  l[base_.dependent] = base_.sign * std::sqrt(std::max(0.0, 1.0 - others));
+  base_.lambda(mu, l.data());
   return l;
 }
 
 Eigen::Vector4d SpatialTree::base_lambda_rate(const Eigen::Vector4d& l, const double* qd) const {
+  const double mud[3] = {qd[base_.lambda_dof[0]], qd[base_.lambda_dof[1]], qd[base_.lambda_dof[2]]};
   Eigen::Vector4d ld;
-  double dot = 0.0;
-  for (int i = 0, k = 0; i < 4; ++i) {
-    if (i == base_.dependent) continue;
-    ld[i] = qd[base_.lambda_dof[k++]];
-    dot += l[i] * ld[i];
-  }
-  ld[base_.dependent] = -dot / l[base_.dependent];
+  base_.lambda_rate(l.data(), mud, ld.data());
   return ld;
 }
 

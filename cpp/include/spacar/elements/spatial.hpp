@@ -66,6 +66,8 @@ Eigen::Matrix3d hinge_frame(const Eigen::Vector3d& axis, const std::string& what
 Eigen::Matrix<double, 3, 4> euler_G(const double* l);
 // E(λ): ω = 2 E(λ) λ̇ is the angular velocity in global axes (formulation.md §0).
 Eigen::Matrix<double, 3, 4> euler_E(const Eigen::Vector4d& l);
+// R(λ) = E(λ) G(λ)ᵀ: body axes → global.
+Eigen::Matrix3d euler_R(const Eigen::Vector4d& l);
 
 // Mass and convective inertia force of rotational kinetic energy
 // T = ½ Σ_ij ω_iᵀ A_ij ω_j with ω_i = 2 G(λ_i) λ̇_i the body angular velocity of LAMBDA block i

@@ -34,6 +34,7 @@
 
 #include "spacar/elements/spatial.hpp"
 #include "spacar/recursive/articulated.hpp"
+#include "spacar/recursive/free_base.hpp"
 
 namespace spacar {
 
@@ -209,11 +210,11 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   void applied_loads() override;
   // A floating base (spatial_tree.cpp): the root body's origin (XYZ node, DYNX) and orientation
   // (LAMBDA node, three Euler parameters DYNX, the dependent one calculable: FreeRotation).
-  struct FreeBase {
+  // FreeBaseMaps' dependent (0..3: the calculable parameter) and sign (of the dependent
+  // parameter, which stays away from 0: see repartition).
+  struct FreeBase : FreeBaseMaps {
     int x_dof = -1;                  // q index of the origin's x (y, z follow)
     std::array<int, 3> lambda_dof{};  // q indices of the three independent Euler parameters
-    int dependent = 0;               // 0..3: the calculable one
-    double sign = 1.0;               // of the dependent parameter (it stays away from 0: see repartition)
     Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();  // R(λ) at the recognition (the body's reference)
     Eigen::Vector4d lambda0 = Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
   };
