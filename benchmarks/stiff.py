@@ -20,7 +20,7 @@ against the beam's exact deformation modes, finite EA), so exudyn's error is mea
 own solution at its smallest step. Times: spacar — best wall time of ``spacar.simulate`` over
 repeats (whole call, Python included); exudyn — best wall time of ``SolveDynamic``.
 
-    python benchmarks/stiff.py [--quick] [--no-write] [--no-plot] [--from-results]
+    python benchmarks/stiff.py [--quick] [--no-write] [--no-plot] [--from-results] [--scaling-case CASE]
 """
 from __future__ import annotations
 
@@ -92,6 +92,13 @@ def exudyn_runs(cfg, quick):
 def run(a) -> dict:
     C.quiet_exudyn()
     quick = a.quick
+    if a.scaling_case:   # one case of the scaling tables, merged into the last full run's results
+        r = C.load_results("stiff")
+        cfg = stiff_scaling.QUICK if quick else stiff_scaling.FULL
+        r["scaling"][a.scaling_case] = stiff_scaling.run_case(a.scaling_case, quick)
+        r["scaling"]["config"][a.scaling_case] = cfg[a.scaling_case]
+        r["quick"] = quick
+        return r
     cfg = QUICK if quick else FULL
     out = {"quick": quick, "config": cfg, "machine": C.machine(peers=True), "spacar": {}, "reference": {}}
     for damped in (False, True):
@@ -212,7 +219,11 @@ def plot(r: dict) -> dict:
 
 
 def main(argv=None) -> int:
-    return C.standard_main("stiff", __doc__, run, section, plot, argv)
+    def extra(p):
+        p.add_argument("--scaling-case", choices=stiff_scaling.CASES,
+                       help="measure only this case of the step-count tables (stiff_scaling.py) and merge it into "
+                            "benchmarks/results/stiff.json")
+    return C.standard_main("stiff", __doc__, run, section, plot, argv, extra_args=extra)
 
 
 if __name__ == "__main__":
