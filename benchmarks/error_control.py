@@ -37,8 +37,9 @@ def planar(n: int, eps: float, damped: bool) -> spacar.Model:
     return m
 
 
-def spatial(n: int, eps: float, damped: bool = False) -> spacar.Model:
-    """n BEAMs along x, clamped at x = 0, bending about y and z (EIz = 4 EIy), gravity off both."""
+def spatial(n: int, eps: float, damped: bool = False, rotary: float = 0.0) -> spacar.Model:
+    """n BEAMs along x, clamped at x = 0, bending about y and z (EIz = 4 EIy), gravity off both;
+    ``rotary``: the sections' rotary inertia ρIy = ρIz per length (EMASS's extension; none here)."""
     m = spacar.Model()
     for i in range(n):
         m.beam(i + 1, i + 1, 101 + i, i + 2, 102 + i, 0.0, 1.0, 0.0)
@@ -49,7 +50,7 @@ def spatial(n: int, eps: float, damped: bool = False) -> spacar.Model:
     for i in range(n):
         m.dyne(i + 1, 2, 3, 4, 5, 6)
         m.estiff(i + 1, 0.0, EI, EI, 4.0 * EI)
-        m.emass(i + 1, RHO_A, 1e-4, 0.0, 0.0)
+        m.emass(i + 1, RHO_A, 1e-4, rotary, rotary)
     m.gravity(0.0, -G, -0.5 * G)
     m.epsint(eps)
     m.epsind(eps)

@@ -97,6 +97,8 @@ def run(a) -> dict:
         cfg = stiff_scaling.QUICK if quick else stiff_scaling.FULL
         r["scaling"][a.scaling_case] = stiff_scaling.run_case(a.scaling_case, quick)
         r["scaling"]["config"][a.scaling_case] = cfg[a.scaling_case]
+        r["scaling"].setdefault("measured_apart", {})[a.scaling_case] = dict(C.machine(peers=True),
+                                                                          date=time.strftime("%Y-%m-%d %H:%M"))
         r["quick"] = quick
         return r
     cfg = QUICK if quick else FULL

@@ -27,6 +27,7 @@ GA_FIXED_EPS = [1e-7, 1e-5, 1e-3]     # its fixed-step runs: EPSINT = EPSIND, wh
 # 1e-8, or the reference's where that stalls): each program at its best settings.
 EXUDYN_NEWTON_RTOL = [None, 1e-6, 1e-4]
 EI_ROD = 0.0012723                    # the manual's rod
+RHO_I = 6.5e-6                        # spatial case: rotary inertia ρIy = ρIz [kg m] (a 10 mm steel square's)
 RUN_BUDGET = 3.0    # s: a series ends after a run this long
 RUN_LIMIT = 10.0    # s: no single run longer than this
 
@@ -68,7 +69,8 @@ def cantilever(n, t_end, eps, n_out=1):
 def spatial(n, t_end, eps, n_out=1):
     import error_control
 
-    m = error_control.spatial(n, eps)
+    m = error_control.spatial(n, eps, rotary=RHO_I)
+    m.epskin(1e-10)    # as the planar cantilever's (models.cantilever)
     m.timestep(n_out, t_end)
     return m
 
@@ -231,7 +233,7 @@ def run_case(case, quick):
         if case == "spatial":
             import _exudyn_beam3d
 
-            em = _exudyn_beam3d.build(variant)
+            em = _exudyn_beam3d.build(variant, rotary=RHO_I)
         else:
             em = sx.build(BUILD[case](variant, cfg["t_end"], 1e-6),
                           **({"axial_stiffness": 1e4 * 175.0} if case == "cantilever" else {}))
@@ -262,8 +264,8 @@ def run(quick):
 def steady(series, target):
     """The fastest run from which on every tighter run of the series reaches the target (the
     series ends with two such runs, see _sweep); None if the series did not end on target. A last
-    setting refused for the time limit was not run: it counts as neither, as the settings after a
-    run past the budget."""
+    setting stopped at (spacar) or refused for (exudyn) the time limit counts as neither, as the
+    settings after a run past the budget: the run before it may be the only one on target."""
     best = None
     for k, r in enumerate(reversed(series)):
         if r.get("over_limit") and k == 0:
@@ -338,30 +340,34 @@ def section_lines(res) -> list:
              "`spacar.compare.exudyn` (ANCF cables with the penalty axial stiffness 1e4·EI/l0²);",
              f"* the steel cantilever above with n PLBEAMs (2n DOFs), undamped, {ca['t_end']:g} s; error: tip y at the "
              f"end; target {ca['target']:g} m. exudyn: n ANCF cables, EA = 1e4·EI/L²;",
-             "* its spatial twin (benchmarks/error_control.py's `spatial`): 16 BEAMs bending about both axes "
-             "(EIz = 4 EIy, torsion GJ = EI, gravity off both axes), undamped, same span; error: the larger of the tip's "
-             "y and z errors at the end; target as the cantilever's. exudyn: 16 `ObjectBeamGeometricallyExact` "
-             "(Simo–Reissner, linear interpolation; Tait–Bryan nodes, since its Lie-group nodes do not converge under "
-             "generalized-α), penalty EA = GA = 1e4·EI (benchmarks/_exudyn_beam3d.py); its runs take seconds, so its "
+             "* its spatial twin (benchmarks/error_control.py's `spatial`): n BEAMs bending about both axes "
+             f"(EIz = 4 EIy, torsion GJ = EI, gravity off both axes, rotary inertia ρIy = ρIz = {RHO_I:g} kg m), "
+             "undamped, same span; error: the larger of the tip's "
+             "y and z errors at the end; target as the cantilever's. exudyn: n `ObjectBeamGeometricallyExact` "
+             "(Simo–Reissner, interpolated on SE(3); Tait–Bryan nodes, since its Lie-group nodes do not converge under "
+             "generalized-α; without the rotary inertia its error falls only as h¹), penalty EA = GA = 1e4·EI "
+             "(benchmarks/_exudyn_beam3d.py); its runs take seconds, so its "
              f"series go on past a run of {RUN_BUDGET:g} s up to the limit below. Where the table has no "
              "spatial row, the run predates it.",
              "",
              f"spacar's reference: dop853 at EPS = {sc['ref_eps']:g} (slider-crank), {ca['ref_eps']:g} (cantilever up to 32 elements; "
-             "beyond, where DOP853's steps take minutes, generalized-α at fixed steps 4e-5 and 2e-5 s, "
-             "Richardson-extrapolated); exudyn's: its generalized-α at ρ∞ = 1 and h = "
-             f"{sc['ref_step']:g} s (\"model difference\": between the two references). spacar: EPSINT = EPSIND = EPS "
+             "beyond, where DOP853's steps take minutes, and the spatial cantilever: generalized-α at fixed steps 4e-5 "
+             "and 2e-5 s, Richardson-extrapolated); exudyn's: its generalized-α at ρ∞ = 1 and h = "
+             f"{sc['ref_step']:g} s (slider-crank), {ca['ref_step']:g} s (cantilevers) (\"model difference\": between "
+             "the two references). spacar: EPSINT = EPSIND = EPS "
              f"from {cfg['eps'][0]:g} down to {cfg['eps'][-1]:g}; exudyn: fixed steps h from {cfg['steps'][0]:g} s "
              f"down to {cfg['steps'][-1]:g} s, generalized-α with ρ∞ = {', '.join(f'{r:g}' for r in RHO)} (the best "
              "reported) and the trapezoidal rule (`TrapezoidalIndex2`). A series ends after two settings in a row "
              f"reach the target, after a run of {RUN_BUDGET:g} s, or before a run beyond {RUN_LIMIT:g} s. Cell: the "
-             "*steady* time to the target (the fastest run from which on every tighter run of the series reaches it) "
+             "*steady* time to the target (the fastest run from which on every tighter run of the series reaches it; "
+             "a last setting stopped at the time limit counts as neither, so a cell may rest on one run on target) "
              "/ its steps / its setting; \"—\": the series did not reach the target within the limits. spacar's "
              f"generalized-α: ρ∞ = {', '.join(f'{r:g}' for r in GA_RHO)} (the best reported), with its error control "
              f"(EPS as above) and with fixed steps h as exudyn's (EPS = {', '.join(f'{e:g}' for e in GA_FIXED_EPS)} "
              "then only stops its Newton iterations; the best reported); exudyn's Newton relative tolerance "
              f"{', '.join('its default' if r is None else f'{r:g}' for r in EXUDYN_NEWTON_RTOL)} (the best reported). "
-             "Ratios against the fastest of radau5, auto and generalized-α. The last column, the steps at the loosest setting (reached "
-             "by every series), shows the growth with the stiffness itself: DOP853's steps are set by "
+             "Ratios against the fastest of radau5, auto and generalized-α. The last column, the steps at the loosest setting (run "
+             "by every series that did not stop before it), shows the growth with the stiffness itself: DOP853's steps are set by "
              "stability there.", ""]
     loose = [f"{case} {v}" for case in CASES for v, row in res.get(case, {}).items()
              if row.get("exudyn_reference_newton_rtol")]
@@ -369,6 +375,10 @@ def section_lines(res) -> list:
         lines += [f"exudyn's reference with Newton tolerance 1e-6 relative (its default 1e-8 stalls at its reference step; "
                   f"then also in place of the default in the sweep): "
                   f"{', '.join(loose)}.", ""]
+    for case, info in res.get("measured_apart", {}).items():
+        lines += [f"The {case} case was measured apart (`python benchmarks/stiff.py --scaling-case {case}`) on "
+                  f"{info.get('date', '?')}, on {info.get('CPU', '?')}; compare its ratios, not its times, with the "
+                  "other tables.", ""]
     for case, title in (("slidercrank", "Slider-crank, rod EI × k"), ("cantilever", "Steel cantilever, n PLBEAMs"),
                         ("spatial", "Spatial steel cantilever, n BEAMs")):
         if case not in res:

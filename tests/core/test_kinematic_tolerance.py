@@ -15,7 +15,7 @@ def spin_up(epskin: float) -> spacar.Results:
     m.gravity(0.0, 0.0)
     m.inputx(10001, 1)
     t = np.linspace(0.0, t_end, 41)
-    rate = 3.0  # rad/s after a cosine ramp of 1 s
+    rate = 3.0  # rad/s: the peak rate of a cosine pulse, at 0.5 s; at rest again at 1 s
     angle = 0.5 * rate * (t - np.sin(2.0 * np.pi * t) / (2.0 * np.pi))
     table = spacar.Table(t, angle, kind="cubic")
     return spacar.simulate(m, method="radau5", inputs={(10001, 1): table}, progress=False)
