@@ -36,7 +36,6 @@ from types import SimpleNamespace
 import numpy as np
 
 EI, RHO_A, RHO_IP, G = 175.0, 0.785, 1e-4, 9.81
-SOLVERS = {"generalized_alpha": "GeneralizedAlpha", "trapezoidal": "TrapezoidalIndex2"}
 
 
 class SpatialCantilever:
@@ -74,17 +73,9 @@ class SpatialCantilever:
         """One run from the straight beam at rest to t_end at fixed steps; returns x (the tip's y
         and z at the end, one row) and stats (wall time, steps)."""
         import exudyn as exu
+        from spacar.compare.exudyn import SOLVERS, simulation_settings
 
-        s = exu.SimulationSettings()
-        s.solution.file.write = False
-        s.solution.sensors.active = False
-        s.show.computationTime = False
-        s.show.statistics = False
-        ti = s.timeIntegration
-        ti.verboseMode = 0
-        ti.endTime = t_end
-        ti.automaticStepSize = False
-        ti.numberOfSteps = max(1, int(round(t_end / step)))
+        s = simulation_settings(self.mbs, 0.0, t_end, solver, None, None, step)
         if configure is not None:
             configure(s)
         start = time.perf_counter()
@@ -95,7 +86,7 @@ class SpatialCantilever:
         p = np.asarray(self.mbs.GetNodeOutput(self.tip, exu.OutputVariableType.Position))
         if not np.all(np.isfinite(p)) or np.abs(p).max() > 10.0:
             raise RuntimeError(f"exudyn's {solver} diverged at step {step}")
-        return SimpleNamespace(x=np.array([[p[1], p[2]]]), stats={"wall_time": wall, "steps": ti.numberOfSteps})
+        return SimpleNamespace(x=np.array([[p[1], p[2]]]), stats={"wall_time": wall, "steps": s.timeIntegration.numberOfSteps})
 
 
 def build(n: int, penalty: float = 1e4, rotary: float = 0.0) -> SpatialCantilever:

@@ -266,11 +266,11 @@ def steady(series, target):
     series ends with two such runs, see _sweep); None if the series did not end on target. A last
     setting stopped at (spacar) or refused for (exudyn) the time limit counts as neither, as the
     settings after a run past the budget: the run before it may be the only one on target."""
+    if series and series[-1].get("over_limit"):
+        series = series[:-1]
     best = None
-    for k, r in enumerate(reversed(series)):
-        if r.get("over_limit") and k == 0:
-            continue
-        if r.get("over_limit") or r["error"] > target:
+    for r in reversed(series):
+        if r["error"] > target:
             break
         if best is None or r["wall"] < best["wall"]:
             best = r

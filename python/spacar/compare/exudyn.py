@@ -144,6 +144,36 @@ class ExudynResults:
         return f"<spacar.compare.exudyn.ExudynResults: {len(self.t)} times, {self.x.shape[1]} coordinates>"
 
 
+def simulation_settings(mbs, t_start, t_end, solver, rtol, atol, step):
+    """exudyn's SimulationSettings for one quiet run of ``mbs`` from t_start to t_end: no files,
+    sensors or printing; the error-controlled ``solver`` (ADAPTIVE) with rtol and atol when step
+    is None, else fixed steps of about ``step``; the sparse solver beyond 200 coordinates."""
+    s = exu.SimulationSettings()
+    s.solution.file.write = False
+    s.solution.sensors.active = False
+    s.show.computationTime = False
+    s.show.statistics = False
+    s.show.globalTimers = False
+    ti = s.timeIntegration
+    ti.verboseMode = 0
+    ti.startTime = t_start
+    ti.endTime = t_end
+    if solver in ADAPTIVE and step is None:
+        ti.automaticStepSize = True
+        ti.relativeTolerance = rtol
+        ti.absoluteTolerance = atol
+        ti.numberOfSteps = 1
+        ti.minimumStepSize = 1e-14
+    else:
+        if step is None:
+            raise ValueError(f"solver {solver!r} needs a fixed step")
+        ti.automaticStepSize = False
+        ti.numberOfSteps = max(1, int(round((t_end - t_start) / step)))
+    if len(mbs.systemData.GetODE2Coordinates()) > 200:
+        s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+    return s
+
+
 class ExudynModel:
     """An exudyn model equivalent to a spacar model. ``SC``, ``mbs``: exudyn's system container
     and main system (assembled); ``topology``: the analysis of the spacar model."""
@@ -530,30 +560,7 @@ class ExudynModel:
     # --- simulation -----------------------------------------------------------------------
 
     def settings(self, t_start, t_end, solver, rtol, atol, step):
-        s = exu.SimulationSettings()
-        s.solution.file.write = False
-        s.solution.sensors.active = False
-        s.show.computationTime = False
-        s.show.statistics = False
-        s.show.globalTimers = False
-        ti = s.timeIntegration
-        ti.verboseMode = 0
-        ti.startTime = t_start
-        ti.endTime = t_end
-        if solver in ADAPTIVE and step is None:
-            ti.automaticStepSize = True
-            ti.relativeTolerance = rtol
-            ti.absoluteTolerance = atol
-            ti.numberOfSteps = 1
-            ti.minimumStepSize = 1e-14
-        else:
-            if step is None:
-                raise ValueError(f"solver {solver!r} needs a fixed step")
-            ti.automaticStepSize = False
-            ti.numberOfSteps = max(1, int(round((t_end - t_start) / step)))
-        if len(self.mbs.systemData.GetODE2Coordinates()) > 200:
-            s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-        return s
+        return simulation_settings(self.mbs, t_start, t_end, solver, rtol, atol, step)
 
     def solve(self, t_end=None, n_out=None, solver=None, rtol=None, atol=None, step=None, times=None,
               configure=None) -> ExudynResults:
