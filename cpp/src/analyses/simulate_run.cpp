@@ -21,6 +21,13 @@ namespace spacar {
 
 namespace {
 
+// The smallest change of a state the implicit methods' Newton iterations resolve, times the
+// model's length scale (at least 1): ten times the floor of the position solves
+// (simulation_kinematic_tolerance), in each state's SI unit as the absolute tolerance
+// 10⁻³ EPS is (formulation.md §8.1). A spinning 16-PLBEAM beam's iterates settle at about
+// 2·10⁻¹² m/s in the rates of its deformations; with no floor EPS 10⁻¹⁰ stalled there.
+constexpr double kNewtonFloor = 1e-12;
+
 // Warnings for the position nodes that the first assembly moved far (more than 1e-3 of the
 // model's size, the spread of the X positions) from where X put them: the X positions do not
 // close a loop with the lengths given (LENGTHO), the targets of E or the inputs' start values.
@@ -429,6 +436,7 @@ Simulation::SegmentEnd Simulation::integrate_segment(BlockResults& res, const Ru
   rtol.setConstant(st.epsint);
   rtol.segment(nd + ny, nd).setConstant(st.epsind);
   stepper->set_tolerances(rtol, 1e-3 * rtol);  // formulation.md §8.1: sc = EPS (10⁻³ + |y|)
+  stepper->set_newton_floor(kNewtonFloor * std::max(1.0, sys_->length_scale));
   stepper->set_max_step(st.hmax);
   stepper->set_max_steps(options.max_steps - res.steps);
   if (h > 0.0) stepper->set_initial_step(h);

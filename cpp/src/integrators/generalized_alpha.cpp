@@ -214,6 +214,7 @@ GeneralizedAlpha::Attempt GeneralizedAlpha::newton(const Rhs& f, double t, doubl
   const double gh = gamma_d_ * h, bh2 = beta_d_ * h * h;
   const int r = r0_ - m_;
   scale_ = atol_.array() + rtol_.array() * y.array().abs();
+  newton_divisors(scale_, newton_tol_, newton_scale_);
   shift_acceleration(h);
   d_new_ = d_;
   faccon_ = std::pow(std::max(faccon_, kRound), 0.8);
@@ -226,8 +227,8 @@ GeneralizedAlpha::Attempt GeneralizedAlpha::newton(const Rhs& f, double t, doubl
     if (!newton_residual(f, t + h)) return Attempt::Failed;
     newton_solve(res_, dd_);
     // The increment's effect on the states, in units of the tolerance.
-    const double sq = (bh2 * dd_.segment(r, m_).array() / scale_.head(m_).array()).square().sum() +
-                      (gh * dd_.array() / scale_.tail(nz_).array()).square().sum();
+    const double sq = (bh2 * dd_.segment(r, m_).array() / newton_scale_.head(m_).array()).square().sum() +
+                      (gh * dd_.array() / newton_scale_.tail(nz_).array()).square().sum();
     const double dn = std::sqrt(sq / n_);
     if (!std::isfinite(dn)) {
       failure_ = "singular Newton matrix";

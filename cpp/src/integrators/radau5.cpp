@@ -253,6 +253,7 @@ void Radau5::starting_values(double h) {
 Radau5::Attempt Radau5::newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y) {
   const Tableau& tb = tableau();
   scale_ = atol_.array() + rtol_.array() * y.array().abs();
+  newton_divisors(scale_, fnewt_, newton_scale_);
   starting_values(h);
   faccon_ = std::pow(std::max(faccon_, kRound), 0.8);
   theta_ = theta_reuse_;
@@ -280,7 +281,7 @@ Radau5::Attempt Radau5::newton(const Rhs& f, double t, double h, const Eigen::Ve
       return Attempt::Failed;
     }
     double sum = 0.0;
-    for (int j = 0; j < 3; ++j) sum += (fz_[j].array() / scale_.array()).square().sum();
+    for (int j = 0; j < 3; ++j) sum += (fz_[j].array() / newton_scale_.array()).square().sum();
     const double dyno = std::sqrt(sum / (3.0 * n_));
     if (it > 1 && it < kMaxNewton) {
       const Contraction c = newton_contraction(it, dyno, dyno_old, thq_old, fnewt_);

@@ -103,6 +103,16 @@ void Stepper::set_max_step(double hmax) {
   hmax_ = hmax;
 }
 
+void Stepper::set_newton_floor(double floor) {
+  if (!(floor >= 0) || !std::isfinite(floor))
+    throw std::invalid_argument(std::string(name_) + ": the Newton floor must be finite and >= 0");
+  newton_floor_ = floor;
+}
+
+void Stepper::newton_divisors(const Eigen::VectorXd& scale, double tolerance, Eigen::VectorXd& divisors) const {
+  divisors = scale.cwiseMax(newton_floor_ / tolerance);
+}
+
 void Stepper::set_max_steps(long n) {
   if (n < 1) throw std::invalid_argument(std::string(name_) + ": the step limit must be positive");
   max_steps_ = n;

@@ -122,7 +122,7 @@ class GeneralizedAlpha : public Stepper {
   // residual form's Newton matrix for a step h is then a sum, not a product (factorize).
   Eigen::MatrixXd WJz_, WJq_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
-  Eigen::VectorXd d_, a_, a_use_, d_new_, a_new_, d_prev_, dd_, y_new_, fy_, res_, scale_, y_out_, wv_;
+  Eigen::VectorXd d_, a_, a_use_, d_new_, a_new_, d_prev_, dd_, y_new_, fy_, res_, scale_, newton_scale_, y_out_, wv_;
 };
 
 }  // namespace spacar

@@ -110,7 +110,7 @@ class Radau5 : public Stepper {
   Eigen::VectorXd rr_;
   Eigen::VectorXcd cr_;
   std::vector<int> piv_real_, piv_complex_;  // row interchanges of the LU factors in E1_, E2_
-  Eigen::VectorXd f0_, scale_, y_stage_, y_new_, y_out_, err_v_, dz_, tmp_;
+  Eigen::VectorXd f0_, scale_, newton_scale_, y_stage_, y_new_, y_out_, err_v_, dz_, tmp_;
   Eigen::VectorXcd ctmp_;
   Eigen::VectorXd z_[3], w_[3], fz_[3], poly_[3];
 };

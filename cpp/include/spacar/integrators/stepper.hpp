@@ -87,6 +87,12 @@ class Stepper {
   // them to its error estimate (Radau5).
   void set_tolerances(const Eigen::VectorXd& rtol, const Eigen::VectorXd& atol);
   void set_max_step(double hmax);  // default +inf
+  // The smallest change of a state (in its own unit) the implicit methods' Newton iterations
+  // resolve (default 0). They stop below it however small the tolerance of a component near
+  // zero: at EPS 10⁻¹⁰ the absolute tolerance 10⁻³ EPS of a deformation rate asks for 10⁻¹³,
+  // under the 2·10⁻¹² at which a spinning beam's iterates settle, and the steps were halved to
+  // 10⁻⁸ s to pass (issue 36: a 16-beam spin-up stalled at 0.49 s).
+  void set_newton_floor(double floor);
   // Steps (accepted and rejected) one integrate() call may take before IntegrationError
   // (default kMaxSteps).
   void set_max_steps(long n);
@@ -166,6 +172,10 @@ class Stepper {
   const char* name_;  // in the messages: "Integrator", "Radau5", "GeneralizedAlpha"
   int n_;
   Eigen::VectorXd rtol_, atol_;
+  double newton_floor_ = 0.0;
+  // The divisors of Newton's increments: the error's scale, but not below newton_floor_ / tolerance
+  // (the tolerance of the iteration's stop, in units of the scale).
+  void newton_divisors(const Eigen::VectorXd& scale, double tolerance, Eigen::VectorXd& divisors) const;
   double hmax_ = std::numeric_limits<double>::infinity();
   long max_steps_ = kMaxSteps;
   double h_initial_ = 0.0, h_last_ = 0.0;
