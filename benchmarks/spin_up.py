@@ -70,7 +70,7 @@ def main(t_end=3.0, eps=1e-8, methods=("radau5", "auto", "generalized_alpha"), w
             try:
                 res = spacar.simulate(m, method=method, inputs=inputs, progress=False, time_limit=600)
             except spacar.TimeLimitError as exc:
-                print(f"| {method} | {epskin:g} | over 600 s ({exc}) | | | | |", flush=True)
+                print(f"| {method} | {epskin:g} | over 600 s ({exc}) | | | | |{' |' if with_reference else ''}", flush=True)
                 continue
             wall = time.perf_counter() - start
             tip = res.node(TIP).x[-1, :2]
@@ -83,7 +83,10 @@ def main(t_end=3.0, eps=1e-8, methods=("radau5", "auto", "generalized_alpha"), w
 
 
 if __name__ == "__main__":
-    a = [v for v in sys.argv[1:] if v != "--reference"]
+    flags = [v for v in sys.argv[1:] if v.startswith("--")]
+    if set(flags) - {"--reference"}:
+        sys.exit(f"unknown option {', '.join(sorted(set(flags) - {'--reference'}))}; usage: see the module's docstring")
+    a = [v for v in sys.argv[1:] if not v.startswith("--")]
     main(float(a[0]) if a else 3.0, float(a[1]) if len(a) > 1 else 1e-8,
          tuple(a[2].split(",")) if len(a) > 2 else ("radau5", "auto", "generalized_alpha"),
          with_reference="--reference" in sys.argv[1:])

@@ -68,7 +68,8 @@ void spacar::bindings::bind_ode(py::module_& m) {
         py::arg("hmax") = std::numeric_limits<double>::infinity(), py::arg("first_step") = 0.0,
         py::arg("max_steps") = spacar::Stepper::kMaxSteps,
         "Integrate dy/dt = f(t, y) (Jacobian jac(t, y), n x n, or None) from t0 to t_end with the "
-        "stepper of `method` as a run makes it (make_stepper; the first `positions` states are positions whose "
+        "stepper of `method` as a run makes it (make_stepper, without a run's floor of the Newton increments: "
+        "set_newton_floor; the first `positions` states are positions whose "
         "rates are the last ones); returns t and y at touts, y_end, t_reached, last_step and the counters "
         "nfev, nsteps, naccept, nreject, njev, ndec, nnewton.");
 }

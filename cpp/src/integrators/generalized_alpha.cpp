@@ -58,7 +58,7 @@ GeneralizedAlpha::GeneralizedAlpha(int n, int m, int rate_offset, double rho_inf
   // J_, N_ and lu_ (dense, n² and nz²) are sized at the first Jacobian: a Newton system
   // (set_newton_system) never needs them.
   for (Eigen::VectorXd* v : {&d_, &a_, &a_use_, &d_new_, &a_new_, &d_prev_, &dd_, &res_}) v->setZero(nz_);
-  for (Eigen::VectorXd* v : {&y_new_, &fy_, &scale_, &y_out_}) v->setZero(n);
+  for (Eigen::VectorXd* v : {&y_new_, &fy_, &scale_, &newton_scale_, &y_out_}) v->setZero(n);
   wv_.setZero(m);
 }
 

@@ -71,7 +71,7 @@ Radau5::Radau5(int n) : Stepper("Radau5", n) {
   set_tolerances(Eigen::VectorXd::Constant(n, 1e-6), Eigen::VectorXd::Constant(n, 1e-6));
   J_.setZero(n, n);
   set_second_order(0);
-  for (Eigen::VectorXd* v : {&f0_, &scale_, &y_stage_, &y_new_, &y_out_, &err_v_, &dz_, &tmp_}) v->setZero(n);
+  for (Eigen::VectorXd* v : {&f0_, &scale_, &newton_scale_, &y_stage_, &y_new_, &y_out_, &err_v_, &dz_, &tmp_}) v->setZero(n);
   ctmp_.setZero(n);
   for (int i = 0; i < 3; ++i)
     for (Eigen::VectorXd* v : {&z_[i], &w_[i], &fz_[i], &poly_[i]}) v->setZero(n);

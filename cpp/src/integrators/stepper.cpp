@@ -110,7 +110,8 @@ void Stepper::set_newton_floor(double floor) {
 }
 
 void Stepper::newton_divisors(const Eigen::VectorXd& scale, double tolerance, Eigen::VectorXd& divisors) const {
-  divisors = scale.cwiseMax(newton_floor_ / tolerance);
+  if (newton_floor_ > 0 && tolerance > 0) divisors = scale.cwiseMax(newton_floor_ / tolerance);
+  else divisors = scale;
 }
 
 void Stepper::set_max_steps(long n) {
