@@ -176,19 +176,24 @@ def test_runs_with_and_without_the_chain_agree(name, method):
 def test_generalized_alpha_in_residual_form_agrees(name):
     """Generalized-α iterates on the residual M̄ (q̈ − q̈(Y)) on an open chain (no equations of
     motion solved) and on q̈(Y) − q̈ on the general path: the iterations stop at different points
-    within the Newton tolerance, so the two runs differ by a small fraction of the method's own
-    error (measured: 3-6 %), taken against DOP853 at the same EPS (1e-9)."""
+    within the Newton tolerance, so the two runs differ by a fraction of the method's own error,
+    taken against DOP853 at the same EPS (1e-9). At this EPS both stop at the floor of Newton's
+    increments (1e-12, docs/formulation.md "Error control"): measured on the spatial chain, the
+    forms differ by 9-11 % of that error in x and ẋ and 26 % in ẍ (6 % and 18 % before the floor),
+    while each run's own error is unchanged (ẍ: 4.00e-6 and 4.66e-6, before 4.21e-6 and 4.66e-6)."""
     model = CHAINS[name]()
     model.forcemode(1)
     runs = [spacar.simulate(model.copy(), method="generalized_alpha", recursive=recursive, progress=False)
             for recursive in (True, False)]
     fast, general = runs
     reference = spacar.simulate(model.copy(), method="dop853", progress=False)
-    assert fast.stats["rhs_evaluations"] <= 1.1 * general.stats["rhs_evaluations"]
+    # The floor saved the general path more right-hand sides than the residual form on the
+    # spatial chain (5 726 → 3 815 against 5 728 → 4 396): 1.15×.
+    assert fast.stats["rhs_evaluations"] <= 1.2 * general.stats["rhs_evaluations"]
     for field in ("x", "xd", "xdd", "sigma", "reaction"):
         a, b, c = (np.array(getattr(r, field)) for r in (fast, general, reference))
         error = np.abs(b - c).max()
-        assert np.abs(a - b).max() <= 0.2 * error + 1e-12 * np.abs(c).max(), field
+        assert np.abs(a - b).max() <= 0.3 * error + 1e-12 * np.abs(c).max(), field
 
 
 REFUSED = {
