@@ -73,10 +73,11 @@ def main(t_end=3.0, eps=1e-8, methods=("radau5", "auto", "generalized_alpha"), w
                 print(f"| {method} | {epskin:g} | over 600 s ({exc}) | | | | |{' |' if with_reference else ''}", flush=True)
                 continue
             wall = time.perf_counter() - start
-            tip = res.node(TIP).x[-1, :2]
+            path = tips(res)
+            tip = path[-1]
             first = tip if first is None else first
             s = res.stats
-            error = (f" {np.linalg.norm(tips(res) - ref, axis=1).max() / eps:.2g} |" if with_reference else "")
+            error = (f" {np.linalg.norm(path - ref, axis=1).max() / eps:.2g} |" if with_reference else "")
             print(f"| {s.get('method', method)} | {epskin:g} | {wall:.2f} s | {s['steps']} | "
                   f"{s.get('rejected', '—')} | {s.get('jacobians', '—')} | {np.abs(tip - first).max():.1e} |{error}",
                   flush=True)
