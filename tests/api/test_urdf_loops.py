@@ -31,12 +31,15 @@ def rsur(rate=1.5):
 pytestmark = pytest.mark.filterwarnings("ignore:.*joint limits")
 
 
-def test_loop_closed_by_a_ball_joint_matches_constraint_dynamics():
+@pytest.mark.parametrize("recursive", [True, False])
+def test_loop_closed_by_a_ball_joint_matches_constraint_dynamics(recursive):
+    """On the recursive path (the tree's inverse dynamics with the loop closed by Newton's method
+    in the three dependent joints, closed_loop.hpp) and on the general path."""
     pin = pytest.importorskip("pinocchio")
     model = rsur()
     assert model.urdf_joints == ["crank", "rocker", "cross", "coupler"]
-    res = spacar.simulate(model, method="dop853")
-    assert res.dof_labels == ["e(1,1) HINGE"] and res.stats["path"] == "general"
+    res = spacar.simulate(model, method="dop853", recursive=recursive)
+    assert res.dof_labels == ["e(1,1) HINGE"] and res.stats["path"] == ("tree" if recursive else "general")
 
     pm = pin.buildModelFromUrdf(str(URDF))
     crank, coupler = pm.getJointId("crank"), pm.getJointId("coupler")

@@ -31,6 +31,21 @@ MODELS = {
 }
 
 
+# Closed loops on the recursive path (closed_loop.hpp): Tᵀ τ_id(θ, θ̇, T q̈ + g) in the tree's
+# coordinates with the loop closed.
+LOOPS = {
+    "spatial RSUR loop (a ball joint closes it)": trees.rsur,
+    "spatial RSUR loop from a URDF, a spring on a dependent joint": lambda: sprung(trees.urdf_rsur()),
+    "spatial 7R loop (closed at a point and a cut hinge)": trees.seven_bar,
+}
+
+
+def sprung(model):
+    model.estiff(2, 0.8)  # the rocker's hinge: a released rotation with a spring
+    model.edampp(2, 0.1)
+    return model
+
+
 def loaded_prismatic():
     """tests/data/prismatic.urdf (a carriage sliding on the ground, an arm, a finger sliding on it)
     with FORCEs on the finger (two) and the arm (two) below the sliding joints, TORQUELs, a spring
@@ -67,9 +82,9 @@ def general_path(model, q, qd, qdd):
     return np.array(out)
 
 
-@pytest.mark.parametrize("name", MODELS)
+@pytest.mark.parametrize("name", list(MODELS) + list(LOOPS))
 def test_recursive_inverse_dynamics_matches_the_reduced_equations(name):
-    model = MODELS[name]()
+    model = MODELS[name]() if name in MODELS else LOOPS[name]()
     sim = _core.Simulation(model.copy().core)
     sim.assemble()
     n = sim.system.n_dof
@@ -98,6 +113,11 @@ def test_other_systems_take_the_reduced_equations():
     assert path == "general"
     np.testing.assert_allclose(force, general_path(model.copy(), q, qd, qdd), rtol=1e-12, atol=1e-14)
     assert spacar.inverse_dynamics(model, q[0], qd[0], qdd[0]).shape == (1,)
+
+
+def test_closed_loops_have_no_derivatives_yet():
+    with pytest.raises(InputError, match="not computed on closed loops"):
+        spacar.dynamics_derivatives(trees.rsur(), [0.1], [0.0], [0.0])
 
 
 def test_bad_arguments_are_input_errors():

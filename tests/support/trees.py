@@ -213,7 +213,32 @@ def spherical_joint():
 def rsur():
     from support.spatial_models import rssr_model
 
-    return rssr_model(coupler="beam", dynamic=True)
+    model = rssr_model(coupler="beam", dynamic=True)
+    model.epskin(1e-14)
+    return model
+
+
+def urdf_rsur():
+    """The RSUR of rsur() as a URDF tree with its loop closed by a ball joint beside it
+    (tests/api/test_urdf_loops.py)."""
+    import warnings
+
+    from support.paths import DATA
+
+    ball = {"parent": "crank", "child": "coupler", "xyz": (0.2, 0.0, 0.0), "type": "spherical"}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # joint limits
+        model = spacar.from_urdf(DATA / "rsur_loop.urdf", loops=[ball], dependent=["rocker", "cross", "coupler"])
+    model.ed(1, 1, 1.5)
+    model.epskin(1e-14)
+    return model
+
+
+def seven_bar():
+    """The spatial 7R loop of spacar.compare.models.seven_r_loop at tight tolerances."""
+    m = models.seven_r_loop(eps=1e-10, epskin=1e-14)
+    m.timestep(5, 0.5)
+    return m
 
 
 def spatial_held_hinge():

@@ -53,7 +53,8 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
 
   bool build() {
     return supported_classes() && read_coordinates() && read_nodes() &&
-           read_elements("BEAM, BEAMNL, HINGE, BEARING or L2MIN1") && group_bodies() && place_bodies() && attach_loads();
+           read_elements("BEAM, BEAMNL, HINGE, BEARING or L2MIN1") && group_bodies() && place_bodies() &&
+           attach_loads() && record_loops();
   }
 
  private:
@@ -127,12 +128,23 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     return true;
   }
 
-  // A revolute joint (DYNE e1, rigid e2 and e3), or a measuring hinge (all released, no law).
+  // A revolute joint (DYNE e1, rigid e2 and e3), or a measuring hinge (all released, no law), or
+  // a passive joint of a closed loop (released e1: its rotation follows from the loop; if a
+  // misalignment is released too, the joint can only be where the loop is cut).
   bool read_hinge(int i, const SystemElement& se, const std::vector<int>& ids) {
     const int k = se.def_offset;
     const DefClass c1 = sys_.def_class[k], c2 = sys_.def_class[k + 1], c3 = sys_.def_class[k + 2];
+    auto rigid_or_released = [](DefClass c) { return c == DefClass::Fixed || c == DefClass::Released; };
     if (c1 == DefClass::Released && c2 == DefClass::Released && c3 == DefClass::Released && !se.has_constitutive)
       return true;  // a measuring hinge: no constraint, no load
+    if (c1 == DefClass::Released && rigid_or_released(c2) && rigid_or_released(c3)) {
+      Hinge h{i, ids.front(), ids.back(), -1};
+      h.passive = true;
+      h.cut_only = c2 != DefClass::Fixed || c3 != DefClass::Fixed;
+      hinges_.push_back(h);
+      passive_ = true;
+      return true;
+    }
     if (c1 != DefClass::Dynamic || c2 != DefClass::Fixed || c3 != DefClass::Fixed)
       return refuse(element_name(se) + " is not a revolute joint (DYNE e1, rigid e2 and e3)");
     hinges_.push_back({i, ids.front(), ids.back(), hinge_dof(se)});
@@ -151,11 +163,19 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
       if (a > 0) rigid = rigid && sys_.def_class[k + a] == DefClass::Fixed;
     }
     if (released) return true;
-    if (sys_.def_class[k] != DefClass::Dynamic || !rigid)
+    const DefClass c1 = sys_.def_class[k];
+    if ((c1 != DefClass::Dynamic && c1 != DefClass::Released) || !rigid)
       return refuse(element_name(se) + " is not a prismatic joint (DYNE e1, rigid e2 … e6)");
     hinges_.push_back({i, ids[1], ids[3], hinge_dof(se), false, ids[0], ids[2]});
+    if (c1 == DefClass::Released) {  // a passive sliding joint of a closed loop
+      hinges_.back().passive = true;
+      passive_ = true;
+    }
     return true;
   }
+
+  // Loops close on the tree where it has passive joints (closed_loop.hpp).
+  bool loops_allowed() const { return passive_; }
 
   // Bodies without a beam: a joint's moving LAMBDA node on no beam is a body of its own (a rotor,
   // a link whose centre of mass is its joint's origin, as URDF's Panda fingers), with the joint's
@@ -180,7 +200,7 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
 
   // The joint of a DOF hinge, from the parent's end (forward: node o1) to the child's. The axis
   // follows from ∂e1/∂λ_o2 = 2 aᵀ E(λ_o2) (plus a multiple of λ_o2ᵀ): a = ½ E(λ_o2) (∂e1/∂λ_o2)ᵀ.
-  bool hinge_joint(const Hinge& h, bool forward, int, Model& bd) const {
+  bool hinge_joint(const Hinge& h, bool forward, int, Model& bd) {
     const SystemElement& se = sys_.elements[h.element];
     const int n = static_cast<int>(se.coords.size());
     Eigen::VectorXd xl(n), e(se.nd);
@@ -188,6 +208,11 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     for (int a = 0; a < n; ++a) xl[a] = x_[se.coords[a]];
     se.kernel->first_derivatives(xl.data(), e.data(), B.data());
     bd.dof = h.dof;
+    if (h.passive) {  // after the DOFs in the tree's coordinates: (q, the dependent joints')
+      bd.dof = sys_.n_dof() + static_cast<int>(tree_.loops_.dependent0.size());
+      tree_.loops_.dependent0.push_back(e_[se.def_offset]);
+      tree_.loops_.dependent_element.push_back(h.element);
+    }
     bd.sign = forward ? 1.0 : -1.0;  // e1 turns (slides) o2's body relative to o1's
     bd.offset = -bd.sign * e_[se.def_offset];  // u = sign · (e1 − e1 at the reference state)
     if (h.pa >= 0) {  // sliding: the axis is ∂e1/∂x_p2, in the world's axes, which are both bodies' here
@@ -228,7 +253,9 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     for (int i : g_.beams[body])
       if (i >= 0) I += tree_detail::element_inertia<6>(sys_.elements[i], x_, row);
     for (int id : g_.points[body]) {
-      if (id == pin_[body] && !owns_pin(body)) continue;  // a hinge's pin: its mass and loads move with the parent
+      // A hinge's pin, or a point where a loop closes: its mass and loads move with the body that
+      // placed it first.
+      if (owner_.at(id) != index) continue;
       for (int c = 0; c < 3; ++c) {
         const int g = nodes_[id].coord + c;
         I += sys_.point_mass[g] * row(g).transpose() * row(g);
@@ -278,8 +305,48 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     return true;
   }
 
+  // The loops closed on the tree: the points two bodies share beyond their joints, and the cut
+  // hinges' rigid misalignments (closed_loop.hpp). The body coordinates of a point are its offset
+  // from the pin at the reference state, when the body's axes are the world's.
+  bool record_loops() {
+    Loops& loops = tree_.loops_;
+    loops.n_dof = sys_.n_dof();
+    for (const ClosurePoint& c : closure_points_) {
+      const int other = owner_.at(c.node);
+      loops.points.push_back({c.body, other, point(c.node) - pin0_[c.body],
+                              other == kGround ? point(c.node) : Vec3(point(c.node) - pin0_[other]), c.node});
+    }
+    for (int i : cuts_) {
+      const Hinge& h = hinges_[i];
+      const SystemElement& se = sys_.elements[h.element];
+      if (h.pa >= 0) return refuse(element_name(se) + " closes a loop: a sliding joint is not cut");
+      Loops::Cut cut;
+      cut.element = h.element;
+      cut.kernel = se.kernel.get();
+      for (int end = 0; end < 2; ++end) {
+        const int id = end == 0 ? h.a : h.b, body = body_of(id);
+        cut.body[end] = body == kGround ? kGround : placed_[body];
+        cut.lambda0[end] = lambda(id);
+      }
+      for (int k = 1; k < se.nd; ++k)
+        if (sys_.def_class[se.def_offset + k] == DefClass::Fixed) {
+          cut.rows.push_back(k);
+          cut.value.push_back(e_[se.def_offset + k]);
+        }
+      loops.cuts.push_back(std::move(cut));
+    }
+    const bool closed = !loops.points.empty() || !loops.cuts.empty();
+    if (closed && tree_.floating_) return refuse("a loop closes on a floating base");
+    if (closed && loops.dependent0.empty()) return refuse("a loop closes with no joint that it determines");
+    if (!closed && !loops.dependent0.empty())
+      return refuse(element_name(sys_.elements[loops.dependent_element.front()]) +
+                    " is released and in no loop");
+    return true;
+  }
+
   const Eigen::VectorXd& e_;
   SpatialTree& tree_;
+  bool passive_ = false;  // a passive joint was read: loops may close
   std::map<int, int> lambda_body_;  // first λ coordinate → index in the tree
   int base_point_ = -1, base_orientation_ = -1;  // a floating base's XYZ and LAMBDA nodes
 };

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "spacar/model/topology.hpp"
+#include "spacar/recursive/closed_loop.hpp"
 #include "spacar/recursive/planar_tree.hpp"
 #include "spacar/recursive/spatial_tree.hpp"
 #include "tree_common.hpp"
@@ -14,7 +15,11 @@
 namespace spacar {
 
 std::unique_ptr<RecursiveTree> RecursiveTree::detect(const System& sys, const Data& data, std::string* why) {
-  if (sys.dim == 3) return SpatialTree::detect(sys, data, why);
+  if (sys.dim == 3) {
+    std::unique_ptr<SpatialTree> tree = SpatialTree::detect(sys, data, why);
+    if (tree && tree->loops().closed()) return ClosedLoopTree::close(std::move(tree), sys, data, why);
+    return tree;
+  }
   return PlanarTree::detect(sys, data, why);
 }
 

@@ -98,6 +98,15 @@ class TreeBuilder {
     int dof;  // position in q, −1: released (a spring, or a measuring hinge)
     bool used = false;
     int pa = -1, pb = -1;  // a sliding joint's points on a's and b's bodies (−1: a hinge)
+    // A joint of a closed loop whose coordinate the loops determine (released e1): a joint of the
+    // tree, or (cut_only: its misalignments released too; or where it closes a loop) a cut.
+    bool passive = false, cut_only = false;
+  };
+
+  // A point of a placed body (index in the tree) that another body (or the ground) placed first:
+  // a loop closes there (Derived::loops_allowed()).
+  struct ClosurePoint {
+    int body, node;
   };
 
   // The points of the sliding joint that places a body: its own point (its pin, which slides)
@@ -202,12 +211,16 @@ class TreeBuilder {
   // DOF hinge to its parent (Derived::hinge_joint, Derived::place), or, planar, by its own
   // rotation (Derived::place_rotated, called for every body placed and the ground).
   bool place_bodies() {
-    std::map<int, std::vector<int>> hinges_at;  // body (or kGround) → its DOF hinges
-    for (size_t i = 0; i < hinges_.size(); ++i) {
-      if (hinges_[i].dof < 0) continue;
-      hinges_at[body_of(hinges_[i].a)].push_back(static_cast<int>(i));
-      hinges_at[body_of(hinges_[i].b)].push_back(static_cast<int>(i));
-    }
+    // body (or kGround) → its joints: the DOF hinges, then the passive ones of loops, so that a
+    // passive joint, not a DOF, is where a loop is cut.
+    std::map<int, std::vector<int>> hinges_at;
+    for (bool dof : {true, false})
+      for (size_t i = 0; i < hinges_.size(); ++i) {
+        const Hinge& h = hinges_[i];
+        if (dof ? h.dof < 0 : !h.passive || h.cut_only) continue;
+        hinges_at[body_of(h.a)].push_back(static_cast<int>(i));
+        hinges_at[body_of(h.b)].push_back(static_cast<int>(i));
+      }
     std::vector<int> queue = {kGround};
     if (!self().place_free_root(queue)) return false;
     for (size_t k = 0; k < queue.size(); ++k) {
@@ -219,7 +232,12 @@ class TreeBuilder {
         const int child = forward ? body_of(h.b) : body_of(h.a);
         const std::string name = element_name(sys_.elements[h.element]);
         if (child == parent) return refuse(name + " joins a body (or the ground) to itself");
-        if (is_placed(child)) return refuse(name + " closes a loop");
+        if (is_placed(child)) {
+          if (!h.passive) return refuse(name + " closes a loop");
+          h.used = true;  // a cut: its misalignments are constraints of the loop
+          cuts_.push_back(i);
+          continue;
+        }
         h.used = true;
         Model bd;
         const Slide slide = h.pa < 0 ? Slide{} : forward ? Slide{h.pb, h.pa} : Slide{h.pa, h.pb};
@@ -232,14 +250,23 @@ class TreeBuilder {
       if (placed_[b] < 0)
         return refuse("the body of node " + std::to_string(*g_.points[b].begin()) +
                       " does not hang from the ground by joints (a spherical joint, or a loop)");
-    for (const Hinge& h : hinges_)
-      if (h.dof >= 0 && !h.used) return refuse(element_name(sys_.elements[h.element]) + " joins no placed body");
+    for (size_t i = 0; i < hinges_.size(); ++i) {
+      Hinge& h = hinges_[i];
+      if (h.used || (h.dof < 0 && !h.passive)) continue;
+      if (!h.passive || !is_placed(body_of(h.a)) || !is_placed(body_of(h.b)))
+        return refuse(element_name(sys_.elements[h.element]) + " joins no placed body");
+      h.used = true;
+      cuts_.push_back(static_cast<int>(i));
+    }
     return true;
   }
 
   // A floating base, the tree's root before the bodies that hang from the ground (Derived may
   // place one and add it to the queue).
   bool place_free_root(std::vector<int>&) { return true; }
+
+  // Whether loops may close on the tree (Derived: the spatial tree, with passive joints).
+  bool loops_allowed() const { return false; }
 
   // The first step of placing a body under the placed body `parent_body` (or kGround) with its
   // joint `bd`: its pin, its parent and its points; index and p0 are its place in the tree and
@@ -260,7 +287,10 @@ class TreeBuilder {
     const bool sliding = slide.pin >= 0;
     // A hinge's pin is the point the body shares with its parent; a sliding joint's is the
     // body's own point of the joint, whose other point is on the parent, and the two share none.
-    const int pin = sliding ? slide.pin : pin_of(body);
+    // In a closed loop the body's other points placed before close the loop (closure_points_).
+    const bool loops = self().loops_allowed();
+    int pin = sliding ? slide.pin : pin_of(body);
+    if (!sliding && pin == -2 && loops) pin = pin_on(body, parent_body, parent);
     if (!sliding && g_.points[body].empty() && parent_body != kGround) {
       // A body of no point (a rotor's LAMBDA node, a link whose mass is at its joint's origin): it
       // turns about its parent's pin, as good as any point of the axis for a body whose mass is
@@ -274,7 +304,8 @@ class TreeBuilder {
       return true;
     }
     if (sliding) {
-      if (!g_.points[body].count(pin) || pin_of(body) != -1 || !on_body(slide.base, parent_body, parent))
+      if (!g_.points[body].count(pin) || (loops ? owner_.count(pin) > 0 : pin_of(body) != -1) ||
+          !on_body(slide.base, parent_body, parent))
         return refuse(joint + " slides a body that is not joined to its parent by that joint alone");
       if (!pivot_of(slide.base, parent_body, parent, joint)) return false;  // the point it slides from
     } else if (pin < 0 || !on_body(pin, parent_body, parent)) {
@@ -287,10 +318,24 @@ class TreeBuilder {
     p0 = point(pin);
     bd.parent = parent;
     bd.r = parent == kGround ? p0 : Point(p0 - pin0_[parent]);
-    for (int id : g_.points[body])
-      if (id != pin || sliding) owner_[id] = index;
+    for (int id : g_.points[body]) {
+      if (id == pin && !sliding) continue;  // the parent's
+      if (owner_.count(id)) closure_points_.push_back({index, id});  // only with loops: refused above otherwise
+      else owner_[id] = index;
+    }
     pin0_.push_back(p0);
     return true;
+  }
+
+  // The one point of the body on the placed body parent_body (index parent), −2 if none or more.
+  int pin_on(int body, int parent_body, int parent) const {
+    int pin = -2;
+    for (int id : g_.points[body])
+      if (owner_.count(id) && on_body(id, parent_body, parent)) {
+        if (pin != -2) return -2;
+        pin = id;
+      }
+    return pin;
   }
 
   // Body `body` is index `index` of the tree, under index `parent` (or kGround); pivot_found: its
@@ -353,6 +398,8 @@ class TreeBuilder {
   std::map<int, NodeInfo> nodes_;
   std::vector<std::pair<int, std::vector<int>>> beams_;  // moving rigid beams: element, nodes
   std::vector<Hinge> hinges_;
+  std::vector<int> cuts_;        // the passive hinges where loops are cut (indices into hinges_)
+  std::vector<ClosurePoint> closure_points_;
   BeamBodies g_;                 // the bodies' nodes and beams
   std::vector<int> placed_;      // body → index in the tree, −1: not yet
   std::vector<int> pin_;         // body → its pin node, −1: not placed

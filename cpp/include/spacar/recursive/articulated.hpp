@@ -93,40 +93,10 @@ class ArticulatedTree : public RecursiveTree {
       throw InputError("inverse_dynamics: the floating base's three Euler parameters have a norm of 1 or more");
     applied_loads();
     // Outwards: the accelerations the given q̈ make, and each body's force f = I a + pA (its bias
-    // forces of inertia less the applied loads).
-    for (size_t i = 0; i < bodies_.size(); ++i) {
-      const Model& m = bodies_[i];
-      BodyWork& d = work_[i];
-      Vector a = Algebra::to_child(m, d.frame, m.parent < 0 ? base_acceleration_ : work_[m.parent].a) + d.bias;
-      if (m.free) a += free_body_acceleration(q, qd, qdd, d);
-      else Algebra::add_joint_acceleration(m, Algebra::joint_acceleration(m, a, qdd), a);
-      d.a = a;
-      d.pA += m.inertia * a;
-    }
-    // Inwards: the joint torque Sᵀ f beyond the joint's spring and damper, the forces summed into
-    // the parents. Then to the DOFs by virtual work: a hinge's q is its angle (u = sign q + offset);
-    // a planar body's absolute rotation q (a DYNX BETA) turns its joint by q − θ_parent, so its
-    // torque also acts on the parent's rotation, which the parent's own joint and its ancestors'
-    // hinges carry (d.u holds what acts on a body's rotation from its subtree).
-    for (BodyWork& d : work_) d.u = 0.0;
-    for (int i = static_cast<int>(bodies_.size()) - 1; i >= 0; --i) {
-      const Model& m = bodies_[i];
-      BodyWork& d = work_[i];
-      if (m.free) {  // the wrench the base's six DOFs carry
-        free_forces(q, d, d.pA, force);
-        continue;
-      }
-      const double torque = Algebra::joint_component(m, d.pA) - d.tau;
-      BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
-      if (p) p->pA += Algebra::to_parent(m, d.frame, d.pA);
-      if (m.absolute) {
-        force[m.dof] = torque + d.u;
-        if (p) p->u -= torque;
-      } else {
-        force[m.dof] = m.sign * (torque + d.u);
-        if (p) p->u += d.u;
-      }
-    }
+    // forces of inertia less the applied loads); inwards the joints' share of them.
+    accelerate(q, qd, qdd, base_acceleration_, true);
+    for (size_t i = 0; i < bodies_.size(); ++i) work_[i].pA += bodies_[i].inertia * work_[i].a;
+    joint_forces(q, force, true);
   }
 
  protected:
@@ -152,7 +122,7 @@ class ArticulatedTree : public RecursiveTree {
   std::vector<BodyWork> work_;
   Vector base_acceleration_ = Vector::Zero();  // −gravity, the fictitious acceleration of the ground
 
- private:
+  // The passes, for the trees that combine them otherwise (closed_loop.hpp: loops closed on a tree).
   // Outwards: placements, velocities, velocity-product accelerations and the bias forces of the
   // bodies' inertia, with the joint torques; the articulated inertias start as the bodies'. False
   // if a floating base's q is no orientation.
@@ -223,6 +193,58 @@ class ArticulatedTree : public RecursiveTree {
       qdd[m.dof] = Algebra::dof_acceleration(m, a, udd);
     }
     return true;
+  }
+
+  // Outwards at the placement and velocities of the last outward(): the bodies' accelerations d.a
+  // for the joint accelerations q̈, from the ground's acceleration `base` (−g, or zero), with the
+  // velocity-product terms d.bias if `velocity`.
+  void accelerate(const double* q, const double* qd, const double* qdd, const Vector& base, bool velocity) {
+    for (size_t i = 0; i < bodies_.size(); ++i) {
+      const Model& m = bodies_[i];
+      BodyWork& d = work_[i];
+      Vector a = Algebra::to_child(m, d.frame, m.parent < 0 ? base : work_[m.parent].a);
+      if (velocity) a += d.bias;
+      if (m.free) a += free_body_acceleration(q, qd, qdd, d);
+      else Algebra::add_joint_acceleration(m, Algebra::joint_acceleration(m, a, qdd), a);
+      d.a = a;
+    }
+  }
+
+  // Inwards: the generalized forces of the DOFs that hold the bodies' forces d.pA (body
+  // coordinates, at their pins; summed into the parents on the way), less the joints' springs
+  // and dampers if `joint_loads`. By virtual work: a hinge's q is its angle (u = sign q + offset);
+  // a planar body's absolute rotation q (a DYNX BETA) turns its joint by q − θ_parent, so its
+  // torque also acts on the parent's rotation, which the parent's own joint and its ancestors'
+  // hinges carry (d.u holds what acts on a body's rotation from its subtree).
+  void joint_forces(const double* q, double* force, bool joint_loads) {
+    for (BodyWork& d : work_) d.u = 0.0;
+    for (int i = static_cast<int>(bodies_.size()) - 1; i >= 0; --i) {
+      const Model& m = bodies_[i];
+      BodyWork& d = work_[i];
+      if (m.free) {  // the wrench the base's six DOFs carry
+        free_forces(q, d, d.pA, force);
+        continue;
+      }
+      const double torque = Algebra::joint_component(m, d.pA) - (joint_loads ? d.tau : 0.0);
+      BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
+      if (p) p->pA += Algebra::to_parent(m, d.frame, d.pA);
+      if (m.absolute) {
+        force[m.dof] = torque + d.u;
+        if (p) p->u -= torque;
+      } else {
+        force[m.dof] = m.sign * (torque + d.u);
+        if (p) p->u += d.u;
+      }
+    }
+  }
+
+  // M(q) u at the placement of the last outward(): the joint forces of the accelerations u alone
+  // (no gravity, no velocities, no loads). Overwrites d.a and d.pA. Fixed bases only (a floating
+  // base's acceleration is not linear in its q̈ alone).
+  void mass_times(const double* u, double* out) {
+    accelerate(nullptr, nullptr, u, Vector::Zero(), false);
+    for (size_t i = 0; i < bodies_.size(); ++i) work_[i].pA = bodies_[i].inertia * work_[i].a;
+    joint_forces(nullptr, out, false);
   }
 };
 
