@@ -105,3 +105,29 @@ def test_bad_loops_are_refused_naming_the_file(kw, message):
     with pytest.raises(spacar.InputError, match=message) as info:
         spacar.from_urdf(URDF, **kw)
     assert "rsur_loop.urdf" in str(info.value)
+
+
+def test_recursive_accelerations_equal_constraint_dynamics_at_fixed_states():
+    """The recursive path's q̈ (closed_loop.hpp) at states the general path reaches by continuation
+    equals pinocchio.constraintDynamics at the joints' values there, to round-off."""
+    pin = pytest.importorskip("pinocchio")
+    from support.simulation import assembled
+
+    pm = pin.buildModelFromUrdf(str(URDF))
+    crank, coupler = pm.getJointId("crank"), pm.getJointId("coupler")
+    B = np.array([0.2, 0.0, 0.0])
+    C = np.asarray(pm.jointPlacements[pm.getJointId("cross")].translation) + \
+        np.asarray(pm.jointPlacements[pm.getJointId("rocker")].translation)
+    accelerations = constrained(pm, crank, B, coupler, B - C)
+    sim = assembled(rsur())
+    labels = [tuple(label) for label in sim.system.def_label]
+    joints = [labels.index((k, 1)) for k in range(1, 5)]
+    q0 = np.array(sim.system.q0)
+    rng = np.random.default_rng(11)
+    for _ in range(5):
+        q, qd = q0 + rng.uniform(-1.0, 1.0, 1), rng.uniform(-2.0, 2.0, 1)
+        sim.move_to(0.0, q, qd)
+        e, ed = np.array(sim.data.e)[joints], np.array(sim.data.ed)[joints]
+        theirs = accelerations(e, ed)[0]
+        ours = sim.recursive_state(q, qd)["qdd"][0]
+        assert abs(ours - theirs) <= 1e-12 * max(1.0, abs(theirs)), (ours, theirs)
