@@ -1,6 +1,7 @@
 """Run every benchmark and write its section of docs/performance.md (and the plots under
 docs/img/): the manual's slider-crank (spacar alone, benchmarks/slidercrank.py), then spacar
-side by side with the peers — rigid chains (chains.py), the UR5 and Panda robots (robots.py), the four-bar (fourbar.py), Newton's
+side by side with the peers — rigid chains (chains.py), the UR5 and Panda robots (robots.py), closed
+loops on the recursive path (closed_loops.py), the four-bar (fourbar.py), Newton's
 iterations of the general path with its predictor and chord (newton.py, spacar alone), the flexible
 cantilever (cantilever.py), the manual's slider-crank against exudyn (slidercrank_exudyn.py) and
 the steel cantilever's time to tip accuracy with the stiff integrator (stiff.py) and the
@@ -24,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import cantilever  # noqa: E402
 import chains  # noqa: E402
+import closed_loops  # noqa: E402
 import fourbar  # noqa: E402
 import modes  # noqa: E402
 import newton  # noqa: E402
@@ -37,6 +39,7 @@ CASES = {
     "slidercrank": slidercrank,
     "chains": chains,
     "robots": robots,
+    "closed_loops": closed_loops,
     "fourbar": fourbar,
     "newton": newton,
     "cantilever": cantilever,

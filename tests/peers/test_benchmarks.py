@@ -22,7 +22,7 @@ def test_run_all_quick(tmp_path):
     assert out.returncode == 0, out.stderr[-3000:]
     for title in ("## Manual slider-crank", "## Rigid N-link chains", "## Four-bar linkage",
                   "## Flexible cantilever", "## Manual slider-crank: spacar, exudyn", "## Stiff integration",
-                  "## Newton's iterations on the general path"):
+                  "## Newton's iterations on the general path", "## Closed loops on the recursive path"):
         assert title in out.stdout
     assert "Time per right-hand side" in out.stdout and "Growth from n" in out.stdout
     assert (doc.read_text() if doc.exists() else None) == before
