@@ -1,16 +1,18 @@
 """Closed loops on the recursive path (issue 37): spacar's tree with its loops closed by Newton's
 method in the passive joints (cpp/include/spacar/recursive/closed_loop.hpp) against spacar's
-general path (the constraint formulation) and Pinocchio's constrained dynamics. Two loops: the
-spatial RSUR linkage of tests/data/rsur_loop.urdf (a crank, a rocker with a universal joint to
-the coupler, the loop closed by a ball joint beside the URDF; 1 DOF, 3 passive joints, 3
-constraints), and the 7R loop of ``spacar.compare.models.seven_r_loop`` (a random 6-link chain
-closed at a point and at a seventh hinge; 1 DOF, 5 passive joints, 5 constraints). Gravity, the
-crank started at 1.5 (RSUR) and 1 rad/s (7R), T = 1 s. Error: the largest joint-angle error at T
+general path (the constraint formulation) and Pinocchio's constrained dynamics. Three loops: the
+free four-bar of ``spacar.compare.models.four_bar`` (planar PLBEAMs, the crank's rotation the DOF,
+the coupler's and rocker's passive; 2 constraints), the spatial RSUR linkage of
+tests/data/rsur_loop.urdf (a crank, a rocker with a universal joint to the coupler, the loop
+closed by a ball joint beside the URDF; 1 DOF, 3 passive joints, 3 constraints), and the 7R loop
+of ``spacar.compare.models.seven_r_loop`` (a random 6-link chain closed at a point and at a
+seventh hinge; 1 DOF, 5 passive joints, 5 constraints). Gravity, the crank started at 2 (four-bar),
+1.5 (RSUR) and 1 rad/s (7R), T = 1 s. Error: the largest joint-angle change error at T
 against spacar's general path at EPSINT = EPSIND = 1e-12 (EPSKIN 1e-14), which its tree at the
-same tolerance equals to the figure given. Pinocchio: the same URDF with the ball joint as a 3-D
-point constraint (``pinocchio.constraintDynamics``, proximal settings at 1e-14), integrated by
-SciPy's DOP853 (rtol = EPS, atol = 1e-3 EPS) from spacar's initial state; it has no revolute
-closure for the 7R loop. Every model built outside the timing; time per right-hand side: spacar's
+same tolerance equals to the figure given. Pinocchio: the four-bar as three revolute joints and the
+URDF, each loop closed by a 3-D point constraint (``pinocchio.constraintDynamics``, proximal
+settings at 1e-14), integrated by SciPy's DOP853 (rtol = EPS, atol = 1e-3 EPS) from spacar's
+initial state; it has no revolute closure for the 7R loop. Every model built outside the timing; time per right-hand side: spacar's
 C++ block over its right-hand sides, Pinocchio's ``constraintDynamics`` call from Python.
 
     python benchmarks/closed_loops.py [--quick] [--no-write]
@@ -50,27 +52,77 @@ def seven_r(t_end, eps):
     return models.seven_r_loop(t_end=t_end, n_out=1, eps=eps, epskin=max(1e-14, 1e-3 * eps))
 
 
-# name → (builder, elements of its joints in the error)
-MODELS = {"RSUR (URDF, ball joint)": (rsur, [1, 2, 3, 4]),
-          "7R loop": (seven_r, [models.HINGE + i for i in range(1, 7)])}
+def four_bar(t_end, eps):
+    return models.four_bar(t_end=t_end, n_out=1, eps=eps, epskin=max(1e-14, 1e-3 * eps))
 
 
-def joints(res, elements, what="e"):
-    return np.array([res.deformation(k, 1, what)[-1] for k in elements])
+def hinge_angles(elements):
+    """The joints' angles (rates) over a run: the hinges' e1 (zero at the start)."""
+    return lambda res, rate=False: np.column_stack([res.deformation(k, 1, "ed" if rate else "e") for k in elements])
+
+
+def four_bar_angles(res, rate=False):
+    """Pinocchio's joint angles (rates) of the four-bar: the crank's, the coupler's relative to the
+    crank and the rocker's, from the start (spacar's BETA nodes 11, 21, 31 hold the links' angles)."""
+    b = {n: res.coordinate(n, 1, "xd" if rate else "x") for n in (11, 21, 31)}
+    if not rate:
+        b = {n: v - v[0] for n, v in b.items()}
+    return np.column_stack([b[11], b[21] - b[11], b[31]])
+
+
+# name → (builder, the joints' angles of a run, its passive joints)
+MODELS = {"four-bar (planar)": (four_bar, four_bar_angles, 2),
+          "RSUR (URDF, ball joint)": (rsur, hinge_angles([1, 2, 3, 4]), 3),
+          "7R loop": (seven_r, hinge_angles([models.HINGE + i for i in range(1, 7)]), 5)}
+
+
+def rod(pin, mass_per_length, p0, p1, origin):
+    """A uniform thin rod from p0 to p1 as a Pinocchio inertia about `origin`."""
+    d = p1 - p0
+    length = np.linalg.norm(d)
+    u = d / length
+    m = mass_per_length * length
+    return pin.Inertia(m, (p0 + p1) / 2 - origin, m * length**2 / 12 * (np.eye(3) - np.outer(u, u)))
+
+
+def pinocchio_four_bar():
+    """The four-bar in Pinocchio (as tests/peers/test_closed_loops.py): three revolute joints about
+    z, rods and the point mass, the loop closed at the coupler–rocker pin."""
+    import pinocchio as pin
+
+    A, B, C_, D = (np.array(p, float) for p in ([0, 0, 0], [0, 1, 0], [2, 1.5, 0], [2.5, 0, 0]))
+    pm = pin.Model()
+    pm.gravity.linear = np.array([0.0, -models.G, 0.0])
+    crank = pm.addJoint(0, pin.JointModelRZ(), pin.SE3(np.eye(3), A), "crank")
+    pm.appendBodyToJoint(crank, rod(pin, 1.0, A, B, A), pin.SE3.Identity())
+    coupler = pm.addJoint(crank, pin.JointModelRZ(), pin.SE3(np.eye(3), B - A), "coupler")
+    pm.appendBodyToJoint(coupler, rod(pin, 1.5, B, C_, B), pin.SE3.Identity())
+    pm.appendBodyToJoint(coupler, pin.Inertia(0.3, C_ - B, np.zeros((3, 3))), pin.SE3.Identity())
+    rocker = pm.addJoint(0, pin.JointModelRZ(), pin.SE3(np.eye(3), D), "rocker")
+    pm.appendBodyToJoint(rocker, rod(pin, 1.2, D, C_, D), pin.SE3.Identity())
+    return constrained_dynamics(pm, coupler, C_ - B, rocker, C_ - D)
 
 
 def pinocchio_rsur():
-    """Pinocchio's model of the URDF, its data and constraint, and q, v → q̈."""
+    """Pinocchio's model of the URDF with the ball joint."""
     import pinocchio as pin
 
     pm = pin.buildModelFromUrdf(str(URDF))
-    pd = pm.createData()
     crank, coupler = pm.getJointId("crank"), pm.getJointId("coupler")
     B = np.array(BALL["xyz"])
     C_ = np.asarray(pm.jointPlacements[pm.getJointId("cross")].translation) + \
         np.asarray(pm.jointPlacements[pm.getJointId("rocker")].translation)
-    cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm, crank, pin.SE3(np.eye(3), B), coupler,
-                                  pin.SE3(np.eye(3), B - C_), pin.ReferenceFrame.LOCAL)
+    return constrained_dynamics(pm, crank, B, coupler, B - C_)
+
+
+def constrained_dynamics(pm, joint1, point1, joint2, point2):
+    """q, v → q̈ of Pinocchio's model with a 3-D point constraint between point1 of joint1's frame
+    and point2 of joint2's; and its nq."""
+    import pinocchio as pin
+
+    pd = pm.createData()
+    cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm, joint1, pin.SE3(np.eye(3), point1), joint2,
+                                  pin.SE3(np.eye(3), point2), pin.ReferenceFrame.LOCAL)
     cms = pin.StdVec_RigidConstraintModel()
     cms.append(cm)
     cds = pin.StdVec_RigidConstraintData()
@@ -95,29 +147,32 @@ def pinocchio_run(nq, qdd, q0, v0, t_end, eps):
     return sol.y[:nq, -1], sol.nfev
 
 
+PINOCCHIO = {"four-bar (planar)": pinocchio_four_bar, "RSUR (URDF, ball joint)": pinocchio_rsur}
+
+
 def run_model(name, t_end, eps_list):
-    build, elements = MODELS[name]
+    build, angles, passive = MODELS[name]
     ref = spacar.simulate(build(t_end, 1e-12), recursive=False)
     ref_tree = spacar.simulate(build(t_end, 1e-12))
-    exact = joints(ref, elements)
-    out = {"agreement": float(np.abs(joints(ref_tree, elements) - exact).max()), "path": ref_tree.stats["path"],
-           "passive": len(elements) - 1}
+    exact = angles(ref)[-1]
+    out = {"agreement": float(np.abs(angles(ref_tree)[-1] - exact).max()), "path": ref_tree.stats["path"],
+           "passive": passive}
     for program, recursive in (("spacar (tree)", True), ("spacar (general path)", False)):
         runs = []
         for eps in eps_list:
             res, t = C.simulate_best(build(t_end, eps), recursive=recursive, min_time=0.3)
-            runs.append((float(np.abs(joints(res, elements) - exact).max()), t, eps, res.stats["rhs_evaluations"]))
+            runs.append((float(np.abs(angles(res)[-1] - exact).max()), t, eps, res.stats["rhs_evaluations"]))
             C.log(name, program, eps, runs[-1])
         out[program] = runs
         per_rhs, _ = C.in_run_per_rhs(build(t_end, 1e-8), recursive=recursive)
         out[program + " per rhs"] = per_rhs
-    if name.startswith("RSUR"):
+    if name in PINOCCHIO:
         try:
-            nq, qdd = pinocchio_rsur()
+            nq, qdd = PINOCCHIO[name]()
         except ImportError:
             return out
-        q0, v0 = joints(ref, elements, "e") * 0.0, np.array([ref.deformation(k, 1, "ed")[0] for k in elements])
-        assert np.abs(np.array([ref.deformation(k, 1, "e")[0] for k in elements])).max() < 1e-12  # the zero pose
+        # Pinocchio's q are the joint angles of both models, zero at the reference pose where both start.
+        q0, v0 = np.zeros(nq), angles(ref, rate=True)[0]
         runs = []
         for eps in eps_list:
             t, (q, nfev) = C.best_time(lambda: pinocchio_run(nq, qdd, q0, v0, t_end, eps), repeat=3, budget=20.0,

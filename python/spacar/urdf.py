@@ -501,8 +501,9 @@ def from_urdf(path, gravity=(0.0, 0.0, -9.81), *, floating: bool = False, loops=
     otherwise the assembly closes it and warns of the nodes it moved). ``dependent``: the names
     of the moving joints whose coordinates the loops determine: their rotations (or slides) are
     released (RLSE) instead of DOFs, so that the DOFs are the other joints, in the same order;
-    element k is still joint k (``model.urdf_joints``). Such a model takes the general path
-    (constraint formulation, exact loops; docs/robots.md, "Closed loops").
+    element k is still joint k (``model.urdf_joints``). Such a model takes the recursive path
+    with its loops closed at every right-hand side (exact loops; ``recursive=False``: the general
+    path, the constraint formulation; docs/robots.md, "Closed loops").
 
     The file must be a regular file (a FIFO or a device
     is refused at once) of at most ``max_bytes`` bytes (default :data:`MAX_URDF_BYTES`, 8 MiB).

@@ -37,6 +37,8 @@ LOOPS = {
     "spatial RSUR loop (a ball joint closes it)": trees.rsur,
     "spatial RSUR loop from a URDF, a spring on a dependent joint": lambda: sprung(trees.urdf_rsur()),
     "spatial 7R loop (closed at a point and a cut hinge)": trees.seven_bar,
+    "planar four-bar (passive rotations of the coupler and rocker)": lambda: models.four_bar(),
+    "planar four-bar, a DYNE PLHINGE crank, springs, a damper, FORCE": trees.hinged_four_bar,
 }
 
 
@@ -104,15 +106,16 @@ def test_recursive_inverse_dynamics_matches_the_reduced_equations(name):
 
 
 def test_other_systems_take_the_reduced_equations():
-    # A four-bar is a closed loop: no tree; its one DOF's force is M̄ (q̈ − q̈₀).
-    model = models.four_bar()
+    # A flexible cantilever is no tree of rigid bodies: its DOFs' forces are M̄ (q̈ − q̈₀).
+    model = models.cantilever(2)
     sim = _core.Simulation(model.copy().core)
     sim.assemble()
-    q, qd, qdd = np.asarray(sim.system.q0)[None, :], np.array([[0.7]]), np.array([[1.3]])
+    n = sim.system.n_dof
+    q, qd, qdd = np.asarray(sim.system.q0)[None, :], np.full((1, n), 0.7), np.full((1, n), 1.3)
     force, path = sim.inverse_dynamics(q, qd, qdd)
     assert path == "general"
     np.testing.assert_allclose(force, general_path(model.copy(), q, qd, qdd), rtol=1e-12, atol=1e-14)
-    assert spacar.inverse_dynamics(model, q[0], qd[0], qdd[0]).shape == (1,)
+    assert spacar.inverse_dynamics(model, q[0], qd[0], qdd[0]).shape == (n,)
 
 
 def test_closed_loops_have_no_derivatives_yet():

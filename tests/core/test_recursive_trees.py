@@ -39,6 +39,8 @@ TREES = {
     "spatial loop RSUR": trees.rsur,
     "spatial loop URDF RSUR": trees.urdf_rsur,
     "spatial loop 7R": trees.seven_bar,
+    "planar loop four-bar": lambda: models.four_bar(eps=1e-10, epskin=1e-14),
+    "planar loop hinged four-bar": trees.hinged_four_bar,
 }
 
 # The states of the comparison with the constraint formulation: the random generator's seed and
@@ -70,7 +72,7 @@ def test_recursive_state_equals_the_constraint_formulation(name):
     assert sim.recursive_state(q0, np.zeros(q0.size)) is not None  # the tree, at the assembly
     seed, tolerances = STATE_CHECKS[algebra(name)]
     rng = np.random.default_rng(seed)
-    span = 0.3 if name == "spatial loop 7R" else 1.0  # the 7R loop locks beyond
+    span = 0.3 if "loop" in name else 1.0  # loops lock beyond (the 7R)
     for _ in range(5):
         q = q0 + rng.uniform(-span, span, q0.size)
         qd = rng.uniform(-2.0, 2.0, q0.size)
@@ -136,7 +138,7 @@ def test_spatial_recursive_accelerations_equal_pinocchio_aba(name):
 @pytest.mark.parametrize("name", ["planar chain springs", "planar chain absolute springs", "planar branched spring",
                                   "spatial chain springs", "spatial branched", "spatial URDF wrist",
                                   "spatial URDF prismatic", "spatial loop RSUR", "spatial loop URDF RSUR",
-                                  "spatial loop 7R"])
+                                  "spatial loop 7R", "planar loop four-bar", "planar loop hinged four-bar"])
 def test_runs_on_both_paths_agree(name):
     """Output times and everything reported there (positions and velocities solved by the
     general path from the tree's, accelerations and stresses from the tree's q̈) agree with a
@@ -159,7 +161,6 @@ def test_runs_on_both_paths_agree(name):
 
 # Models near a tree that are not one, and the part of the reason recursive_refusal() gives.
 NOT_TREES = {
-    "planar four-bar (closed loop)": (lambda: models.four_bar(), "or a loop"),
     "planar hinge held fixed": (trees.planar_held_hinge, "neither a joint (DYNE) nor released"),
     "planar DYNX on a position": (trees.position_dof, "is not a rotation"),
     "planar PLTRUSS": (trees.truss_brace, "(PLTRUSS) is not a PLBEAM or PLHINGE"),
@@ -170,6 +171,7 @@ NOT_TREES = {
     "spatial hinge held fixed": (trees.spatial_held_hinge, "not a revolute joint"),
     "spatial flexible BEAM": (trees.flexible_beam, "(BEAM) is not rigid"),
     "spatial FORCE on a LAMBDA node": (trees.lambda_force, "FORCE on LAMBDA node 100001"),
+    "spatial loop cut at a hinge with a spring": (trees.seven_bar_sprung_cut, "closes a loop and has a law"),
 }
 
 
@@ -327,3 +329,32 @@ def test_a_tree_taken_before_time_loads_leaves_their_state_to_the_equations_of_m
     unloaded = assembled(model.copy())
     unloaded.evaluate_state(0.0, np.concatenate([q, qd]))
     assert np.abs(unloaded.data.xdd - without.data.xdd).max() > 1.0  # the load counts
+
+
+def test_a_far_state_does_not_switch_a_loop_to_its_other_assembly():
+    """The loops are closed by continuation from the last closed state (closed_loop.hpp): after a
+    state four radians of crank away, a state near the start is solved on the start's assembly
+    branch, as the general path's continuation solves it (from the warm start alone, Newton's
+    method converged on the other branch: q̈ −41.4 against 45.2)."""
+    general = assembled(trees.rsur())
+    q0 = np.array(general.system.q0)
+    rate = np.zeros(1)
+    general.move_to(0.0, q0 + 0.05, rate)
+    sim = assembled(trees.rsur())
+    sim.recursive_state(q0 + 4.0, rate)
+    got = sim.recursive_state(q0 + 0.05, rate)
+    np.testing.assert_allclose(got["qdd"], general.data.qdd, rtol=1e-10)
+    np.testing.assert_allclose(got["x"], general.data.x, rtol=0, atol=1e-10)
+
+
+def test_a_loose_tolerance_keeps_the_loop_on_its_branch():
+    """At the default EPSINT of 1e-3 the integrator tries stages far apart (rejected steps): the
+    loops stay on the branch of the general path's run."""
+    model = trees.rsur()
+    model.epsint(1e-3)
+    model.epsind(1e-3)
+    model.timestep(4, 0.4)
+    fast = spacar.simulate(model.copy(), method="dop853")
+    general = spacar.simulate(model.copy(), method="dop853", recursive=False)
+    assert fast.stats["path"] == "tree" and fast.stats["rejected"] > 0
+    np.testing.assert_allclose(fast.x, general.x, rtol=0, atol=0.05)  # the two branches: 1.1 apart

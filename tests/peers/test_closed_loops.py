@@ -1,6 +1,6 @@
 """Closed loops against Pinocchio's constrained dynamics (issue 37): the accelerations of
-spacar's general path (the constraint formulation, which every closed loop takes) equal
-``pinocchio.constraintDynamics`` — Pinocchio's tree with the loop closed by a rigid point
+spacar's recursive path (the tree with its loops closed, closed_loop.hpp) and of its general path
+(the constraint formulation) equal ``pinocchio.constraintDynamics`` — Pinocchio's tree with the loop closed by a rigid point
 constraint, an independent formulation — along a run, at each output time's state:
 
 * the free four-bar of ``spacar.compare.models.four_bar`` (rods, a point mass, gravity; the
@@ -44,7 +44,8 @@ def tight(model):
     return model
 
 
-def test_four_bar_matches_constraint_dynamics():
+@pytest.mark.parametrize("recursive", [True, False])
+def test_four_bar_matches_constraint_dynamics(recursive):
     A, B, C, D = (np.array(p, float) for p in ([0, 0, 0], [0, 1, 0], [2, 1.5, 0], [2.5, 0, 0]))
     pm = pin.Model()
     pm.gravity.linear = np.array([0.0, -G, 0.0])
@@ -57,7 +58,8 @@ def test_four_bar_matches_constraint_dynamics():
     pm.appendBodyToJoint(rocker, rod(1.2, D, C, D), pin.SE3.Identity())
     accelerations = constrained(pm, coupler, C - B, rocker, C - D)
 
-    res = spacar.simulate(tight(models.four_bar(t_end=1.0, n_out=10)), method="dop853")
+    res = spacar.simulate(tight(models.four_bar(t_end=1.0, n_out=10)), method="dop853", recursive=recursive)
+    assert res.stats["path"] == ("tree" if recursive else "general")
     # Pinocchio's joints: the crank's rotation, the coupler's relative to the crank, the rocker's,
     # from the reference state (spacar's BETA nodes 11, 21, 31 hold the links' absolute angles).
     angle = {b: res.coordinate(b, 1, "x") for b in (11, 21, 31)}
@@ -72,7 +74,8 @@ def test_four_bar_matches_constraint_dynamics():
         assert np.abs(ours - theirs).max() <= 1e-10 * max(1.0, np.abs(theirs).max()), (k, ours, theirs)
 
 
-def test_spatial_rsur_matches_constraint_dynamics():
+@pytest.mark.parametrize("recursive", [True, False])
+def test_spatial_rsur_matches_constraint_dynamics(recursive):
     g = RSSR
     B, C = g.B(0.0), g.C(g.phi(0.0))
     A, D = np.asarray(g.A, float), np.asarray(g.D, float)
@@ -92,7 +95,9 @@ def test_spatial_rsur_matches_constraint_dynamics():
     pm.appendBodyToJoint(coupler, pin.Inertia(0.0, np.zeros(3), body), pin.SE3.Identity())
     accelerations = constrained(pm, crank, B - A, coupler, B - C)
 
-    res = spacar.simulate(tight(rssr_model(coupler="beam", dynamic=True, n_out=10, period=1.0)), method="dop853")
+    res = spacar.simulate(tight(rssr_model(coupler="beam", dynamic=True, n_out=10, period=1.0)), method="dop853",
+                          recursive=recursive)
+    assert res.stats["path"] == ("tree" if recursive else "general")
     hinges = (5, 6, 7, 8)  # crank (DYNE), rocker and the universal joint's two (released): Pinocchio's joints
     e, ed, edd = (np.column_stack([res.deformation(h, 1, what) for h in hinges]) for what in ("e", "ed", "edd"))
     for k in range(len(res.t)):

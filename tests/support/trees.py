@@ -234,10 +234,54 @@ def urdf_rsur():
     return model
 
 
+def hinged_four_bar():
+    """A planar four-bar whose crank is turned by a DYNE PLHINGE from the ground's BETA node (a
+    spring and a damper on it) and whose coupler and rocker are joined by a released PLHINGE with a
+    spring: the loop closes at the coupler–rocker pin, the coupler's and rocker's rotations are
+    passive. The geometry of spacar.compare.models.four_bar, a MASS with rotary inertia on the
+    rocker's end, FORCE on the coupler."""
+    m = spacar.Model()
+    m.plbeam(1, 1, 11, 2, 12)
+    m.plbeam(2, 2, 21, 3, 22)
+    m.plbeam(3, 4, 31, 3, 32)
+    for node, xy in ((1, (0.0, 0.0)), (2, (0.0, 1.0)), (3, (2.0, 1.5)), (4, (2.5, 0.0))):
+        m.x(node, *xy)
+    m.plhinge(101, 100, 11)
+    m.dyne(101, 1)
+    m.estiff(101, 4.0)
+    m.edampp(101, 0.3)
+    m.plhinge(102, 22, 32)
+    m.rlse(102, 1)
+    m.estiff(102, 2.0)
+    m.fix(1)
+    m.fix(4)
+    m.fix(100)
+    for e, r in ((1, 1.0), (2, 1.5), (3, 1.2)):
+        m.emass(e, r)
+    m.mass(3, 0.3)
+    m.mass(32, 0.05)
+    m.force(2, 0.4, -0.2)
+    m.ed(101, 1, 1.5)
+    m.gravity(0.0, -9.81)
+    m.epskin(1e-14)
+    m.epsint(1e-10)
+    m.epsind(1e-10)
+    m.timestep(5, 0.5)
+    return m
+
+
 def seven_bar():
     """The spatial 7R loop of spacar.compare.models.seven_r_loop at tight tolerances."""
     m = models.seven_r_loop(eps=1e-10, epskin=1e-14)
     m.timestep(5, 0.5)
+    return m
+
+
+def seven_bar_sprung_cut():
+    """The 7R loop with a spring and a damper on hinge 4, where the tree cuts the loop."""
+    m = seven_bar()
+    m.estiff(models.HINGE + 4, 50.0)
+    m.edampp(models.HINGE + 4, 2.0)
     return m
 
 

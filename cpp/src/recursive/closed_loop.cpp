@@ -1,5 +1,6 @@
-// Closed loops on the recursive path (closed_loop.hpp): the loops' constraints on a spatial tree,
-// closed by Newton's method in the dependent joints, and the equations of motion in the DOFs.
+// Closed loops on the recursive path (closed_loop.hpp): the loops' constraints on a planar or a
+// spatial tree, closed by Newton's method in the passive joints, and the equations of motion in
+// the DOFs.
 #include "spacar/recursive/closed_loop.hpp"
 
 #include <algorithm>
@@ -7,6 +8,8 @@
 
 #include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
+#include "spacar/recursive/planar_tree.hpp"
+#include "spacar/recursive/spatial_tree.hpp"
 
 namespace spacar {
 
@@ -14,28 +17,40 @@ namespace {
 
 constexpr int kMaxIterations = 30;
 // Newton's method stops at residuals of 1e-14 (points: of the tree's size), near round-off: at
-// 1e-12 the accelerations were off by 1e-11 (relative), or at a correction at round-off.
-constexpr double kResidual = 1e-14, kRoundOff = 1e-15;
+// 1e-12 the accelerations were off by 1e-11 (relative); or at a correction at round-off if the
+// residual is below 1e-10 (else the constraints have no solution there: a least-squares minimum).
+constexpr double kResidual = 1e-14, kRoundOff = 1e-15, kStalled = 1e-10;
+// Continuation (close_loops): pieces that move no coordinate by more than 0.1, Newton's correction
+// of a piece's predicted start at most a quarter of its move (plus 1e-12: the same state again),
+// up to 4096 pieces.
+constexpr double kMaxMove = 0.1, kCorrection = 0.25, kSameState = 1e-12;
+constexpr int kMaxPieces = 4096;
+
+using Cut = TreeLoops<Eigen::Vector3d>::Cut;  // spatial
 
 // The Euler parameters of a LAMBDA node on a body (body < 0: the ground) from its parameters at
 // the recognition.
-Eigen::Vector4d node_lambda(const SpatialTree::Loops::Cut& cut, int end, const Eigen::Vector4d& body_lambda) {
+Eigen::Vector4d node_lambda(const Cut& cut, int end, const Eigen::Vector4d& body_lambda) {
   return cut.body[end] < 0 ? cut.lambda0[end] : tree_detail::compose(body_lambda, cut.lambda0[end]);
 }
 
 }  // namespace
 
-ClosedLoopTree::ClosedLoopTree(std::unique_ptr<SpatialTree> tree) : tree_(std::move(tree)), loops_(tree_->loops()) {
+template <class Algebra>
+ClosedLoopTree<Algebra>::ClosedLoopTree(std::unique_ptr<Tree> tree) : tree_(std::move(tree)), loops_(tree_->loops()) {
   nd_ = loops_.n_dof;
   nn_ = static_cast<int>(loops_.dependent0.size());
-  m_ = 3 * static_cast<int>(loops_.points.size());
-  for (const SpatialTree::Loops::Cut& cut : loops_.cuts) m_ += static_cast<int>(cut.rows.size());
+  n_point_rows_ = m_ = Point::RowsAtCompileTime * static_cast<int>(loops_.points.size());
+  for (const auto& cut : loops_.cuts) m_ += static_cast<int>(cut.rows.size());
   const int n = nd_ + nn_;
   theta_ = theta_d_ = theta_dd_ = zero_ = g_ = col_ = Eigen::VectorXd::Zero(n);
   for (int k = 0; k < nn_; ++k) theta_[nd_ + k] = loops_.dependent0[k];
   c_ = gamma_ = Eigen::VectorXd::Zero(m_);
   q_last_ = rhs_ = Eigen::VectorXd::Zero(nd_);
-  start_ = step_ = Eigen::VectorXd::Zero(nn_);
+  w_ = Eigen::VectorXd::Zero(n);
+  start_ = step_ = predicted_ = Eigen::VectorXd::Zero(nn_);
+  from_ = step_q_ = delta_ = Eigen::VectorXd::Zero(nd_);
+  T_start_ = Eigen::MatrixXd::Zero(nn_, nd_);
   J_ = Eigen::MatrixXd::Zero(m_, n);
   T_ = MT_ = Eigen::MatrixXd::Zero(n, nd_);
   A_ = Eigen::MatrixXd::Zero(nd_, nd_);
@@ -44,15 +59,20 @@ ClosedLoopTree::ClosedLoopTree(std::unique_ptr<SpatialTree> tree) : tree_(std::m
   T_.topRows(nd_).setIdentity();
   length_ = 0.0;
   for (const auto& body : tree_->bodies_) length_ += body.r.norm();
-  for (const SpatialTree::Loops::Point& p : loops_.points) length_ = std::max(length_, p.pa.norm());
+  for (const auto& p : loops_.points) length_ = std::max(length_, p.pa.norm());
   if (!(length_ > 0.0)) length_ = 1.0;
 }
 
-std::unique_ptr<RecursiveTree> ClosedLoopTree::close(std::unique_ptr<SpatialTree> tree, const System& sys,
-                                                     const Data& data, std::string* why) {
+template <class Algebra>
+std::unique_ptr<RecursiveTree> ClosedLoopTree<Algebra>::close(std::unique_ptr<Tree> tree, const System& sys,
+                                                              const Data& data, std::string* why) {
   auto loop = std::unique_ptr<ClosedLoopTree>(new ClosedLoopTree(std::move(tree)));
-  // The assembled state: q holds the DOF joints' e1 (a loop's tree has no DYNX).
-  for (int k = 0; k < loop->nd_; ++k) loop->q_last_[k] = loop->theta_[k] = data.e[sys.e_dyn[k]];
+  // The assembled state: q holds the DYNX coordinates (a planar body's rotation), then the DOF
+  // joints' e1.
+  const int nx = static_cast<int>(sys.x_dyn.size());
+  for (int k = 0; k < loop->nd_; ++k)
+    loop->q_last_[k] = loop->theta_[k] = k < nx ? data.x[sys.x_dyn[k]] : data.e[sys.e_dyn[k - nx]];
+  // The tangent there (the first state's predictor).
   loop->tree_->outward(loop->theta_.data(), loop->zero_.data());
   loop->constraints();
   loop->qr_.compute(loop->J_.rightCols(loop->nn_));
@@ -63,42 +83,81 @@ std::unique_ptr<RecursiveTree> ClosedLoopTree::close(std::unique_ptr<SpatialTree
     }
     return nullptr;
   }
+  loop->T_.bottomRows(loop->nn_) = -loop->qr_.solve(loop->J_.leftCols(loop->nd_));
   return loop;
 }
 
-void ClosedLoopTree::add_point_rows(int body, const Vec3& p, double scale, int row) {
+// Points: c = x_a − x_b; a cut (spatial): its rigid misalignments (add_cut_rows).
+template <class Algebra>
+void ClosedLoopTree<Algebra>::constraints() {
+  constexpr int d = Point::RowsAtCompileTime;
+  J_.setZero();
+  int row = 0;
+  for (const auto& p : loops_.points) {
+    const Point xa = world_point(p.a, p.pa), xb = world_point(p.b, p.pb);
+    c_.template segment<d>(row) = xa - xb;
+    add_point_rows(p.a, xa, 1.0, row);
+    if (p.b >= 0) add_point_rows(p.b, xb, -1.0, row);
+    row += d;
+  }
+  add_cut_rows(row);
+}
+
+// After the tree's accelerations at θ̈ = 0 without gravity.
+template <class Algebra>
+void ClosedLoopTree<Algebra>::constraint_bias() {
+  constexpr int d = Point::RowsAtCompileTime;
+  int row = 0;
+  for (const auto& p : loops_.points) {
+    gamma_.template segment<d>(row) = point_acceleration(p.a, p.pa);
+    if (p.b >= 0) gamma_.template segment<d>(row) -= point_acceleration(p.b, p.pb);
+    row += d;
+  }
+  add_cut_bias(row);
+}
+
+// --- spatial: ẋ = Σ (S_j θ̇_j) × (x − pin_j) over the joints on a body's path (a sliding joint's:
+// its axis); a cut's rows e_k(λ_o1, λ_o2) − e_k(recognition), ∂e/∂θ_j = B ½ E(λ)ᵀ ω_j (λ̇ = ½ E(λ)ᵀ ω,
+// world ω).
+
+template <>
+SpatialAlgebra::Point ClosedLoopTree<SpatialAlgebra>::world_point(int body, const Point& b) const {
+  if (body < 0) return b;
+  const auto& d = tree_->work_[body];
+  return d.pin + d.frame.R * b;
+}
+
+template <>
+void ClosedLoopTree<SpatialAlgebra>::add_point_rows(int body, const Point& p, double scale, int row) {
   for (int j = body; j >= 0; j = tree_->bodies_[j].parent) {
     const auto& m = tree_->bodies_[j];
     const auto& d = tree_->work_[j];
-    const Vec3 axis = d.frame.R * m.axis;
-    const Vec3 rate = m.prismatic ? axis : Vec3(axis.cross(p - d.pin));
+    const Eigen::Vector3d axis = d.frame.R * m.axis;
+    const Eigen::Vector3d rate = m.prismatic ? axis : Eigen::Vector3d(axis.cross(p - d.pin));
     J_.block<3, 1>(row, m.dof) += scale * m.sign * rate;
   }
 }
 
-void ClosedLoopTree::add_rotation_row(int body, const Eigen::Matrix<double, 1, 3>& w, int row) {
+// R (a_v + α × b + ω × (v + ω × b)) from the body's motion (body coordinates).
+template <>
+SpatialAlgebra::Point ClosedLoopTree<SpatialAlgebra>::point_acceleration(int body, const Point& b) const {
+  const auto& d = tree_->work_[body];
+  const Eigen::Vector3d w = d.v.head<3>(), v = d.v.tail<3>() + w.cross(b);
+  return d.frame.R * (d.a.tail<3>() + d.a.head<3>().cross(b) + w.cross(v));
+}
+
+template <>
+void ClosedLoopTree<SpatialAlgebra>::add_rotation_row(int body, const Eigen::Matrix<double, 1, 3>& w, int row) {
   for (int j = body; j >= 0; j = tree_->bodies_[j].parent) {
     const auto& m = tree_->bodies_[j];
     if (!m.prismatic) J_(row, m.dof) += m.sign * w.dot(tree_->work_[j].frame.R * m.axis);
   }
 }
 
-// Points: c = x_a − x_b, ẋ = Σ (S_j θ̇_j) × (x − pin_j) over the joints on a body's path (a sliding
-// joint's: its axis). Cuts: c = e_k(λ_o1, λ_o2) − e_k(recognition), ∂e/∂θ_j = B ½ E(λ)ᵀ ω_j
-// (λ̇ = ½ E(λ)ᵀ ω, world ω).
-void ClosedLoopTree::constraints() {
-  J_.setZero();
+template <>
+void ClosedLoopTree<SpatialAlgebra>::add_cut_rows(int row) {
   const auto& work = tree_->work_;
-  int row = 0;
-  for (const SpatialTree::Loops::Point& p : loops_.points) {
-    const Vec3 xa = work[p.a].pin + work[p.a].frame.R * p.pa;
-    const Vec3 xb = p.b < 0 ? p.pb : Vec3(work[p.b].pin + work[p.b].frame.R * p.pb);
-    c_.segment<3>(row) = xa - xb;
-    add_point_rows(p.a, xa, 1.0, row);
-    if (p.b >= 0) add_point_rows(p.b, xb, -1.0, row);
-    row += 3;
-  }
-  for (const SpatialTree::Loops::Cut& cut : loops_.cuts) {
+  for (const Cut& cut : loops_.cuts) {
     Eigen::Matrix<double, 8, 1> x;
     Eigen::Vector3d e;
     Eigen::Matrix<double, 3, 8> B;
@@ -119,23 +178,11 @@ void ClosedLoopTree::constraints() {
   }
 }
 
-// After the tree's accelerations at θ̈ = 0 without gravity (d.a, body coordinates): a point's
-// acceleration R (a_v + α × b + ω × (v + ω × b)); a cut's ë = B ẍ + c(x, ẋ) with
-// λ̈ = ½ E(λ̇)ᵀ ω + ½ E(λ)ᵀ α (world ω, α).
-void ClosedLoopTree::constraint_bias() {
+// A cut's ë = B ẍ + c(x, ẋ) with λ̈ = ½ E(λ̇)ᵀ ω + ½ E(λ)ᵀ α (world ω, α).
+template <>
+void ClosedLoopTree<SpatialAlgebra>::add_cut_bias(int row) {
   const auto& work = tree_->work_;
-  auto point_acceleration = [&](int body, const Vec3& b) -> Vec3 {
-    const auto& d = work[body];
-    const Vec3 w = d.v.head<3>(), v = d.v.tail<3>() + w.cross(b);
-    return d.frame.R * (d.a.tail<3>() + d.a.head<3>().cross(b) + w.cross(v));
-  };
-  int row = 0;
-  for (const SpatialTree::Loops::Point& p : loops_.points) {
-    gamma_.segment<3>(row) = point_acceleration(p.a, p.pa);
-    if (p.b >= 0) gamma_.segment<3>(row) -= point_acceleration(p.b, p.pb);
-    row += 3;
-  }
-  for (const SpatialTree::Loops::Cut& cut : loops_.cuts) {
+  for (const Cut& cut : loops_.cuts) {
     Eigen::Matrix<double, 8, 1> x, xd = Eigen::Matrix<double, 8, 1>::Zero(), xdd = xd;
     Eigen::Vector3d e, conv;
     Eigen::Matrix<double, 3, 8> B;
@@ -145,60 +192,118 @@ void ClosedLoopTree::constraint_bias() {
       x.segment<4>(4 * end) = l;
       if (body < 0) continue;
       const auto& d = work[body];
-      const Vec3 w = d.frame.R * d.v.head<3>(), alpha = d.frame.R * d.a.head<3>();
+      const Eigen::Vector3d w = d.frame.R * d.v.head<3>(), alpha = d.frame.R * d.a.head<3>();
       const Eigen::Vector4d ld = 0.5 * euler_E(l).transpose() * w;
       xd.segment<4>(4 * end) = ld;
       xdd.segment<4>(4 * end) = 0.5 * (euler_E(ld).transpose() * w + euler_E(l).transpose() * alpha);
     }
     cut.kernel->first_derivatives(x.data(), e.data(), B.data());
     cut.kernel->convective(x.data(), xd.data(), conv.data());
-    for (size_t r = 0; r < cut.rows.size(); ++r, ++row) {
-      const int k = cut.rows[r];
-      gamma_[row] = B.row(k).dot(xdd) + conv[k];
-    }
+    for (size_t r = 0; r < cut.rows.size(); ++r, ++row) gamma_[row] = B.row(cut.rows[r]).dot(xdd) + conv[cut.rows[r]];
   }
 }
 
-bool ClosedLoopTree::close_loops(const double* q) {
+// --- planar: ṗ = Σ ω_j ẑ × s_j over the bodies on p's path, s_j the segment of body j from its pin
+// to the next body's pin (to p on p's own body), ω_j its absolute rate: θ̇ of its own rotation (an
+// absolute joint) or ω_parent + sign θ̇ (a hinge). No cuts: a planar loop closes at points.
+
+template <>
+PlanarAlgebra::Point ClosedLoopTree<PlanarAlgebra>::world_point(int body, const Point& b) const {
+  if (body < 0) return b;
+  const auto& d = tree_->work_[body];
+  const auto& f = d.frame;
+  return d.pin + Point(f.cw * b.x() - f.sw * b.y(), f.sw * b.x() + f.cw * b.y());
+}
+
+template <>
+void ClosedLoopTree<PlanarAlgebra>::add_point_rows(int body, const Point& p, double scale, int row) {
+  path_.clear();
+  for (int j = body; j >= 0; j = tree_->bodies_[j].parent) path_.push_back(j);
+  w_.setZero();  // ∂ω_j/∂θ̇, from the root down
+  for (int k = static_cast<int>(path_.size()) - 1; k >= 0; --k) {
+    const int j = path_[k];
+    const auto& m = tree_->bodies_[j];
+    if (m.absolute) w_.setZero();
+    w_[m.dof] += m.absolute ? 1.0 : m.sign;
+    const Point s = (k == 0 ? p : tree_->work_[path_[k - 1]].pin) - tree_->work_[j].pin;
+    J_.row(row) -= scale * s.y() * w_.transpose();
+    J_.row(row + 1) += scale * s.x() * w_.transpose();
+  }
+}
+
+// The point's acceleration from the body's motion (body coordinates), as move_coordinates.
+template <>
+PlanarAlgebra::Point ClosedLoopTree<PlanarAlgebra>::point_acceleration(int body, const Point& b) const {
+  const auto& d = tree_->work_[body];
+  const double w = d.v[0], wd = d.a[0];
+  const double vx = d.v[1] - w * b.y(), vy = d.v[2] + w * b.x();
+  const double ax = d.a[1] - wd * b.y() - w * vy, ay = d.a[2] + wd * b.x() + w * vx;
+  return Point(d.frame.cw * ax - d.frame.sw * ay, d.frame.sw * ax + d.frame.cw * ay);
+}
+
+template <>
+void ClosedLoopTree<PlanarAlgebra>::add_cut_rows(int) {}
+
+template <>
+void ClosedLoopTree<PlanarAlgebra>::add_cut_bias(int) {}
+
+// By continuation from the last closed state, so that the loops stay on the assembly branch they
+// are on (a loop closes in several ways: the other branch is a finite correction away): in
+// pieces of q − q_last that move no coordinate by more than kMaxMove, each started from the
+// last piece's state moved along its tangent, θ_d + T_d Δq (second order in Δq: an integrator's
+// stages, a piece apart, converge in one or two iterations), and accepted only if Newton's
+// correction of that start is small against the move; else in four times as many pieces.
+template <class Algebra>
+bool ClosedLoopTree<Algebra>::close_loops(const double* q) {
   start_ = theta_.tail(nn_);
-  // First from the last closed state moved along its tangent, θ_d + T_d (q − q_last), which
-  // leaves a residual of second order in the step (an integrator's stages are close to each
-  // other); if that fails, from the last closed state itself.
-  for (int k = 0; k < nd_; ++k) q_last_[k] = q[k] - q_last_[k];
-  theta_.tail(nn_).noalias() += T_.bottomRows(nn_) * q_last_;
-  for (int k = 0; k < nd_; ++k) q_last_[k] = q[k] - q_last_[k];  // back to the last closed state's
-  for (int k = 0; k < nd_; ++k) theta_[k] = q[k];
-  if (newton()) return closed(q);
-  theta_.tail(nn_) = start_;
-  if (newton()) return closed(q);
-  theta_.tail(nn_) = start_;
+  from_ = q_last_;
+  T_start_ = T_.bottomRows(nn_);
+  for (int k = 0; k < nd_; ++k) step_q_[k] = q[k] - from_[k];
+  const double move = std::max(step_q_.cwiseAbs().maxCoeff(), (T_start_ * step_q_).cwiseAbs().maxCoeff());
+  if (!std::isfinite(move)) return false;
+  for (int pieces = std::max(1, static_cast<int>(std::ceil(move / kMaxMove))); pieces <= kMaxPieces; pieces *= 4) {
+    bool ok = true;
+    for (int piece = 1; piece <= pieces && ok; ++piece) {
+      delta_ = step_q_ / pieces;
+      predicted_.noalias() = T_.bottomRows(nn_) * delta_;  // the move, then the start
+      const double moved = std::max(delta_.cwiseAbs().maxCoeff(), predicted_.cwiseAbs().maxCoeff());
+      predicted_ += theta_.tail(nn_);
+      theta_.head(nd_) = from_ + step_q_ * (static_cast<double>(piece) / pieces);
+      theta_.tail(nn_) = predicted_;
+      ok = newton() && (theta_.tail(nn_) - predicted_).cwiseAbs().maxCoeff() <= kCorrection * moved + kSameState;
+      if (ok && piece < pieces) T_.bottomRows(nn_) = -qr_.solve(J_.leftCols(nd_));  // the next piece's tangent
+    }
+    if (ok) {
+      for (int k = 0; k < nd_; ++k) q_last_[k] = q[k];
+      return true;
+    }
+    theta_.tail(nn_) = start_;
+    T_.bottomRows(nn_) = T_start_;
+  }
   return false;
 }
 
-bool ClosedLoopTree::newton() {
-  const int n_point_rows = 3 * static_cast<int>(loops_.points.size());
+template <class Algebra>
+bool ClosedLoopTree<Algebra>::newton() {
   for (int it = 0; it < kMaxIterations; ++it) {
     tree_->outward(theta_.data(), zero_.data());
     constraints();
     qr_.compute(J_.rightCols(nn_));
     if (qr_.rank() < nn_) return false;
     double residual = 0.0;
-    for (int r = 0; r < m_; ++r) residual = std::max(residual, std::abs(c_[r]) / (r < n_point_rows ? length_ : 1.0));
+    for (int r = 0; r < m_; ++r) residual = std::max(residual, std::abs(c_[r]) / (r < n_point_rows_ ? length_ : 1.0));
     if (residual <= kResidual) return true;
     if (!std::isfinite(residual)) return false;
     step_ = qr_.solve(c_);
     theta_.tail(nn_) -= step_;
-    if (step_.cwiseAbs().maxCoeff() <= kRoundOff * (1.0 + theta_.tail(nn_).cwiseAbs().maxCoeff())) return true;
+    if (step_.cwiseAbs().maxCoeff() <= kRoundOff * (1.0 + theta_.tail(nn_).cwiseAbs().maxCoeff()))
+      return residual <= kStalled;
   }
   return false;
 }
 
-bool ClosedLoopTree::closed(const double* q) {
-  for (int k = 0; k < nd_; ++k) q_last_[k] = q[k];
-  return true;
-}
-
-bool ClosedLoopTree::prepare(const double* q, const double* qd) {
+template <class Algebra>
+bool ClosedLoopTree<Algebra>::prepare(const double* q, const double* qd) {
   if (!close_loops(q)) return false;
   T_.bottomRows(nn_) = -qr_.solve(J_.leftCols(nd_));
   const Eigen::Map<const Eigen::VectorXd> rates(qd, nd_);
@@ -206,15 +311,16 @@ bool ClosedLoopTree::prepare(const double* q, const double* qd) {
   theta_d_.tail(nn_).noalias() = T_.bottomRows(nn_) * rates;
   tree_->outward(theta_.data(), theta_d_.data());
   tree_->applied_loads();
-  tree_->accelerate(theta_.data(), theta_d_.data(), zero_.data(), SpatialTree::Vector::Zero(), true);
+  tree_->accelerate(theta_.data(), theta_d_.data(), zero_.data(), Tree::Vector::Zero(), true);
   constraint_bias();
   g_.tail(nn_) = -qr_.solve(gamma_);
   return true;
 }
 
-bool ClosedLoopTree::solve(const double* q, const double* qd, double* qdd) {
+template <class Algebra>
+bool ClosedLoopTree<Algebra>::solve(const double* q, const double* qd, double* qdd) {
   if (!prepare(q, qd)) return false;
-  SpatialTree& tree = *tree_;
+  Tree& tree = *tree_;
   // τ_id(θ, θ̇, g): the forces of the accelerations g, the bias forces and the loads.
   tree.accelerate(theta_.data(), theta_d_.data(), g_.data(), tree.base_acceleration_, true);
   for (size_t i = 0; i < tree.bodies_.size(); ++i) tree.work_[i].pA += tree.bodies_[i].inertia * tree.work_[i].a;
@@ -232,7 +338,8 @@ bool ClosedLoopTree::solve(const double* q, const double* qd, double* qdd) {
   return out.allFinite();
 }
 
-void ClosedLoopTree::inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) {
+template <class Algebra>
+void ClosedLoopTree<Algebra>::inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) {
   if (!prepare(q, qd))
     throw InputError("inverse_dynamics: the loops do not close at this state (Newton's method on the passive "
                      "joints failed, or they are not determined there)");
@@ -242,14 +349,19 @@ void ClosedLoopTree::inverse_dynamics(const double* q, const double* qd, const d
   Eigen::Map<Eigen::VectorXd>(force, nd_).noalias() = T_.transpose() * col_;
 }
 
-bool ClosedLoopTree::dynamics_derivatives(int, const double*, const double*, const double*, double*, double*, double*,
-                                          double*) {
+template <class Algebra>
+bool ClosedLoopTree<Algebra>::dynamics_derivatives(int, const double*, const double*, const double*, double*, double*,
+                                                   double*, double*) {
   throw InputError("dynamics_derivatives: not computed on closed loops (the recursive path computes them on trees; "
                    "inverse_dynamics and simulate take closed loops)");
 }
 
-void ClosedLoopTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const {
+template <class Algebra>
+void ClosedLoopTree<Algebra>::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const {
   tree_->move_coordinates(x, xd, xdd);
 }
+
+template class ClosedLoopTree<SpatialAlgebra>;
+template class ClosedLoopTree<PlanarAlgebra>;
 
 }  // namespace spacar

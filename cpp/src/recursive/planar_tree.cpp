@@ -39,7 +39,8 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
 
   bool build() {
     return supported_classes() && read_coordinates() && read_nodes() && read_elements("PLBEAM or PLHINGE") &&
-           group_bodies() && index_points() && place_bodies() && all_dofs_are_joints() && attach_springs();
+           group_bodies() && index_points() && place_bodies() && all_dofs_are_joints() && attach_springs() &&
+           record_loops();
   }
 
  private:
@@ -103,20 +104,59 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
   }
 
   // The bodies pinned at the points of `parent` (or the ground) and turned by their own DYNX
-  // rotation coordinate.
+  // rotation coordinate; then those of a closed loop, turned by their own calculable rotation
+  // (a passive joint: the loops determine it; none of its BETA nodes is DYNX, no DOF hinge
+  // turns it).
   bool place_rotated(int parent, std::vector<int>& queue) {
-    for (int id : owned_points(parent))
-      for (int child : bodies_at_[id]) {
-        const int coord = dynamic_rotation(child);
-        if (is_placed(child) || coord == -1) continue;
-        if (coord < 0) return refuse("a body has more than one DYNX rotation");
-        Model bd;
-        bd.absolute = true;
-        bd.dof = dof_of_coord_.at(coord);
-        bd.offset = x_[coord];
-        if (!place(child, parent, bd, "DYNX " + sys_.coord_name(coord), Slide{})) return false;
-        queue.push_back(child);
-      }
+    for (bool passive : {false, true})
+      for (int id : owned_points(parent))
+        for (int child : bodies_at_[id]) {
+          if (is_placed(child)) continue;
+          const int dynx = dynamic_rotation(child);
+          if (dynx < -1) return refuse("a body has more than one DYNX rotation");
+          if (passive ? dynx != -1 || turned_by_dof_hinge(child) : dynx == -1) continue;
+          const int coord = passive ? nodes_.at(*g_.orientations[child].begin()).coord : dynx;
+          Model bd;
+          bd.absolute = true;
+          bd.offset = x_[coord];
+          const std::string joint = (passive ? "the rotation of " : "DYNX ") + sys_.coord_name(coord);
+          if (passive) {  // after the DOFs in the tree's coordinates: (q, the passive rotations)
+            bd.dof = sys_.n_dof() + static_cast<int>(tree_.loops_.dependent0.size());
+            tree_.loops_.dependent0.push_back(x_[coord]);
+            tree_.loops_.dependent.push_back(joint);
+          } else {
+            bd.dof = dof_of_coord_.at(coord);
+          }
+          if (!place(child, parent, bd, joint, Slide{})) return false;
+          queue.push_back(child);
+        }
+    return true;
+  }
+
+  // Whether a DOF PLHINGE joins the body to another.
+  bool turned_by_dof_hinge(int body) const {
+    for (const Hinge& h : hinges_)
+      if (h.dof >= 0 && (body_of(h.a) == body || body_of(h.b) == body)) return true;
+    return false;
+  }
+
+  // A planar loop closes at points (a body's second pin on a placed body); its passive joints
+  // are the bodies' own rotations (place_rotated).
+  bool loops_allowed() const { return true; }
+
+  // The loops closed on the tree: the points two bodies share beyond their pins (closed_loop.hpp).
+  // The body coordinates of a point are its offset from the pin at the reference state.
+  bool record_loops() {
+    auto& loops = tree_.loops_;
+    loops.n_dof = sys_.n_dof();
+    for (const ClosurePoint& c : closure_points_) {
+      const int other = owner_.at(c.node);
+      loops.points.push_back({c.body, other, point(c.node) - pin0_[c.body],
+                              other == kGround ? point(c.node) : Point(point(c.node) - pin0_[other]), c.node});
+    }
+    if (loops.closed() && loops.dependent0.empty()) return refuse("a loop closes with no body that it turns");
+    if (!loops.closed() && !loops.dependent0.empty())
+      return refuse(loops.dependent.front() + " is neither a DOF nor determined by a loop");
     return true;
   }
 
@@ -139,7 +179,7 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
   }
 
   bool all_dofs_are_joints() {
-    if (tree_.n_bodies() == sys_.n_dof()) return true;
+    if (tree_.n_bodies() == sys_.n_dof() + static_cast<int>(tree_.loops_.dependent0.size())) return true;
     return refuse("a degree of freedom is not the rotation of a body");
   }
 
@@ -151,8 +191,8 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
     if (!attach(body, parent_body, bd, joint, index, p0, slide)) return false;
     Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
     for (int i : g_.beams[body]) I += element_inertia(sys_.elements[i], p0);
-    for (int id : g_.points[body])
-      if (id != pin_[body]) follow(id, index, p0, I);
+    for (int id : g_.points[body])  // not its pin, nor a point where a loop closes: the first body's
+      if (owner_.at(id) == index) follow(id, index, p0, I);
     for (int id : g_.orientations[body]) follow(id, index, p0, I);
     // The projection is a rigid body's inertia only if the mass model moves rigidly with the
     // nodes (equal masses in x and y, no coupling between them).

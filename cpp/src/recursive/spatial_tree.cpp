@@ -211,7 +211,7 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     if (h.passive) {  // after the DOFs in the tree's coordinates: (q, the dependent joints')
       bd.dof = sys_.n_dof() + static_cast<int>(tree_.loops_.dependent0.size());
       tree_.loops_.dependent0.push_back(e_[se.def_offset]);
-      tree_.loops_.dependent_element.push_back(h.element);
+      tree_.loops_.dependent.push_back(element_name(se));
     }
     bd.sign = forward ? 1.0 : -1.0;  // e1 turns (slides) o2's body relative to o1's
     bd.offset = -bd.sign * e_[se.def_offset];  // u = sign · (e1 − e1 at the reference state)
@@ -320,6 +320,8 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
       const Hinge& h = hinges_[i];
       const SystemElement& se = sys_.elements[h.element];
       if (h.pa >= 0) return refuse(element_name(se) + " closes a loop: a sliding joint is not cut");
+      if (se.has_constitutive)  // its σ would act on the loop's constraint rows: not built
+        return refuse(element_name(se) + " closes a loop and has a law (ESTIFF, EDAMPP): a cut has none");
       Loops::Cut cut;
       cut.element = h.element;
       cut.kernel = se.kernel.get();
@@ -339,8 +341,7 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     if (closed && tree_.floating_) return refuse("a loop closes on a floating base");
     if (closed && loops.dependent0.empty()) return refuse("a loop closes with no joint that it determines");
     if (!closed && !loops.dependent0.empty())
-      return refuse(element_name(sys_.elements[loops.dependent_element.front()]) +
-                    " is released and in no loop");
+      return refuse(loops.dependent.front() + " is released and in no loop");
     return true;
   }
 

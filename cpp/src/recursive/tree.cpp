@@ -14,13 +14,21 @@
 
 namespace spacar {
 
+namespace {
+
+// The tree, or its loops closed on it if it has any.
+template <class Algebra, class Tree>
+std::unique_ptr<RecursiveTree> with_loops(std::unique_ptr<Tree> tree, const System& sys, const Data& data,
+                                          std::string* why) {
+  if (!tree || !tree->loops().closed()) return tree;
+  return ClosedLoopTree<Algebra>::close(std::move(tree), sys, data, why);
+}
+
+}  // namespace
+
 std::unique_ptr<RecursiveTree> RecursiveTree::detect(const System& sys, const Data& data, std::string* why) {
-  if (sys.dim == 3) {
-    std::unique_ptr<SpatialTree> tree = SpatialTree::detect(sys, data, why);
-    if (tree && tree->loops().closed()) return ClosedLoopTree::close(std::move(tree), sys, data, why);
-    return tree;
-  }
-  return PlanarTree::detect(sys, data, why);
+  if (sys.dim == 3) return with_loops<SpatialAlgebra>(SpatialTree::detect(sys, data, why), sys, data, why);
+  return with_loops<PlanarAlgebra>(PlanarTree::detect(sys, data, why), sys, data, why);
 }
 
 bool RecursiveTree::solve(const double* q, const double* qd, Eigen::VectorXd& x, Eigen::VectorXd& xd,

@@ -25,6 +25,9 @@
 //   joint_acceleration(m, a, qdd)      its inverse: ü from q̈ and the body's acceleration a before S ü
 #pragma once
 
+#include <Eigen/Dense>
+#include <array>
+#include <string>
 #include <vector>
 
 #include "spacar/errors.hpp"
@@ -72,6 +75,34 @@ double hinge_angle(const BodyModel<Algebra>& m, const double* q, const double* q
   return m.sign * q[m.dof] + m.offset;
 }
 
+// The loops closed on a tree (closed_loop.hpp), as the recognizer found them: the tree's
+// coordinates are (q, the passive joints' coordinates), n_dof + dependent0.size() of them.
+template <class Point>
+struct TreeLoops {
+  int n_dof = 0;                        // the system's DOFs
+  std::vector<double> dependent0;       // the passive joints' coordinates at the recognition
+  std::vector<std::string> dependent;   // and what they are (for messages)
+  struct ClosurePoint {                 // a point of body a and of body b (or the ground, −1)
+    int a, b;
+    Point pa, pb;                       // in their body coordinates (the ground's: the world)
+    int node;
+  };
+  struct Cut {                          // a passive spatial HINGE between two placed bodies (or the ground)
+    int element = 0;
+    const ElementKernel* kernel = nullptr;   // the system's: the tree lives no longer than it
+    std::array<int, 2> body{};               // of its LAMBDA nodes o1, o2 (index in the tree, or −1)
+    std::array<Eigen::Vector4d, 2> lambda0;  // their Euler parameters at the recognition
+    std::vector<int> rows;                   // its rigid deformations (1: e2, 2: e3)
+    std::vector<double> value;               // and their values
+  };
+  std::vector<ClosurePoint> points;
+  std::vector<Cut> cuts;
+  bool closed() const { return !points.empty() || !cuts.empty(); }
+};
+
+template <class Algebra>
+class ClosedLoopTree;
+
 template <class Algebra>
 class ArticulatedTree : public RecursiveTree {
  public:
@@ -80,7 +111,10 @@ class ArticulatedTree : public RecursiveTree {
   using Vector = typename Algebra::Vector;
   using Inertia = typename Algebra::Inertia;
 
+  using Loops = TreeLoops<typename Algebra::Point>;
+
   int n_bodies() const { return static_cast<int>(bodies_.size()); }
+  const Loops& loops() const { return loops_; }
 
   bool solve(const double* q, const double* qd, double* qdd) final {
     if (!outward(q, qd)) return false;
@@ -121,6 +155,8 @@ class ArticulatedTree : public RecursiveTree {
   std::vector<Model> bodies_;
   std::vector<BodyWork> work_;
   Vector base_acceleration_ = Vector::Zero();  // −gravity, the fictitious acceleration of the ground
+  Loops loops_;  // loops closed on the tree, if any (then ClosedLoopTree runs it)
+  friend class ClosedLoopTree<Algebra>;  // runs the passes below in the tree's coordinates
 
   // The passes, for the trees that combine them otherwise (closed_loop.hpp: loops closed on a tree).
   // Outwards: placements, velocities, velocity-product accelerations and the bias forces of the

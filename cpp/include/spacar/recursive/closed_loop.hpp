@@ -1,7 +1,8 @@
-// Closed loops on the recursive path (formulation.md §7): a spatial tree of rigid bodies
-// (spatial_tree.hpp) whose passive joints (released HINGE or BEARING rotations and translations)
-// the loops determine, closed by constraints at the points two bodies share and at the cut
-// hinges' rigid misalignments.
+// Closed loops on the recursive path (formulation.md §7): a tree of rigid bodies whose passive
+// joints the loops determine (spatial_tree.hpp: released HINGE or BEARING rotations and
+// translations; planar_tree.hpp: bodies turned by their own calculable rotation), closed by
+// constraints at the points two bodies share and (spatial) at the cut hinges' rigid
+// misalignments.
 //
 // The tree's coordinates are θ = (q, θ_d): the DOFs and the dependent joints' coordinates. At
 // (q, q̇) the loops are closed by Newton's method in θ_d (a few unknowns, warm-started from the
@@ -19,19 +20,26 @@
 #include <Eigen/Dense>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "spacar/kinematics/data.hpp"
 #include "spacar/model/system.hpp"
-#include "spacar/recursive/spatial_tree.hpp"
+#include "spacar/recursive/articulated.hpp"
 
 namespace spacar {
 
+// Over the planar (planar_tree.hpp) and the spatial algebra (spatial_tree.hpp); the loops'
+// kinematics (constraints, add_point_rows, constraint_bias) are written for each.
+template <class Algebra>
 class ClosedLoopTree : public RecursiveTree {
  public:
+  using Tree = ArticulatedTree<Algebra>;
+  using Point = typename Algebra::Point;
+
   // The tree with its loops closed, or nullptr and the reason if the loops do not determine the
-  // dependent joints at the recognized state (data: the system's DOFs there).
-  static std::unique_ptr<RecursiveTree> close(std::unique_ptr<SpatialTree> tree, const System& sys,
-                                              const Data& data, std::string* why);
+  // passive joints at the recognized state (data: the system's DOFs there).
+  static std::unique_ptr<RecursiveTree> close(std::unique_ptr<Tree> tree, const System& sys, const Data& data,
+                                              std::string* why);
 
   bool solve(const double* q, const double* qd, double* qdd) override;
   // Tᵀ τ_id(θ, θ̇, T q̈ + g): the generalized forces on the DOFs.
@@ -43,34 +51,42 @@ class ClosedLoopTree : public RecursiveTree {
   void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
 
  private:
-  using Vec3 = Eigen::Vector3d;
-  explicit ClosedLoopTree(std::unique_ptr<SpatialTree> tree);
+  explicit ClosedLoopTree(std::unique_ptr<Tree> tree);
 
-  // θ at q with the loops closed (θ_d from the last closed state); false if Newton's method fails
-  // or J_d loses rank. Leaves c_ and J_ (and its factorization) at θ.
+  // θ at q with the loops closed, by continuation from the last closed state; false (θ and the
+  // tangent left at that state) if Newton's method fails or J_d loses rank. Leaves c_ and J_ (and
+  // its factorization) at θ.
   bool close_loops(const double* q);
-  bool newton();                 // from θ: true if closed (c_, J_, qr_ at θ)
-  bool closed(const double* q);  // q is the last closed state's: true
+  bool newton();  // from θ: true if closed (c_, J_, qr_ at θ)
   // The constraints c_ and their Jacobian J_ at the tree's placement (outward() at θ).
   void constraints();
+  // The world position of point b of body i (the ground's: b).
+  Point world_point(int body, const Point& b) const;
+  // Adds the rates of point p (world) of body i per unit θ̇ of the joints on its path, times
+  // `scale`, to the rows from `row` of J_.
+  void add_point_rows(int body, const Point& p, double scale, int row);
   // γ_: the constraints' accelerations at θ̈ = 0 without gravity (after the tree's velocity-product
   // accelerations).
   void constraint_bias();
+  Point point_acceleration(int body, const Point& b) const;  // world axes, at θ̈ = 0 without gravity
+  // A spatial cut's rows of c_, J_ and γ_ from `row` (the planar tree has no cuts).
+  void add_cut_rows(int row);
+  void add_cut_bias(int row);
+  void add_rotation_row(int body, const Eigen::Matrix<double, 1, 3>& w, int row);  // w · ω of the body
   // At (q, q̇): θ, θ̇ and the tree placed and moving there (outward, applied loads), T_ and g_.
   bool prepare(const double* q, const double* qd);
 
-  // The world rate of a point p (world) of body i, and of its angular velocity, per unit θ̇ of
-  // the joints on its path: added to row block `rows` of J_ with the factor `scale`.
-  void add_point_rows(int body, const Vec3& p, double scale, int row);
-  void add_rotation_row(int body, const Eigen::Matrix<double, 1, 3>& w, int row);
-
-  std::unique_ptr<SpatialTree> tree_;
-  const SpatialTree::Loops& loops_;
-  int nd_ = 0, nn_ = 0, m_ = 0;       // DOFs, dependent joints, constraint rows
+  std::unique_ptr<Tree> tree_;
+  const typename Tree::Loops& loops_;
+  int nd_ = 0, nn_ = 0, m_ = 0;       // DOFs, passive joints, constraint rows
+  int n_point_rows_ = 0;              // the first rows: the points'
   double length_ = 1.0;               // a length of the tree: the scale of the points' residuals
   Eigen::VectorXd theta_, theta_d_, theta_dd_, zero_, c_, gamma_, g_, col_;
-  Eigen::VectorXd q_last_, start_, step_, rhs_;  // the last closed state's q; Newton's work; Tᵀ (−τ_id)
+  Eigen::VectorXd q_last_, rhs_, w_;  // the last closed state's q; Tᵀ (−τ_id); a planar row
+  Eigen::VectorXd start_, from_, step_q_, delta_, predicted_, step_;  // close_loops' and Newton's work
+  Eigen::MatrixXd T_start_;                                          // T_d at the last closed state
   Eigen::MatrixXd J_, T_, MT_, A_;               // A_ = Tᵀ M T
+  std::vector<int> path_;                            // a body's path to the root (planar rows)
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_;  // of J_d
   Eigen::LLT<Eigen::MatrixXd> llt_;                 // of A_
 };

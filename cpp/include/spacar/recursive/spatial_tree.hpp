@@ -195,33 +195,7 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
 
-  // The loops closed on the tree, as detect() found them: the tree's coordinates are (q, the
-  // dependent joints' coordinates), n_dof + dependent0.size() of them.
-  struct Loops {
-    int n_dof = 0;                        // the system's DOFs
-    std::vector<double> dependent0;       // the passive joints' coordinates (e1) at the recognition
-    std::vector<int> dependent_element;   // their elements (indices into the system's)
-    struct Point {                        // a point of body a and of body b (or the ground, kGround)
-      int a, b;
-      Eigen::Vector3d pa, pb;             // in their body coordinates (the ground's: the world)
-      int node;
-    };
-    struct Cut {                          // a passive HINGE between two placed bodies (or the ground)
-      int element = 0;
-      const ElementKernel* kernel = nullptr;  // the system's: the tree lives no longer than it
-      std::array<int, 2> body{};               // of its LAMBDA nodes o1, o2 (index in the tree, or −1)
-      std::array<Eigen::Vector4d, 2> lambda0;  // their Euler parameters at the recognition
-      std::vector<int> rows;                   // its rigid deformations (1: e2, 2: e3)
-      std::vector<double> value;               // and their values
-    };
-    std::vector<Point> points;
-    std::vector<Cut> cuts;
-    bool closed() const { return !points.empty() || !cuts.empty(); }
-  };
-  const Loops& loops() const { return loops_; }
-
  private:
-  friend class ClosedLoopTree;  // runs the tree's passes in its coordinates (closed_loop.hpp)
   using Vec3 = Eigen::Vector3d;
   using Quat = Eigen::Vector4d;
   // A coordinate moving with a body: an XYZ node at body point b, or a LAMBDA node turned by the
@@ -260,7 +234,6 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
 
   std::vector<Follower> followers_;
   std::vector<Load> loads_;
-  Loops loops_;
   bool floating_ = false;
   FreeBase base_;
 
