@@ -3,8 +3,10 @@
 Model (spacar.compare.models.four_bar): three rigid PLBEAMs with EMASS, a MASS at the coupler
 joint, crank rotation as DOF with an initial rate of 2 rad/s, T = 1 s. exudyn needs redundant
 coordinates and constraints for a closed loop, hence its implicit solvers: generalized-α (its
-default) and the index-2 trapezoidal rule, both 2nd order with fixed steps. Pinocchio has no
-closed loops (its kinematic trees would need an extra constraint solver) and is not run.
+default) and the index-2 trapezoidal rule, both 2nd order with fixed steps. spacar runs its
+default path: since issue 37 the recursive one, the loop closed by Newton's method in the coupler's
+and rocker's rotations (benchmarks/closed_loops.py compares it with the general path and with
+Pinocchio's constrained dynamics).
 
 * time-to-accuracy: error = largest position error of the moving joints (nodes 2 and 3, m) at T
   against spacar at EPSINT = EPSIND = 1e-13 (cross-checked against exudyn's finest run);
@@ -103,10 +105,12 @@ def section(r: dict, plots: dict | None = None) -> str:
              f"four-bar of `spacar.compare.models.four_bar` (closed loop, 1 DOF, gravity, crank started at 2 rad/s), "
              f"T = {r['t_end']} s. exudyn: redundant coordinates (`ObjectRigidBody2D` + `ObjectJointRevolute2D`) with "
              "its implicit fixed-step solvers; its explicit error-controlled solvers do not take joint constraints. "
-             "Pinocchio: not applicable (no closed loops).", "", *C.machine_table(r["machine"]), "",
+             "spacar: its default path, since issue 37 the recursive one with the loop closed (section \"Closed "
+             "loops on the recursive path\" compares it with the general path and Pinocchio).", "",
+             *C.machine_table(r["machine"]), "",
              "| figure | value |", "|---|---|",
              f"| spacar time per right-hand side in a run (EPSINT = {r['spacar_eps_for_rhs']:g}) | {C.fmt_time(r['spacar_in_run'])} "
-             f"({r['spacar_newton_per_rhs']:.2f} Newton iterations) |",
+             f"({r['spacar_newton_per_rhs']:.2f} Newton iterations of the general path) |",
              f"| spacar `evaluate()` from Python | {C.fmt_time(r['spacar_evaluate'])} |",
              f"| exudyn generalized-α, time per step (h = 1e-4) | {C.fmt_time(r['exudyn_ga_step'])} |",
              "", "Error: largest position error of the moving joints at T (m) against spacar at EPSINT = 1e-13 "
