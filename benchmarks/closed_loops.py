@@ -116,25 +116,10 @@ def pinocchio_rsur():
 
 
 def constrained_dynamics(pm, joint1, point1, joint2, point2):
-    """q, v → q̈ of Pinocchio's model with a 3-D point constraint between point1 of joint1's frame
-    and point2 of joint2's; and its nq."""
-    import pinocchio as pin
+    """Pinocchio's nq and q, v → q̈ of its model with a 3-D point constraint."""
+    from spacar.compare.pinocchio import point_constrained
 
-    pd = pm.createData()
-    cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm, joint1, pin.SE3(np.eye(3), point1), joint2,
-                                  pin.SE3(np.eye(3), point2), pin.ReferenceFrame.LOCAL)
-    cms = pin.StdVec_RigidConstraintModel()
-    cms.append(cm)
-    cds = pin.StdVec_RigidConstraintData()
-    cds.append(cm.createData())
-    pin.initConstraintDynamics(pm, pd, cms, cds)
-    settings = pin.ProximalSettings(1e-14, 1e-12, 100)
-    tau = np.zeros(pm.nv)
-
-    def qdd(q, v):
-        return pin.constraintDynamics(pm, pd, q, v, tau, cms, cds, settings)
-
-    return pm.nq, qdd
+    return pm.nq, point_constrained(pm, joint1, point1, joint2, point2)
 
 
 def pinocchio_run(nq, qdd, q0, v0, t_end, eps):

@@ -145,15 +145,9 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
   bool loops_allowed() const { return true; }
 
   // The loops closed on the tree: the points two bodies share beyond their pins (closed_loop.hpp).
-  // The body coordinates of a point are its offset from the pin at the reference state.
   bool record_loops() {
     auto& loops = tree_.loops_;
-    loops.n_dof = sys_.n_dof();
-    for (const ClosurePoint& c : closure_points_) {
-      const int other = owner_.at(c.node);
-      loops.points.push_back({c.body, other, point(c.node) - pin0_[c.body],
-                              other == kGround ? point(c.node) : Point(point(c.node) - pin0_[other]), c.node});
-    }
+    record_closure_points(loops);
     if (loops.closed() && loops.dependent0.empty()) return refuse("a loop closes with no body that it turns");
     if (!loops.closed() && !loops.dependent0.empty())
       return refuse(loops.dependent.front() + " is neither a DOF nor determined by a loop");

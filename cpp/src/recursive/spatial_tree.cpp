@@ -306,16 +306,10 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
   }
 
   // The loops closed on the tree: the points two bodies share beyond their joints, and the cut
-  // hinges' rigid misalignments (closed_loop.hpp). The body coordinates of a point are its offset
-  // from the pin at the reference state, when the body's axes are the world's.
+  // hinges' rigid misalignments (closed_loop.hpp).
   bool record_loops() {
     Loops& loops = tree_.loops_;
-    loops.n_dof = sys_.n_dof();
-    for (const ClosurePoint& c : closure_points_) {
-      const int other = owner_.at(c.node);
-      loops.points.push_back({c.body, other, point(c.node) - pin0_[c.body],
-                              other == kGround ? point(c.node) : Vec3(point(c.node) - pin0_[other]), c.node});
-    }
+    record_closure_points(loops);
     for (int i : cuts_) {
       const Hinge& h = hinges_[i];
       const SystemElement& se = sys_.elements[h.element];

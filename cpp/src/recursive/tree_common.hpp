@@ -389,6 +389,19 @@ class TreeBuilder {
     return true;
   }
 
+  // The points two bodies share beyond their joints (closure_points_) as the loops' constraints
+  // (closed_loop.hpp): a point's body coordinates are its offset from the pin at the reference
+  // state, when the body's axes are the world's (the ground's: the world position).
+  template <class Loops>
+  void record_closure_points(Loops& loops) const {
+    loops.n_dof = sys_.n_dof();
+    for (const ClosurePoint& c : closure_points_) {
+      const int other = owner_.at(c.node);
+      loops.points.push_back({c.body, other, point(c.node) - pin0_[c.body],
+                              other == kGround ? point(c.node) : Point(point(c.node) - pin0_[other]), c.node});
+    }
+  }
+
   Derived& self() { return *static_cast<Derived*>(this); }
 
   const System& sys_;

@@ -372,3 +372,24 @@ def free_flyer_rhs(model, data):
 
     return f
 
+
+def point_constrained(model, joint1, point1, joint2, point2):
+    """q, v → q̈ of Pinocchio's constrained dynamics of ``model`` (no joint torques) with a rigid
+    3-D point constraint between point1 (in joint1's frame) and point2 (in joint2's): the
+    independent reference of spacar's closed loops (tests/peers/test_closed_loops.py,
+    benchmarks/closed_loops.py). Proximal settings at 1e-14."""
+    data = model.createData()
+    cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, model, joint1, pin.SE3(np.eye(3), point1),
+                                  joint2, pin.SE3(np.eye(3), point2), pin.ReferenceFrame.LOCAL)
+    cms = pin.StdVec_RigidConstraintModel()
+    cms.append(cm)
+    cds = pin.StdVec_RigidConstraintData()
+    cds.append(cm.createData())
+    pin.initConstraintDynamics(model, data, cms, cds)
+    settings = pin.ProximalSettings(1e-14, 1e-12, 100)
+    tau = np.zeros(model.nv)
+
+    def accelerations(q, v):
+        return pin.constraintDynamics(model, data, q, v, tau, cms, cds, settings)
+
+    return accelerations
