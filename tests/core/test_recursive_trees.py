@@ -39,6 +39,7 @@ TREES = {
     "spatial loop RSUR": trees.rsur,
     "spatial loop URDF RSUR": trees.urdf_rsur,
     "spatial loop 7R": trees.seven_bar,
+    "spatial loop 7R, its DOF mid-loop": lambda: trees.seven_bar(dof=4),
     "planar loop four-bar": lambda: models.four_bar(eps=1e-10, epskin=1e-14),
     "planar loop hinged four-bar": trees.hinged_four_bar,
 }
@@ -138,7 +139,8 @@ def test_spatial_recursive_accelerations_equal_pinocchio_aba(name):
 @pytest.mark.parametrize("name", ["planar chain springs", "planar chain absolute springs", "planar branched spring",
                                   "spatial chain springs", "spatial branched", "spatial URDF wrist",
                                   "spatial URDF prismatic", "spatial loop RSUR", "spatial loop URDF RSUR",
-                                  "spatial loop 7R", "planar loop four-bar", "planar loop hinged four-bar"])
+                                  "spatial loop 7R", "spatial loop 7R, its DOF mid-loop", "planar loop four-bar",
+                                  "planar loop hinged four-bar"])
 def test_runs_on_both_paths_agree(name):
     """Output times and everything reported there (positions and velocities solved by the
     general path from the tree's, accelerations and stresses from the tree's q̈) agree with a

@@ -270,18 +270,19 @@ def hinged_four_bar():
     return m
 
 
-def seven_bar():
-    """The spatial 7R loop of spacar.compare.models.seven_r_loop at tight tolerances."""
-    m = models.seven_r_loop(eps=1e-10, epskin=1e-14)
+def seven_bar(dof=1):
+    """The spatial 7R loop of spacar.compare.models.seven_r_loop at tight tolerances, hinge `dof`
+    its DOF (4: in the middle of the loop, which the tree must cut elsewhere)."""
+    m = models.seven_r_loop(eps=1e-10, epskin=1e-14, dof=dof)
     m.timestep(5, 0.5)
     return m
 
 
 def seven_bar_sprung_cut():
-    """The 7R loop with a spring and a damper on hinge 4, where the tree cuts the loop."""
+    """The 7R loop with a spring and a damper on hinge 7, where the tree cuts the loop."""
     m = seven_bar()
-    m.estiff(models.HINGE + 4, 50.0)
-    m.edampp(models.HINGE + 4, 2.0)
+    m.estiff(models.HINGE + 7, 50.0)
+    m.edampp(models.HINGE + 7, 2.0)
     return m
 
 

@@ -211,13 +211,24 @@ class TreeBuilder {
   // DOF hinge to its parent (Derived::hinge_joint, Derived::place), or, planar, by its own
   // rotation (Derived::place_rotated, called for every body placed and the ground).
   bool place_bodies() {
-    // body (or kGround) → its joints: the DOF hinges, then the passive ones of loops, so that a
-    // passive joint, not a DOF, is where a loop is cut.
+    // body (or kGround) → its joints: every DOF hinge, and the passive hinges of a spanning tree
+    // grown from the DOF ones (each joining two bodies not yet connected), so that a loop is cut at
+    // a passive joint wherever its DOF joints are; the other passive hinges are cuts (below).
     std::map<int, std::vector<int>> hinges_at;
+    std::vector<int> set(g_.points.size() + 1);  // union–find over the bodies and the ground (last)
+    for (size_t b = 0; b < set.size(); ++b) set[b] = static_cast<int>(b);
+    auto root = [&](int body) {
+      int r = body == kGround ? static_cast<int>(g_.points.size()) : body;
+      while (set[r] != r) r = set[r] = set[set[r]];
+      return r;
+    };
     for (bool dof : {true, false})
       for (size_t i = 0; i < hinges_.size(); ++i) {
         const Hinge& h = hinges_[i];
         if (dof ? h.dof < 0 : !h.passive || h.cut_only) continue;
+        const int a = root(body_of(h.a)), b = root(body_of(h.b));
+        if (!dof && a == b) continue;  // closes a loop: a cut
+        set[a] = b;
         hinges_at[body_of(h.a)].push_back(static_cast<int>(i));
         hinges_at[body_of(h.b)].push_back(static_cast<int>(i));
       }

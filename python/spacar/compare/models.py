@@ -132,11 +132,11 @@ def spatial_chain(n: int, seed: int = 0, joints: str = "hinge", t_end: float = 0
 
 
 def seven_r_loop(seed: int = 2, crank_rate: float = 1.0, t_end: float = 1.0, n_out: int = 10, eps: float = 1e-8,
-                 epskin: float = 1e-13) -> Model:
+                 epskin: float = 1e-13, dof: int = 1) -> Model:
     """A spatial 7R loop: a random (seeded) 6-link chain as :func:`spatial_chain` (rigid BEAMs
     with EMASS and rotary inertia, point masses, inertia tensors, gravity along a random
-    direction) whose first HINGE is the DOF (initial rate ``crank_rate``) and whose HINGEs 2 … 6
-    are released (passive), its tip node fixed to the ground and a seventh HINGE (e1 released, e2
+    direction) whose HINGE ``dof`` (1 … 6, the first by default) is the DOF (initial rate
+    ``crank_rate``) and whose other HINGEs are released (passive), its tip node fixed to the ground and a seventh HINGE (e1 released, e2
     and e3 rigid) from the last link's LAMBDA node to the ground's about a random axis. The loop
     closes at a point and at a hinge: five constraints for five passive joints, mobility one.
     The seed's geometry keeps the loop away from its locking positions over 1 s."""
@@ -152,7 +152,7 @@ def seven_r_loop(seed: int = 2, crank_rate: float = 1.0, t_end: float = 1.0, n_o
         p = p + d
         m.xyz(i + 1, *p)
         m.hinge(HINGE + i, END + i - 1, START + i, *rng.normal(size=3))
-        (m.dyne if i == 1 else m.rlse)(HINGE + i, 1)
+        (m.dyne if i == dof else m.rlse)(HINGE + i, 1)
         m.emass(i, 1.0 + rng.random(), 1e-3, 2e-3, 3e-3)
         m.mass(i + 1, 0.2 + 0.3 * rng.random())
         Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
@@ -165,7 +165,7 @@ def seven_r_loop(seed: int = 2, crank_rate: float = 1.0, t_end: float = 1.0, n_o
     m.fix(END)
     g = rng.normal(size=3)
     m.gravity(*(G * g / np.linalg.norm(g)))
-    m.ed(HINGE + 1, 1, crank_rate)
+    m.ed(HINGE + dof, 1, crank_rate)
     _tolerances(m, eps, epskin)
     m.timestep(n_out, t_end)
     return m
