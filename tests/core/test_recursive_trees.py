@@ -173,7 +173,7 @@ NOT_TREES = {
     "spatial hinge held fixed": (trees.spatial_held_hinge, "not a revolute joint"),
     "spatial flexible BEAM": (trees.flexible_beam, "(BEAM) is not rigid"),
     "spatial FORCE on a LAMBDA node": (trees.lambda_force, "FORCE on LAMBDA node 100001"),
-    "spatial loop cut at a hinge with a spring": (trees.seven_bar_sprung_cut, "closes a loop and has a law"),
+    "spatial loop cut at a hinge with a spring": (trees.rsur_sprung_cut, "closes a loop and has a law"),
 }
 
 
@@ -360,3 +360,42 @@ def test_a_loose_tolerance_keeps_the_loop_on_its_branch():
     general = spacar.simulate(model.copy(), method="dop853", recursive=False)
     assert fast.stats["path"] == "tree" and fast.stats["rejected"] > 0
     np.testing.assert_allclose(fast.x, general.x, rtol=0, atol=0.05)  # the two branches: 1.1 apart
+
+
+def test_a_loop_is_cut_at_a_hinge_without_a_law():
+    """Of the 7R loop's passive hinges the one with a spring is a joint of the tree, another the cut."""
+    model = trees.seven_bar()
+    model.estiff(models.HINGE + 7, 50.0)  # the cut without it
+    model.edampp(models.HINGE + 7, 2.0)
+    assert assembled(model.copy()).recursive_refusal() == ""
+    model.timestep(2, 0.2)
+    fast = spacar.simulate(model.copy())
+    general = spacar.simulate(model.copy(), recursive=False)
+    assert fast.stats["path"] == "tree"
+    np.testing.assert_allclose(fast.x, general.x, rtol=0, atol=1e-8)
+
+
+def test_a_crank_many_turns_round():
+    """A crank 409 rad round (65 turns) from the assembled state, in one call: the continuation's
+    tolerances follow the coordinates' own round-off (3e-14 at 300 rad), as the general path's
+    continuation solves it."""
+    general = assembled(models.four_bar(eps=1e-10, epskin=1e-14))
+    q, qd = np.array([409.0]), np.array([0.5])
+    general.move_to(0.0, q, qd)
+    got = assembled(models.four_bar(eps=1e-10, epskin=1e-14)).recursive_state(q, qd)
+    assert got is not None
+    np.testing.assert_allclose(got["qdd"], general.data.qdd, rtol=1e-9)
+
+
+def test_a_state_next_to_a_fold_does_not_stick():
+    """After states up to 1e-9 from a fold of the loop (the rocker-driven four-bar's crank and
+    coupler in line), states away from it close again (from the recognized state when the steep
+    tangent at the fold stops the continuation), equal to a fresh tree's."""
+    fold = -0.400625
+    path = np.linspace(0.0, fold + 1e-9, 300)[:, None]
+    dyn = spacar.Dynamics(trees.rocker_driven_four_bar())
+    dyn.inverse_dynamics(path, 0.0 * path, 0.0 * path)
+    for q in (0.0, -0.2, -0.35):
+        state = np.array([q])
+        fresh = spacar.Dynamics(trees.rocker_driven_four_bar()).inverse_dynamics(state, np.zeros(1), np.zeros(1))
+        np.testing.assert_allclose(dyn.inverse_dynamics(state, np.zeros(1), np.zeros(1)), fresh, rtol=1e-10)

@@ -278,11 +278,34 @@ def seven_bar(dof=1):
     return m
 
 
-def seven_bar_sprung_cut():
-    """The 7R loop with a spring and a damper on hinge 7, where the tree cuts the loop."""
-    m = seven_bar()
-    m.estiff(models.HINGE + 7, 50.0)
-    m.edampp(models.HINGE + 7, 2.0)
+def rocker_driven_four_bar():
+    """The four-bar of spacar.compare.models.four_bar with its rocker's rotation as the DOF: the
+    crank and the coupler straighten (a fold of the loop) at a rocker angle of about −0.4006."""
+    m = spacar.Model()
+    m.plbeam(1, 1, 11, 2, 12)
+    m.plbeam(2, 2, 21, 3, 22)
+    m.plbeam(3, 4, 31, 3, 32)
+    for node, xy in ((1, (0.0, 0.0)), (2, (0.0, 1.0)), (3, (2.0, 1.5)), (4, (2.5, 0.0))):
+        m.x(node, *xy)
+    m.fix(1)
+    m.fix(4)
+    m.dynx(31, 1)
+    for e, r in ((1, 1.0), (2, 1.5), (3, 1.2)):
+        m.emass(e, r)
+    m.mass(3, 0.3)
+    m.gravity(0.3, -9.81)
+    m.epskin(1e-14)
+    return m
+
+
+def rsur_sprung_cut():
+    """The RSUR with a HINGE between nodes 12 and 17 whose three deformations are released and
+    sprung: it closes a loop (a cut) and has a law, which a cut cannot carry."""
+    m = rsur()
+    m.hinge(9, 12, 17, 0.0, 0.0, 1.0)
+    m.rlse(9)
+    m.estiff(9, 5.0)
+    m.edampp(9, 0.5)
     return m
 
 

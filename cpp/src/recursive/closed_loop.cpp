@@ -16,15 +16,17 @@ namespace spacar {
 namespace {
 
 constexpr int kMaxIterations = 30;
-// Newton's method stops at residuals of 1e-14 (points: of the tree's size), near round-off: at
-// 1e-12 the accelerations were off by 1e-11 (relative); or at a correction at round-off if the
-// residual is below 1e-10 (else the constraints have no solution there: a least-squares minimum).
+// Newton's method stops at residuals of 1e-14 (points: of the tree's size; times 1 + the largest
+// coordinate), near round-off: at 1e-12 the accelerations were off by 1e-11 (relative); or at a
+// correction at round-off if the residual is below 1e-10 (else the constraints have no solution
+// there: a least-squares minimum).
 constexpr double kResidual = 1e-14, kRoundOff = 1e-15, kStalled = 1e-10;
-// Continuation (close_loops): pieces that move no coordinate by more than 0.1, Newton's correction
-// of a piece's predicted start at most a quarter of its move (plus 1e-12: the same state again),
-// up to 4096 pieces.
-constexpr double kMaxMove = 0.1, kCorrection = 0.25, kSameState = 1e-12;
-constexpr int kMaxPieces = 4096;
+// Continuation (continue_to): pieces that move no coordinate by more than 0.1, Newton's
+// correction of a piece's predicted start at most a quarter of its move (plus 1e-12: the same
+// state again), pieces down to 1e-14 of the path, at most 20 000 of them (a jump of 300 rad takes
+// 3000, some milliseconds).
+constexpr double kMaxMove = 0.1, kCorrection = 0.25, kSameState = 1e-12, kMinPiece = 1e-14;
+constexpr int kMaxAttempts = 20000;
 
 using Cut = TreeLoops<Eigen::Vector3d>::Cut;  // spatial
 
@@ -84,6 +86,9 @@ std::unique_ptr<RecursiveTree> ClosedLoopTree<Algebra>::close(std::unique_ptr<Tr
     return nullptr;
   }
   loop->T_.bottomRows(loop->nn_) = -loop->qr_.solve(loop->J_.leftCols(loop->nd_));
+  loop->q0_ = loop->q_last_;  // the recognized state: close_loops' second start
+  loop->theta0_ = loop->theta_.tail(loop->nn_);
+  loop->T0_ = loop->T_.bottomRows(loop->nn_);
   return loop;
 }
 
@@ -248,37 +253,63 @@ template <>
 void ClosedLoopTree<PlanarAlgebra>::add_cut_bias(int) {}
 
 // By continuation from the last closed state, so that the loops stay on the assembly branch they
-// are on (a loop closes in several ways: the other branch is a finite correction away): in
-// pieces of q − q_last that move no coordinate by more than kMaxMove, each started from the
-// last piece's state moved along its tangent, θ_d + T_d Δq (second order in Δq: an integrator's
-// stages, a piece apart, converge in one or two iterations), and accepted only if Newton's
-// correction of that start is small against the move; else in four times as many pieces.
+// are on (a loop closes in several ways: the other branch is a finite correction away); if that
+// fails (from a state next to a fold, where the tangent is steep), from the recognized state.
 template <class Algebra>
 bool ClosedLoopTree<Algebra>::close_loops(const double* q) {
   start_ = theta_.tail(nn_);
   from_ = q_last_;
   T_start_ = T_.bottomRows(nn_);
-  for (int k = 0; k < nd_; ++k) step_q_[k] = q[k] - from_[k];
-  const double move = std::max(step_q_.cwiseAbs().maxCoeff(), (T_start_ * step_q_).cwiseAbs().maxCoeff());
-  if (!std::isfinite(move)) return false;
-  for (int pieces = std::max(1, static_cast<int>(std::ceil(move / kMaxMove))); pieces <= kMaxPieces; pieces *= 4) {
-    bool ok = true;
-    for (int piece = 1; piece <= pieces && ok; ++piece) {
-      delta_ = step_q_ / pieces;
-      predicted_.noalias() = T_.bottomRows(nn_) * delta_;  // the move, then the start
-      const double moved = std::max(delta_.cwiseAbs().maxCoeff(), predicted_.cwiseAbs().maxCoeff());
-      predicted_ += theta_.tail(nn_);
-      theta_.head(nd_) = from_ + step_q_ * (static_cast<double>(piece) / pieces);
-      theta_.tail(nn_) = predicted_;
-      ok = newton() && (theta_.tail(nn_) - predicted_).cwiseAbs().maxCoeff() <= kCorrection * moved + kSameState;
-      if (ok && piece < pieces) T_.bottomRows(nn_) = -qr_.solve(J_.leftCols(nd_));  // the next piece's tangent
+  for (const bool recognized : {false, true}) {
+    if (recognized) {
+      theta_.tail(nn_) = theta0_;
+      q_last_ = q0_;
+      T_.bottomRows(nn_) = T0_;
     }
-    if (ok) {
+    if (continue_to(q)) {
       for (int k = 0; k < nd_; ++k) q_last_[k] = q[k];
       return true;
     }
-    theta_.tail(nn_) = start_;
-    T_.bottomRows(nn_) = T_start_;
+  }
+  theta_.tail(nn_) = start_;
+  q_last_ = from_;
+  T_.bottomRows(nn_) = T_start_;
+  return false;
+}
+
+// Along the straight path from q_last to q in pieces, each started from the last piece's state
+// moved along its tangent, θ_d + T_d Δq (second order in Δq: an integrator's stages, a piece apart,
+// converge in one or two iterations) and accepted only if Newton's correction of that start is at
+// most kCorrection of the move; a piece moves no coordinate by more than kMaxMove, doubles after
+// an accepted piece and quarters after a rejected one (down to kMinPiece of the path: a fold).
+template <class Algebra>
+bool ClosedLoopTree<Algebra>::continue_to(const double* q) {
+  for (int k = 0; k < nd_; ++k) step_q_[k] = q[k] - q_last_[k];
+  if (!step_q_.allFinite()) return false;
+  accepted_ = theta_.tail(nn_);
+  double done = 0.0, piece = 1.0;
+  for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
+    const double steep = std::max(step_q_.cwiseAbs().maxCoeff(), (T_.bottomRows(nn_) * step_q_).cwiseAbs().maxCoeff());
+    if (steep > 0.0) piece = std::min(piece, kMaxMove / steep);
+    const bool last = piece >= 1.0 - done;
+    const double to = last ? 1.0 : done + piece;
+    delta_ = step_q_ * (to - done);
+    predicted_.noalias() = T_.bottomRows(nn_) * delta_;  // the move, then the start
+    const double moved = std::max(delta_.cwiseAbs().maxCoeff(), predicted_.cwiseAbs().maxCoeff());
+    predicted_ += accepted_;
+    for (int k = 0; k < nd_; ++k) theta_[k] = last ? q[k] : q_last_[k] + step_q_[k] * to;
+    theta_.tail(nn_) = predicted_;
+    if (newton() && (theta_.tail(nn_) - predicted_).cwiseAbs().maxCoeff() <= kCorrection * moved + kSameState) {
+      if (last) return true;
+      done = to;
+      accepted_ = theta_.tail(nn_);
+      T_.bottomRows(nn_) = -qr_.solve(J_.leftCols(nd_));  // the next piece's tangent
+      piece *= 2.0;
+    } else {
+      theta_.tail(nn_) = accepted_;
+      piece *= 0.25;
+      if (piece < kMinPiece) return false;
+    }
   }
   return false;
 }
@@ -292,12 +323,13 @@ bool ClosedLoopTree<Algebra>::newton() {
     if (qr_.rank() < nn_) return false;
     double residual = 0.0;
     for (int r = 0; r < m_; ++r) residual = std::max(residual, std::abs(c_[r]) / (r < n_point_rows_ ? length_ : 1.0));
-    if (residual <= kResidual) return true;
+    // The coordinates' own round-off: a crank 300 rad round holds its angle to 3e-14.
+    const double scale = 1.0 + theta_.cwiseAbs().maxCoeff();
+    if (residual <= kResidual * scale) return true;
     if (!std::isfinite(residual)) return false;
     step_ = qr_.solve(c_);
     theta_.tail(nn_) -= step_;
-    if (step_.cwiseAbs().maxCoeff() <= kRoundOff * (1.0 + theta_.tail(nn_).cwiseAbs().maxCoeff()))
-      return residual <= kStalled;
+    if (step_.cwiseAbs().maxCoeff() <= kRoundOff * scale) return residual <= kStalled * scale;
   }
   return false;
 }

@@ -213,7 +213,8 @@ class TreeBuilder {
   bool place_bodies() {
     // body (or kGround) → its joints: every DOF hinge, and the passive hinges of a spanning tree
     // grown from the DOF ones (each joining two bodies not yet connected), so that a loop is cut at
-    // a passive joint wherever its DOF joints are; the other passive hinges are cuts (below).
+    // a passive joint wherever its DOF joints are, and not at one that cannot be cut if another
+    // can; the other passive hinges are cuts (below).
     std::map<int, std::vector<int>> hinges_at;
     std::vector<int> set(g_.points.size() + 1);  // union–find over the bodies and the ground (last)
     for (size_t b = 0; b < set.size(); ++b) set[b] = static_cast<int>(b);
@@ -222,12 +223,18 @@ class TreeBuilder {
       while (set[r] != r) r = set[r] = set[set[r]];
       return r;
     };
-    for (bool dof : {true, false})
+    // Passes: the DOF hinges; the passive ones that cannot be cuts (a law, a sliding joint); the rest.
+    auto pass_of = [&](const Hinge& h) {
+      if (h.dof >= 0) return 0;
+      if (!h.passive || h.cut_only) return -1;
+      return h.pa >= 0 || sys_.elements[h.element].has_constitutive ? 1 : 2;
+    };
+    for (int pass = 0; pass < 3; ++pass)
       for (size_t i = 0; i < hinges_.size(); ++i) {
         const Hinge& h = hinges_[i];
-        if (dof ? h.dof < 0 : !h.passive || h.cut_only) continue;
+        if (pass_of(h) != pass) continue;
         const int a = root(body_of(h.a)), b = root(body_of(h.b));
-        if (!dof && a == b) continue;  // closes a loop: a cut
+        if (pass > 0 && a == b) continue;  // closes a loop: a cut
         set[a] = b;
         hinges_at[body_of(h.a)].push_back(static_cast<int>(i));
         hinges_at[body_of(h.b)].push_back(static_cast<int>(i));

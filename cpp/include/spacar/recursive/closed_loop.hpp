@@ -53,10 +53,11 @@ class ClosedLoopTree : public RecursiveTree {
  private:
   explicit ClosedLoopTree(std::unique_ptr<Tree> tree);
 
-  // θ at q with the loops closed, by continuation from the last closed state; false (θ and the
-  // tangent left at that state) if Newton's method fails or J_d loses rank. Leaves c_ and J_ (and
-  // its factorization) at θ.
+  // θ at q with the loops closed, by continuation from the last closed state (or the recognized
+  // one); false (θ and the tangent left at the last state) if that fails. Leaves c_ and J_ (and its
+  // factorization) at θ.
   bool close_loops(const double* q);
+  bool continue_to(const double* q);  // from (q_last_, θ_d, T_d) along the straight path to q
   bool newton();  // from θ: true if closed (c_, J_, qr_ at θ)
   // The constraints c_ and their Jacobian J_ at the tree's placement (outward() at θ).
   void constraints();
@@ -83,8 +84,10 @@ class ClosedLoopTree : public RecursiveTree {
   double length_ = 1.0;               // a length of the tree: the scale of the points' residuals
   Eigen::VectorXd theta_, theta_d_, theta_dd_, zero_, c_, gamma_, g_, col_;
   Eigen::VectorXd q_last_, rhs_, w_;  // the last closed state's q; Tᵀ (−τ_id); a planar row
-  Eigen::VectorXd start_, from_, step_q_, delta_, predicted_, step_;  // close_loops' and Newton's work
-  Eigen::MatrixXd T_start_;                                          // T_d at the last closed state
+  Eigen::VectorXd start_, from_, step_q_, delta_, predicted_, accepted_, step_;  // close_loops', Newton's work
+  Eigen::MatrixXd T_start_;                                                    // T_d at the last closed state
+  Eigen::VectorXd q0_, theta0_;                                                // the recognized state
+  Eigen::MatrixXd T0_;
   Eigen::MatrixXd J_, T_, MT_, A_;               // A_ = Tᵀ M T
   std::vector<int> path_;                            // a body's path to the root (planar rows)
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_;  // of J_d
