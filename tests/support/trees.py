@@ -234,18 +234,30 @@ def urdf_rsur():
     return model
 
 
-def hinged_four_bar():
-    """A planar four-bar whose crank is turned by a DYNE PLHINGE from the ground's BETA node (a
-    spring and a damper on it) and whose coupler and rocker are joined by a released PLHINGE with a
-    spring: the loop closes at the coupler–rocker pin, the coupler's and rocker's rotations are
-    passive. The geometry of spacar.compare.models.four_bar, a MASS with rotary inertia on the
-    rocker's end, FORCE on the coupler."""
+def four_bar_links():
+    """The links of spacar.compare.models.four_bar without a DOF: crank PLBEAM 1 (1 → 2, BETA 11,
+    12), coupler 2 (2 → 3), rocker 3 (4 → 3), nodes 1 and 4 fixed, EMASS, a MASS at node 3."""
     m = spacar.Model()
     m.plbeam(1, 1, 11, 2, 12)
     m.plbeam(2, 2, 21, 3, 22)
     m.plbeam(3, 4, 31, 3, 32)
     for node, xy in ((1, (0.0, 0.0)), (2, (0.0, 1.0)), (3, (2.0, 1.5)), (4, (2.5, 0.0))):
         m.x(node, *xy)
+    m.fix(1)
+    m.fix(4)
+    for e, r in ((1, 1.0), (2, 1.5), (3, 1.2)):
+        m.emass(e, r)
+    m.mass(3, 0.3)
+    return m
+
+
+def hinged_four_bar():
+    """A planar four-bar whose crank is turned by a DYNE PLHINGE from the ground's BETA node (a
+    spring and a damper on it) and whose coupler and rocker are joined by a released PLHINGE with a
+    spring: the loop closes at the coupler–rocker pin, the coupler's and rocker's rotations are
+    passive. The geometry of spacar.compare.models.four_bar, a MASS with rotary inertia on the
+    rocker's end, FORCE on the coupler."""
+    m = four_bar_links()
     m.plhinge(101, 100, 11)
     m.dyne(101, 1)
     m.estiff(101, 4.0)
@@ -253,12 +265,7 @@ def hinged_four_bar():
     m.plhinge(102, 22, 32)
     m.rlse(102, 1)
     m.estiff(102, 2.0)
-    m.fix(1)
-    m.fix(4)
     m.fix(100)
-    for e, r in ((1, 1.0), (2, 1.5), (3, 1.2)):
-        m.emass(e, r)
-    m.mass(3, 0.3)
     m.mass(32, 0.05)
     m.force(2, 0.4, -0.2)
     m.ed(101, 1, 1.5)
@@ -281,18 +288,8 @@ def seven_bar(dof=1):
 def rocker_driven_four_bar():
     """The four-bar of spacar.compare.models.four_bar with its rocker's rotation as the DOF: the
     crank and the coupler straighten (a fold of the loop) at a rocker angle of about −0.4006."""
-    m = spacar.Model()
-    m.plbeam(1, 1, 11, 2, 12)
-    m.plbeam(2, 2, 21, 3, 22)
-    m.plbeam(3, 4, 31, 3, 32)
-    for node, xy in ((1, (0.0, 0.0)), (2, (0.0, 1.0)), (3, (2.0, 1.5)), (4, (2.5, 0.0))):
-        m.x(node, *xy)
-    m.fix(1)
-    m.fix(4)
+    m = four_bar_links()
     m.dynx(31, 1)
-    for e, r in ((1, 1.0), (2, 1.5), (3, 1.2)):
-        m.emass(e, r)
-    m.mass(3, 0.3)
     m.gravity(0.3, -9.81)
     m.epskin(1e-14)
     return m
