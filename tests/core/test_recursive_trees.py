@@ -42,6 +42,7 @@ TREES = {
     "spatial loop 7R, its DOF mid-loop": lambda: trees.seven_bar(dof=4),
     "planar loop four-bar": lambda: models.four_bar(eps=1e-10, epskin=1e-14),
     "planar loop hinged four-bar": trees.hinged_four_bar,
+    "planar loop four-bar driven between crank and coupler": trees.four_bar_driven_between_links,
 }
 
 # The states of the comparison with the constraint formulation: the random generator's seed and
@@ -140,7 +141,8 @@ def test_spatial_recursive_accelerations_equal_pinocchio_aba(name):
                                   "spatial chain springs", "spatial branched", "spatial URDF wrist",
                                   "spatial URDF prismatic", "spatial loop RSUR", "spatial loop URDF RSUR",
                                   "spatial loop 7R", "spatial loop 7R, its DOF mid-loop", "planar loop four-bar",
-                                  "planar loop hinged four-bar"])
+                                  "planar loop hinged four-bar",
+                                  "planar loop four-bar driven between crank and coupler"])
 def test_runs_on_both_paths_agree(name):
     """Output times and everything reported there (positions and velocities solved by the
     general path from the tree's, accelerations and stresses from the tree's q̈) agree with a

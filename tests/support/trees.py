@@ -285,6 +285,22 @@ def seven_bar(dof=1):
     return m
 
 
+def four_bar_driven_between_links():
+    """The four-bar driven by a DYNE PLHINGE between the crank and the coupler (their relative
+    angle the DOF): the crank's and the rocker's rotations are passive, the coupler hangs from the
+    crank by the DOF hinge."""
+    m = four_bar_links()
+    m.plhinge(101, 12, 21)
+    m.dyne(101, 1)
+    m.ed(101, 1, 1.0)
+    m.gravity(0.3, -9.81)
+    m.epskin(1e-14)
+    m.epsint(1e-10)
+    m.epsind(1e-10)
+    m.timestep(5, 0.5)
+    return m
+
+
 def rocker_driven_four_bar():
     """The four-bar of spacar.compare.models.four_bar with its rocker's rotation as the DOF: the
     crank and the coupler straighten (a fold of the loop) at a rocker angle of about −0.4006."""

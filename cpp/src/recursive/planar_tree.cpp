@@ -105,8 +105,8 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
 
   // The bodies pinned at the points of `parent` (or the ground) and turned by their own DYNX
   // rotation coordinate; then those of a closed loop, turned by their own calculable rotation
-  // (a passive joint: the loops determine it; none of its BETA nodes is DYNX, no DOF hinge
-  // turns it).
+  // (a passive joint: the loops determine it; none of its BETA nodes is DYNX, no DOF hinge joins
+  // it to a placed body).
   bool place_rotated(int parent, std::vector<int>& queue) {
     for (bool passive : {false, true})
       for (int id : owned_points(parent))
@@ -114,7 +114,7 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
           if (is_placed(child)) continue;
           const int dynx = dynamic_rotation(child);
           if (dynx < -1) return refuse("a body has more than one DYNX rotation");
-          if (passive ? dynx != -1 || turned_by_dof_hinge(child) : dynx == -1) continue;
+          if (passive ? dynx != -1 || hinged_to_placed(child) : dynx == -1) continue;
           const int coord = passive ? nodes_.at(*g_.orientations[child].begin()).coord : dynx;
           Model bd;
           bd.absolute = true;
@@ -133,10 +133,14 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
     return true;
   }
 
-  // Whether a DOF PLHINGE joins the body to another.
-  bool turned_by_dof_hinge(int body) const {
-    for (const Hinge& h : hinges_)
-      if (h.dof >= 0 && (body_of(h.a) == body || body_of(h.b) == body)) return true;
+  // Whether a DOF PLHINGE joins the body to a placed body (or the ground): that hinge is its joint.
+  // A DOF hinge to a body not yet placed turns that body (its child) instead.
+  bool hinged_to_placed(int body) const {
+    for (const Hinge& h : hinges_) {
+      if (h.dof < 0) continue;
+      const int a = body_of(h.a), b = body_of(h.b);
+      if ((a == body && is_placed(b)) || (b == body && is_placed(a))) return true;
+    }
     return false;
   }
 
