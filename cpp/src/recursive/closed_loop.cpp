@@ -354,9 +354,7 @@ bool ClosedLoopTree<Algebra>::solve(const double* q, const double* qd, double* q
   if (!prepare(q, qd)) return false;
   Tree& tree = *tree_;
   // τ_id(θ, θ̇, g): the forces of the accelerations g, the bias forces and the loads.
-  tree.accelerate(theta_.data(), theta_d_.data(), g_.data(), tree.base_acceleration_, true);
-  for (size_t i = 0; i < tree.bodies_.size(); ++i) tree.work_[i].pA += tree.bodies_[i].inertia * tree.work_[i].a;
-  tree.joint_forces(theta_.data(), col_.data(), true);
+  tree.forces(theta_.data(), theta_d_.data(), g_.data(), col_.data());
   rhs_.noalias() = -T_.transpose() * col_;
   for (int k = 0; k < nd_; ++k) tree.mass_times(T_.col(k).data(), MT_.col(k).data());
   A_.noalias() = T_.transpose() * MT_;
@@ -377,7 +375,7 @@ void ClosedLoopTree<Algebra>::inverse_dynamics(const double* q, const double* qd
                      "joints failed, or they are not determined there)");
   theta_dd_.noalias() = T_ * Eigen::Map<const Eigen::VectorXd>(qdd, nd_);
   theta_dd_ += g_;
-  tree_->inverse_dynamics(theta_.data(), theta_d_.data(), theta_dd_.data(), col_.data());
+  tree_->forces(theta_.data(), theta_d_.data(), theta_dd_.data(), col_.data());  // at prepare()'s placement
   Eigen::Map<Eigen::VectorXd>(force, nd_).noalias() = T_.transpose() * col_;
 }
 

@@ -121,9 +121,7 @@ class PlanarTree::Builder : public tree_detail::TreeBuilder<PlanarTree::Builder,
           bd.offset = x_[coord];
           const std::string joint = (passive ? "the rotation of " : "DYNX ") + sys_.coord_name(coord);
           if (passive) {  // after the DOFs in the tree's coordinates: (q, the passive rotations)
-            bd.dof = sys_.n_dof() + static_cast<int>(tree_.loops_.dependent0.size());
-            tree_.loops_.dependent0.push_back(x_[coord]);
-            tree_.loops_.dependent.push_back(joint);
+            bd.dof = tree_.loops_.add_passive(sys_.n_dof(), x_[coord], joint);
           } else {
             bd.dof = dof_of_coord_.at(coord);
           }

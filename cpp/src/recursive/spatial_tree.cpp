@@ -209,9 +209,7 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
     se.kernel->first_derivatives(xl.data(), e.data(), B.data());
     bd.dof = h.dof;
     if (h.passive) {  // after the DOFs in the tree's coordinates: (q, the dependent joints')
-      bd.dof = sys_.n_dof() + static_cast<int>(tree_.loops_.dependent0.size());
-      tree_.loops_.dependent0.push_back(e_[se.def_offset]);
-      tree_.loops_.dependent.push_back(element_name(se));
+      bd.dof = tree_.loops_.add_passive(sys_.n_dof(), e_[se.def_offset], element_name(se));
     }
     bd.sign = forward ? 1.0 : -1.0;  // e1 turns (slides) o2's body relative to o1's
     bd.offset = -bd.sign * e_[se.def_offset];  // u = sign · (e1 − e1 at the reference state)
@@ -317,7 +315,6 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
       if (se.has_constitutive)  // its σ would act on the loop's constraint rows: not built
         return refuse(element_name(se) + " closes a loop and has a law (ESTIFF, EDAMPP): a cut has none");
       Loops::Cut cut;
-      cut.element = h.element;
       cut.kernel = se.kernel.get();
       for (int end = 0; end < 2; ++end) {
         const int id = end == 0 ? h.a : h.b, body = body_of(id);

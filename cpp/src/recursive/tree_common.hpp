@@ -416,7 +416,7 @@ class TreeBuilder {
     for (const ClosurePoint& c : closure_points_) {
       const int other = owner_.at(c.node);
       loops.points.push_back({c.body, other, point(c.node) - pin0_[c.body],
-                              other == kGround ? point(c.node) : Point(point(c.node) - pin0_[other]), c.node});
+                              other == kGround ? point(c.node) : Point(point(c.node) - pin0_[other])});
     }
   }
 

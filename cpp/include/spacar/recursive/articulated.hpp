@@ -28,6 +28,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "spacar/errors.hpp"
@@ -85,10 +86,8 @@ struct TreeLoops {
   struct ClosurePoint {                 // a point of body a and of body b (or the ground, −1)
     int a, b;
     Point pa, pb;                       // in their body coordinates (the ground's: the world)
-    int node;
   };
   struct Cut {                          // a passive spatial HINGE between two placed bodies (or the ground)
-    int element = 0;
     const ElementKernel* kernel = nullptr;   // the system's: the tree lives no longer than it
     std::array<int, 2> body{};               // of its LAMBDA nodes o1, o2 (index in the tree, or −1)
     std::array<Eigen::Vector4d, 2> lambda0;  // their Euler parameters at the recognition
@@ -98,6 +97,12 @@ struct TreeLoops {
   std::vector<ClosurePoint> points;
   std::vector<Cut> cuts;
   bool closed() const { return !points.empty() || !cuts.empty(); }
+  // A passive joint at `value`, described by `what`: its position in the tree's coordinates.
+  int add_passive(int system_dofs, double value, std::string what) {
+    dependent0.push_back(value);
+    dependent.push_back(std::move(what));
+    return system_dofs + static_cast<int>(dependent0.size()) - 1;
+  }
 };
 
 template <class Algebra>
@@ -126,11 +131,7 @@ class ArticulatedTree : public RecursiveTree {
     if (!outward(q, qd))
       throw InputError("inverse_dynamics: the floating base's three Euler parameters have a norm of 1 or more");
     applied_loads();
-    // Outwards: the accelerations the given q̈ make, and each body's force f = I a + pA (its bias
-    // forces of inertia less the applied loads); inwards the joints' share of them.
-    accelerate(q, qd, qdd, base_acceleration_, true);
-    for (size_t i = 0; i < bodies_.size(); ++i) work_[i].pA += bodies_[i].inertia * work_[i].a;
-    joint_forces(q, force, true);
+    forces(q, qd, qdd, force);
   }
 
  protected:
@@ -272,6 +273,15 @@ class ArticulatedTree : public RecursiveTree {
         if (p) p->u += d.u;
       }
     }
+  }
+
+  // The inverse dynamics at the placement, velocities and loads of the last outward() and
+  // applied_loads(): outwards the accelerations the given q̈ make, and each body's force
+  // f = I a + pA (its bias forces of inertia less the applied loads); inwards the joints' share.
+  void forces(const double* q, const double* qd, const double* qdd, double* force) {
+    accelerate(q, qd, qdd, base_acceleration_, true);
+    for (size_t i = 0; i < bodies_.size(); ++i) work_[i].pA += bodies_[i].inertia * work_[i].a;
+    joint_forces(q, force, true);
   }
 
   // M(q) u at the placement of the last outward(): the joint forces of the accelerations u alone
