@@ -38,6 +38,35 @@ Eigen::Vector4d node_lambda(const Cut& cut, int end, const Eigen::Vector4d& body
 
 }  // namespace
 
+void DependentJoints::resize(int m, int n) {
+  m_ = m;
+  n_ = n;
+  lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n);
+  qr_ = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(m, n);
+}
+
+bool DependentJoints::compute(const Eigen::Ref<const Eigen::MatrixXd>& Jd) {
+  // Below this ratio of the smallest to the largest pivot the QR decides (its rank threshold
+  // lies far below it). The ratio, not Eigen's rcond(): its estimate cost more than the LU.
+  constexpr double kWellConditioned = 1e-10;
+  if (m_ == n_) {
+    lu_.compute(Jd);
+    const auto pivots = lu_.matrixLU().diagonal().cwiseAbs();
+    lu_used_ = n_ > 0 && pivots.minCoeff() > kWellConditioned * pivots.maxCoeff();
+    if (lu_used_) return true;
+  }
+  lu_used_ = false;
+  qr_.compute(Jd);
+  return qr_.rank() == n_;
+}
+
+void DependentJoints::solve(const Eigen::Ref<const Eigen::MatrixXd>& b, Eigen::Ref<Eigen::MatrixXd> x) const {
+  if (lu_used_)
+    x.noalias() = lu_.solve(b);
+  else
+    x.noalias() = qr_.solve(b);
+}
+
 template <class Algebra>
 ClosedLoopTree<Algebra>::ClosedLoopTree(std::unique_ptr<Tree> tree) : tree_(std::move(tree)), loops_(tree_->loops()) {
   nd_ = loops_.n_dof;
@@ -56,7 +85,7 @@ ClosedLoopTree<Algebra>::ClosedLoopTree(std::unique_ptr<Tree> tree) : tree_(std:
   J_ = Eigen::MatrixXd::Zero(m_, n);
   T_ = MT_ = Eigen::MatrixXd::Zero(n, nd_);
   A_ = Eigen::MatrixXd::Zero(nd_, nd_);
-  qr_ = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(m_, nn_);
+  qr_.resize(m_, nn_);
   llt_ = Eigen::LLT<Eigen::MatrixXd>(nd_);
   T_.topRows(nd_).setIdentity();
   length_ = 0.0;
@@ -77,15 +106,14 @@ std::unique_ptr<RecursiveTree> ClosedLoopTree<Algebra>::close(std::unique_ptr<Tr
   // The tangent there (the first state's predictor).
   loop->tree_->outward(loop->theta_.data(), loop->zero_.data());
   loop->constraints();
-  loop->qr_.compute(loop->J_.rightCols(loop->nn_));
-  if (loop->qr_.rank() < loop->nn_) {
+  if (!loop->qr_.compute(loop->J_.rightCols(loop->nn_))) {
     if (why) {
       *why = "the loops do not determine their " + std::to_string(loop->nn_) + " passive joints (" +
              std::to_string(loop->m_) + " constraints of rank " + std::to_string(loop->qr_.rank()) + ")";
     }
     return nullptr;
   }
-  loop->T_.bottomRows(loop->nn_) = -loop->qr_.solve(loop->J_.leftCols(loop->nd_));
+  loop->dependent_tangent();
   loop->q0_ = loop->q_last_;  // the recognized state: close_loops' second start
   loop->theta0_ = loop->theta_.tail(loop->nn_);
   loop->T0_ = loop->T_.bottomRows(loop->nn_);
@@ -303,7 +331,7 @@ bool ClosedLoopTree<Algebra>::continue_to(const double* q) {
       if (last) return true;
       done = to;
       accepted_ = theta_.tail(nn_);
-      T_.bottomRows(nn_) = -qr_.solve(J_.leftCols(nd_));  // the next piece's tangent
+      dependent_tangent();  // the next piece's
       piece *= 2.0;
     } else {
       theta_.tail(nn_) = accepted_;
@@ -317,35 +345,44 @@ bool ClosedLoopTree<Algebra>::continue_to(const double* q) {
 template <class Algebra>
 bool ClosedLoopTree<Algebra>::newton() {
   for (int it = 0; it < kMaxIterations; ++it) {
-    tree_->outward(theta_.data(), zero_.data());
+    tree_->place(theta_.data(), zero_.data());
     constraints();
-    qr_.compute(J_.rightCols(nn_));
-    if (qr_.rank() < nn_) return false;
+    if (!qr_.compute(J_.rightCols(nn_))) return false;
     double residual = 0.0;
     for (int r = 0; r < m_; ++r) residual = std::max(residual, std::abs(c_[r]) / (r < n_point_rows_ ? length_ : 1.0));
     // The coordinates' own round-off: a crank 300 rad round holds its angle to 3e-14.
     const double scale = 1.0 + theta_.cwiseAbs().maxCoeff();
     if (residual <= kResidual * scale) return true;
     if (!std::isfinite(residual)) return false;
-    step_ = qr_.solve(c_);
+    qr_.solve(c_, step_);
     theta_.tail(nn_) -= step_;
-    if (step_.cwiseAbs().maxCoeff() <= kRoundOff * scale) return residual <= kStalled * scale;
+    if (step_.cwiseAbs().maxCoeff() <= kRoundOff * scale) {
+      tree_->place(theta_.data(), zero_.data());  // the tree placed at θ, as after every other return
+      return residual <= kStalled * scale;
+    }
   }
   return false;
 }
 
 template <class Algebra>
+void ClosedLoopTree<Algebra>::dependent_tangent() {
+  qr_.solve(J_.leftCols(nd_), T_.bottomRows(nn_));
+  T_.bottomRows(nn_) = -T_.bottomRows(nn_);
+}
+
+template <class Algebra>
 bool ClosedLoopTree<Algebra>::prepare(const double* q, const double* qd) {
   if (!close_loops(q)) return false;
-  T_.bottomRows(nn_) = -qr_.solve(J_.leftCols(nd_));
+  dependent_tangent();
   const Eigen::Map<const Eigen::VectorXd> rates(qd, nd_);
   theta_d_.head(nd_) = rates;
   theta_d_.tail(nn_).noalias() = T_.bottomRows(nn_) * rates;
-  tree_->outward(theta_.data(), theta_d_.data());
+  tree_->outward(theta_.data(), theta_d_.data(), true);  // placed at θ by close_loops()
   tree_->applied_loads();
   tree_->accelerate(theta_.data(), theta_d_.data(), zero_.data(), Tree::Vector::Zero(), true);
   constraint_bias();
-  g_.tail(nn_) = -qr_.solve(gamma_);
+  qr_.solve(gamma_, g_.tail(nn_));
+  g_.tail(nn_) = -g_.tail(nn_);
   return true;
 }
 
@@ -362,9 +399,8 @@ bool ClosedLoopTree<Algebra>::solve(const double* q, const double* qd, double* q
   if (llt_.info() != Eigen::Success) return false;
   Eigen::Map<Eigen::VectorXd> out(qdd, nd_);
   out = llt_.solve(rhs_);
-  theta_dd_.noalias() = T_ * out;
+  theta_dd_.noalias() = T_ * out;  // the bodies' accelerations from it in move_coordinates()
   theta_dd_ += g_;
-  tree.accelerate(theta_.data(), theta_d_.data(), theta_dd_.data(), tree.base_acceleration_, true);
   return out.allFinite();
 }
 
@@ -387,7 +423,8 @@ bool ClosedLoopTree<Algebra>::dynamics_derivatives(int, const double*, const dou
 }
 
 template <class Algebra>
-void ClosedLoopTree<Algebra>::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const {
+void ClosedLoopTree<Algebra>::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
+  tree_->accelerate(theta_.data(), theta_d_.data(), theta_dd_.data(), tree_->base_acceleration_, true);
   tree_->move_coordinates(x, xd, xdd);
 }
 

@@ -292,7 +292,7 @@ void PlanarTree::applied_loads() {
 }
 
 // Positions, velocities and accelerations of the coordinates moving with the bodies.
-void PlanarTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const {
+void PlanarTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
   const double gx = -base_acceleration_[1], gy = -base_acceleration_[2];
   for (const Follower& f : followers_) {
     const BodyWork& bd = work_[f.body];

@@ -441,7 +441,7 @@ void SpatialTree::free_forces(const double* q, const BodyWork& d, const Vector& 
 }
 
 // Positions, velocities and accelerations of the coordinates moving with the bodies.
-void SpatialTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const {
+void SpatialTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
   const Vec3 g = -base_acceleration_.tail<3>();
   for (const Follower& f : followers_) {
     const BodyWork& bd = work_[f.body];

@@ -162,8 +162,9 @@ class ArticulatedTree : public RecursiveTree {
   // The passes, for the trees that combine them otherwise (closed_loop.hpp: loops closed on a tree).
   // Outwards: placements, velocities, velocity-product accelerations and the bias forces of the
   // bodies' inertia, with the joint torques; the articulated inertias start as the bodies'. False
-  // if a floating base's q is no orientation.
-  bool outward(const double* q, const double* qd) {
+  // if a floating base's q is no orientation. `placed`: the bodies are placed at q already (by
+  // place(q, ...): the loops' last Newton iteration), their frames are kept.
+  bool outward(const double* q, const double* qd, bool placed = false) {
     for (size_t i = 0; i < bodies_.size(); ++i) {
       const Model& m = bodies_[i];
       BodyWork& d = work_[i];
@@ -174,7 +175,7 @@ class ArticulatedTree : public RecursiveTree {
         d.bias = Vector::Zero();
       } else {
         const double theta = Algebra::joint_angle(m, p, q, qd, d);  // rotation relative to the parent
-        Algebra::place(m, p, theta, d);
+        if (!placed) Algebra::place(m, p, theta, d);
         Vector v = Algebra::joint_motion(m, d.ud);
         if (p) v += Algebra::to_child(m, d.frame, p->v);
         d.v = v;
@@ -183,6 +184,23 @@ class ArticulatedTree : public RecursiveTree {
       const Vector& v = d.v;
       d.IA = m.inertia;
       d.pA = Algebra::cross_force(v, m.inertia * v) - m.load;
+    }
+    return true;
+  }
+
+  // Outwards: the placements alone, the joint rates qd (a floating base's) recorded but no
+  // velocities, bias terms or inertias computed: the loops' Newton iterations (closed_loop.hpp)
+  // need the bodies' frames and pins only. False as outward().
+  bool place(const double* q, const double* qd) {
+    for (size_t i = 0; i < bodies_.size(); ++i) {
+      const Model& m = bodies_[i];
+      BodyWork& d = work_[i];
+      const BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
+      if (m.free) {
+        if (!free_body_motion(q, qd, d)) return false;
+      } else {
+        Algebra::place(m, p, Algebra::joint_angle(m, p, q, qd, d), d);
+      }
     }
     return true;
   }

@@ -28,6 +28,27 @@
 
 namespace spacar {
 
+// The factorization of J_d, the constraints' Jacobian in the passive joints (m × n, m ≥ n): an LU
+// with partial pivoting where J_d is square and well conditioned (every loop the general path
+// assembles: it refuses redundant constraints; the LU takes a third of the time of the
+// column-pivoted QR, which was 40 % of Newton's iterations at 3 × 3), else the column-pivoted QR,
+// whose rank decides whether the loops determine the passive joints (its solutions least squares
+// where rows are redundant). Near a singular J_d the QR decides, as before the LU.
+class DependentJoints {
+ public:
+  void resize(int m, int n);
+  bool compute(const Eigen::Ref<const Eigen::MatrixXd>& Jd);  // false: rank below n
+  int rank() const { return lu_used_ ? n_ : static_cast<int>(qr_.rank()); }
+  // x = J_d⁺ b (x: n × k, b: m × k).
+  void solve(const Eigen::Ref<const Eigen::MatrixXd>& b, Eigen::Ref<Eigen::MatrixXd> x) const;
+
+ private:
+  int m_ = 0, n_ = 0;
+  bool lu_used_ = false;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_;
+};
+
 // Over the planar (planar_tree.hpp) and the spatial algebra (spatial_tree.hpp); the loops'
 // kinematics (constraints, add_point_rows, constraint_bias) are written for each.
 template <class Algebra>
@@ -48,7 +69,7 @@ class ClosedLoopTree : public RecursiveTree {
                             double* dqd, double* dtau) override;
 
  protected:
-  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
+  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) override;
 
  private:
   explicit ClosedLoopTree(std::unique_ptr<Tree> tree);
@@ -59,6 +80,7 @@ class ClosedLoopTree : public RecursiveTree {
   bool close_loops(const double* q);
   bool continue_to(const double* q);  // from (q_last_, θ_d, T_d) along the straight path to q
   bool newton();  // from θ: true if closed (c_, J_, qr_ at θ)
+  void dependent_tangent();  // T_d = −J_d⁺ J_q from J_ and its factorization
   // The constraints c_ and their Jacobian J_ at the tree's placement (outward() at θ).
   void constraints();
   // The world position of point b of body i (the ground's: b).
@@ -90,7 +112,7 @@ class ClosedLoopTree : public RecursiveTree {
   Eigen::MatrixXd T0_;
   Eigen::MatrixXd J_, T_, MT_, A_;               // A_ = Tᵀ M T
   std::vector<int> path_;                            // a body's path to the root (planar rows)
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_;  // of J_d
+  DependentJoints qr_;                              // of J_d
   Eigen::LLT<Eigen::MatrixXd> llt_;                 // of A_
 };
 

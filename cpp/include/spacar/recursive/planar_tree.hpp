@@ -132,7 +132,7 @@ class PlanarTree : public ArticulatedTree<PlanarAlgebra> {
   class Builder;
 
   void applied_loads() override;
-  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
+  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) override;
 
   std::vector<Follower> followers_;
   std::vector<Load> loads_;

@@ -230,7 +230,7 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   void free_body_qdd(const double* q, const double* qd, const BodyWork& d, const Vector& acc, double* qdd) override;
   Vector free_body_acceleration(const double* q, const double* qd, const double* qdd, const BodyWork& d) override;
   void free_forces(const double* q, const BodyWork& d, const Vector& f, double* force) override;
-  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const override;
+  void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) override;
 
   std::vector<Follower> followers_;
   std::vector<Load> loads_;

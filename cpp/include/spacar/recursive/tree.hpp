@@ -51,8 +51,9 @@ class RecursiveTree {
   }
 
  protected:
-  // The coordinates moving with the bodies, after solve().
-  virtual void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) const = 0;
+  // The coordinates moving with the bodies, after solve() (which may leave the bodies'
+  // accelerations to this call: a loop's solve() needs only q̈).
+  virtual void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) = 0;
 };
 
 }  // namespace spacar
