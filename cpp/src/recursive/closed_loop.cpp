@@ -48,11 +48,11 @@ void DependentJoints::resize(int m, int n) {
 bool DependentJoints::compute(const Eigen::Ref<const Eigen::MatrixXd>& Jd) {
   // Below this ratio of the smallest to the largest pivot the QR decides (its rank threshold
   // lies far below it). The ratio, not Eigen's rcond(): its estimate cost more than the LU.
-  constexpr double kWellConditioned = 1e-10;
+  constexpr double kNearSingular = 1e-10;
   if (m_ == n_) {
     lu_.compute(Jd);
     const auto pivots = lu_.matrixLU().diagonal().cwiseAbs();
-    lu_used_ = n_ > 0 && pivots.minCoeff() > kWellConditioned * pivots.maxCoeff();
+    lu_used_ = n_ > 0 && pivots.allFinite() && pivots.minCoeff() > kNearSingular * pivots.maxCoeff();
     if (lu_used_) return true;
   }
   lu_used_ = false;
@@ -79,7 +79,7 @@ ClosedLoopTree<Algebra>::ClosedLoopTree(std::unique_ptr<Tree> tree) : tree_(std:
   c_ = gamma_ = Eigen::VectorXd::Zero(m_);
   q_last_ = rhs_ = Eigen::VectorXd::Zero(nd_);
   w_ = Eigen::VectorXd::Zero(n);
-  start_ = step_ = predicted_ = Eigen::VectorXd::Zero(nn_);
+  start_ = step_ = predicted_ = tangent_move_ = Eigen::VectorXd::Zero(nn_);
   from_ = step_q_ = delta_ = Eigen::VectorXd::Zero(nd_);
   T_start_ = Eigen::MatrixXd::Zero(nn_, nd_);
   J_ = Eigen::MatrixXd::Zero(m_, n);
@@ -317,7 +317,8 @@ bool ClosedLoopTree<Algebra>::continue_to(const double* q) {
   accepted_ = theta_.tail(nn_);
   double done = 0.0, piece = 1.0;
   for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
-    const double steep = std::max(step_q_.cwiseAbs().maxCoeff(), (T_.bottomRows(nn_) * step_q_).cwiseAbs().maxCoeff());
+    tangent_move_.noalias() = T_.bottomRows(nn_) * step_q_;
+    const double steep = std::max(step_q_.cwiseAbs().maxCoeff(), tangent_move_.cwiseAbs().maxCoeff());
     if (steep > 0.0) piece = std::min(piece, kMaxMove / steep);
     const bool last = piece >= 1.0 - done;
     const double to = last ? 1.0 : done + piece;
@@ -347,13 +348,12 @@ bool ClosedLoopTree<Algebra>::newton() {
   for (int it = 0; it < kMaxIterations; ++it) {
     tree_->place(theta_.data(), zero_.data());
     constraints();
-    if (!qr_.compute(J_.rightCols(nn_))) return false;
+    if (!c_.allFinite() || !qr_.compute(J_.rightCols(nn_))) return false;  // (std::max below drops NaNs)
     double residual = 0.0;
     for (int r = 0; r < m_; ++r) residual = std::max(residual, std::abs(c_[r]) / (r < n_point_rows_ ? length_ : 1.0));
     // The coordinates' own round-off: a crank 300 rad round holds its angle to 3e-14.
     const double scale = 1.0 + theta_.cwiseAbs().maxCoeff();
     if (residual <= kResidual * scale) return true;
-    if (!std::isfinite(residual)) return false;
     qr_.solve(c_, step_);
     theta_.tail(nn_) -= step_;
     if (step_.cwiseAbs().maxCoeff() <= kRoundOff * scale) {

@@ -29,9 +29,10 @@
 namespace spacar {
 
 // The factorization of J_d, the constraints' Jacobian in the passive joints (m × n, m ≥ n): an LU
-// with partial pivoting where J_d is square and well conditioned (every loop the general path
-// assembles: it refuses redundant constraints; the LU takes a third of the time of the
-// column-pivoted QR, which was 40 % of Newton's iterations at 3 × 3), else the column-pivoted QR,
+// with partial pivoting where J_d is square and not near singular (smallest / largest |U_ii| above
+// 1e-10: every loop the general path assembles, which refuses redundant constraints; the LU takes
+// a third of the time of the column-pivoted QR, which was 40 % of Newton's iterations at 3 × 3),
+// else the column-pivoted QR,
 // whose rank decides whether the loops determine the passive joints (its solutions least squares
 // where rows are redundant). Near a singular J_d the QR decides, as before the LU.
 class DependentJoints {
@@ -75,13 +76,14 @@ class ClosedLoopTree : public RecursiveTree {
   explicit ClosedLoopTree(std::unique_ptr<Tree> tree);
 
   // θ at q with the loops closed, by continuation from the last closed state (or the recognized
-  // one); false (θ and the tangent left at the last state) if that fails. Leaves c_ and J_ (and its
-  // factorization) at θ.
+  // one); false (θ and the tangent left at the last state) if that fails. Leaves the tree placed
+  // at θ and c_ and J_ (and its factorization) there (or, after Newton's round-off exit, one
+  // correction of round-off size before).
   bool close_loops(const double* q);
   bool continue_to(const double* q);  // from (q_last_, θ_d, T_d) along the straight path to q
-  bool newton();  // from θ: true if closed (c_, J_, qr_ at θ)
+  bool newton();  // from θ: true if closed (the tree placed at θ; c_, J_, qr_ as close_loops says)
   void dependent_tangent();  // T_d = −J_d⁺ J_q from J_ and its factorization
-  // The constraints c_ and their Jacobian J_ at the tree's placement (outward() at θ).
+  // The constraints c_ and their Jacobian J_ at the tree's placement (place() at θ).
   void constraints();
   // The world position of point b of body i (the ground's: b).
   Point world_point(int body, const Point& b) const;
@@ -106,7 +108,7 @@ class ClosedLoopTree : public RecursiveTree {
   double length_ = 1.0;               // a length of the tree: the scale of the points' residuals
   Eigen::VectorXd theta_, theta_d_, theta_dd_, zero_, c_, gamma_, g_, col_;
   Eigen::VectorXd q_last_, rhs_, w_;  // the last closed state's q; Tᵀ (−τ_id); a planar row
-  Eigen::VectorXd start_, from_, step_q_, delta_, predicted_, accepted_, step_;  // close_loops', Newton's work
+  Eigen::VectorXd start_, from_, step_q_, delta_, predicted_, accepted_, step_, tangent_move_;  // close_loops', Newton's work
   Eigen::MatrixXd T_start_;                                                    // T_d at the last closed state
   Eigen::VectorXd q0_, theta0_;                                                // the recognized state
   Eigen::MatrixXd T0_;
