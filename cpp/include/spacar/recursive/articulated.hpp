@@ -188,21 +188,15 @@ class ArticulatedTree : public RecursiveTree {
     return true;
   }
 
-  // Outwards: the placements alone, the joint rates qd (a floating base's) recorded but no
-  // velocities, bias terms or inertias computed: the loops' Newton iterations (closed_loop.hpp)
-  // need the bodies' frames and pins only. False as outward().
-  bool place(const double* q, const double* qd) {
+  // Outwards: the placements alone (frames and pins; qd only for the joints' own records), no
+  // velocities, bias terms or inertias: the loops' Newton iterations (closed_loop.hpp) need no
+  // more. Trees without a floating base only (loops on one are refused).
+  void place(const double* q, const double* qd) {
     for (size_t i = 0; i < bodies_.size(); ++i) {
       const Model& m = bodies_[i];
-      BodyWork& d = work_[i];
       const BodyWork* p = m.parent < 0 ? nullptr : &work_[m.parent];
-      if (m.free) {
-        if (!free_body_motion(q, qd, d)) return false;
-      } else {
-        Algebra::place(m, p, Algebra::joint_angle(m, p, q, qd, d), d);
-      }
+      Algebra::place(m, p, Algebra::joint_angle(m, p, q, qd, work_[i]), work_[i]);
     }
-    return true;
   }
 
   // Inwards: articulated inertias and bias forces; false if a joint's articulated inertia is not
