@@ -137,7 +137,8 @@ def dynamics_derivatives(model: Model, q, qd, tau, *, time_limit=None):
     from the recursive Newton–Euler algorithm on dual numbers on planar ones, and
     ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇), in C++ over the whole batch. For planar and spatial trees of
     rigid bodies on the recursive path (URDF robots, pendulums, branched linkages, floating bases
-    in their DOFs of the origin and three Euler parameters; formulation.md §7); other models raise
+    in their DOFs of the origin and three Euler parameters; formulation.md §7) and planar closed loops
+    (their forward dynamics on dual numbers); other models, spatial loops among them, raise
     InputError saying why they are not one. ``time_limit``: wall-clock
     seconds (:class:`spacar.TimeLimitError`), the set-up included. Each call compiles and
     assembles the model: :class:`Dynamics` does that once for many calls."""

@@ -251,6 +251,29 @@ def four_bar_links():
     return m
 
 
+def five_bar():
+    """A planar five-bar of 2 DOFs (the rotations of its two cranks, DYNX on BETA 11 and 41): ground
+    pivots at nodes 1 and 4, cranks 1 (1 → 2) and 4 (4 → 5), couplers 2 (2 → 3) and 3 (5 → 3) closing
+    the loop at node 3 (their rotations passive); EMASS, a MASS at node 3, gravity."""
+    m = spacar.Model()
+    m.plbeam(1, 1, 11, 2, 12)
+    m.plbeam(2, 2, 21, 3, 22)
+    m.plbeam(3, 5, 31, 3, 32)
+    m.plbeam(4, 4, 41, 5, 42)
+    for node, xy in ((1, (0.0, 0.0)), (2, (0.0, 1.0)), (3, (1.5, 1.8)), (5, (3.0, 1.0)), (4, (3.0, 0.0))):
+        m.x(node, *xy)
+    m.fix(1)
+    m.fix(4)
+    m.dynx(11, 1)
+    m.dynx(41, 1)
+    for e, r in ((1, 1.0), (2, 1.5), (3, 1.2), (4, 0.8)):
+        m.emass(e, r)
+    m.mass(3, 0.3)
+    m.gravity(0.0, -9.81)
+    m.epskin(1e-14)
+    return m
+
+
 def hinged_four_bar():
     """A planar four-bar whose crank is turned by a DYNE PLHINGE from the ground's BETA node (a
     spring and a damper on it) and whose coupler and rocker are joined by a released PLHINGE with a

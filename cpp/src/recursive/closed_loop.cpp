@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "spacar/autodiff.hpp"
 #include "spacar/elements/spatial.hpp"
 #include "spacar/errors.hpp"
+#include "spacar/recursive/planar_rnea.hpp"
 #include "spacar/recursive/planar_tree.hpp"
 #include "spacar/recursive/spatial_tree.hpp"
 
@@ -415,11 +417,200 @@ void ClosedLoopTree<Algebra>::inverse_dynamics(const double* q, const double* qd
   Eigen::Map<Eigen::VectorXd>(force, nd_).noalias() = T_.transpose() * col_;
 }
 
-template <class Algebra>
-bool ClosedLoopTree<Algebra>::dynamics_derivatives(int, const double*, const double*, const double*, double*, double*,
-                                                   double*, double*) {
-  throw InputError("dynamics_derivatives: not computed on closed loops (the recursive path computes them on trees; "
-                   "inverse_dynamics and simulate take closed loops)");
+// --- derivatives of planar loops: the forward dynamics of solve() written once on a scalar type and
+// run on dual numbers. Exact first derivatives of θ_d(q) come from one Newton correction on duals
+// from the closed state, θ_d = θ_d* − J_d⁻¹ c(q, θ_d*) (c vanishes there: its derivative is
+// −J_d⁻¹ J_q); the rest (J, T, γ, g, τ_id, M T, Tᵀ M T) follows by the chain rule.
+
+namespace {
+
+// B ← A⁻¹ B (A: k × k, B: k × c, both row major), Gaussian elimination with row pivoting on the
+// values; false if A is singular.
+template <class S>
+bool solve_small(int k, std::vector<S>& A, int c, std::vector<S>& B) {
+  for (int col = 0; col < k; ++col) {
+    int pivot = col;
+    for (int r = col + 1; r < k; ++r)
+      if (std::abs(value_of(A[r * k + col])) > std::abs(value_of(A[pivot * k + col]))) pivot = r;
+    if (!(std::abs(value_of(A[pivot * k + col])) > 0.0)) return false;
+    if (pivot != col) {
+      for (int j = 0; j < k; ++j) std::swap(A[pivot * k + j], A[col * k + j]);
+      for (int j = 0; j < c; ++j) std::swap(B[pivot * c + j], B[col * c + j]);
+    }
+    for (int r = col + 1; r < k; ++r) {
+      const S f = A[r * k + col] / A[col * k + col];
+      for (int j = col; j < k; ++j) A[r * k + j] = A[r * k + j] - f * A[col * k + j];
+      for (int j = 0; j < c; ++j) B[r * c + j] = B[r * c + j] - f * B[col * c + j];
+    }
+  }
+  for (int r = k - 1; r >= 0; --r)
+    for (int j = 0; j < c; ++j) {
+      S sum = B[r * c + j];
+      for (int t = r + 1; t < k; ++t) sum = sum - A[r * k + t] * B[t * c + j];
+      B[r * c + j] = sum / A[r * k + r];
+    }
+  return true;
+}
+
+}  // namespace
+
+template <>
+template <class S>
+void ClosedLoopTree<PlanarAlgebra>::planar_points(const std::vector<S>& theta, const std::vector<S>* rates,
+                                                  std::vector<S>& c, std::vector<S>* J, std::vector<S>* gamma) const {
+  const auto& bodies = tree_->bodies_;
+  const int nb = static_cast<int>(bodies.size()), n = nd_ + nn_;
+  // The placements (PlanarAlgebra::place): absolute rotations φ, pins; the absolute rates ω and
+  // their coefficients w = ∂ω/∂θ̇ (constants: 1 or a hinge's sign along the path).
+  std::vector<S> phi(nb), px(nb), py(nb), omega(nb, S(0.0));
+  std::vector<std::vector<double>> w(nb, std::vector<double>(n, 0.0));
+  for (int i = 0; i < nb; ++i) {
+    const auto& m = bodies[i];
+    const bool root = m.parent < 0;
+    const S parent_phi = root ? S(0.0) : phi[m.parent];
+    const S joint = m.absolute ? theta[m.dof] - m.offset - parent_phi : m.sign * theta[m.dof] + m.offset;
+    phi[i] = parent_phi + joint;
+    if (root) {
+      px[i] = S(m.r.x());
+      py[i] = S(m.r.y());
+    } else {
+      const S cp = cos(parent_phi), sp = sin(parent_phi);
+      px[i] = px[m.parent] + cp * m.r.x() - sp * m.r.y();
+      py[i] = py[m.parent] + sp * m.r.x() + cp * m.r.y();
+    }
+    if (!m.absolute && !root) w[i] = w[m.parent];
+    w[i][m.dof] += m.absolute ? 1.0 : m.sign;
+    if (rates)
+      for (int k = 0; k < n; ++k)
+        if (w[i][k] != 0.0) omega[i] = omega[i] + w[i][k] * (*rates)[k];
+  }
+  const int m_rows = 2 * static_cast<int>(loops_.points.size());
+  c.assign(m_rows, S(0.0));
+  if (J) J->assign(static_cast<size_t>(m_rows) * n, S(0.0));
+  if (gamma) gamma->assign(m_rows, S(0.0));
+  // A point of body i (the ground's: −1) into rows `row`, `row + 1` with sign `scale`: its
+  // position, its rate rows Σ_j w_j (ẑ × s_j) and its acceleration at θ̈ = 0, −Σ_j ω_j² s_j, over
+  // the bodies j on its path (s_j: from j's pin to the next pin on the path, or the point).
+  auto add_point = [&](int body, const Eigen::Vector2d& b, double scale, int row) {
+    S x = S(b.x()), y = S(b.y());
+    if (body >= 0) {
+      const S cw = cos(phi[body]), sw = sin(phi[body]);
+      x = px[body] + cw * b.x() - sw * b.y();
+      y = py[body] + sw * b.x() + cw * b.y();
+    }
+    c[row] = c[row] + scale * x;
+    c[row + 1] = c[row + 1] + scale * y;
+    S ex = x, ey = y;  // the end of the segment of body j on the path
+    for (int j = body; j >= 0; j = bodies[j].parent) {
+      const S sx = ex - px[j], sy = ey - py[j];
+      if (J)
+        for (int k = 0; k < n; ++k) {
+          if (w[j][k] == 0.0) continue;
+          (*J)[row * n + k] = (*J)[row * n + k] - scale * w[j][k] * sy;
+          (*J)[(row + 1) * n + k] = (*J)[(row + 1) * n + k] + scale * w[j][k] * sx;
+        }
+      if (gamma) {
+        const S w2 = omega[j] * omega[j];
+        (*gamma)[row] = (*gamma)[row] - scale * w2 * sx;
+        (*gamma)[row + 1] = (*gamma)[row + 1] - scale * w2 * sy;
+      }
+      ex = px[j];
+      ey = py[j];
+    }
+  };
+  int row = 0;
+  for (const auto& p : loops_.points) {
+    add_point(p.a, p.pa, 1.0, row);
+    add_point(p.b, p.pb, -1.0, row);
+    row += 2;
+  }
+}
+
+template <>
+template <class S>
+bool ClosedLoopTree<PlanarAlgebra>::loop_dynamics(const S* q, const S* qd, const S* tau, S* qdd) {
+  const int n = nd_ + nn_;
+  if (m_ != nn_) return false;
+  // θ_d by one Newton correction on S from the closed state (J_d⁻¹ of the double solve).
+  Eigen::MatrixXd Jd_inverse(nn_, m_);
+  qr_.solve(Eigen::MatrixXd::Identity(m_, m_), Jd_inverse);
+  std::vector<S> theta(n), rates(n, S(0.0)), c, J, gamma;
+  for (int k = 0; k < nd_; ++k) theta[k] = q[k];
+  for (int k = nd_; k < n; ++k) theta[k] = S(theta_[k]);
+  planar_points<S>(theta, nullptr, c, nullptr, nullptr);
+  for (int i = 0; i < nn_; ++i)
+    for (int r = 0; r < m_; ++r) theta[nd_ + i] = theta[nd_ + i] - Jd_inverse(i, r) * c[r];
+  // T_d = −J_d⁻¹ J_q and θ̇_d = T_d q̇ at θ.
+  planar_points<S>(theta, nullptr, c, &J, nullptr);
+  std::vector<S> Jd(static_cast<size_t>(nn_) * nn_), Td(static_cast<size_t>(nn_) * nd_);
+  for (int r = 0; r < m_; ++r) {
+    for (int k = 0; k < nn_; ++k) Jd[r * nn_ + k] = J[r * n + nd_ + k];
+    for (int k = 0; k < nd_; ++k) Td[r * nd_ + k] = -J[r * n + k];
+  }
+  std::vector<S> Jd_work = Jd;
+  if (!solve_small(nn_, Jd_work, nd_, Td)) return false;
+  for (int k = 0; k < nd_; ++k) rates[k] = qd[k];
+  for (int i = 0; i < nn_; ++i)
+    for (int k = 0; k < nd_; ++k) rates[nd_ + i] = rates[nd_ + i] + Td[i * nd_ + k] * qd[k];
+  // g = [0; −J_d⁻¹ γ] at (θ, θ̇).
+  planar_points<S>(theta, &rates, c, nullptr, &gamma);
+  Jd_work = Jd;
+  if (!solve_small(nn_, Jd_work, 1, gamma)) return false;
+  std::vector<S> g(n, S(0.0)), zero(n, S(0.0)), unit(n, S(0.0)), bias(n), rest(n), column(n);
+  for (int i = 0; i < nn_; ++i) g[nd_ + i] = -gamma[i];
+  // Tᵀ M T q̈ = τ − Tᵀ τ_id(θ, θ̇, g), M T column by column from the inverse dynamics (affine in θ̈).
+  const PlanarTree& tree = static_cast<const PlanarTree&>(*tree_);
+  tree.inverse_dynamics_on(theta.data(), rates.data(), g.data(), bias.data());
+  tree.inverse_dynamics_on(theta.data(), zero.data(), zero.data(), rest.data());
+  auto T = [&](int row, int k) -> S { return row < nd_ ? S(row == k ? 1.0 : 0.0) : Td[(row - nd_) * nd_ + k]; };
+  std::vector<S> A(static_cast<size_t>(nd_) * nd_, S(0.0)), rhs(nd_);
+  for (int k = 0; k < nd_; ++k) {
+    for (int row = 0; row < n; ++row) unit[row] = T(row, k);
+    tree.inverse_dynamics_on(theta.data(), zero.data(), unit.data(), column.data());
+    for (int i = 0; i < nd_; ++i)
+      for (int row = 0; row < n; ++row) A[i * nd_ + k] = A[i * nd_ + k] + T(row, i) * (column[row] - rest[row]);
+  }
+  for (int i = 0; i < nd_; ++i) {
+    rhs[i] = tau[i];
+    for (int row = 0; row < n; ++row) rhs[i] = rhs[i] - T(row, i) * bias[row];
+  }
+  if (!solve_small(nd_, A, 1, rhs)) return false;
+  for (int i = 0; i < nd_; ++i) qdd[i] = rhs[i];
+  return true;
+}
+
+template <>
+bool ClosedLoopTree<PlanarAlgebra>::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau,
+                                                         double* qdd, double* dq, double* dqd, double* dtau) {
+  if (n != nd_) return false;
+  if (!prepare(q, qd))
+    throw InputError("dynamics_derivatives: the loops do not close at this state (Newton's method on the passive "
+                     "joints failed, or they are not determined there)");
+  // The 3n directions (q, q̇, τ), kWidth at a time.
+  constexpr int kWidth = 4;
+  using Dual = Jet<double, kWidth>;
+  std::vector<Dual> dq_in(q, q + n), dqd_in(qd, qd + n), dtau_in(tau, tau + n), out(n);
+  auto variable = [&](int k) -> Dual& { return k < n ? dq_in[k] : k < 2 * n ? dqd_in[k - n] : dtau_in[k - 2 * n]; };
+  for (int first = 0; first < 3 * n; first += kWidth) {
+    const int last = std::min(3 * n, first + kWidth);
+    for (int k = first; k < last; ++k) variable(k).d[k - first] = 1.0;
+    if (!loop_dynamics(dq_in.data(), dqd_in.data(), dtau_in.data(), out.data())) return false;
+    for (int k = first; k < last; ++k) {
+      variable(k).d[k - first] = 0.0;
+      double* target = k < n ? dq : k < 2 * n ? dqd : dtau;
+      const int j = k % n;
+      for (int i = 0; i < n; ++i) target[i * n + j] = out[i].d[k - first];
+    }
+  }
+  for (int i = 0; i < n; ++i) qdd[i] = out[i].a;
+  return true;
+}
+
+template <>
+bool ClosedLoopTree<SpatialAlgebra>::dynamics_derivatives(int, const double*, const double*, const double*, double*,
+                                                          double*, double*, double*) {
+  throw InputError("dynamics_derivatives: not computed on spatial closed loops (the recursive path computes them on "
+                   "trees and on planar loops; inverse_dynamics and simulate take spatial loops)");
 }
 
 template <class Algebra>

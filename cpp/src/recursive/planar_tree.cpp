@@ -262,9 +262,7 @@ std::unique_ptr<PlanarTree> PlanarTree::detect(const System& sys, const Data& da
 bool PlanarTree::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd,
                                       double* dq, double* dqd, double* dtau) {
   if (n != n_bodies()) return false;  // every body turned by one joint, its DOF
-  auto id = [&](const auto* qq, const auto* qqd, const auto* qqdd, auto* out) {
-    rnea::planar_inverse_dynamics(bodies_, base_acceleration_, loads_, springs_, qq, qqd, qqdd, out);
-  };
+  auto id = [&](const auto* qq, const auto* qqd, const auto* qqdd, auto* out) { inverse_dynamics_on(qq, qqd, qqdd, out); };
   return rnea::forward_dynamics_derivatives(n, q, qd, tau, id, qdd, dq, dqd, dtau);
 }
 

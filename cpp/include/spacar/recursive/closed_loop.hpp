@@ -100,6 +100,15 @@ class ClosedLoopTree : public RecursiveTree {
   void add_rotation_row(int body, const Eigen::Matrix<double, 1, 3>& w, int row);  // w · ω of the body
   // At (q, q̇): θ, θ̇ and the tree placed and moving there (outward, applied loads), T_ and g_.
   bool prepare(const double* q, const double* qd);
+  // Planar loops: q̈ at (q, q̇) under τ on a scalar type S (dual numbers: its exact derivatives),
+  // at the state prepare() closed; false if the loops' J_d is not square or a matrix is singular.
+  template <class S>
+  bool loop_dynamics(const S* q, const S* qd, const S* tau, S* qdd);
+  // The point rows c (m), J (m × θ) and the constraints' accelerations γ at θ̈ = 0 on S, at θ
+  // and θ̇ (J, γ: if given); the planar kinematics of add_point_rows and point_acceleration.
+  template <class S>
+  void planar_points(const std::vector<S>& theta, const std::vector<S>* rates, std::vector<S>& c, std::vector<S>* J,
+                     std::vector<S>* gamma) const;
 
   std::unique_ptr<Tree> tree_;
   const typename Tree::Loops& loops_;

@@ -140,3 +140,12 @@ void planar_inverse_dynamics(const std::vector<BodyModel<PlanarAlgebra>>& bodies
 }
 
 }  // namespace spacar::rnea
+
+namespace spacar {
+
+template <class S>
+void PlanarTree::inverse_dynamics_on(const S* q, const S* qd, const S* qdd, S* force) const {
+  rnea::planar_inverse_dynamics(bodies_, base_acceleration_, loads_, springs_, q, qd, qdd, force);
+}
+
+}  // namespace spacar

@@ -108,6 +108,10 @@ class PlanarTree : public ArticulatedTree<PlanarAlgebra> {
   // rnea_derivatives.hpp).
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
+  // The inverse dynamics on a scalar type S (double or dual numbers; planar_rnea.hpp, which
+  // defines it): the closed loops' derivatives run it in the tree's coordinates.
+  template <class S>
+  void inverse_dynamics_on(const S* q, const S* qd, const S* qdd, S* force) const;
 
  private:
   // A coordinate moving with a body: XY components at body point b, or a BETA angle.
