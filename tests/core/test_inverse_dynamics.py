@@ -121,49 +121,60 @@ def test_other_systems_take_the_reduced_equations():
 PLANAR_LOOPS = {
     "four-bar, DYNX crank": models.four_bar,
     "four-bar, DYNE PLHINGE crank, springs, damper, FORCE": trees.hinged_four_bar,
+    "four-bar, reversed DYNE PLHINGE, a sprung and damped released hinge": trees.reversed_hinged_four_bar,
     "four-bar driven between crank and coupler": trees.four_bar_driven_between_links,
     "four-bar driven at the rocker": trees.rocker_driven_four_bar,
     "five-bar, 2 DOFs": trees.five_bar,
+    "six-bar, two loops": trees.six_bar,
 }
 
 
+def double_path_accelerations(sim, dyn, q, qd, tau):
+    """q̈ under τ without the dual numbers: the forward dynamics of a run's right-hand side (τ = 0,
+    ClosedLoopTree::solve) plus M⁻¹ τ, M from the loops' inverse dynamics (affine in q̈)."""
+    n = len(q)
+    rest = dyn.inverse_dynamics(q, np.zeros(n), np.zeros(n))
+    M = np.column_stack([dyn.inverse_dynamics(q, np.zeros(n), e) - rest for e in np.eye(n)])
+    return sim.recursive_state(q, qd)["qdd"] + np.linalg.solve(M, tau)
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.3])
 @pytest.mark.parametrize("name", PLANAR_LOOPS)
-def test_planar_loops_have_exact_derivatives(name):
+def test_planar_loops_have_exact_derivatives(name, offset):
     """spacar.dynamics_derivatives on planar closed loops (the loops' forward dynamics on dual
     numbers, closed_loop.cpp): its q̈ under τ gives back τ through spacar.inverse_dynamics (the
-    loops' double recursion, checked above against the reduced equations), ∂q̈/∂τ is the inverse
-    of the mass matrix that inverse_dynamics implies, q̈ under τ = 0 is the forward dynamics of a
-    run's right-hand side, and ∂q̈/∂q, ∂q̈/∂q̇ equal central differences of q̈ to 1e-7 (each
-    state's loops closed anew from the recognized state)."""
+    loops' double recursion, checked above against the reduced equations) and equals the double
+    path's forward dynamics; ∂q̈/∂τ is the inverse of the mass matrix that inverse_dynamics implies;
+    ∂q̈/∂q, ∂q̈/∂q̇ equal central differences of the double path's q̈ to 1e-7. At a state near the
+    assembled one and one 0.3 rad further (reached by continuation)."""
     model = PLANAR_LOOPS[name]()
     sim = _core.Simulation(model.copy().core)
     sim.assemble()
+    dyn = spacar.Dynamics(model)
     rng = np.random.default_rng(7)
     n = sim.system.n_dof
-    q = np.array(sim.system.q0) + rng.uniform(-0.05, 0.05, n)
+    q = np.array(sim.system.q0) + offset + rng.uniform(-0.05, 0.05, n)
     qd, tau = rng.uniform(-1.0, 1.0, n), rng.uniform(-1.0, 1.0, n)
-    qdd, dq, dqd, dtau = spacar.dynamics_derivatives(model, q, qd, tau)
-    scale = max(1.0, np.abs(tau).max(), np.abs(spacar.inverse_dynamics(model, q, qd, np.zeros(n))).max())
-    assert np.abs(spacar.inverse_dynamics(model, q, qd, qdd) - tau).max() <= 1e-11 * scale
-    rest = spacar.inverse_dynamics(model, q, np.zeros(n), np.zeros(n))
-    M = np.column_stack([spacar.inverse_dynamics(model, q, np.zeros(n), e) - rest for e in np.eye(n)])
+    qdd, dq, dqd, dtau = dyn.dynamics_derivatives(q, qd, tau)
+    scale = max(1.0, np.abs(tau).max(), np.abs(dyn.inverse_dynamics(q, qd, np.zeros(n))).max())
+    assert np.abs(dyn.inverse_dynamics(q, qd, qdd) - tau).max() <= 1e-11 * scale
+    np.testing.assert_allclose(qdd, double_path_accelerations(sim, dyn, q, qd, tau), rtol=1e-10, atol=1e-10)
+    rest = dyn.inverse_dynamics(q, np.zeros(n), np.zeros(n))
+    M = np.column_stack([dyn.inverse_dynamics(q, np.zeros(n), e) - rest for e in np.eye(n)])
     assert np.abs(dtau @ M - np.eye(n)).max() <= 1e-10
-    free = spacar.dynamics_derivatives(model, q, qd, np.zeros(n))[0]
-    np.testing.assert_allclose(free, sim.recursive_state(q, qd)["qdd"], rtol=1e-11, atol=1e-11)
     h = 1e-6
     for j in range(n):
         e = h * np.eye(n)[j]
-        fd_q = (spacar.dynamics_derivatives(model, q + e, qd, tau)[0]
-                - spacar.dynamics_derivatives(model, q - e, qd, tau)[0]) / (2 * h)
-        fd_qd = (spacar.dynamics_derivatives(model, q, qd + e, tau)[0]
-                 - spacar.dynamics_derivatives(model, q, qd - e, tau)[0]) / (2 * h)
+        fd_q = (double_path_accelerations(sim, dyn, q + e, qd, tau)
+                - double_path_accelerations(sim, dyn, q - e, qd, tau)) / (2 * h)
+        fd_qd = (double_path_accelerations(sim, dyn, q, qd + e, tau)
+                 - double_path_accelerations(sim, dyn, q, qd - e, tau)) / (2 * h)
         assert np.abs(dq[:, j] - fd_q).max() <= 1e-7 * max(1.0, np.abs(dq).max())
         assert np.abs(dqd[:, j] - fd_qd).max() <= 1e-7 * max(1.0, np.abs(dqd).max())
-    # A batch: one call, the states' own derivatives.
-    batch = spacar.dynamics_derivatives(model, np.array([q, q + 0.01]), np.array([qd, -qd]), np.array([tau, tau]))
-    np.testing.assert_allclose(batch[1][0], dq, rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(batch[1][1], spacar.dynamics_derivatives(model, q + 0.01, -qd, tau)[1], rtol=1e-12,
-                               atol=1e-12)
+    # A batch: one call, each state's own derivatives.
+    batch = dyn.dynamics_derivatives(np.array([q, q + 0.01]), np.array([qd, -qd]), np.array([tau, tau]))
+    np.testing.assert_allclose(batch[1][0], dq, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(batch[1][1], dyn.dynamics_derivatives(q + 0.01, -qd, tau)[1], rtol=1e-10, atol=1e-10)
 
 
 def test_spatial_loops_have_no_derivatives_yet():

@@ -274,6 +274,52 @@ def five_bar():
     return m
 
 
+def six_bar():
+    """A planar six-bar of two loops (Watt type: the four-bar of four_bar_links and a dyad from its
+    coupler–rocker joint, node 3, to a third ground pivot, node 6): 1 DOF (the crank, DYNX on BETA
+    11), 4 passive rotations; EMASS, MASSes at nodes 3 and 5, gravity."""
+    m = spacar.Model()
+    m.plbeam(1, 1, 11, 2, 12)
+    m.plbeam(2, 2, 21, 3, 22)
+    m.plbeam(3, 4, 31, 3, 32)
+    m.plbeam(4, 3, 41, 5, 42)
+    m.plbeam(5, 6, 51, 5, 52)
+    for node, xy in ((1, (0.0, 0.0)), (2, (0.0, 1.0)), (3, (2.0, 1.5)), (4, (2.5, 0.0)), (5, (3.5, 2.2)),
+                     (6, (4.5, 0.3))):
+        m.x(node, *xy)
+    m.fix(1)
+    m.fix(4)
+    m.fix(6)
+    m.dynx(11, 1)
+    for e, r in ((1, 1.0), (2, 1.5), (3, 1.2), (4, 0.7), (5, 0.9)):
+        m.emass(e, r)
+    m.mass(3, 0.3)
+    m.mass(5, 0.2)
+    m.gravity(0.0, -9.81)
+    m.epskin(1e-14)
+    return m
+
+
+def reversed_hinged_four_bar():
+    """The four-bar turned by a DYNE PLHINGE that points from the crank to the ground (its angle
+    the negative of the crank's rotation), a released sprung and damped PLHINGE from rocker to
+    coupler, FORCE on the coupler."""
+    m = four_bar_links()
+    m.plhinge(101, 11, 100)
+    m.dyne(101, 1)
+    m.fix(100)
+    m.ed(101, 1, -1.5)
+    m.plhinge(102, 32, 22)
+    m.rlse(102, 1)
+    m.estiff(102, 2.0)
+    m.edampp(102, 0.1)
+    m.mass(32, 0.05)
+    m.force(2, 0.4, -0.2)
+    m.gravity(0.0, -9.81)
+    m.epskin(1e-14)
+    return m
+
+
 def hinged_four_bar():
     """A planar four-bar whose crank is turned by a DYNE PLHINGE from the ground's BETA node (a
     spring and a damper on it) and whose coupler and rocker are joined by a released PLHINGE with a

@@ -457,13 +457,23 @@ bool solve_small(int k, std::vector<S>& A, int c, std::vector<S>& B) {
 template <>
 template <class S>
 void ClosedLoopTree<PlanarAlgebra>::planar_points(const std::vector<S>& theta, const std::vector<S>* rates,
-                                                  std::vector<S>& c, std::vector<S>* J, std::vector<S>* gamma) const {
+                                                  std::vector<S>& c, std::vector<S>* J, std::vector<S>* gamma) {
   const auto& bodies = tree_->bodies_;
   const int nb = static_cast<int>(bodies.size()), n = nd_ + nn_;
-  // The placements (PlanarAlgebra::place): absolute rotations φ, pins; the absolute rates ω and
-  // their coefficients w = ∂ω/∂θ̇ (constants: 1 or a hinge's sign along the path).
+  // The absolute rates' coefficients w_i = ∂ω_i/∂θ̇ (constants: 1 or a hinge's sign along the
+  // path, reset at an absolute rotation), once.
+  if (rate_coefficients_.empty()) {
+    rate_coefficients_.assign(static_cast<size_t>(nb) * n, 0.0);
+    for (int i = 0; i < nb; ++i) {
+      const auto& m = bodies[i];
+      double* wi = rate_coefficients_.data() + static_cast<size_t>(i) * n;
+      if (!m.absolute && m.parent >= 0) std::copy_n(rate_coefficients_.data() + static_cast<size_t>(m.parent) * n, n, wi);
+      wi[m.dof] += m.absolute ? 1.0 : m.sign;
+    }
+  }
+  auto w = [&](int i, int k) { return rate_coefficients_[static_cast<size_t>(i) * n + k]; };
+  // The placements (PlanarAlgebra::place): absolute rotations φ, pins; the absolute rates ω.
   std::vector<S> phi(nb), px(nb), py(nb), omega(nb, S(0.0));
-  std::vector<std::vector<double>> w(nb, std::vector<double>(n, 0.0));
   for (int i = 0; i < nb; ++i) {
     const auto& m = bodies[i];
     const bool root = m.parent < 0;
@@ -478,11 +488,9 @@ void ClosedLoopTree<PlanarAlgebra>::planar_points(const std::vector<S>& theta, c
       px[i] = px[m.parent] + cp * m.r.x() - sp * m.r.y();
       py[i] = py[m.parent] + sp * m.r.x() + cp * m.r.y();
     }
-    if (!m.absolute && !root) w[i] = w[m.parent];
-    w[i][m.dof] += m.absolute ? 1.0 : m.sign;
     if (rates)
       for (int k = 0; k < n; ++k)
-        if (w[i][k] != 0.0) omega[i] = omega[i] + w[i][k] * (*rates)[k];
+        if (w(i, k) != 0.0) omega[i] = omega[i] + w(i, k) * (*rates)[k];
   }
   const int m_rows = 2 * static_cast<int>(loops_.points.size());
   c.assign(m_rows, S(0.0));
@@ -505,9 +513,9 @@ void ClosedLoopTree<PlanarAlgebra>::planar_points(const std::vector<S>& theta, c
       const S sx = ex - px[j], sy = ey - py[j];
       if (J)
         for (int k = 0; k < n; ++k) {
-          if (w[j][k] == 0.0) continue;
-          (*J)[row * n + k] = (*J)[row * n + k] - scale * w[j][k] * sy;
-          (*J)[(row + 1) * n + k] = (*J)[(row + 1) * n + k] + scale * w[j][k] * sx;
+          if (w(j, k) == 0.0) continue;
+          (*J)[row * n + k] = (*J)[row * n + k] - scale * w(j, k) * sy;
+          (*J)[(row + 1) * n + k] = (*J)[(row + 1) * n + k] + scale * w(j, k) * sx;
         }
       if (gamma) {
         const S w2 = omega[j] * omega[j];
@@ -528,12 +536,11 @@ void ClosedLoopTree<PlanarAlgebra>::planar_points(const std::vector<S>& theta, c
 
 template <>
 template <class S>
-bool ClosedLoopTree<PlanarAlgebra>::loop_dynamics(const S* q, const S* qd, const S* tau, S* qdd) {
+bool ClosedLoopTree<PlanarAlgebra>::loop_dynamics(const S* q, const S* qd, const S* tau,
+                                                  const Eigen::MatrixXd& Jd_inverse, S* qdd) {
   const int n = nd_ + nn_;
-  if (m_ != nn_) return false;
+  const char* singular = "dynamics_derivatives: the loops' Jacobian in the passive joints is singular at this state";
   // θ_d by one Newton correction on S from the closed state (J_d⁻¹ of the double solve).
-  Eigen::MatrixXd Jd_inverse(nn_, m_);
-  qr_.solve(Eigen::MatrixXd::Identity(m_, m_), Jd_inverse);
   std::vector<S> theta(n), rates(n, S(0.0)), c, J, gamma;
   for (int k = 0; k < nd_; ++k) theta[k] = q[k];
   for (int k = nd_; k < n; ++k) theta[k] = S(theta_[k]);
@@ -548,14 +555,14 @@ bool ClosedLoopTree<PlanarAlgebra>::loop_dynamics(const S* q, const S* qd, const
     for (int k = 0; k < nd_; ++k) Td[r * nd_ + k] = -J[r * n + k];
   }
   std::vector<S> Jd_work = Jd;
-  if (!solve_small(nn_, Jd_work, nd_, Td)) return false;
+  if (!solve_small(nn_, Jd_work, nd_, Td)) throw InputError(singular);
   for (int k = 0; k < nd_; ++k) rates[k] = qd[k];
   for (int i = 0; i < nn_; ++i)
     for (int k = 0; k < nd_; ++k) rates[nd_ + i] = rates[nd_ + i] + Td[i * nd_ + k] * qd[k];
   // g = [0; −J_d⁻¹ γ] at (θ, θ̇).
   planar_points<S>(theta, &rates, c, nullptr, &gamma);
   Jd_work = Jd;
-  if (!solve_small(nn_, Jd_work, 1, gamma)) return false;
+  if (!solve_small(nn_, Jd_work, 1, gamma)) throw InputError(singular);
   std::vector<S> g(n, S(0.0)), zero(n, S(0.0)), unit(n, S(0.0)), bias(n), rest(n), column(n);
   for (int i = 0; i < nn_; ++i) g[nd_ + i] = -gamma[i];
   // Tᵀ M T q̈ = τ − Tᵀ τ_id(θ, θ̇, g), M T column by column from the inverse dynamics (affine in θ̈).
@@ -574,7 +581,11 @@ bool ClosedLoopTree<PlanarAlgebra>::loop_dynamics(const S* q, const S* qd, const
     rhs[i] = tau[i];
     for (int row = 0; row < n; ++row) rhs[i] = rhs[i] - T(row, i) * bias[row];
   }
-  if (!solve_small(nd_, A, 1, rhs)) return false;
+  // Positive definite, as solve()'s Cholesky requires (a loop that moves no mass fails here).
+  Eigen::MatrixXd values(nd_, nd_);
+  for (int i = 0; i < nd_; ++i)
+    for (int k = 0; k < nd_; ++k) values(i, k) = value_of(A[i * nd_ + k]);
+  if (Eigen::LLT<Eigen::MatrixXd>(values).info() != Eigen::Success || !solve_small(nd_, A, 1, rhs)) return false;
   for (int i = 0; i < nd_; ++i) qdd[i] = rhs[i];
   return true;
 }
@@ -583,9 +594,15 @@ template <>
 bool ClosedLoopTree<PlanarAlgebra>::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau,
                                                          double* qdd, double* dq, double* dqd, double* dtau) {
   if (n != nd_) return false;
+  if (m_ != nn_) {
+    throw InputError("dynamics_derivatives: not computed on loops with redundant constraints (" + std::to_string(m_) +
+                     " constraints on " + std::to_string(nn_) + " passive joints)");
+  }
   if (!prepare(q, qd))
     throw InputError("dynamics_derivatives: the loops do not close at this state (Newton's method on the passive "
                      "joints failed, or they are not determined there)");
+  Eigen::MatrixXd Jd_inverse(nn_, m_);  // J_d⁻¹ at the closed state: the duals' Newton correction
+  qr_.solve(Eigen::MatrixXd::Identity(m_, m_), Jd_inverse);
   // The 3n directions (q, q̇, τ), kWidth at a time.
   constexpr int kWidth = 4;
   using Dual = Jet<double, kWidth>;
@@ -594,7 +611,7 @@ bool ClosedLoopTree<PlanarAlgebra>::dynamics_derivatives(int n, const double* q,
   for (int first = 0; first < 3 * n; first += kWidth) {
     const int last = std::min(3 * n, first + kWidth);
     for (int k = first; k < last; ++k) variable(k).d[k - first] = 1.0;
-    if (!loop_dynamics(dq_in.data(), dqd_in.data(), dtau_in.data(), out.data())) return false;
+    if (!loop_dynamics(dq_in.data(), dqd_in.data(), dtau_in.data(), Jd_inverse, out.data())) return false;
     for (int k = first; k < last; ++k) {
       variable(k).d[k - first] = 0.0;
       double* target = k < n ? dq : k < 2 * n ? dqd : dtau;

@@ -101,14 +101,16 @@ class ClosedLoopTree : public RecursiveTree {
   // At (q, q̇): θ, θ̇ and the tree placed and moving there (outward, applied loads), T_ and g_.
   bool prepare(const double* q, const double* qd);
   // Planar loops: q̈ at (q, q̇) under τ on a scalar type S (dual numbers: its exact derivatives),
-  // at the state prepare() closed; false if the loops' J_d is not square or a matrix is singular.
+  // at the state prepare() closed, with Jd_inverse = J_d⁻¹ there; false if Tᵀ M T is not
+  // positive definite (InputError if J_d is singular on the way).
   template <class S>
-  bool loop_dynamics(const S* q, const S* qd, const S* tau, S* qdd);
+  bool loop_dynamics(const S* q, const S* qd, const S* tau, const Eigen::MatrixXd& Jd_inverse, S* qdd);
   // The point rows c (m), J (m × θ) and the constraints' accelerations γ at θ̈ = 0 on S, at θ
   // and θ̇ (J, γ: if given); the planar kinematics of add_point_rows and point_acceleration.
   template <class S>
   void planar_points(const std::vector<S>& theta, const std::vector<S>* rates, std::vector<S>& c, std::vector<S>* J,
-                     std::vector<S>* gamma) const;
+                     std::vector<S>* gamma);
+  std::vector<double> rate_coefficients_;  // planar: ∂ω_i/∂θ̇ of every body (row i), made once
 
   std::unique_ptr<Tree> tree_;
   const typename Tree::Loops& loops_;
