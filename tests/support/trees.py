@@ -278,22 +278,15 @@ def six_bar():
     """A planar six-bar of two loops (Watt type: the four-bar of four_bar_links and a dyad from its
     coupler–rocker joint, node 3, to a third ground pivot, node 6): 1 DOF (the crank, DYNX on BETA
     11), 4 passive rotations; EMASS, MASSes at nodes 3 and 5, gravity."""
-    m = spacar.Model()
-    m.plbeam(1, 1, 11, 2, 12)
-    m.plbeam(2, 2, 21, 3, 22)
-    m.plbeam(3, 4, 31, 3, 32)
+    m = four_bar_links()
     m.plbeam(4, 3, 41, 5, 42)
     m.plbeam(5, 6, 51, 5, 52)
-    for node, xy in ((1, (0.0, 0.0)), (2, (0.0, 1.0)), (3, (2.0, 1.5)), (4, (2.5, 0.0)), (5, (3.5, 2.2)),
-                     (6, (4.5, 0.3))):
-        m.x(node, *xy)
-    m.fix(1)
-    m.fix(4)
+    m.x(5, 3.5, 2.2)
+    m.x(6, 4.5, 0.3)
     m.fix(6)
     m.dynx(11, 1)
-    for e, r in ((1, 1.0), (2, 1.5), (3, 1.2), (4, 0.7), (5, 0.9)):
-        m.emass(e, r)
-    m.mass(3, 0.3)
+    m.emass(4, 0.7)
+    m.emass(5, 0.9)
     m.mass(5, 0.2)
     m.gravity(0.0, -9.81)
     m.epskin(1e-14)
