@@ -11,6 +11,7 @@
 #include "spacar/errors.hpp"
 #include "spacar/recursive/planar_rnea.hpp"
 #include "spacar/recursive/planar_tree.hpp"
+#include "spacar/recursive/spatial_rnea.hpp"
 #include "spacar/recursive/spatial_tree.hpp"
 
 namespace spacar {
@@ -456,7 +457,7 @@ bool solve_small(int k, std::vector<S>& A, int c, std::vector<S>& B) {
 
 template <>
 template <class S>
-void ClosedLoopTree<PlanarAlgebra>::planar_points(const std::vector<S>& theta, const std::vector<S>* rates,
+void ClosedLoopTree<PlanarAlgebra>::loop_points(const std::vector<S>& theta, const std::vector<S>* rates,
                                                   std::vector<S>& c, std::vector<S>* J, std::vector<S>* gamma) {
   const auto& bodies = tree_->bodies_;
   const int nb = static_cast<int>(bodies.size()), n = nd_ + nn_;
@@ -536,19 +537,78 @@ void ClosedLoopTree<PlanarAlgebra>::planar_points(const std::vector<S>& theta, c
 
 template <>
 template <class S>
-bool ClosedLoopTree<PlanarAlgebra>::loop_dynamics(const S* q, const S* qd, const S* tau,
-                                                  const Eigen::MatrixXd& Jd_inverse, S* qdd) {
+void ClosedLoopTree<PlanarAlgebra>::tree_inverse_dynamics(const S* q, const S* qd, const S* qdd, S* force) const {
+  static_cast<const PlanarTree&>(*tree_).inverse_dynamics_on(q, qd, qdd, force);
+}
+
+template <>
+template <class S>
+void ClosedLoopTree<SpatialAlgebra>::tree_inverse_dynamics(const S* q, const S* qd, const S* qdd, S* force) const {
+  static_cast<const SpatialTree&>(*tree_).inverse_dynamics_on(q, qd, qdd, force);
+}
+
+// Spatial points: the placements and motions of spatial_outward (spatial_rnea.hpp) at θ̈ = 0
+// without gravity; a point's rows Σ sign (S_j) × (x − pin_j) (a sliding joint's: its axis), its
+// acceleration R (a_v + α × b + ω × (v + ω × b)).
+template <>
+template <class S>
+void ClosedLoopTree<SpatialAlgebra>::loop_points(const std::vector<S>& theta, const std::vector<S>* rates,
+                                                 std::vector<S>& c, std::vector<S>* J, std::vector<S>* gamma) {
+  using rnea::V3;
+  const auto& bodies = tree_->bodies_;
+  const int n = nd_ + nn_;
+  const std::vector<S> zero(n, S(0.0));
+  std::vector<rnea::SpatialMotion<S>> motion;
+  rnea::spatial_outward(bodies, Eigen::Matrix<double, 6, 1>::Zero(), theta.data(), rates ? rates->data() : zero.data(),
+                        zero.data(), motion);
+  const int m_rows = 3 * static_cast<int>(loops_.points.size());
+  c.assign(m_rows, S(0.0));
+  if (J) J->assign(static_cast<size_t>(m_rows) * n, S(0.0));
+  if (gamma) gamma->assign(m_rows, S(0.0));
+  auto add_point = [&](int body, const Eigen::Vector3d& b, double scale, int row) {
+    const V3<S> bb = rnea::constant<S>(b);
+    V3<S> x = bb;
+    if (body >= 0) {
+      const rnea::SpatialMotion<S>& d = motion[body];
+      x = rnea::plus(d.pin, rnea::times(d.R, bb));
+      if (gamma) {
+        const V3<S> v = rnea::plus(d.v, rnea::cross(d.w, bb));
+        const V3<S> a = rnea::times(d.R, rnea::plus(rnea::plus(d.acc, rnea::cross(d.alpha, bb)), rnea::cross(d.w, v)));
+        for (int k = 0; k < 3; ++k) (*gamma)[row + k] = (*gamma)[row + k] + scale * a[k];
+      }
+    }
+    for (int k = 0; k < 3; ++k) c[row + k] = c[row + k] + scale * x[k];
+    if (!J) return;
+    for (int j = body; j >= 0; j = bodies[j].parent) {
+      const auto& m = bodies[j];
+      const V3<S> axis = rnea::times(motion[j].R, rnea::constant<S>(m.axis));
+      const V3<S> rate = m.prismatic ? axis : rnea::cross(axis, rnea::minus(x, motion[j].pin));
+      for (int k = 0; k < 3; ++k) (*J)[(row + k) * n + m.dof] = (*J)[(row + k) * n + m.dof] + scale * m.sign * rate[k];
+    }
+  };
+  int row = 0;
+  for (const auto& p : loops_.points) {
+    add_point(p.a, p.pa, 1.0, row);
+    add_point(p.b, p.pb, -1.0, row);
+    row += 3;
+  }
+}
+
+template <class Algebra>
+template <class S>
+bool ClosedLoopTree<Algebra>::loop_dynamics(const S* q, const S* qd, const S* tau, const Eigen::MatrixXd& Jd_inverse,
+                                            S* qdd) {
   const int n = nd_ + nn_;
   const char* singular = "dynamics_derivatives: the loops' Jacobian in the passive joints is singular at this state";
   // θ_d by one Newton correction on S from the closed state (J_d⁻¹ of the double solve).
   std::vector<S> theta(n), rates(n, S(0.0)), c, J, gamma;
   for (int k = 0; k < nd_; ++k) theta[k] = q[k];
   for (int k = nd_; k < n; ++k) theta[k] = S(theta_[k]);
-  planar_points<S>(theta, nullptr, c, nullptr, nullptr);
+  loop_points<S>(theta, nullptr, c, nullptr, nullptr);
   for (int i = 0; i < nn_; ++i)
     for (int r = 0; r < m_; ++r) theta[nd_ + i] = theta[nd_ + i] - Jd_inverse(i, r) * c[r];
   // T_d = −J_d⁻¹ J_q and θ̇_d = T_d q̇ at θ.
-  planar_points<S>(theta, nullptr, c, &J, nullptr);
+  loop_points<S>(theta, nullptr, c, &J, nullptr);
   std::vector<S> Jd(static_cast<size_t>(nn_) * nn_), Td(static_cast<size_t>(nn_) * nd_);
   for (int r = 0; r < m_; ++r) {
     for (int k = 0; k < nn_; ++k) Jd[r * nn_ + k] = J[r * n + nd_ + k];
@@ -560,20 +620,19 @@ bool ClosedLoopTree<PlanarAlgebra>::loop_dynamics(const S* q, const S* qd, const
   for (int i = 0; i < nn_; ++i)
     for (int k = 0; k < nd_; ++k) rates[nd_ + i] = rates[nd_ + i] + Td[i * nd_ + k] * qd[k];
   // g = [0; −J_d⁻¹ γ] at (θ, θ̇).
-  planar_points<S>(theta, &rates, c, nullptr, &gamma);
+  loop_points<S>(theta, &rates, c, nullptr, &gamma);
   Jd_work = Jd;
   if (!solve_small(nn_, Jd_work, 1, gamma)) throw InputError(singular);
   std::vector<S> g(n, S(0.0)), zero(n, S(0.0)), unit(n, S(0.0)), bias(n), rest(n), column(n);
   for (int i = 0; i < nn_; ++i) g[nd_ + i] = -gamma[i];
   // Tᵀ M T q̈ = τ − Tᵀ τ_id(θ, θ̇, g), M T column by column from the inverse dynamics (affine in θ̈).
-  const PlanarTree& tree = static_cast<const PlanarTree&>(*tree_);
-  tree.inverse_dynamics_on(theta.data(), rates.data(), g.data(), bias.data());
-  tree.inverse_dynamics_on(theta.data(), zero.data(), zero.data(), rest.data());
+  tree_inverse_dynamics(theta.data(), rates.data(), g.data(), bias.data());
+  tree_inverse_dynamics(theta.data(), zero.data(), zero.data(), rest.data());
   auto T = [&](int row, int k) -> S { return row < nd_ ? S(row == k ? 1.0 : 0.0) : Td[(row - nd_) * nd_ + k]; };
   std::vector<S> A(static_cast<size_t>(nd_) * nd_, S(0.0)), rhs(nd_);
   for (int k = 0; k < nd_; ++k) {
     for (int row = 0; row < n; ++row) unit[row] = T(row, k);
-    tree.inverse_dynamics_on(theta.data(), zero.data(), unit.data(), column.data());
+    tree_inverse_dynamics(theta.data(), zero.data(), unit.data(), column.data());
     for (int i = 0; i < nd_; ++i)
       for (int row = 0; row < n; ++row) A[i * nd_ + k] = A[i * nd_ + k] + T(row, i) * (column[row] - rest[row]);
   }
@@ -590,10 +649,13 @@ bool ClosedLoopTree<PlanarAlgebra>::loop_dynamics(const S* q, const S* qd, const
   return true;
 }
 
-template <>
-bool ClosedLoopTree<PlanarAlgebra>::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau,
-                                                         double* qdd, double* dq, double* dqd, double* dtau) {
+template <class Algebra>
+bool ClosedLoopTree<Algebra>::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau,
+                                                   double* qdd, double* dq, double* dqd, double* dtau) {
   if (n != nd_) return false;
+  if (!loops_.cuts.empty())
+    throw InputError("dynamics_derivatives: not computed on loops closed at a cut hinge (the recursive path computes "
+                     "them on trees and on loops closed at points; inverse_dynamics and simulate take cut loops)");
   if (m_ != nn_) {
     throw InputError("dynamics_derivatives: not computed on loops with redundant constraints (" + std::to_string(m_) +
                      " constraints on " + std::to_string(nn_) + " passive joints)");
@@ -623,12 +685,7 @@ bool ClosedLoopTree<PlanarAlgebra>::dynamics_derivatives(int n, const double* q,
   return true;
 }
 
-template <>
-bool ClosedLoopTree<SpatialAlgebra>::dynamics_derivatives(int, const double*, const double*, const double*, double*,
-                                                          double*, double*, double*) {
-  throw InputError("dynamics_derivatives: not computed on spatial closed loops (the recursive path computes them on "
-                   "trees and on planar loops; inverse_dynamics and simulate take spatial loops)");
-}
+
 
 template <class Algebra>
 void ClosedLoopTree<Algebra>::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {

@@ -194,6 +194,11 @@ class SpatialTree : public ArticulatedTree<SpatialAlgebra> {
   // world axes, ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇).
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
+  // The inverse dynamics on a scalar type S (double or dual numbers; spatial_rnea.hpp, which
+  // defines it), without a floating base: the closed loops' derivatives run it in the tree's
+  // coordinates.
+  template <class S>
+  void inverse_dynamics_on(const S* q, const S* qd, const S* qdd, S* force) const;
 
  private:
   using Vec3 = Eigen::Vector3d;
