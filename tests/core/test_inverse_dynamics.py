@@ -128,6 +128,7 @@ POINT_LOOPS = {
     "six-bar, two loops": trees.six_bar,
     "spatial RSUR, closed at a point": trees.rsur,
     "spatial RSUR from a URDF, closed by a ball joint": trees.urdf_rsur,
+    "spatial RSUP (a sliding passive joint) with a pendulum, 2 DOFs, springs and loads": trees.urdf_rsup_pendulum,
 }
 
 

@@ -234,6 +234,30 @@ def urdf_rsur():
     return model
 
 
+def urdf_rsup_pendulum():
+    """The URDF RSUR with its rocker a sliding joint (a passive BEARING) and a pendulum hanging from
+    the coupler (a second DOF), closed by a ball joint beside the URDF; gravity off the axes, springs
+    and dampers on hinges (passive and DOF), FORCE and TORQUEL on bodies."""
+    import warnings
+
+    from support.paths import DATA
+
+    ball = {"parent": "crank", "child": "coupler", "xyz": (0.2, 0.0, 0.0), "type": "spherical"}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # joint limits
+        m = spacar.from_urdf(DATA / "rsup_pendulum_loop.urdf", loops=[ball], dependent=["rocker", "cross", "coupler"])
+    m.gravity(0.5, -1.0, -9.81)
+    for e, (k, d) in zip((3, 4, 1, 5), ((2.0, 0.3), (0.7, 0.1), (3.5, 0.4), (1.2, 0.05))):
+        m.estiff(e, k)
+        m.edampp(e, d)
+    for node, f in zip((12, 21, 23), ((0.4, -0.3, 0.2), (-0.5, 0.1, 0.6), (0.2, 0.7, -0.4))):
+        m.force(node, *f)
+    for node, t in zip((10, 11, 4), ((0.1, -0.2, 0.05), (-0.15, 0.1, 0.2), (0.05, 0.25, -0.1))):
+        m.torquel(node, *t)
+    m.epskin(1e-14)
+    return m
+
+
 def four_bar_links():
     """The links of spacar.compare.models.four_bar without a DOF: crank PLBEAM 1 (1 → 2, BETA 11,
     12), coupler 2 (2 → 3), rocker 3 (4 → 3), nodes 1 and 4 fixed, EMASS, a MASS at node 3."""

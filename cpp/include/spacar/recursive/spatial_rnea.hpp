@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 
 #include "spacar/autodiff.hpp"
+#include "spacar/errors.hpp"
 #include "spacar/recursive/spatial_tree.hpp"
 
 namespace spacar::rnea {
@@ -182,6 +183,8 @@ namespace spacar {
 
 template <class S>
 void SpatialTree::inverse_dynamics_on(const S* q, const S* qd, const S* qdd, S* force) const {
+  // The passes have no floating base (loops on one are refused, the only callers).
+  if (floating_) throw InputError("SpatialTree::inverse_dynamics_on: not written for a floating base");
   rnea::spatial_inverse_dynamics(bodies_, base_acceleration_, loads_, q, qd, qdd, force);
 }
 
