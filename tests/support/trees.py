@@ -218,9 +218,9 @@ def rsur():
     return model
 
 
-def urdf_rsur():
-    """The RSUR of rsur() as a URDF tree with its loop closed by a ball joint beside it
-    (tests/api/test_urdf_loops.py)."""
+def rsur_urdf_loop(name):
+    """tests/data/<name> read with the RSUR's loop beside it: the coupler end a ball joint on the
+    crank, the rocker's, the cross's and the coupler's joints passive."""
     import warnings
 
     from support.paths import DATA
@@ -228,7 +228,13 @@ def urdf_rsur():
     ball = {"parent": "crank", "child": "coupler", "xyz": (0.2, 0.0, 0.0), "type": "spherical"}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # joint limits
-        model = spacar.from_urdf(DATA / "rsur_loop.urdf", loops=[ball], dependent=["rocker", "cross", "coupler"])
+        return spacar.from_urdf(DATA / name, loops=[ball], dependent=["rocker", "cross", "coupler"])
+
+
+def urdf_rsur():
+    """The RSUR of rsur() as a URDF tree with its loop closed by a ball joint beside it
+    (tests/api/test_urdf_loops.py)."""
+    model = rsur_urdf_loop("rsur_loop.urdf")
     model.ed(1, 1, 1.5)
     model.epskin(1e-14)
     return model
@@ -238,14 +244,7 @@ def urdf_rsup_pendulum():
     """The URDF RSUR with its rocker a sliding joint (a passive BEARING) and a pendulum hanging from
     the coupler (a second DOF), closed by a ball joint beside the URDF; gravity off the axes, springs
     and dampers on hinges (passive and DOF), FORCE and TORQUEL on bodies."""
-    import warnings
-
-    from support.paths import DATA
-
-    ball = {"parent": "crank", "child": "coupler", "xyz": (0.2, 0.0, 0.0), "type": "spherical"}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # joint limits
-        m = spacar.from_urdf(DATA / "rsup_pendulum_loop.urdf", loops=[ball], dependent=["rocker", "cross", "coupler"])
+    m = rsur_urdf_loop("rsup_pendulum_loop.urdf")
     m.gravity(0.5, -1.0, -9.81)
     for e, (k, d) in zip((3, 4, 1, 5), ((2.0, 0.3), (0.7, 0.1), (3.5, 0.4), (1.2, 0.05))):
         m.estiff(e, k)

@@ -418,8 +418,8 @@ void ClosedLoopTree<Algebra>::inverse_dynamics(const double* q, const double* qd
   Eigen::Map<Eigen::VectorXd>(force, nd_).noalias() = T_.transpose() * col_;
 }
 
-// --- derivatives of planar loops: the forward dynamics of solve() written once on a scalar type and
-// run on dual numbers. Exact first derivatives of θ_d(q) come from one Newton correction on duals
+// --- derivatives of loops closed at points (planar and spatial): the forward dynamics of solve()
+// written once on a scalar type and run on dual numbers. Exact first derivatives of θ_d(q) come from one Newton correction on duals
 // from the closed state, θ_d = θ_d* − J_d⁻¹ c(q, θ_d*) (c vanishes there: its derivative is
 // −J_d⁻¹ J_q); the rest (J, T, γ, g, τ_id, M T, Tᵀ M T) follows by the chain rule.
 
@@ -684,8 +684,6 @@ bool ClosedLoopTree<Algebra>::dynamics_derivatives(int n, const double* q, const
   for (int i = 0; i < n; ++i) qdd[i] = out[i].a;
   return true;
 }
-
-
 
 template <class Algebra>
 void ClosedLoopTree<Algebra>::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {

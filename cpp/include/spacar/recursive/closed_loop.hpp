@@ -112,7 +112,6 @@ class ClosedLoopTree : public RecursiveTree {
                    std::vector<S>* gamma);
   template <class S>
   void tree_inverse_dynamics(const S* q, const S* qd, const S* qdd, S* force) const;  // the tree's, on S
-  std::vector<double> rate_coefficients_;  // planar: ∂ω_i/∂θ̇ of every body (row i), made once
 
   std::unique_ptr<Tree> tree_;
   const typename Tree::Loops& loops_;
@@ -127,6 +126,7 @@ class ClosedLoopTree : public RecursiveTree {
   Eigen::MatrixXd T0_;
   Eigen::MatrixXd J_, T_, MT_, A_;               // A_ = Tᵀ M T
   std::vector<int> path_;                            // a body's path to the root (planar rows)
+  std::vector<double> rate_coefficients_;            // planar, on S: ∂ω_i/∂θ̇ of every body (row i), made once
   DependentJoints qr_;                              // of J_d
   Eigen::LLT<Eigen::MatrixXd> llt_;                 // of A_
 };
