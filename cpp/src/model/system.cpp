@@ -92,6 +92,7 @@ void number_coordinates(const Model& model, System& sys, NodeOffsets& node_offse
 }
 
 void build_elements(const Model& model, System& sys, const NodeOffsets& node_offset, bool line_as_dof) {
+  sys.elements.reserve(model.elements.size());
   for (const auto& [id, el] : model.elements) {
     const ElementType& t = element_catalogue()[el.type];
     ElementSetup setup;
@@ -103,6 +104,7 @@ void build_elements(const Model& model, System& sys, const NodeOffsets& node_off
     se.id = id;
     se.type = el.type;
     se.kernel = t.make(setup);
+    se.coords.reserve(se.kernel->n_coords());
     for (size_t s = 0; s < el.nodes.size(); ++s)
       for (int i = 0; i < node_size(t.nodes[s]); ++i) se.coords.push_back(node_offset.at(el.nodes[s]) + i);
     se.def_offset = sys.ne;

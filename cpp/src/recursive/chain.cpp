@@ -13,12 +13,12 @@ namespace spacar {
 
 namespace {
 
-// The distinct coordinates of element i not yet known.
-std::vector<int> unknown_coords(const System& sys, const std::vector<char>& known, int i) {
-  std::vector<int> u;
+// The distinct coordinates of element i not yet known, in u (its storage reused: the recognition
+// of a long chain asks this of every element a few times).
+void unknown_coords(const System& sys, const std::vector<char>& known, int i, std::vector<int>& u) {
+  u.clear();
   for (int g : sys.elements[i].coords)
     if (!known[g] && std::find(u.begin(), u.end(), g) == u.end()) u.push_back(g);
-  return u;
 }
 
 // LU factors of A with partial pivoting, in place (the row swaps in piv): the blocks have a few
@@ -173,16 +173,17 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
   // Greedy: an element whose rows, with those of the pending elements whose unknowns lie within
   // its own (the L2MIN1 of a rotation it reaches), are as many as its unknowns determines them.
   // None left while elements are pending means a closed loop or a group of elements that only
-  // determine their coordinates together. group_of: that group, empty if the rows do not match
-  // the unknowns; alone: the element by itself.
-  auto group_of = [&](int i, const std::vector<int>& U, bool alone) {
-    std::vector<int> group{i};
+  // determine their coordinates together. group_of: whether there is that group (in `group`);
+  // alone: the element by itself.
+  std::vector<int> U, Uj, group;
+  auto group_of = [&](int i, bool alone) {
+    group.assign(1, i);
     int rows = position_rows(sys, i);
     for (int g : U)
       for (int t = touching_start[g]; t < touching_start[g + 1]; ++t) {
         const int j = touching[t];
         if (alone || j == i || !is_pending[j] || std::find(group.begin(), group.end(), j) != group.end()) continue;
-        const std::vector<int> Uj = unknown_coords(sys, known, j);
+        unknown_coords(sys, known, j, Uj);
         const bool inside = !Uj.empty() && std::all_of(Uj.begin(), Uj.end(), [&](int c) {
           return std::find(U.begin(), U.end(), c) != U.end();
         });
@@ -191,13 +192,14 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
           rows += position_rows(sys, j);
         }
       }
-    return rows == static_cast<int>(U.size()) ? group : std::vector<int>{};
+    return rows == static_cast<int>(U.size());
   };
   // Elements that determine their unknowns alone are taken first: small blocks, and a beam after
   // the hinge that turns its end is solved in closed form.
   // Taken elements are marked (is_pending) and dropped from the list only when they are more than
   // half of it, and the scan starts after the taken ones at its front: linear in the number of
   // elements for a chain in any order (erasing each taken element at once made it quadratic).
+  chain->blocks_.reserve(pending.size());
   size_t first = 0, taken = 0;
   for (bool progress = true; progress && first < pending.size();) {
     progress = false;
@@ -205,13 +207,12 @@ std::unique_ptr<ExplicitChain> ExplicitChain::detect(const System& sys) {
       for (size_t p = first; p < pending.size() && !progress; ++p) {
         const int i = pending[p];
         if (!is_pending[i]) continue;
-        const std::vector<int> U = unknown_coords(sys, known, i);
+        unknown_coords(sys, known, i, U);
         if (U.empty()) return nullptr;  // rows on known coordinates only: a loop closes here
-        const std::vector<int> group = group_of(i, U, pass == 0);
-        if (group.empty()) continue;
-        chain->blocks_.push_back(make_block(sys, group, U));
+        if (!group_of(i, pass == 0)) continue;
         for (int g : U) known[g] = 1;
         for (int j : group) is_pending[j] = 0;
+        chain->blocks_.push_back(make_block(sys, group, U));
         taken += group.size();
         progress = true;
       }
