@@ -326,7 +326,9 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
   kkt_.reset(n_, n_);
   element_scale_start_.push_back(0);
   std::vector<int> fi, cr;  // an element's free indices and constraint rows (reused)
+  rest_start_.push_back(0);
   for (const SystemElement& se : sys.elements) {
+    rest_start_.push_back(rest_start_.back() + static_cast<int>(se.coords.size() * se.coords.size()));
     for (int g : se.coords) element_scale_.push_back(layout.free_of[g] >= 0 ? layout.scale[layout.free_of[g]] : 1.0);
     element_scale_start_.push_back(static_cast<int>(element_scale_.size()));
     fi.resize(se.coords.size());
@@ -358,6 +360,7 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
     for (Eigen::SparseMatrix<double>::InnerIterator it(A, c); it; ++it)
       if (it.row() == c) diagonal_[c] = static_cast<int>(&it.value() - A.valuePtr());
   rhs_ = sol_ = res_ = Eigen::VectorXd::Zero(n_);
+  rest_.assign(rest_start_.back(), 0.0);
   if (!symmetric_) {
     lu_.analyze(A);
     return;
@@ -393,11 +396,10 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
   kkt_.set_zero();
   // H, scaled to energies: H_s(a, b) = H(a, b) s_a s_b.
   auto scale_of = [&](int g) { return layout_.free_of[g] >= 0 ? s[layout_.free_of[g]] : 1.0; };
-  rest_.resize(sys.elements.size());
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
-    spacar::element_rest(sys, data, i, sigma, c, rest_[i]);
-    local_ = rest_[i];
+    spacar::element_rest(sys, data, i, sigma, c, local_);
+    std::copy(local_.data(), local_.data() + local_.size(), rest_.data() + rest_start_[i]);
     add_constitutive(sys, se, data.work[i].B, se.S, c.stiffness, &layout_, local_);
     add_constitutive(sys, se, data.work[i].B, se.D, c.damping, &layout_, local_);
     const int n = static_cast<int>(se.coords.size());
@@ -607,7 +609,7 @@ Eigen::VectorXd ReducedSystem::product(const Eigen::VectorXd& q, Eigen::VectorXd
     xe.resize(n);
     for (int j = 0; j < n; ++j) xe[j] = dx[se.coords[j]];
     // The rest of H (geometric, loads', mass) element by element; its terms do not cancel.
-    const Eigen::VectorXd fe = saddle_.element_rest(i) * xe;
+    const Eigen::VectorXd fe = saddle_.element_rest(i, n) * xe;
     for (int j = 0; j < n; ++j) f[se.coords[j]] += fe[j];
     if (!se.has_constitutive || (c_.stiffness == 0.0 && c_.damping == 0.0)) continue;
     // The deformations' increments, those of DOF deformations exactly; their stresses, of a

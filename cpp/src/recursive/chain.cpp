@@ -21,9 +21,11 @@ void unknown_coords(const System& sys, const std::vector<char>& known, int i, st
     if (!known[g] && std::find(u.begin(), u.end(), g) == u.end()) u.push_back(g);
 }
 
-// LU factors of A with partial pivoting, in place (the row swaps in piv): the blocks have a few
-// unknowns (3 for a planar beam, 7 for a spatial one), where a general LU's blocking and dispatch
-// cost more than the arithmetic. False if A is singular.
+// LU factors of A with partial pivoting, in place (the row swaps in piv), U's diagonal stored as
+// its reciprocals (the solves, run for every block at every right-hand side, then multiply: a
+// division's latency was a tenth of the adjoint sweep): the blocks have a few unknowns (3 for a
+// planar beam, 7 for a spatial one), where a general LU's blocking and dispatch cost more than
+// the arithmetic. False if A is singular.
 bool small_factor(Eigen::MatrixXd& A, std::vector<int>& piv) {
   const int n = static_cast<int>(A.rows());
   piv.resize(n);
@@ -34,15 +36,17 @@ bool small_factor(Eigen::MatrixXd& A, std::vector<int>& piv) {
     if (!(A(p, c) != 0.0)) return false;
     piv[c] = p;
     if (p != c) A.row(p).swap(A.row(c));
+    const double inverse = 1.0 / A(c, c);
     for (int i = c + 1; i < n; ++i) {
-      const double f = A(i, c) /= A(c, c);
+      const double f = A(i, c) *= inverse;
       for (int j = c + 1; j < n; ++j) A(i, j) -= f * A(c, j);
     }
+    A(c, c) = inverse;
   }
   return true;
 }
 
-// x = A⁻¹ r from the factors (P A = L U).
+// x = A⁻¹ r from the factors (P A = L U, U's diagonal inverted).
 void solve_factored(const Eigen::MatrixXd& LU, const std::vector<int>& piv, const Eigen::VectorXd& r, Eigen::VectorXd& x) {
   const int n = static_cast<int>(LU.rows());
   x = r;
@@ -51,7 +55,7 @@ void solve_factored(const Eigen::MatrixXd& LU, const std::vector<int>& piv, cons
     for (int i = c + 1; i < n; ++i) x[i] -= LU(i, c) * x[c];
   for (int c = n - 1; c >= 0; --c) {
     for (int j = c + 1; j < n; ++j) x[c] -= LU(c, j) * x[j];
-    x[c] /= LU(c, c);
+    x[c] *= LU(c, c);
   }
 }
 
@@ -62,7 +66,7 @@ void solve_factored_transposed(const Eigen::MatrixXd& LU, const std::vector<int>
   x = r;
   for (int c = 0; c < n; ++c) {
     for (int j = 0; j < c; ++j) x[c] -= LU(j, c) * x[j];
-    x[c] /= LU(c, c);
+    x[c] *= LU(c, c);
   }
   for (int c = n - 1; c >= 0; --c)
     for (int i = c + 1; i < n; ++i) x[c] -= LU(i, c) * x[i];

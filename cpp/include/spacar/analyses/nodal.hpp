@@ -120,8 +120,10 @@ class SaddlePoint {
   const NodalLayout& layout() const { return layout_; }
   const Eigen::SparseMatrix<double>& matrix() const { return kkt_.matrix(); }
   // Element i's part of the last H without its constitutive terms (the geometric stiffness, the
-  // loads' stiffness, the mass, with their coefficients; local, unscaled).
-  const Eigen::MatrixXd& element_rest(size_t i) const { return rest_[i]; }
+  // loads' stiffness, the mass, with their coefficients; local, n x n, unscaled).
+  Eigen::Map<const Eigen::MatrixXd> element_rest(size_t i, int n) const {
+    return Eigen::Map<const Eigen::MatrixXd>(rest_.data() + rest_start_[i], n, n);
+  }
 
  private:
   void assemble(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c);
@@ -143,7 +145,10 @@ class SaddlePoint {
   int sign_ = 1, negative_ = -1;
   Eigen::VectorXd rhs_, sol_, res_;
   Eigen::MatrixXd local_, rows_;  // an element's block of H and its rows of A (work space)
-  std::vector<Eigen::MatrixXd> rest_;
+  // element_rest of every element in one array (one allocation, not one per element), element
+  // i's n x n values (column-major) from rest_start_[i].
+  std::vector<double> rest_;
+  std::vector<int> rest_start_;
 };
 
 // The reduced system of the degrees of freedom q of sys (x^d, e^d),
