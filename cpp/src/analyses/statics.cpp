@@ -72,7 +72,7 @@ class EquilibriumPath {
     double last_correction = std::numeric_limits<double>::infinity();
     double last_residual = std::numeric_limits<double>::infinity();
     bool crossed = false;
-    bool fresh = false;  // the factorization is that of the last iterate
+    bool fresh = false;  // the factorization is that of the previous iterate
     for (int it = 0;; ++it) {
       check_thread_deadline("(in the static analysis)");
       try {
@@ -101,22 +101,24 @@ class EquilibriumPath {
           a.converged = true;
         return a;
       };
-      // Converged after a small Newton correction: the tangent of the last iterate, that
-      // correction away (below 1e-4 of the DOFs' scale; about √tolerance when Newton converges
-      // quadratically), stands for this state's in the checks of its determinant's sign and of
-      // stability (indefinite()), and the factorization at the solution (a sixth of the work of
-      // a solve in five iterations) is not made. Not after the first iteration: its tangent is
-      // the one at the start of the step (the previous load), on the other side of any critical
-      // point the step passes (a linear problem converges there).
+      // Converged after a small Newton correction: the last tangent factorized, at most two
+      // corrections away (each below 1e-4 of the DOFs' scale; about √tolerance when Newton
+      // converges quadratically; two after the chord below), stands for this state's in the
+      // checks of its determinant's sign and of stability (indefinite()), and the factorization
+      // at the solution (a sixth of the work of a solve in five iterations) is not made. Not
+      // after the first iteration: its tangent is the one at the start of the step (the previous
+      // load), on the other side of any critical point the step passes (a linear problem
+      // converges there).
       const double residual = nd_ > 0 ? Rs.cwiseAbs().maxCoeff() : 0.0;
       if (it >= 2 && last_correction <= 1e-4 && nd_ > 0 && factorized_ && residual_converged(residual))
         return converged(last_sign);
-      // The last correction by the chord (the factorization of the iterate before, which then
-      // stands for this state's as above) where that is certain to converge: near the solution
-      // the chord contracts the residual by about the ratio r_k / r_k−1 of the last Newton step,
-      // and with a tenth of the tolerance to spare it ends below the tolerance. The last
-      // Newton iteration then costs no factorization (a fifth of a cantilever's static solve).
-      const bool chord = it >= 2 && fresh && factorized_ && !tangent_.singular() &&
+      // The last correction by the chord: the factorization of the previous iterate, a small
+      // correction away (as above), where the chord should end below the tolerance: near the
+      // solution it contracts the residual by about the ratio r_k / r_k−1 of the last Newton
+      // step, here with a factor 10 to spare. The last Newton iteration then costs no
+      // factorization (4-6 % of a cold static solve of a cantilever); if the chord falls short,
+      // the next iteration factorizes again.
+      const bool chord = it >= 2 && fresh && last_correction <= 1e-4 && factorized_ && !tangent_.singular() &&
                          10.0 * residual * (residual / last_residual) <= opt_.tolerance * force;
       fresh = !chord;
       last_residual = residual;

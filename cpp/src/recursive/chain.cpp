@@ -25,7 +25,7 @@ void unknown_coords(const System& sys, const std::vector<char>& known, int i, st
 // its reciprocals (the solves, run for every block at every right-hand side, then multiply: a
 // division's latency was a tenth of the adjoint sweep): the blocks have a few unknowns (3 for a
 // planar beam, 7 for a spatial one), where a general LU's blocking and dispatch cost more than
-// the arithmetic. False if A is singular.
+// the arithmetic. False if A is singular (a zero or subnormal pivot).
 bool small_factor(Eigen::MatrixXd& A, std::vector<int>& piv) {
   const int n = static_cast<int>(A.rows());
   piv.resize(n);
@@ -37,6 +37,7 @@ bool small_factor(Eigen::MatrixXd& A, std::vector<int>& piv) {
     piv[c] = p;
     if (p != c) A.row(p).swap(A.row(c));
     const double inverse = 1.0 / A(c, c);
+    if (!std::isfinite(inverse)) return false;  // a subnormal pivot: singular to working precision
     for (int i = c + 1; i < n; ++i) {
       const double f = A(i, c) *= inverse;
       for (int j = c + 1; j < n; ++j) A(i, j) -= f * A(c, j);
