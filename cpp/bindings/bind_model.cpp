@@ -85,9 +85,15 @@ void bind_model(py::module_& m) {
       .def("__repr__", &element_repr);
   bind_fields<Settings>(m, "Settings", kSettingsFields);
 
+  py::class_<LazyModelCopy, std::shared_ptr<LazyModelCopy>>(
+      m, "LazyModelCopy", "A model's copy made when first needed (spacar/model/model.hpp)")
+      .def("model", &LazyModelCopy::model, "A Model equal to the model as it was (a new one at every call)");
   py::class_<Model>(m, "Model")
       .def(py::init<>())
       .def("copy", [](const Model& self) { return Model(self); })
+      .def("lazy_copy", &Model::lazy_copy,
+           "A copy of the model as it is now, made when first needed (spacar._core.LazyModelCopy): when the "
+           "model changes next, or when its model() is asked for")
       .def(py::pickle([](const Model& self) { return py::cast(model_state(self)).cast<py::tuple>(); },
                       &model_from_pickle))
       .def("add_element", &Model::add_element, py::arg("type"), py::arg("id"), py::arg("nodes"),

@@ -88,6 +88,13 @@ def require_results(res, what: str) -> None:
         raise InputError(f"spacar.{what} needs spacar.Results (of spacar.simulate or spacar.static), got {show(res)}")
 
 
+def model_core(source):
+    """The core model of ``source``: a core model itself, or the model of a lazy copy
+    (``_core.LazyModelCopy``, what results keep: the copy is made when the model changes next or
+    when it is first asked for here)."""
+    return source.model() if isinstance(source, _core.LazyModelCopy) else source
+
+
 def dof_labels(system, core, coords=None, defs=None) -> list:
     """Labels of the degrees of freedom of a compiled system (``_core.Simulation(...).system``) in
     its DOF order, the order of q in the core: the DYNX coordinates ascending (``"x(5,1)"``),
@@ -95,6 +102,7 @@ def dof_labels(system, core, coords=None, defs=None) -> list:
     ``coords``, ``defs``: the system's coordinate and deformation labels, if already taken."""
     # Each attribute of the compiled system is a fresh copy of the whole list (20 µs for a
     # 20-link spatial chain): taken once (inside the loops, a chain of 4000 beams took minutes).
+    core = model_core(core)
     coords = system.coord_label if coords is None else coords
     defs = system.def_label if defs is None else defs
     coords, defs = (a.tolist() if isinstance(a, np.ndarray) else a for a in (coords, defs))
@@ -284,12 +292,13 @@ class Results:
         return self._dof_values(self.xdd, self.edd)
 
     # The geometry is only needed for drawing, plotting and saving, and building it costs more than
-    # a small run: spacar.simulate stores a copy of the model's core as it was at the run
-    # (``_geometry_source``) and the Geometry is made from it on first access.
+    # a small run: spacar.simulate and spacar.static keep a lazy copy of the model's core as it
+    # was at the run (``_geometry_source``, see model_core) and the Geometry is made from it on
+    # first access.
     @property
     def geometry(self) -> Geometry | None:
         if self._geometry_source is not None:
-            self._geometry = Geometry.from_model(self._geometry_source)
+            self._geometry = Geometry.from_model(model_core(self._geometry_source))
             self._geometry_source = None
         return self._geometry
 

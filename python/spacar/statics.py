@@ -48,13 +48,14 @@ def _results(arrays: dict, model, *, end_model=None) -> Results:
         "wall_time": float(arrays["wall_time"]),
     }
     res = Results(table, arrays["coord_label"], arrays["def_label"], stats)
-    # A copy of the model at the end of the solve: res.geometry is built from it when first used,
-    # and spacar.compliance(res, node) takes the loads and elements from it (not pickled); a
-    # StaticSolver's results share its model for the geometry instead, and `end_model` makes
+    # A copy of the model at the end of the solve, made when first needed (a lazy copy: when the
+    # model changes next, or when it is asked for): res.geometry is built from it when first
+    # used, and spacar.compliance(res, node) takes the loads and elements from it (not pickled);
+    # a StaticSolver's results share its model for the geometry instead, and `end_model` makes
     # compliance's copy with the solve's loads when first needed.
     if end_model is None:
-        res._geometry_source = core = model.core.copy()
-        res._static_model = Model._of_core(core)
+        res._geometry_source = core = model.core.lazy_copy()
+        res._static_model = lambda: Model._of_core(core.model())
     else:
         res._geometry_source = core = model.core
         res._static_model = end_model

@@ -558,6 +558,7 @@ void Simulation::repartition(int which, double t, Eigen::VectorXd& Y) {
 }
 
 void Simulation::store_state() {
+  model_.before_change();
   const System& sys = *sys_;
   int g = 0;
   for (auto& [id, n] : model_.nodes)

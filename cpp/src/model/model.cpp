@@ -81,6 +81,7 @@ void require_count(const std::vector<double>& values, size_t lo, size_t hi, cons
 // --- lookups ---
 
 Node& Model::node(int id) {
+  before_change();
   auto it = nodes.find(id);
   if (it == nodes.end()) fail("node ", id, " is not defined (nodes are created by elements)");
   return it->second;
@@ -88,6 +89,7 @@ Node& Model::node(int id) {
 const Node& Model::node(int id) const { return const_cast<Model*>(this)->node(id); }
 
 Element& Model::element(int id) {
+  before_change();
   auto it = elements.find(id);
   if (it == elements.end()) fail("element ", id, " is not defined");
   return it->second;
@@ -146,6 +148,7 @@ Node& Model::attach_node(int id, NodeKind kind, const std::string& element_name)
 
 void Model::add_element(const std::string& type_name, int id, const std::vector<int>& node_ids,
                         const std::vector<double>& params, const std::string& origin) {
+  before_change();
   require_open("new elements");
   const int type = find_element_type(type_name);
   if (type < 0) fail("unknown element type ", type_name);
@@ -205,6 +208,7 @@ void Model::add_element(const std::string& type_name, int id, const std::vector<
 
 void Model::set_coordinates(int id, NodeKind kind, const std::vector<double>& values,
                             const std::string& origin) {
+  before_change();
   require_finite(values, node_keyword(kind));
   if (id <= 0) fail("node numbers must be positive, got ", id);
   if (kind == NodeKind::Any) {
@@ -260,6 +264,7 @@ void Model::set_coordinates(int id, NodeKind kind, const std::vector<double>& va
 // --- boundary conditions ---
 
 void Model::set_coordinate_class(int id, const std::vector<int>& components, CoordClass cls) {
+  before_change();
   Node& n = node(id);
   if (components.empty()) {
     for (auto& c : n.cls) c = cls;
@@ -270,6 +275,7 @@ void Model::set_coordinate_class(int id, const std::vector<int>& components, Coo
 }
 
 void Model::set_deformation_class(int id, const std::vector<int>& indices, DefClass cls) {
+  before_change();
   Element& el = element(id);
   std::vector<int> list = indices;
   if (list.empty())
@@ -292,6 +298,7 @@ void Model::set_deformation_class(int id, const std::vector<int>& indices, DefCl
 }
 
 void Model::set_nonholonomic(int e1, int i1, int e2, int i2) {
+  before_change();
   Element& a = element(e1);
   Element& b = element(e2);
   const int k1 = deformation_index(a, i1);
@@ -325,18 +332,21 @@ void Model::set_nonholonomic(int e1, int i1, int e2, int i2) {
 // --- initial values ---
 
 void Model::set_xd(int id, int component, double value) {
+  before_change();
   require_finite(value, "XD");
   Node& n = node(id);
   n.xd[component_index(n, component)] = value;
 }
 
 void Model::set_xdd(int id, int component, double value) {
+  before_change();
   require_finite(value, "XDD");
   Node& n = node(id);
   n.xdd[component_index(n, component)] = value;
 }
 
 void Model::set_e(int id, int index, double value) {
+  before_change();
   require_finite(value, "E");
   Element& el = element(id);
   const int k = deformation_index(el, index);
@@ -345,23 +355,27 @@ void Model::set_e(int id, int index, double value) {
 }
 
 void Model::set_ed(int id, int index, double value) {
+  before_change();
   require_finite(value, "ED");
   Element& el = element(id);
   el.ed[deformation_index(el, index)] = value;
 }
 
 void Model::set_edd(int id, int index, double value) {
+  before_change();
   require_finite(value, "EDD");
   Element& el = element(id);
   el.edd[deformation_index(el, index)] = value;
 }
 
 void Model::set_time(double t) {
+  before_change();
   require_finite(t, "TIME");
   time = t;
 }
 
 void Model::set_direction(int id, const std::vector<double>& xyz) {
+  before_change();
   require_open("DIR");
   require_count(xyz, 3, 3, "DIR");
   require_finite(xyz, "DIR");
@@ -372,6 +386,7 @@ void Model::set_direction(int id, const std::vector<double>& xyz) {
 }
 
 void Model::set_lgeomy(int id, const std::vector<double>& values) {
+  before_change();
   require_finite(values, "LGEOMY");
   Element& el = element(id);
   const int n = type_of(el).n_lgeomy;
@@ -381,6 +396,7 @@ void Model::set_lgeomy(int id, const std::vector<double>& values) {
 }
 
 void Model::set_lengtho(int id, double l0) {
+  before_change();
   require_finite(l0, "LENGTHO");
   Element& el = element(id);
   if (!type_of(el).has_length) fail(type_of(el).name, " has no reference length (LENGTHO)");
@@ -391,6 +407,7 @@ void Model::set_lengtho(int id, double l0) {
 // --- properties ---
 
 void Model::set_mass(int id, const std::vector<double>& values) {
+  before_change();
   require_finite(values, "MASS");
   Node& n = node(id);
   switch (n.kind) {
@@ -422,6 +439,7 @@ void Model::set_mass(int id, const std::vector<double>& values) {
 }
 
 void Model::set_emass(int id, const std::vector<double>& values) {
+  before_change();
   require_finite(values, "EMASS");
   Element& el = element(id);
   const ElementType& t = type_of(el);
@@ -433,6 +451,7 @@ void Model::set_emass(int id, const std::vector<double>& values) {
 }
 
 void Model::set_estiff(int id, const std::vector<double>& values) {
+  before_change();
   require_finite(values, "ESTIFF");
   Element& el = element(id);
   const ElementType& t = type_of(el);
@@ -443,6 +462,7 @@ void Model::set_estiff(int id, const std::vector<double>& values) {
 }
 
 void Model::set_edampp(int id, const std::vector<double>& values) {
+  before_change();
   require_finite(values, "EDAMPP");
   Element& el = element(id);
   const ElementType& t = type_of(el);
@@ -453,6 +473,7 @@ void Model::set_edampp(int id, const std::vector<double>& values) {
 }
 
 void Model::set_force(int id, const std::vector<double>& values) {
+  before_change();
   require_finite(values, "FORCE");
   Node& n = node(id);
   if (n.kind == NodeKind::Any) fail("node ", id, " is not used by an element yet; define its element before FORCE");
@@ -472,16 +493,19 @@ void set_torque(Node& n, int id, const std::vector<double>& values, const char* 
 }  // namespace
 
 void Model::set_torquel(int id, const std::vector<double>& values) {
+  before_change();
   Node& n = node(id);
   set_torque(n, id, values, "TORQUEL", n.torquel);
 }
 
 void Model::set_torqueg(int id, const std::vector<double>& values) {
+  before_change();
   Node& n = node(id);
   set_torque(n, id, values, "TORQUEG", n.torqueg);
 }
 
 void Model::set_gravity(const std::vector<double>& g) {
+  before_change();
   require_count(g, 2, 3, "GRAVITY");
   require_finite(g, "GRAVITY");
   gravity = {g[0], g[1], g.size() > 2 ? g[2] : 0.0};
@@ -491,6 +515,7 @@ void Model::set_gravity(const std::vector<double>& g) {
 // --- settings ---
 
 void Model::set_timestep(int n, double tp) {
+  before_change();
   require_finite(tp, "TIMESTEP");
   if (n < 0) fail("the number of output intervals must not be negative, got ", n);
   if (tp < 0.0) fail("the time period must not be negative, got ", tp);
@@ -501,12 +526,14 @@ void Model::set_timestep(int n, double tp) {
 }
 
 void Model::set_hmax(double h) {
+  before_change();
   require_finite(h, "HMAX");
   if (!(h > 0.0)) fail("HMAX must be positive, got ", h);
   settings.hmax = h;
 }
 
 void Model::set_maxiterat(int n) {
+  before_change();
   if (n < 1 || n > 1000) fail("MAXITERAT must be between 1 and 1000, got ", n);
   settings.maxiterat = n;
 }
@@ -521,19 +548,55 @@ void check_flag(int v, int max, const char* what) {
 }
 }  // namespace
 
-void Model::set_epskin(double eps) { check_tolerance(eps, "EPSKIN"); settings.epskin = eps; }
-void Model::set_epsint(double eps) { check_tolerance(eps, "EPSINT"); settings.epsint = eps; }
-void Model::set_epsind(double eps) { check_tolerance(eps, "EPSIND"); settings.epsind = eps; }
-void Model::set_forcemode(int mode) { check_flag(mode, 2, "FORCEMODE"); settings.forcemode = mode; }
-void Model::set_animate(int flag) { check_flag(flag, 1, "ANIMATE"); settings.animate = flag; }
-void Model::set_matasc(int flag) { check_flag(flag, 1, "MATASC"); settings.matasc = flag; }
-void Model::set_jobid(int id) { settings.jobid = id; }
-void Model::set_restart(int flag) { check_flag(flag, 1, "RESTART"); settings.restart = flag; }
-void Model::set_linear(int mode) { check_flag(mode, 2, "LINEAR"); settings.linear = mode; }
+void Model::set_epskin(double eps) {
+  before_change();
+  check_tolerance(eps, "EPSKIN");
+  settings.epskin = eps;
+}
+void Model::set_epsint(double eps) {
+  before_change();
+  check_tolerance(eps, "EPSINT");
+  settings.epsint = eps;
+}
+void Model::set_epsind(double eps) {
+  before_change();
+  check_tolerance(eps, "EPSIND");
+  settings.epsind = eps;
+}
+void Model::set_forcemode(int mode) {
+  before_change();
+  check_flag(mode, 2, "FORCEMODE");
+  settings.forcemode = mode;
+}
+void Model::set_animate(int flag) {
+  before_change();
+  check_flag(flag, 1, "ANIMATE");
+  settings.animate = flag;
+}
+void Model::set_matasc(int flag) {
+  before_change();
+  check_flag(flag, 1, "MATASC");
+  settings.matasc = flag;
+}
+void Model::set_jobid(int id) {
+  before_change();
+  settings.jobid = id;
+}
+void Model::set_restart(int flag) {
+  before_change();
+  check_flag(flag, 1, "RESTART");
+  settings.restart = flag;
+}
+void Model::set_linear(int mode) {
+  before_change();
+  check_flag(mode, 2, "LINEAR");
+  settings.linear = mode;
+}
 
 // --- preparation at END ---
 
 void Model::prepare() {
+  before_change();
   if (!frozen_) {
     for (const auto& [id, n] : nodes)
       if (n.kind == NodeKind::Any)
@@ -617,6 +680,40 @@ void Model::compute_reference_geometry() {
       el.lgeomy = lgeomy;
     }
   }
+}
+
+// --- lazy copies -------------------------------------------------------------------------------
+
+Model LazyModelCopy::model() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return copy_ ? Model(*copy_) : Model(*live_);  // the live model, unchanged since (else copy_ is made)
+}
+
+void LazyModelCopy::take(const Model& live) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (live_ != &live) return;
+  copy_ = std::make_unique<Model>(live);
+  live_ = nullptr;
+}
+
+void PendingCopies::add(const Model& owner, const std::shared_ptr<LazyModelCopy>& copy) {
+  owner_ = &owner;
+  list_.erase(std::remove_if(list_.begin(), list_.end(), [](const auto& w) { return w.expired(); }), list_.end());
+  list_.push_back(copy);
+}
+
+void PendingCopies::make() {
+  std::vector<std::weak_ptr<LazyModelCopy>> list;
+  list.swap(list_);
+  for (const auto& w : list)
+    if (const auto copy = w.lock()) copy->take(*owner_);
+}
+
+std::shared_ptr<LazyModelCopy> Model::lazy_copy() const {
+  auto copy = std::make_shared<LazyModelCopy>();
+  copy->live_ = this;
+  pending_.add(*this, copy);
+  return copy;
 }
 
 }  // namespace spacar

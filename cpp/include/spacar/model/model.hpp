@@ -7,6 +7,8 @@
 
 #include <array>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -144,8 +146,73 @@ inline constexpr auto kSettingsFields = std::make_tuple(
     field("restart", &Settings::restart, "RESTART"),
     field("linear", &Settings::linear, "LINEAR 0/1/2 (None: not given)"));
 
-class Model {
+class Model;
+
+// A copy of a model as it was when the copy was asked for (Model::lazy_copy), made only when it
+// is first needed: when the model is about to change (its methods, an analysis storing its state),
+// is destroyed or assigned, or when the copy is read. spacar.static and spacar.simulate keep one
+// in their results (for the drawing, the DOF labels, compliance): a model of 512 beams copied at
+// once is 11 000 allocations, 7 % of its cold static solve, for results that are rarely drawn.
+class LazyModelCopy {
  public:
+  // A Model equal to the model as it was (a new one at every call).
+  Model model();
+
+ private:
+  friend class Model;
+  friend class PendingCopies;
+  void take(const Model& live);  // the copy made now, if not yet
+  std::mutex mutex_;
+  const Model* live_ = nullptr;  // the model, unchanged since, while the copy is not made
+  std::unique_ptr<Model> copy_;
+};
+
+// The lazy copies of a model not yet made. Not copied or moved with the model: a copy or a moved-to
+// model has none, and a moved-from or assigned-to model makes its own first (it is declared first
+// in Model, so that this happens before any other member changes).
+class PendingCopies {
+ public:
+  PendingCopies() = default;
+  PendingCopies(const PendingCopies&) {}
+  PendingCopies(PendingCopies&& other) { other.make(); }
+  PendingCopies& operator=(const PendingCopies&) {
+    make();
+    return *this;
+  }
+  PendingCopies& operator=(PendingCopies&& other) {
+    make();
+    other.make();
+    return *this;
+  }
+  ~PendingCopies() = default;
+  bool empty() const { return list_.empty(); }
+  void add(const Model& owner, const std::shared_ptr<LazyModelCopy>& copy);
+  void make();  // every pending copy made from the owner as it is now
+
+ private:
+  const Model* owner_ = nullptr;
+  std::vector<std::weak_ptr<LazyModelCopy>> list_;
+};
+
+class Model {
+  mutable PendingCopies pending_;  // first: see PendingCopies
+
+ public:
+  Model() = default;
+  Model(const Model&) = default;
+  Model(Model&&) = default;
+  Model& operator=(const Model&) = default;
+  Model& operator=(Model&&) = default;
+  ~Model() { before_change(); }
+
+  // A copy of the model as it is now, made when first needed (LazyModelCopy).
+  std::shared_ptr<LazyModelCopy> lazy_copy() const;
+  // Called first by everything that changes the model (its methods here, Simulation::store_state):
+  // the lazy copies not yet made are made now, of the model as it still is.
+  void before_change() {
+    if (!pending_.empty()) pending_.make();
+  }
+
   // --- topology (before the first END) ---
   // `origin` names the input line (file, line, keyword) for errors found later, at prepare().
   void add_element(const std::string& type, int id, const std::vector<int>& nodes,
@@ -201,7 +268,10 @@ class Model {
   bool frozen() const { return frozen_; }
   // Deserialisation only (pickle): the model was prepared when it was saved; its reference
   // geometry and automatic elements are part of the saved state, so nothing is recomputed.
-  void restore_prepared() { frozen_ = true; }
+  void restore_prepared() {
+    before_change();
+    frozen_ = true;
+  }
 
   // Lookups that raise InputError naming the missing item.
   Node& node(int id);
