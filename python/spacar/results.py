@@ -88,11 +88,26 @@ def require_results(res, what: str) -> None:
         raise InputError(f"spacar.{what} needs spacar.Results (of spacar.simulate or spacar.static), got {show(res)}")
 
 
+class KeptModel:
+    """The model that results keep (spacar.static, spacar.simulate): a lazy copy of the model's
+    core at the solve (``_core.LazyModelCopy``, made when the model changes next, or is deleted,
+    or here), made a core model once, when the geometry, the DOF labels or compliance first need
+    it."""
+
+    __slots__ = ("_lazy", "_made")
+
+    def __init__(self, model):
+        self._lazy, self._made = model.core.lazy_copy(), None
+
+    def core(self):
+        if self._made is None:
+            self._made, self._lazy = self._lazy.model(), None
+        return self._made
+
+
 def model_core(source):
-    """The core model of ``source``: a core model itself, or the model of a lazy copy
-    (``_core.LazyModelCopy``, what results keep: the copy is made when the model changes next or
-    when it is first asked for here)."""
-    return source.model() if isinstance(source, _core.LazyModelCopy) else source
+    """The core model of ``source``: a core model itself, or a KeptModel's."""
+    return source.core() if isinstance(source, KeptModel) else source
 
 
 def dof_labels(system, core, coords=None, defs=None) -> list:
@@ -292,9 +307,8 @@ class Results:
         return self._dof_values(self.xdd, self.edd)
 
     # The geometry is only needed for drawing, plotting and saving, and building it costs more than
-    # a small run: spacar.simulate and spacar.static keep a lazy copy of the model's core as it
-    # was at the run (``_geometry_source``, see model_core) and the Geometry is made from it on
-    # first access.
+    # a small run: spacar.simulate and spacar.static keep the model as it was at the run
+    # (``_geometry_source``, a KeptModel) and the Geometry is made from it on first access.
     @property
     def geometry(self) -> Geometry | None:
         if self._geometry_source is not None:

@@ -16,7 +16,7 @@ from .errors import InputError, KinematicsError, SpacarError
 from .io.matasc import MatascWriter, default_stem
 from .linearize import Linearization
 from .model import Model
-from .results import Results, dof_labels
+from .results import KeptModel, Results, dof_labels
 from .table import Table
 from .control import Controller
 from .energy import Energy
@@ -41,7 +41,7 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     coords, defs = system.coord_label, system.def_label  # each a fresh copy of the list: taken once
     lins = [Linearization(d, coords, defs) for d in arrays["linearizations"]]
     res = Results(arrays, coords, defs, stats, None, lins, model.settings.linear)
-    res._geometry_source = core = model.core.lazy_copy()  # res.geometry is built from it when first used
+    res._geometry_source = core = KeptModel(model)  # res.geometry is built from it when first used
     res.shapes = getattr(model, "urdf_shapes", None)  # a URDF robot's link shapes, for spacar.view3d
     # The DOF labels, when first asked for, from the compiled system's lists and the copy.
     dofs = SimpleNamespace(x_dyn=system.x_dyn, e_dyn=system.e_dyn)

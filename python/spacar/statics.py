@@ -26,7 +26,7 @@ from . import _core
 from ._util import seconds_or_none, show
 from .errors import InputError, SpacarError, StaticError  # noqa: F401  (StaticError: spacar.statics.StaticError)
 from .model import Model
-from .results import Results, dof_labels
+from .results import KeptModel, Results, dof_labels
 
 
 def _results(arrays: dict, model, *, end_model=None) -> Results:
@@ -54,8 +54,8 @@ def _results(arrays: dict, model, *, end_model=None) -> Results:
     # a StaticSolver's results share its model for the geometry instead, and `end_model` makes
     # compliance's copy with the solve's loads when first needed.
     if end_model is None:
-        res._geometry_source = core = model.core.lazy_copy()
-        res._static_model = lambda: Model._of_core(core.model())
+        res._geometry_source = core = KeptModel(model)
+        res._static_model = lambda: Model._of_core(core.core())
     else:
         res._geometry_source = core = model.core
         res._static_model = end_model

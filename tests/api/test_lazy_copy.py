@@ -1,7 +1,8 @@
 """The model that results keep (spacar.static, spacar.simulate): a copy of the model as it was at
-the solve, made only when it is first needed (``_core.LazyModelCopy``: when the model changes next,
-is deleted, or when the copy is read). Every way of changing the model must make the copy first:
-the results then draw, label and take compliance from the model of their solve, never a later one."""
+the solve, made only when it is first needed (``_core.LazyModelCopy`` in a ``KeptModel``: when
+the model changes next, is deleted, or when the copy is read). Every way of changing the model
+must make the copy first: the results then draw, label and take compliance from the model of
+their solve, never a later one."""
 from __future__ import annotations
 
 import gc
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 import spacar
-from spacar import _core
+from spacar.results import KeptModel
 from support.paths import EXAMPLES
 
 
@@ -42,6 +43,8 @@ CHANGES = {
     "mass and class": lambda m: (m.mass(5, 0.5), m.fix(5)),
     "setting": lambda m: m.epskin(1e-9),
     "another static": lambda m: spacar.static(m, steps=1),
+    "compliance of the live model": lambda m: (m.force(9, 0.0, 2.0), spacar.compliance(m, 9)),
+    "linearize": lambda m: (m.xd(9, 1, 0.5), spacar.linearize(m)),
 }
 
 
@@ -71,7 +74,7 @@ def test_compliance_takes_the_loads_of_the_solve():
 def test_an_unchanged_model_is_copied_when_read():
     model = cantilever()
     res = spacar.static(model, steps=1)
-    assert isinstance(res._geometry_source, _core.LazyModelCopy)
+    assert isinstance(res._geometry_source, KeptModel)
     assert res.geometry == spacar.Geometry.from_model(model)
     assert state(res._static_model()) == state(model)
 
@@ -109,4 +112,15 @@ def test_each_copy_is_its_own():
     other.force(9, 0.0, 3.0)
     assert state(first._static_model()) == s1
     assert state(second._static_model()) == s2
-    assert first._static_model().core is not second._static_model().core
+
+
+def test_a_copy_read_first_stays_when_the_model_changes():
+    model = cantilever()
+    res = spacar.static(model, steps=1)
+    at_solve = state(model)
+    labels = res.dof_labels                 # the kept model made now, from the unchanged model
+    model.force(9, 0.0, 2.0)
+    spacar.static(model, steps=1)
+    assert state(res._static_model()) == at_solve and res.dof_labels == labels
+    # one copy serves the labels, the geometry and compliance
+    assert res._static_model().core is res._geometry_source.core()

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include <Eigen/Dense>
 
@@ -80,21 +81,26 @@ void require_count(const std::vector<double>& values, size_t lo, size_t hi, cons
 
 // --- lookups ---
 
-Node& Model::node(int id) {
-  before_change();
+const Node& Model::node(int id) const {
   auto it = nodes.find(id);
   if (it == nodes.end()) fail("node ", id, " is not defined (nodes are created by elements)");
   return it->second;
 }
-const Node& Model::node(int id) const { return const_cast<Model*>(this)->node(id); }
-
-Element& Model::element(int id) {
+// A node or element that may be changed through the reference: the lazy copies are made first.
+Node& Model::node(int id) {
   before_change();
+  return const_cast<Node&>(std::as_const(*this).node(id));
+}
+
+const Element& Model::element(int id) const {
   auto it = elements.find(id);
   if (it == elements.end()) fail("element ", id, " is not defined");
   return it->second;
 }
-const Element& Model::element(int id) const { return const_cast<Model*>(this)->element(id); }
+Element& Model::element(int id) {
+  before_change();
+  return const_cast<Element&>(std::as_const(*this).element(id));
+}
 
 const ElementType& Model::type_of(const Element& el) const { return element_catalogue()[el.type]; }
 
@@ -686,7 +692,10 @@ void Model::compute_reference_geometry() {
 
 Model LazyModelCopy::model() {
   std::lock_guard<std::mutex> lock(mutex_);
-  return copy_ ? Model(*copy_) : Model(*live_);  // the live model, unchanged since (else copy_ is made)
+  if (copy_) return Model(*copy_);
+  if (live_) return Model(*live_);  // the live model, unchanged since (else copy_ is made)
+  throw Error("the copy of the model these results keep could not be made when the model was deleted "
+              "(out of memory)");
 }
 
 void LazyModelCopy::take(const Model& live) {
@@ -703,10 +712,21 @@ void PendingCopies::add(const Model& owner, const std::shared_ptr<LazyModelCopy>
 }
 
 void PendingCopies::make() {
-  std::vector<std::weak_ptr<LazyModelCopy>> list;
-  list.swap(list_);
-  for (const auto& w : list)
-    if (const auto copy = w.lock()) copy->take(*owner_);
+  // One at a time, each dropped once made: if a copy fails (out of memory), it and the rest stay
+  // pending, and the change that asked for them is not made (before_change() comes first).
+  while (!list_.empty()) {
+    if (const auto copy = list_.back().lock()) copy->take(*owner_);
+    list_.pop_back();
+  }
+}
+
+void PendingCopies::abandon() {
+  for (const auto& w : list_)
+    if (const auto copy = w.lock()) {
+      std::lock_guard<std::mutex> lock(copy->mutex_);
+      copy->live_ = nullptr;
+    }
+  list_.clear();
 }
 
 std::shared_ptr<LazyModelCopy> Model::lazy_copy() const {

@@ -188,6 +188,7 @@ class PendingCopies {
   bool empty() const { return list_.empty(); }
   void add(const Model& owner, const std::shared_ptr<LazyModelCopy>& copy);
   void make();  // every pending copy made from the owner as it is now
+  void abandon();  // the pending copies told that they cannot be made (their model() raises)
 
  private:
   const Model* owner_ = nullptr;
@@ -203,12 +204,20 @@ class Model {
   Model(Model&&) = default;
   Model& operator=(const Model&) = default;
   Model& operator=(Model&&) = default;
-  ~Model() { before_change(); }
+  ~Model() {
+    try {
+      before_change();
+    } catch (...) {  // out of memory: the results that kept this model raise when they need it
+      pending_.abandon();
+    }
+  }
 
   // A copy of the model as it is now, made when first needed (LazyModelCopy).
   std::shared_ptr<LazyModelCopy> lazy_copy() const;
-  // Called first by everything that changes the model (its methods here, Simulation::store_state):
-  // the lazy copies not yet made are made now, of the model as it still is.
+  // Called first by everything that changes the model (its methods here, the writable node() and
+  // element(), Simulation::store_state; anything that writes the public members below must call
+  // it first): the lazy copies not yet made are made now, of the model as it still is. Not safe
+  // for two threads changing one model at once (no analysis is).
   void before_change() {
     if (!pending_.empty()) pending_.make();
   }
