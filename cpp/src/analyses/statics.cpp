@@ -109,7 +109,8 @@ class EquilibriumPath {
       // after the first iteration: its tangent is the one at the start of the step (the previous
       // load), on the other side of any critical point the step passes (a linear problem
       // converges there).
-      const double residual = nd_ > 0 ? Rs.cwiseAbs().maxCoeff() : 0.0;
+      int worst = -1;  // the DOF of the largest scaled residual
+      const double residual = nd_ > 0 ? Rs.cwiseAbs().maxCoeff(&worst) : 0.0;
       if (it >= 2 && last_correction <= 1e-4 && nd_ > 0 && factorized_ && residual_converged(residual))
         return converged(last_sign);
       // The last correction by the chord: the factorization of the previous iterate, a small
@@ -139,11 +140,10 @@ class EquilibriumPath {
         }
       }
       const bool singular = tangent_.singular();
-      const int sign = last_sign;
-      double res_max = 0.0, correction = 0.0;
+      double correction = 0.0;
       if (nd_ > 0) {
-        res_max = Rs.cwiseAbs().maxCoeff(&a.worst);
-        a.worst_residual = R[a.worst];
+        a.worst = worst;
+        a.worst_residual = R[worst];
         if (!singular) {
           solve_dofs(-R, dq, dx);
           correction = dq.cwiseQuotient(scale_).cwiseAbs().maxCoeff();
@@ -151,7 +151,7 @@ class EquilibriumPath {
       }
       // Converged on the residual, or the correction would move the DOFs by less than round-off
       // (nothing is loaded: a mechanism moved by its inputs).
-      if (residual_converged(res_max) || (!singular && correction <= 1e-13)) return converged(sign);
+      if (residual_converged(residual) || (!singular && correction <= 1e-13)) return converged(last_sign);
       if (it == opt_.max_iterations) {
         a.why = "Newton's method did not converge in " + std::to_string(opt_.max_iterations) + " iterations";
         return a;
