@@ -93,6 +93,10 @@ void bind_system(py::module_& m) {
       .def_readonly("ne", &System::ne)
       .def_readonly("coord_label", &System::coord_label)
       .def_readonly("def_label", &System::def_label)
+      .def_property_readonly("coord_label_array", [](const System& s) { return label_array(s.coord_label); },
+                             "coord_label as an (nx, 2) integer array")
+      .def_property_readonly("def_label_array", [](const System& s) { return label_array(s.def_label); },
+                             "def_label as an (ne, 2) integer array")
       .def_readonly("coord_class", &System::coord_class)
       .def_readonly("def_class", &System::def_class)
       .def_readonly("x_calc", &System::x_calc)
@@ -154,6 +158,9 @@ void bind_setup(py::class_<Simulation>& sim) {
            py::arg("model"), py::arg("time_limit") = 0.0, py::arg("time_spent") = 0.0, py::keep_alive<1, 2>(),
            "Prepare and compile `model` for its analyses within `time_limit` seconds (0: no limit) of which "
            "`time_spent` are spent.")
+      .def("renew", &Simulation::renew,
+           "Ready for the model's next block without compiling it again, if the model has not changed since this "
+           "simulation's last run, which took the recursive path; False (nothing done) otherwise.")
       .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", [](Simulation& s) { s.assemble(); })

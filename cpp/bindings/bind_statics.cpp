@@ -12,15 +12,13 @@
 
 namespace spacar::bindings {
 
-namespace {
-
-// Labels as an (n, 2) integer array: one conversion, where a list of pairs is a Python object
-// per label (1 ms for the labels of 512 beams).
-Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor> label_array(const std::vector<std::array<int, 2>>& labels) {
-  Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor> a(labels.size(), 2);
+LabelArray label_array(const std::vector<std::array<int, 2>>& labels) {
+  LabelArray a(labels.size(), 2);
   for (size_t i = 0; i < labels.size(); ++i) a.row(static_cast<Eigen::Index>(i)) << labels[i][0], labels[i][1];
   return a;
 }
+
+namespace {
 
 py::dict static_results_to_dict(StaticResults&& r) {
   py::dict d;

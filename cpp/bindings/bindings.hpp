@@ -4,8 +4,10 @@
 
 #include <pybind11/pybind11.h>
 
+#include <array>
 #include <exception>
 #include <utility>
+#include <vector>
 
 #include "spacar/analyses/linearize.hpp"
 
@@ -48,6 +50,11 @@ py::dict run_released(Results& results, Work&& work, ToDict&& to_dict, Partial&&
   }
   return to_dict(std::move(results));
 }
+
+// Labels (node or element, index) as an (n, 2) integer array: one conversion, where a list of
+// pairs is a Python object per label (1 ms for the labels of 512 beams).
+using LabelArray = Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor>;
+LabelArray label_array(const std::vector<std::array<int, 2>>& labels);
 
 py::dict linearization_to_dict(const Linearization& l);
 py::dict nodal_linearization_to_dict(NodalLinearization&& n);

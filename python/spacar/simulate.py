@@ -38,7 +38,9 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     stats.update(wall_time=arrays["wall_time"], recursive=arrays["recursive"], path=arrays["path"])
     stats["method"] = _method_used(arrays)
     stats["switches"] = [tuple(s) for s in arrays["switches"]]
-    coords, defs = system.coord_label, system.def_label  # each a fresh copy of the list: taken once
+    # The labels as (n, 2) arrays, one conversion each (a list is a Python pair per label), taken
+    # once; the results make their lookups from them when first used.
+    coords, defs = system.coord_label_array, system.def_label_array
     lins = [Linearization(d, coords, defs) for d in arrays["linearizations"]]
     res = Results(arrays, coords, defs, stats, None, lins, model.settings.linear)
     res._geometry_source = core = KeptModel(model)  # res.geometry is built from it when first used
@@ -145,20 +147,39 @@ def _dead_position_hint(err, res, system, model) -> str:
             "other two (Grashof). Check the link lengths, or keep the input within its range.")
 
 
-# Runs on one model, one at a time (issue 38): a run starts from the model's state and leaves its
-# end state in it, so threads simulating the same model started at the same time and blocks were
-# lost (six threads of one 5 s run each left the manual's slider-crank at t = 10, not 30). A run
-# now waits for the one before and continues from its end, as runs one after the other do.
-_RUN_LOCKS_GUARD = threading.Lock()
-_RUN_LOCKS: "weakref.WeakKeyDictionary[Model, threading.RLock]" = weakref.WeakKeyDictionary()
+class _Runs:
+    """A model's runs. One at a time (issue 38): a run starts from the model's state and leaves its
+    end state in it, so threads simulating the same model started at the same time and blocks were
+    lost (six threads of one 5 s run each left the manual's slider-crank at t = 10, not 30); a run
+    now waits for the one before and continues from its end, as runs one after the other do. And
+    the simulation of the last run, when it took the recursive path: the next run of the unchanged
+    model renews it instead of compiling the model and recognizing its tree again (issue 37)."""
+
+    __slots__ = ("lock", "simulation", "__weakref__")
+
+    def __init__(self):
+        self.lock = threading.RLock()
+        self.simulation = None
+
+    def take_simulation(self, model: Model, time_limit: float):
+        """The kept simulation renewed for the model's next block, or a new one (which prepares
+        the model, at its first END, and compiles it)."""
+        sim, self.simulation = self.simulation, None
+        if sim is not None and sim.renew():
+            return sim
+        return _core.Simulation(model.core, time_limit=time_limit)
 
 
-def _run_lock(model: Model) -> threading.RLock:
-    with _RUN_LOCKS_GUARD:
-        lock = _RUN_LOCKS.get(model)
-        if lock is None:
-            lock = _RUN_LOCKS[model] = threading.RLock()
-        return lock
+_RUNS_GUARD = threading.Lock()
+_RUNS: "weakref.WeakKeyDictionary[Model, _Runs]" = weakref.WeakKeyDictionary()
+
+
+def _runs(model: Model) -> _Runs:
+    with _RUNS_GUARD:
+        runs = _RUNS.get(model)
+        if runs is None:
+            runs = _RUNS[model] = _Runs()
+        return runs
 
 
 def check_method_options(method, rho_inf, fixed_step, recursive) -> float:
@@ -259,9 +280,10 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
         raise InputError(f"energy must be True or False, got {show(energy)}")
     if controller is not None and not isinstance(controller, Controller):
         raise InputError(f"controller must be a spacar.Controller or None, got {show(controller)}")
-    with _run_lock(model):  # one run at a time on a model: each starts where the last ended
+    runs = _runs(model)
+    with runs.lock:  # one run at a time on a model: each starts where the last ended
         started = time.monotonic()   # the time limit covers the set-up too
-        sim = _core.Simulation(model.core, time_limit=limit)  # prepares the model (the first END) and compiles it
+        sim = runs.take_simulation(model, limit)
         system = sim.system
         for name, value in (("forces", forces), ("inputs", inputs)):
             if value is not None and not isinstance(value, dict):  # before its truth value (an array has none)
@@ -332,4 +354,6 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
                 bar.close()
         model._continue_step = arrays["last_step"]
         model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
+        if arrays["recursive"]:
+            runs.simulation = sim
         return _results(arrays, sim.system, model, method)

@@ -120,8 +120,31 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     finish();
     throw;
   }
+  // The tree, kept for the next run of the unchanged model (renew()); not after a repartition.
+  std::unique_ptr<RhsPath> tree = path_->tree() && sys_->free_rotations.empty() ? std::move(path_) : nullptr;
   finish();
   store_state();
+  kept_tree_ = std::move(tree);
+  kept_revision_ = model_.revision();
+}
+
+bool Simulation::renew() {
+  if (!kept_tree_ || model_.revision() != kept_revision_) return false;
+  model_.prepare();  // as at every END: the Euler parameters normalized
+  reload_state(model_, *sys_);
+  data_->reset_state(*sys_, /*keep_pivots=*/true);  // the last block's pivots replayed: no search
+  int g = 0;
+  for (const auto& [id, n] : model_.nodes)
+    for (double v : n.x) data_->x[g++] = v;
+  predicted_.setZero();
+  run_ = RunState();
+  qhat_transfer_.resize(0);
+  have_transfer_ = false;
+  linearizer_.reset();
+  timed_ = TimeLoads();
+  rollout_ = RolloutStart();
+  x_given_.resize(0);
+  return true;
 }
 
 // Requests that cannot be carried out are refused before any work (formulation.md §8.1).
@@ -251,7 +274,10 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   // The recursive and explicit-chain paths know neither time-dependent loads nor the energy's
   // quadrature states.
   const bool plain = timed_.empty() && !options.energy && options.sample_period == 0.0;
-  path_ = RhsPath::choose(*sys_, *data_, plan.integrate && options.recursive && plain);
+  const bool recursive = plan.integrate && options.recursive && plain;
+  if (recursive && kept_tree_) path_ = std::move(kept_tree_);  // the last run's (renew())
+  else path_ = RhsPath::choose(*sys_, *data_, recursive);
+  kept_tree_.reset();
   res.recursive = path_->tree() != nullptr;
   res.path = path_->name();
   if (res.recursive) {

@@ -37,7 +37,7 @@ Data::Data(const System& sys) {
   number_equations_of_motion(sys);
 }
 
-void Data::reset_state(const System& sys) {
+void Data::reset_state(const System& sys, bool keep_pivots) {
   t = 0.0;
   for (Eigen::VectorXd* v : {&x, &xd, &xdd, &e, &ed, &edd, &sigma, &conv, &qhat, &qhat_d, &qhat_dd, &target, &residual,
                              &acc0, &step, &rhs_V, &sol_V, &h, &f, &inertia_residual, &reaction, &acc_known,
@@ -59,6 +59,7 @@ void Data::reset_state(const System& sys) {
   total_newton_iterations = 0;
   // The sparse LUs forget their pivot sequences (replayed from one factorization to the next),
   // so that a solve from here gives the same digits whatever was solved before.
+  if (keep_pivots) return;
   if (constraint_blocks_ready) analyze_constraint_blocks(sys);
   if (equations_ready) luK.analyze(KKT.matrix());
 }

@@ -331,13 +331,20 @@ std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& de
   number_coordinates(model, *sys, node_offset, dependent);
   build_elements(model, *sys, node_offset, line_as_dof);
   partition(*sys);
-  initial_values(model, *sys);
   masses_and_loads(model, *sys, node_offset);
   length_scales(model, *sys);
-  for (int k : sys->auto_released)
-    if (!element_catalogue()[sys->elements[sys->e_element[k]].type].automatic)  // a fixed LAMBDA node is normal
-      sys->warnings.push_back(sys->def_name(k) + " is fixed but none of its coordinates is calculable: it is checked, not solved for");
+  sys->n_structure_warnings = sys->warnings.size();
+  reload_state(model, *sys);
   return sys;
+}
+
+void reload_state(const Model& model, System& sys) {
+  sys.warnings.resize(sys.n_structure_warnings);
+  sys.y_defs.clear();
+  initial_values(model, sys);
+  for (int k : sys.auto_released)
+    if (!element_catalogue()[sys.elements[sys.e_element[k]].type].automatic)  // a fixed LAMBDA node is normal
+      sys.warnings.push_back(sys.def_name(k) + " is fixed but none of its coordinates is calculable: it is checked, not solved for");
 }
 
 }  // namespace spacar

@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -325,6 +326,13 @@ class Simulation {
   void run(BlockResults& res, const RunOptions& options);
   // Write the state reached into the model (coordinates, rates, deformation values, time).
   void store_state();
+  // Ready for the model's next block without compiling it again, if the model has not changed
+  // since this simulation's last run stored its state and that run took the recursive path (a
+  // tree of rigid bodies, no free rotation): the block's start read from the model as a new
+  // simulation reads it, the data reset, the tree kept for the next run. False (nothing done)
+  // otherwise: then a new simulation is needed. spacar.simulate keeps the simulation of a model's
+  // last run for this: the next run of a 6-link chain is ~100 µs cheaper (issue 37).
+  bool renew();
 
   // Runs from many initial states over the same output times (spacar.Rollout): the rows of q0
   // and qd0 (one state each, one column per DOF; the integrated deformations start from the
@@ -443,6 +451,10 @@ class Simulation {
   // How the states are evaluated (rhs_path.hpp): chosen for a run (RunOptions::recursive), the
   // general path outside runs, except that recursive_state() keeps the tree it took.
   std::unique_ptr<RhsPath> path_ = std::make_unique<GeneralPath>();
+  // The tree path of the last run, kept for the next run of the unchanged model (renew()), and the
+  // model's revision when that run stored its state.
+  std::unique_ptr<RhsPath> kept_tree_;
+  std::uint64_t kept_revision_ = 0;
   void newton_refresh(double t, const Eigen::VectorXd& Y);
   // The tree's state at (t, Y) into run_.base (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.

@@ -30,7 +30,10 @@ struct Data {
   // no angle branches, no reusable Jacobian, no load case, the LUs' pivots forgotten), the sizes
   // and the patterns built on first use kept: a prepared analysis (StaticSolver) starts each
   // solve from here. The dense arrays of ensure_dense are not reset (no static solve reads them).
-  void reset_state(const System& sys);
+  // keep_pivots: the LUs replay their last pivot sequences (each replayed pivot checked: a poor
+  // one makes that factorization choose again), for the next block of a run (Simulation::renew),
+  // whose digits then may differ from a fresh analysis's in the last places.
+  void reset_state(const System& sys, bool keep_pivots = false);
   // Allocate the dense matrices of the full path (transfer functions, reduced mass matrix).
   void ensure_dense(const System& sys);
   bool dense_ready = false;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -217,10 +218,15 @@ class Model {
   // Called first by everything that changes the model (its methods here, the writable node() and
   // element(), Simulation::store_state; anything that writes the public members below must call
   // it first): the lazy copies not yet made are made now, of the model as it still is. Not safe
-  // for two threads changing one model at once (no analysis is).
+  // for two threads changing one model at once (no analysis is). Every call counts as a change
+  // (revision()).
   void before_change() {
     if (!pending_.empty()) pending_.make();
+    ++revision_;
   }
+  // How many changes the model has seen (before_change() calls): a Simulation kept for the next
+  // run of an unchanged model (Simulation::renew) checks it.
+  std::uint64_t revision() const { return revision_; }
 
   // --- topology (before the first END) ---
   // `origin` names the input line (file, line, keyword) for errors found later, at prepare().
@@ -304,6 +310,7 @@ class Model {
   void add_automatic_constraints();
   void compute_reference_geometry();
   bool frozen_ = false;
+  std::uint64_t revision_ = 0;
 };
 
 }  // namespace spacar

@@ -107,8 +107,10 @@ struct System {
   // nonholonomic constraints and the values of released velocity-level deformations; y0 initial.
   std::vector<int> y_defs;
   Eigen::VectorXd y0;
-  // Warnings found while compiling (printed as comments by the front ends).
+  // Warnings found while compiling (printed as comments by the front ends); the first
+  // n_structure_warnings of them are of the model's structure, the rest of its state.
   std::vector<std::string> warnings;
+  size_t n_structure_warnings = 0;
 
   // Mass and loads.
   Eigen::VectorXd point_mass;   // per coordinate: m on position coordinates, Izz on BETA (0 if none)
@@ -133,5 +135,11 @@ struct System {
 // line_as_dof: LINE parameters become coordinates (dynamic), for the linearized equations.
 std::unique_ptr<System> compile(const Model& model, const std::map<int, int>& dependent = {},
                                 bool line_as_dof = false);
+
+// The parts of a compiled system that follow the model's state (time, positions, rates, deformation
+// values; its warnings of them) read again, for another run of a model whose structure has not
+// changed (Simulation::renew): what compile() would give, without free rotations (whose partition
+// follows the state too).
+void reload_state(const Model& model, System& sys);
 
 }  // namespace spacar
