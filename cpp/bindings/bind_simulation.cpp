@@ -161,6 +161,7 @@ void bind_setup(py::class_<Simulation>& sim) {
       .def("renew", &Simulation::renew,
            "Ready for the model's next block without compiling it again, if the model has not changed since this "
            "simulation's last run, which took the recursive path; False (nothing done) otherwise.")
+      .def_property_readonly("renewable", &Simulation::renewable, "Whether renew() would succeed now.")
       .def_property_readonly("system", &Simulation::system, py::return_value_policy::reference_internal)
       .def_property_readonly("data", &Simulation::data, py::return_value_policy::reference_internal)
       .def("assemble", [](Simulation& s) { s.assemble(); })

@@ -354,6 +354,6 @@ def simulate(model, *, method: str = "auto", on_output=None, progress=None, outp
                 bar.close()
         model._continue_step = arrays["last_step"]
         model.warnings.extend(w for w in arrays["warnings"] if w not in model.warnings)
-        if arrays["recursive"]:
+        if sim.renewable:  # a run on an open tree that nothing else changed the model during
             runs.simulation = sim
         return _results(arrays, sim.system, model, method)

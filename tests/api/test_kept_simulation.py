@@ -23,9 +23,10 @@ def planar(n=4):
     return models.planar_chain(n, angle=0.3, t_end=0.05, n_out=2, eps=1e-8, epskin=1e-11)
 
 
-def assert_same_run(kept, fresh):
-    """The two runs' outputs equal to rounding (the tree recognized at another state)."""
-    assert kept.stats["path"] == fresh.stats["path"] == "tree"
+def assert_same_run(kept, fresh, path="tree"):
+    """The two runs' outputs equal to rounding (the tree recognized at another state, the first
+    output solved by the block before, the LUs' pivots of another state)."""
+    assert kept.stats["path"] == fresh.stats["path"] == path
     assert kept.stats["rhs_evaluations"] == fresh.stats["rhs_evaluations"]
     np.testing.assert_array_equal(kept.t, fresh.t)
     for name in ("x", "xd", "xdd", "e", "ed", "edd", "sigma"):
@@ -73,9 +74,10 @@ def test_runs_off_the_tree_keep_nothing():
     spacar.simulate(model, recursive=False)
     assert _runs(model).simulation is None
     spacar.simulate(model)
-    res = spacar.simulate(model, recursive=False)  # the kept tree is not used
-    assert res.stats["path"] != "tree" and _runs(model).simulation is None
     fresh = model.copy()
+    res = spacar.simulate(model, recursive=False)  # renewed, but the kept tree is not used
+    assert_same_run(res, spacar.simulate(fresh, recursive=False), path="general")
+    assert _runs(model).simulation is None
     assert_same_run(spacar.simulate(model), spacar.simulate(fresh))
 
 
@@ -86,3 +88,47 @@ def test_a_failed_run_keeps_nothing():
     with pytest.raises(spacar.InputError):
         spacar.simulate(model)
     assert _runs(model).simulation is None
+
+
+def test_the_continued_first_output_is_complete():
+    """A block continued on the kept tree records its first output from the last block's: the
+    reactions (FORCEMODE 1) and what on_output receives are those a fresh copy solves."""
+    model = spatial()
+    model.forcemode(1)
+    spacar.simulate(model)
+    fresh = model.copy()
+    seen = {}
+    kept = spacar.simulate(model, on_output=lambda k, state: seen.setdefault(k, state))
+    fresh_seen = {}
+    again = spacar.simulate(fresh, on_output=lambda k, state: fresh_seen.setdefault(k, state))
+    assert_same_run(kept, again)
+    np.testing.assert_allclose(kept.reaction, again.reaction, rtol=1e-10, atol=1e-10 * np.abs(again.reaction).max())
+    assert np.abs(again.reaction[0]).max() > 0.0
+    assert sorted(seen) == sorted(fresh_seen) == [0, 1, 2]
+    for name in ("t", "x", "xd", "xdd", "e", "sigma", "reaction"):
+        np.testing.assert_allclose(seen[0][name], fresh_seen[0][name], rtol=1e-10,
+                                   atol=1e-10 * max(1.0, np.abs(fresh_seen[0][name]).max()), err_msg=name)
+
+
+@pytest.mark.parametrize("change", ["gravity", "mass", "period"])
+def test_a_change_during_a_block_reaches_the_next(change):
+    """A change made while a block runs (from on_output here; another thread alike) is not the
+    block's own: the next block compiles the changed model (review of issue 37's first version)."""
+    model, fresh = spatial(), spatial()
+
+    def on_output(k, state):
+        if k == 1:
+            CHANGES[change](model)
+
+    spacar.simulate(model, on_output=on_output)
+    spacar.simulate(fresh)
+    CHANGES[change](fresh)
+    assert_same_run(spacar.simulate(model), spacar.simulate(fresh.copy()))
+
+
+def test_closed_loops_are_recognized_at_every_block():
+    """A tree with loops closed starts its loop closure from the state it was recognized at: it is
+    not kept for the next block."""
+    model = models.seven_r_loop(t_end=0.05, n_out=2)
+    res = spacar.simulate(model)
+    assert res.stats["path"] == "tree" and _runs(model).simulation is None

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "spacar/kinematics/diagnosis.hpp"
 #include "spacar/kinematics/dynamics.hpp"
@@ -90,6 +91,7 @@ void cut_rows(BlockResults& res, int rows) {
 
 void Simulation::run(BlockResults& res, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  const std::uint64_t revision_at_start = model_.revision();
   res = BlockResults();
   res.warnings = sys_->warnings;
   rollout_ = RolloutStart();  // the run moves the data a rollout prepared
@@ -120,22 +122,25 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     finish();
     throw;
   }
-  // The tree, kept for the next run of the unchanged model (renew()); not after a repartition.
-  std::unique_ptr<RhsPath> tree = path_->tree() && sys_->free_rotations.empty() ? std::move(path_) : nullptr;
+  // The tree, kept for the next run of the unchanged model (renew()): not with free rotations
+  // (their partition follows the state), nor a tree whose loop closure starts from the state it
+  // was recognized at, nor if the model was changed during the run (from on_output, or another
+  // thread): then the revision has moved by more than store_state's own change.
+  const RecursiveTree* used = path_->tree();
+  std::unique_ptr<RhsPath> tree =
+      used && used->serves_any_state() && sys_->free_rotations.empty() ? std::move(path_) : nullptr;
   finish();
   store_state();
-  kept_tree_ = std::move(tree);
-  kept_revision_ = model_.revision();
+  if (model_.revision() == revision_at_start + 1) {
+    kept_tree_ = std::move(tree);
+    kept_revision_ = model_.revision();
+  }
 }
 
 bool Simulation::renew() {
-  if (!kept_tree_ || model_.revision() != kept_revision_) return false;
+  if (!renewable()) return false;
   model_.prepare();  // as at every END: the Euler parameters normalized
   reload_state(model_, *sys_);
-  data_->reset_state(*sys_, /*keep_pivots=*/true);  // the last block's pivots replayed: no search
-  int g = 0;
-  for (const auto& [id, n] : model_.nodes)
-    for (double v : n.x) data_->x[g++] = v;
   predicted_.setZero();
   run_ = RunState();
   qhat_transfer_.resize(0);
@@ -144,7 +149,16 @@ bool Simulation::renew() {
   timed_ = TimeLoads();
   rollout_ = RolloutStart();
   x_given_.resize(0);
+  data_->total_newton_iterations = 0;
+  renewed_ = true;  // the data still hold the last block's last output: see integrate_block
   return true;
+}
+
+void Simulation::restart_data() {
+  data_->reset_state(*sys_, /*keep_pivots=*/true);  // the last block's pivots replayed: no search
+  int g = 0;
+  for (const auto& [id, n] : model_.nodes)
+    for (double v : n.x) data_->x[g++] = v;
 }
 
 // Requests that cannot be carried out are refused before any work (formulation.md §8.1).
@@ -266,35 +280,48 @@ void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) cons
 }
 
 void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out) {
-  assemble();
-  if (x_given_.size()) {
-    warn_of_assembly_moves(*sys_, x_given_, data_->x, res.warnings);
-    x_given_.resize(0);
-  }
   // The recursive and explicit-chain paths know neither time-dependent loads nor the energy's
   // quadrature states.
   const bool plain = timed_.empty() && !options.energy && options.sample_period == 0.0;
   const bool recursive = plan.integrate && options.recursive && plain;
-  if (recursive && kept_tree_) path_ = std::move(kept_tree_);  // the last run's (renew())
-  else path_ = RhsPath::choose(*sys_, *data_, recursive);
+  // The next block of a renewed simulation on its kept tree continues from the data as the last
+  // block left them: its last output solved the state this block starts in (the model holds
+  // that state, unchanged since), so neither the assembly nor the first output solves it again.
+  const bool renewed = std::exchange(renewed_, false);
+  const bool continuing = renewed && recursive && kept_tree_ && !plan.linear;
+  if (continuing) {
+    path_ = std::move(kept_tree_);
+    remember(run_.base);  // the state at t0, as the first output leaves it
+  } else {
+    if (renewed) restart_data();  // from the model's state, as a new simulation starts
+    assemble();
+    if (x_given_.size()) {
+      warn_of_assembly_moves(*sys_, x_given_, data_->x, res.warnings);
+      x_given_.resize(0);
+    }
+    path_ = RhsPath::choose(*sys_, *data_, recursive);
+  }
   kept_tree_.reset();
   res.recursive = path_->tree() != nullptr;
   res.path = path_->name();
-  if (res.recursive) {
+  if (res.recursive && !continuing) {
     run_.base.xd = run_.base.xdd = Eigen::VectorXd::Zero(sys_->nx);
     run_.base.t = plan.t0;
   }
   const Settings& st = plan.st;
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
+  bool first_solved = continuing;  // the first output's state is in the data already
   auto output = [&](double t, const Eigen::VectorXd& Y) {
     check_time(t);
-    evaluate_state(t, Y);
-    if (run_.n_energy) {
-      res.energy.row(k_out) << kinetic_energy(*sys_, *data_), gravity_potential(*sys_, *data_),
-          strain_energy(*sys_, *data_), Y[2 * nd + ny], Y[2 * nd + ny + 1];
+    if (!std::exchange(first_solved, false)) {
+      evaluate_state(t, Y);
+      if (run_.n_energy) {
+        res.energy.row(k_out) << kinetic_energy(*sys_, *data_), gravity_potential(*sys_, *data_),
+            strain_energy(*sys_, *data_), Y[2 * nd + ny], Y[2 * nd + ny + 1];
+      }
+      if (st.forcemode >= 1 || plan.linear) forces();
+      else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
     }
-    if (st.forcemode >= 1 || plan.linear) forces();
-    else constitutive_stresses(*sys_, *data_);  // FORCEMODE 0: no reaction stresses
     require_finite_state(t);
     if (plan.linear) res.linearizations.push_back(linearize());
     record(res, k_out);

@@ -222,11 +222,11 @@ class Model {
   // (revision()).
   void before_change() {
     if (!pending_.empty()) pending_.make();
-    ++revision_;
+    ++revision_.count;
   }
-  // How many changes the model has seen (before_change() calls): a Simulation kept for the next
-  // run of an unchanged model (Simulation::renew) checks it.
-  std::uint64_t revision() const { return revision_; }
+  // How many changes the model has seen (before_change() calls, assignments): a Simulation kept
+  // for the next run of an unchanged model (Simulation::renew) checks it.
+  std::uint64_t revision() const { return revision_.count; }
 
   // --- topology (before the first END) ---
   // `origin` names the input line (file, line, keyword) for errors found later, at prepare().
@@ -310,7 +310,17 @@ class Model {
   void add_automatic_constraints();
   void compute_reference_geometry();
   bool frozen_ = false;
-  std::uint64_t revision_ = 0;
+  // Not the value of a model: a copy starts at 0, a model assigned to counts the assignment as a
+  // change (a Simulation bound to it must not take the other model's count for its own).
+  struct Revision {
+    Revision() = default;
+    Revision(const Revision&) {}
+    Revision& operator=(const Revision&) {
+      ++count;
+      return *this;
+    }
+    std::uint64_t count = 0;
+  } revision_;
 };
 
 }  // namespace spacar

@@ -68,6 +68,7 @@ class ClosedLoopTree : public RecursiveTree {
   void inverse_dynamics(const double* q, const double* qd, const double* qdd, double* force) override;
   bool dynamics_derivatives(int n, const double* q, const double* qd, const double* tau, double* qdd, double* dq,
                             double* dqd, double* dtau) override;
+  bool serves_any_state() const override { return false; }
 
  protected:
   void move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) override;

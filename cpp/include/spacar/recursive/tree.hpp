@@ -49,6 +49,11 @@ class RecursiveTree {
                                     double* /*qdd*/, double* /*dq*/, double* /*dqd*/, double* /*dtau*/) {
     return false;
   }
+  // Whether the tree may serve the next block of its model, recognized at another state
+  // (Simulation::renew): an open tree's bodies, joints and inertias do not depend on the state; a
+  // tree with loops closed keeps the state it was recognized at as the start of its loop closure
+  // and its rank check, which a later block must make at its own start.
+  virtual bool serves_any_state() const { return true; }
 
  protected:
   // The coordinates moving with the bodies, after solve() (which may leave the bodies'
