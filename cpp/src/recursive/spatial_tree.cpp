@@ -347,6 +347,9 @@ std::unique_ptr<SpatialTree> SpatialTree::detect(const System& sys, const Data& 
   auto tree = std::unique_ptr<SpatialTree>(new SpatialTree());
   if (!tree_detail::build(Builder(sys, data, *tree), why)) return nullptr;
   tree->base_acceleration_.tail<3>() = -sys.gravity;
+  // The world frames only at the outputs (move_coordinates) where the passes do not read them.
+  tree->world_frames_ = !tree->loads_.empty() || tree->loops_.closed() ||
+                        std::any_of(tree->bodies_.begin(), tree->bodies_.end(), [](const Model& m) { return m.free; });
   return tree;
 }
 
@@ -442,6 +445,9 @@ void SpatialTree::free_forces(const double* q, const BodyWork& d, const Vector& 
 
 // Positions, velocities and accelerations of the coordinates moving with the bodies.
 void SpatialTree::move_coordinates(Eigen::VectorXd& x, Eigen::VectorXd& xd, Eigen::VectorXd& xdd) {
+  if (!world_frames_)  // the passes placed the bodies relative to their parents only
+    for (size_t i = 0; i < bodies_.size(); ++i)
+      SpatialAlgebra::place_world(bodies_[i], bodies_[i].parent < 0 ? nullptr : &work_[bodies_[i].parent], work_[i]);
   const Vec3 g = -base_acceleration_.tail<3>();
   for (const Follower& f : followers_) {
     const BodyWork& bd = work_[f.body];

@@ -157,6 +157,10 @@ class ArticulatedTree : public RecursiveTree {
   std::vector<BodyWork> work_;
   Vector base_acceleration_ = Vector::Zero();  // −gravity, the fictitious acceleration of the ground
   Loops loops_;  // loops closed on the tree, if any (then ClosedLoopTree runs it)
+  // Whether outward() places the bodies in the world too (rotations, Euler parameters, pins): a
+  // tree sets it false when nothing in its passes reads them (no loads, floating base or loops);
+  // its move_coordinates then places them from the frames relative to the parents.
+  bool world_frames_ = true;
   friend class ClosedLoopTree<Algebra>;  // runs the passes below in the tree's coordinates
 
   // The passes, for the trees that combine them otherwise (closed_loop.hpp: loops closed on a tree).
@@ -175,7 +179,7 @@ class ArticulatedTree : public RecursiveTree {
         d.bias = Vector::Zero();
       } else {
         const double theta = Algebra::joint_angle(m, p, q, qd, d);  // rotation relative to the parent
-        if (!placed) Algebra::place(m, p, theta, d);
+        if (!placed) Algebra::place(m, p, theta, d, world_frames_);
         Vector v = Algebra::joint_motion(m, d.ud);
         if (p) v += Algebra::to_child(m, d.frame, p->v);
         d.v = v;
@@ -213,8 +217,9 @@ class ArticulatedTree : public RecursiveTree {
       if (d.d <= 0.0) return false;
       d.u = d.tau - Algebra::joint_component(m, d.pA);
       if (m.parent < 0) continue;
-      const Inertia Ia = d.IA - d.U * d.U.transpose() / d.d;
-      const Vector pa = d.pA + Ia * d.bias + d.U * (d.u / d.d);
+      const double inv_d = 1.0 / d.d;  // one division, not one per entry of U Uᵀ / d
+      const Inertia Ia = d.IA - (d.U * d.U.transpose()) * inv_d;
+      const Vector pa = d.pA + Ia * d.bias + d.U * (d.u * inv_d);
       BodyWork& p = work_[m.parent];
       Algebra::add_inertia_to_parent(m, d.frame, Ia, p.IA);
       p.pA += Algebra::to_parent(m, d.frame, pa);

@@ -42,7 +42,8 @@ struct PlanarAlgebra {
     return q[m.dof] - m.offset - (p ? p->frame.phi : 0.0);
   }
 
-  static void place(const Model& m, const Work* p, double theta, Work& d) {
+  // `world`: always (a child's angle is read from its parent's absolute rotation).
+  static void place(const Model& m, const Work* p, double theta, Work& d, bool /*world*/ = true) {
     Frame& f = d.frame;
     f.c = std::cos(theta);
     f.s = std::sin(theta);

@@ -69,6 +69,7 @@ struct SpatialAlgebra {
     Eigen::Matrix3d R;       // body coordinates → world
     Eigen::Vector4d lambda;  // Euler parameters (λ0, λ1, λ2, λ3) of R
     Eigen::Vector3d r;       // the pin from the parent's, in the parent's coordinates (a sliding joint's moves)
+    double ch = 1.0, sh = 0.0;  // cosine and sine of half the hinge's angle (λ relative to the parent)
   };
   using Model = BodyModel<SpatialAlgebra>;
   using Work = BodyData<SpatialAlgebra>;
@@ -89,27 +90,37 @@ struct SpatialAlgebra {
   }
 
   // The body's rotation relative to its parent and its pin: a hinge turns by θ about its axis, a
-  // sliding joint moves the pin by θ along its axis without turning.
-  static void place(const Model& m, const Work* p, double theta, Work& d) {
+  // sliding joint moves the pin by θ along its axis without turning. `world`: its rotation, Euler
+  // parameters and pin in the world too (place_world), which the passes of a right-hand side
+  // need only with loads, a floating base or loops (ArticulatedTree::world_frames_).
+  static void place(const Model& m, const Work* p, double theta, Work& d, bool world = true) {
     Frame& f = d.frame;
-    Eigen::Matrix3d rel = Eigen::Matrix3d::Identity();  // body → parent
-    Eigen::Vector4d q_rel(1.0, 0.0, 0.0, 0.0);
     f.r = m.r;
     if (m.prismatic) {
       f.r += theta * m.axis;
+      f.E.setIdentity();
+      f.ch = 1.0;
+      f.sh = 0.0;
     } else {
       const double ch = std::cos(0.5 * theta), sh = std::sin(0.5 * theta);  // of the half angle, for λ too
       const double c = 1.0 - 2.0 * sh * sh, s = 2.0 * sh * ch;
-      rel = axis_rotation(m.axis, c, s);
-      q_rel << ch, sh * m.axis;
+      f.E = axis_rotation(m.axis, c, -s);  // the transpose: parent → body
+      f.ch = ch;
+      f.sh = sh;
     }
-    f.E = rel.transpose();
+    if (world) place_world(m, p, d);
+  }
+  // The body's rotation, Euler parameters and pin in the world, from its placement relative to
+  // its parent (place) and the parent's in the world.
+  static void place_world(const Model& m, const Work* p, Work& d) {
+    Frame& f = d.frame;
+    const Eigen::Vector4d q_rel(f.ch, f.sh * m.axis[0], f.sh * m.axis[1], f.sh * m.axis[2]);
     if (!p) {
-      f.R = rel;
+      f.R = f.E.transpose();
       f.lambda = q_rel;
       d.pin = f.r;
     } else {
-      f.R = p->frame.R * rel;
+      f.R.noalias() = p->frame.R * f.E.transpose();
       f.lambda = tree_detail::compose(p->frame.lambda, q_rel);
       d.pin = p->pin + p->frame.R * f.r;
     }
@@ -145,9 +156,16 @@ struct SpatialAlgebra {
     const Mat3& E = f.E;
     const Mat3 Ib = I.topLeftCorner<3, 3>(), Bb = I.topRightCorner<3, 3>(), Cb = I.bottomRightCorner<3, 3>();
     const Mat3 A = E.transpose() * Ib * E, B = E.transpose() * Bb * E, C = E.transpose() * Cb * E;
-    const Mat3 rx = skew(f.r);
-    const Mat3 rC = rx * C, rBt = rx * B.transpose();
-    parent.topLeftCorner<3, 3>() += A + rBt + rBt.transpose() - rC * rx;
+    // The products with r̃ by cross products (r̃ M: r × each column; M r̃: each row × r), a third
+    // of the multiplications of the 3×3 products.
+    const Eigen::Vector3d& r = f.r;
+    Mat3 rC, rBt, rCr;
+    for (int j = 0; j < 3; ++j) {
+      rC.col(j) = r.cross(C.col(j));
+      rBt.col(j) = r.cross(B.row(j).transpose());
+    }
+    for (int i = 0; i < 3; ++i) rCr.row(i) = rC.row(i).transpose().cross(r).transpose();
+    parent.topLeftCorner<3, 3>() += A + rBt + rBt.transpose() - rCr;
     const Mat3 coupling = B + rC;
     parent.topRightCorner<3, 3>() += coupling;
     parent.bottomLeftCorner<3, 3>() += coupling.transpose();
