@@ -132,3 +132,19 @@ def test_closed_loops_are_recognized_at_every_block():
     model = models.seven_r_loop(t_end=0.05, n_out=2)
     res = spacar.simulate(model)
     assert res.stats["path"] == "tree" and _runs(model).simulation is None
+
+
+def test_a_renewed_simulation_that_evaluated_another_state_assembles_again():
+    """The core's Simulation used directly: after evaluating another state, a renewed run does
+    not take the data for its start (they no longer hold the last block's last output)."""
+    model = spatial()
+    spacar.simulate(model)
+    fresh = model.copy()
+    sim = _runs(model).simulation
+    n = len(sim.system.x_dyn) + len(sim.system.e_dyn)
+    sim.evaluate(model.current_time + 0.3, np.full(n, 0.2), np.full(n, -0.5))
+    assert sim.renew()
+    arrays = sim.run()
+    np.testing.assert_allclose(arrays["t"][0], fresh.current_time)
+    again = spacar.simulate(fresh)
+    np.testing.assert_allclose(arrays["x"], again.x, rtol=1e-10, atol=1e-10)

@@ -154,6 +154,24 @@ bool Simulation::renew() {
   return true;
 }
 
+// The data hold the state the block starts in (time, DOFs and their rates): the last block's
+// last output, unless something evaluated another state since (evaluate, a rollout, ...).
+bool Simulation::data_holds_start() const {
+  const System& sys = *sys_;
+  const Data& d = *data_;
+  if (d.t != sys.t0) return false;
+  int j = 0;
+  for (int g : sys.x_dyn) {
+    if (d.x[g] != sys.q0[j] || d.xd[g] != sys.qd0[j]) return false;
+    ++j;
+  }
+  for (int k : sys.e_dyn) {
+    if (d.e[k] != sys.q0[j] || d.ed[k] != sys.qd0[j]) return false;
+    ++j;
+  }
+  return true;
+}
+
 void Simulation::restart_data() {
   data_->reset_state(*sys_, /*keep_pivots=*/true);  // the last block's pivots replayed: no search
   int g = 0;
@@ -288,7 +306,7 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   // block left them: its last output solved the state this block starts in (the model holds
   // that state, unchanged since), so neither the assembly nor the first output solves it again.
   const bool renewed = std::exchange(renewed_, false);
-  const bool continuing = renewed && recursive && kept_tree_ && !plan.linear;
+  const bool continuing = renewed && recursive && kept_tree_ && !plan.linear && data_holds_start();
   if (continuing) {
     path_ = std::move(kept_tree_);
     remember(run_.base);  // the state at t0, as the first output leaves it

@@ -464,6 +464,7 @@ class Simulation {
   // After renew(), for a block that does not continue on the kept tree: the data reset and the
   // positions read from the model, as a new simulation starts.
   void restart_data();
+  bool data_holds_start() const;
   void newton_refresh(double t, const Eigen::VectorXd& Y);
   // The tree's state at (t, Y) into run_.base (positions, rates, accelerations) and qdd; false if a
   // body moves no mass.
