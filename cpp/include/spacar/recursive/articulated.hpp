@@ -64,6 +64,7 @@ struct BodyData {
   double tau = 0.0;  // joint torque
   double u = 0.0;    // joint force left after the bias forces (inverse dynamics: the torque on the body's rotation)
   double d = 0.0;    // the joint's articulated inertia Sᵀ Iᴬ S
+  double inv_d = 0.0;  // 1 / d
   Vector v, bias, pA, a, U;
   typename Algebra::Inertia IA;
 };
@@ -215,11 +216,13 @@ class ArticulatedTree : public RecursiveTree {
       // Not positive: a body that moves no mass. Not finite (a trial state out of range): the
       // integrator rejects the non-finite q̈ like the general path's.
       if (d.d <= 0.0) return false;
+      // One division, not one per entry of U Uᵀ / d, and none in the outward pass of the
+      // accelerations, whose chain from the root to the leaves waits for each.
+      d.inv_d = 1.0 / d.d;
       d.u = d.tau - Algebra::joint_component(m, d.pA);
       if (m.parent < 0) continue;
-      const double inv_d = 1.0 / d.d;  // one division, not one per entry of U Uᵀ / d
-      const Inertia Ia = d.IA - (d.U * d.U.transpose()) * inv_d;
-      const Vector pa = d.pA + Ia * d.bias + d.U * (d.u * inv_d);
+      const Inertia Ia = d.IA - (d.U * d.U.transpose()) * d.inv_d;
+      const Vector pa = d.pA + Ia * d.bias + d.U * (d.u * d.inv_d);
       BodyWork& p = work_[m.parent];
       Algebra::add_inertia_to_parent(m, d.frame, Ia, p.IA);
       p.pA += Algebra::to_parent(m, d.frame, pa);
@@ -241,7 +244,7 @@ class ArticulatedTree : public RecursiveTree {
         free_body_qdd(q, qd, d, d.a - a, qdd);
         continue;
       }
-      const double udd = (d.u - d.U.dot(a)) / d.d;
+      const double udd = (d.u - d.U.dot(a)) * d.inv_d;
       Algebra::add_joint_acceleration(m, udd, a);
       d.a = a;
       qdd[m.dof] = Algebra::dof_acceleration(m, a, udd);
