@@ -41,7 +41,10 @@ def _results(arrays: dict, system, model, method: str = "dop853") -> Results:
     # The labels as (n, 2) arrays, one conversion each (a list is a Python pair per label), taken
     # once; the results make their lookups from them when first used.
     coords, defs = system.coord_label_array, system.def_label_array
-    lins = [Linearization(d, coords, defs) for d in arrays["linearizations"]]
+    lins = arrays["linearizations"]
+    if lins:  # each takes the labels as Python pairs: converted once
+        coord_list, def_list = coords.tolist(), defs.tolist()
+        lins = [Linearization(d, coord_list, def_list) for d in lins]
     res = Results(arrays, coords, defs, stats, None, lins, model.settings.linear)
     res._geometry_source = core = KeptModel(model)  # res.geometry is built from it when first used
     res.shapes = getattr(model, "urdf_shapes", None)  # a URDF robot's link shapes, for spacar.view3d
@@ -155,7 +158,7 @@ class _Runs:
     the simulation of the last run, when it took the recursive path: the next run of the unchanged
     model renews it instead of compiling the model and recognizing its tree again (issue 37)."""
 
-    __slots__ = ("lock", "simulation", "__weakref__")
+    __slots__ = ("lock", "simulation")
 
     def __init__(self):
         self.lock = threading.RLock()

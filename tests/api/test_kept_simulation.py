@@ -1,6 +1,7 @@
 """spacar.simulate keeps the simulation of a model's last run on the recursive path (issue 37): the
-next run of the unchanged model renews it (its state read from the model again, its data reset)
-instead of compiling the model and recognizing its tree again. A run on the kept simulation must
+next run of the unchanged model renews it (its state read from the model again; the block
+continued from the data of the last block's last output) instead of compiling the model, assembling
+it and recognizing its tree again. A run on the kept simulation must
 give what a run on a fresh copy of the model gives (the tree was recognized at another state:
 equal to rounding), and any change of the model between the runs must discard it."""
 from __future__ import annotations
@@ -148,3 +149,15 @@ def test_a_renewed_simulation_that_evaluated_another_state_assembles_again():
     np.testing.assert_allclose(arrays["t"][0], fresh.current_time)
     again = spacar.simulate(fresh)
     np.testing.assert_allclose(arrays["x"], again.x, rtol=1e-10, atol=1e-10)
+
+
+def test_a_change_after_the_renewal_is_not_taken_for_the_runs_own():
+    """A change between renew() and the run (another thread; the core used directly) leaves the
+    run's system older than the model: its tree is not kept for a later block."""
+    model = spatial()
+    spacar.simulate(model)
+    sim = _runs(model).simulation
+    assert sim.renew()
+    model.mass(3, 2.5)
+    sim.run()
+    assert not sim.renewable

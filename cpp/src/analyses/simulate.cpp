@@ -50,6 +50,7 @@ Simulation::Simulation(Model& model)
   for (const auto& [id, n] : model_.nodes)
     for (double v : n.x) data_->x[g++] = v;
   if (x_given_.size()) x_given_ = data_->x;
+  compiled_revision_ = model_.revision();
 }
 
 void Simulation::remember(Solved& s) const {

@@ -91,7 +91,9 @@ void cut_rows(BlockResults& res, int rows) {
 
 void Simulation::run(BlockResults& res, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  const std::uint64_t revision_at_start = model_.revision();
+  // What renew() prepared, for this run only (also when the run fails before its block).
+  std::unique_ptr<RhsPath> kept_tree = std::move(kept_tree_);
+  const bool renewed = std::exchange(renewed_, false);
   res = BlockResults();
   res.warnings = sys_->warnings;
   rollout_ = RolloutStart();  // the run moves the data a rollout prepared
@@ -116,7 +118,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
     run_.fixed_step = 0.0;
   };
   try {
-    integrate_block(res, options, plan, k_out);
+    integrate_block(res, options, plan, k_out, renewed, std::move(kept_tree));
   } catch (...) {
     cut_rows(res, k_out);
     finish();
@@ -124,14 +126,15 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
   }
   // The tree, kept for the next run of the unchanged model (renew()): not with free rotations
   // (their partition follows the state), nor a tree whose loop closure starts from the state it
-  // was recognized at, nor if the model was changed during the run (from on_output, or another
-  // thread): then the revision has moved by more than store_state's own change.
+  // was recognized at, nor if the model changed since the system was compiled or reloaded (from
+  // on_output, another thread, between runs): then the revision has moved by more than
+  // store_state's own change.
   const RecursiveTree* used = path_->tree();
   std::unique_ptr<RhsPath> tree =
       used && used->serves_any_state() && sys_->free_rotations.empty() ? std::move(path_) : nullptr;
   finish();
   store_state();
-  if (model_.revision() == revision_at_start + 1) {
+  if (model_.revision() == compiled_revision_ + 1) {
     kept_tree_ = std::move(tree);
     kept_revision_ = model_.revision();
   }
@@ -151,6 +154,7 @@ bool Simulation::renew() {
   x_given_.resize(0);
   data_->total_newton_iterations = 0;
   renewed_ = true;  // the data still hold the last block's last output: see integrate_block
+  compiled_revision_ = model_.revision();
   return true;
 }
 
@@ -297,7 +301,8 @@ void Simulation::allocate_results(BlockResults& res, const BlockPlan& plan) cons
   if (run_.n_energy) res.energy.resize(nt, std::size(kEnergyColumns));
 }
 
-void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out) {
+void Simulation::integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out,
+                                 bool renewed, std::unique_ptr<RhsPath> kept_tree) {
   // The recursive and explicit-chain paths know neither time-dependent loads nor the energy's
   // quadrature states.
   const bool plain = timed_.empty() && !options.energy && options.sample_period == 0.0;
@@ -305,10 +310,9 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
   // The next block of a renewed simulation on its kept tree continues from the data as the last
   // block left them: its last output solved the state this block starts in (the model holds
   // that state, unchanged since), so neither the assembly nor the first output solves it again.
-  const bool renewed = std::exchange(renewed_, false);
-  const bool continuing = renewed && recursive && kept_tree_ && !plan.linear && data_holds_start();
+  const bool continuing = renewed && recursive && kept_tree && !plan.linear && data_holds_start();
   if (continuing) {
-    path_ = std::move(kept_tree_);
+    path_ = std::move(kept_tree);
     remember(run_.base);  // the state at t0, as the first output leaves it
   } else {
     if (renewed) restart_data();  // from the model's state, as a new simulation starts
@@ -319,7 +323,6 @@ void Simulation::integrate_block(BlockResults& res, const RunOptions& options, c
     }
     path_ = RhsPath::choose(*sys_, *data_, recursive);
   }
-  kept_tree_.reset();
   res.recursive = path_->tree() != nullptr;
   res.path = path_->name();
   if (res.recursive && !continuing) {

@@ -386,7 +386,10 @@ class Simulation {
                                    const PeriodNames& names, std::vector<std::string>& warnings);
   void allocate_results(BlockResults& res, const BlockPlan& plan) const;
   // k_out: the output times recorded (also when it throws).
-  void integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out);
+  // renewed, kept_tree: what renew() prepared (the tree of the last run, and whether the data may
+  // hold the block's start), taken by run().
+  void integrate_block(BlockResults& res, const RunOptions& options, const BlockPlan& plan, int& k_out,
+                       bool renewed, std::unique_ptr<RhsPath> kept_tree);
   // The integration of the state Y from plan.t0 through the output times plan.times[k_out…]
   // (output(t, Y) at each) to plan.t_end: segment by segment, for the controller's samples, the
   // repartitions of free rotations and AUTO's switches of method. Counters to res.
@@ -461,6 +464,7 @@ class Simulation {
   std::unique_ptr<RhsPath> kept_tree_;
   std::uint64_t kept_revision_ = 0;
   bool renewed_ = false;  // renew() made this simulation ready for the next block, not yet run
+  std::uint64_t compiled_revision_ = 0;  // the model's revision the system was compiled or reloaded at
   // After renew(), for a block that does not continue on the kept tree: the data reset and the
   // positions read from the model, as a new simulation starts.
   void restart_data();

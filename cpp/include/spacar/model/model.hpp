@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -222,11 +223,11 @@ class Model {
   // (revision()).
   void before_change() {
     if (!pending_.empty()) pending_.make();
-    ++revision_.count;
+    revision_.count.fetch_add(1, std::memory_order_relaxed);
   }
   // How many changes the model has seen (before_change() calls, assignments): a Simulation kept
   // for the next run of an unchanged model (Simulation::renew) checks it.
-  std::uint64_t revision() const { return revision_.count; }
+  std::uint64_t revision() const { return revision_.count.load(std::memory_order_relaxed); }
 
   // --- topology (before the first END) ---
   // `origin` names the input line (file, line, keyword) for errors found later, at prepare().
@@ -311,15 +312,16 @@ class Model {
   void compute_reference_geometry();
   bool frozen_ = false;
   // Not the value of a model: a copy starts at 0, a model assigned to counts the assignment as a
-  // change (a Simulation bound to it must not take the other model's count for its own).
+  // change (a Simulation bound to it must not take the other model's count for its own). Atomic:
+  // a change from another thread during a run must be seen by the run's end (Simulation::run).
   struct Revision {
     Revision() = default;
     Revision(const Revision&) {}
     Revision& operator=(const Revision&) {
-      ++count;
+      count.fetch_add(1, std::memory_order_relaxed);
       return *this;
     }
-    std::uint64_t count = 0;
+    std::atomic<std::uint64_t> count{0};
   } revision_;
 };
 

@@ -108,7 +108,8 @@ struct System {
   std::vector<int> y_defs;
   Eigen::VectorXd y0;
   // Warnings found while compiling (printed as comments by the front ends); the first
-  // n_structure_warnings of them are of the model's structure, the rest of its state.
+  // n_structure_warnings of them come before those reload_state makes again (of the state, and
+  // of the fixed deformations that are checked, not solved, which it lists last as compile did).
   std::vector<std::string> warnings;
   size_t n_structure_warnings = 0;
 

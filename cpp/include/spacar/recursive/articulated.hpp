@@ -13,7 +13,9 @@
 // An Algebra provides the types Point (a pin), Vector (motion and force vectors), Inertia and
 // Frame (a body's rotation relative to its parent and in the world), and the static functions
 //   joint_angle(m, parent, q, qd, d)   the joint's rotation; sets d.ud, d.tau
-//   place(m, parent, theta, d)         d.frame and d.pin from the parent's
+//   place(m, parent, theta, d, world)  d.frame relative to the parent; with `world` (or, in a
+//                                      spatial tree without loads, floating base or loops, only
+//                                      at its outputs) its world rotation and d.pin too
 //   joint_motion(m, ud)                S u̇, the joint's motion in body coordinates
 //   to_child(m, frame, v)              motion vectors, parent → body coordinates
 //   to_parent(m, frame, f)             force vectors, body → parent coordinates
@@ -58,8 +60,8 @@ struct BodyModel {
 template <class Algebra>
 struct BodyData {
   using Vector = typename Algebra::Vector;
-  typename Algebra::Frame frame;  // rotation relative to the parent and in the world
-  typename Algebra::Point pin;    // world position of the pin
+  typename Algebra::Frame frame;  // rotation relative to the parent and in the world (see place)
+  typename Algebra::Point pin;    // world position of the pin (see place)
   double ud = 0.0;   // joint rate u̇
   double tau = 0.0;  // joint torque
   double u = 0.0;    // joint force left after the bias forces (inverse dynamics: the torque on the body's rotation)

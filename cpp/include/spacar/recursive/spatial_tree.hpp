@@ -66,8 +66,8 @@ struct SpatialAlgebra {
   using Axis = Eigen::Vector3d;  // unit joint axis, the same in the parent's and the body's coordinates
   struct Frame {
     Eigen::Matrix3d E;       // parent coordinates → body coordinates
-    Eigen::Matrix3d R;       // body coordinates → world
-    Eigen::Vector4d lambda;  // Euler parameters (λ0, λ1, λ2, λ3) of R
+    Eigen::Matrix3d R;       // body coordinates → world (place_world)
+    Eigen::Vector4d lambda;  // Euler parameters (λ0, λ1, λ2, λ3) of R (place_world)
     Eigen::Vector3d r;       // the pin from the parent's, in the parent's coordinates (a sliding joint's moves)
     double ch = 1.0, sh = 0.0;  // cosine and sine of half the hinge's angle (λ relative to the parent)
   };
@@ -156,7 +156,7 @@ struct SpatialAlgebra {
     const Mat3& E = f.E;
     const Mat3 Ib = I.topLeftCorner<3, 3>(), Bb = I.topRightCorner<3, 3>(), Cb = I.bottomRightCorner<3, 3>();
     const Mat3 A = E.transpose() * Ib * E, B = E.transpose() * Bb * E, C = E.transpose() * Cb * E;
-    // The products with r̃ by cross products (r̃ M: r × each column; M r̃: each row × r), a third
+    // The products with r̃ by cross products (r̃ M: r × each column; M r̃: each row × r), two thirds
     // of the multiplications of the 3×3 products.
     const Eigen::Vector3d& r = f.r;
     Mat3 rC, rBt, rCr;
