@@ -70,6 +70,10 @@ RUN_BUDGET = 10.0  # s: a tool stops tightening its tolerance once a run took a 
 
 
 SPATIAL_SIZES, QUICK_SPATIAL_SIZES = [6, 20], [3]
+# The spatial chains' tolerances at half decades down to 1e-8, the granularity of MuJoCo's steps
+# below (1e-2, 3e-3, ...): a scan by decades would give the tolerance-driven programs (spacar,
+# exudyn, Pinocchio + DOP853) a target's time at up to ten times the accuracy it asks for.
+SPATIAL_TOLS = [1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 1e-10, 1e-12]
 # MuJoCo's RK4 at fixed steps (s); a Python loop of mj_step, stopped like the others at RUN_BUDGET / 3.
 MUJOCO_STEPS, QUICK_MUJOCO_STEPS = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5], [1e-2, 1e-3]
 
@@ -331,7 +335,7 @@ def run_spatial(quick: bool = False) -> dict:
     C.quiet_exudyn()
     sizes = QUICK_SPATIAL_SIZES if quick else SPATIAL_SIZES
     t_end = QUICK_T_END if quick else T_END
-    tols = QUICK_TOLS if quick else TOLS
+    tols = QUICK_TOLS if quick else SPATIAL_TOLS
     steps = (QUICK_MUJOCO_STEPS if quick else MUJOCO_STEPS) if have_mujoco() else ()
     result = {"sizes": sizes, "t_end": t_end, "machine": C.machine(peers=True), "mujoco": bool(steps),
               "rhs": {}, "acc": {}, "stats": {}}
@@ -510,9 +514,10 @@ def spatial_section(r: dict, quick: bool) -> list:
                   f"longer run {C.fmt_time(x['spacar_in_long_run'])} ({x['spacar_in_long_run'] / x['pinocchio_aba']:.2f}×). "
                   "The slope rests on two best-of timings and moves with the machine's load."]
     lines += ["", "Time to accuracy (error: largest joint-angle error at T against Pinocchio's ABA integrated by "
-              "DOP853 at rtol 1e-13; time: the shortest run that reached it, best of repeats as above; MuJoCo: its "
-              "RK4 at fixed steps from " + ", ".join(f"{h:g}" for h in MUJOCO_STEPS) + " s, a Python loop of "
-              "`mj_step`):", "",
+              "DOP853 at rtol 1e-13; time: the shortest run that reached it, best of repeats as above; spacar, "
+              "exudyn and Pinocchio + DOP853 at the tolerances " + ", ".join(f"{t:g}" for t in SPATIAL_TOLS) +
+              " (half decades, as MuJoCo's steps); MuJoCo: its RK4 at fixed steps from " +
+              ", ".join(f"{h:g}" for h in MUJOCO_STEPS) + " s, a Python loop of `mj_step`):", "",
               "| N | target | spacar `simulate` | spacar `Rollout` | spacar general path | exudyn tree DOPRI5 | "
               "MuJoCo RK4 | Pinocchio ABA + DOP853 | exudyn / spacar | MuJoCo / spacar | MuJoCo / Rollout | "
               "general path / spacar |",
