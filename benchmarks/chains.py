@@ -70,12 +70,17 @@ RUN_BUDGET = 10.0  # s: a tool stops tightening its tolerance once a run took a 
 
 
 SPATIAL_SIZES, QUICK_SPATIAL_SIZES = [6, 20], [3]
-# The spatial chains' tolerances at half decades down to 1e-8, the granularity of MuJoCo's steps
-# below (1e-2, 3e-3, ...): a scan by decades would give the tolerance-driven programs (spacar,
-# exudyn, Pinocchio + DOP853) a target's time at up to ten times the accuracy it asks for.
-SPATIAL_TOLS = [1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 1e-10, 1e-12]
+# The spatial chains' tolerances at half decades from 1e-2 down to 1e-8, as MuJoCo's steps below:
+# a scan by decades, or from 1e-4 only, would give the tolerance-driven programs (spacar, exudyn,
+# Pinocchio + DOP853) a target's time at up to ten (a hundred) times the accuracy it asks for.
+SPATIAL_TOLS = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 1e-10, 1e-12]
 # MuJoCo's RK4 at fixed steps (s); a Python loop of mj_step, stopped like the others at RUN_BUDGET / 3.
-MUJOCO_STEPS, QUICK_MUJOCO_STEPS = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5], [1e-2, 1e-3]
+# T_END in 8 … 10 000 steps, their number in ratios of about 10^(1/8): RK4's error (∝ h⁴) in steps
+# of half a decade, the granularity of the other programs' tolerances (SPATIAL_TOLS), so that no
+# program's time to a target is taken at much more accuracy than it asks for. Whole numbers of
+# steps, so that each run ends at T_END; 8 steps (0.0375 s) are past RK4's stability at 20 links.
+MUJOCO_STEPS = [T_END / n for n in sorted({round(8 * 10 ** (k / 8)) for k in range(25)} | {10000})]
+QUICK_MUJOCO_STEPS = [1e-2, 1e-3]
 
 
 def chain(n, t_end, eps=1e-6):
@@ -516,8 +521,9 @@ def spatial_section(r: dict, quick: bool) -> list:
     lines += ["", "Time to accuracy (error: largest joint-angle error at T against Pinocchio's ABA integrated by "
               "DOP853 at rtol 1e-13; time: the shortest run that reached it, best of repeats as above; spacar, "
               "exudyn and Pinocchio + DOP853 at the tolerances " + ", ".join(f"{t:g}" for t in SPATIAL_TOLS) +
-              " (half decades, as MuJoCo's steps); MuJoCo: its RK4 at fixed steps from " +
-              ", ".join(f"{h:g}" for h in MUJOCO_STEPS) + " s, a Python loop of `mj_step`):", "",
+              " (half decades); MuJoCo: its RK4 at fixed steps from " + f"{MUJOCO_STEPS[0]:g} s down to "
+              f"{MUJOCO_STEPS[-1]:g} s in ratios of 10^(1/8) (its error, ∝ h⁴, in half decades as well), a Python "
+              "loop of `mj_step`):", "",
               "| N | target | spacar `simulate` | spacar `Rollout` | spacar general path | exudyn tree DOPRI5 | "
               "MuJoCo RK4 | Pinocchio ABA + DOP853 | exudyn / spacar | MuJoCo / spacar | MuJoCo / Rollout | "
               "general path / spacar |",
