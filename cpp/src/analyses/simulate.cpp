@@ -46,11 +46,15 @@ Simulation::Simulation(Model& model)
   check_thread_deadline("(in the allocation of the work arrays)");
   predicted_ = Eigen::VectorXd::Zero(sys_->nx);
   for (const FreeRotation& fr : sys_->free_rotations) dependent_[fr.node] = fr.dependent;
+  positions_from_model();
+  if (x_given_.size()) x_given_ = data_->x;
+  compiled_revision_ = model_.revision();
+}
+
+void Simulation::positions_from_model() {
   int g = 0;
   for (const auto& [id, n] : model_.nodes)
     for (double v : n.x) data_->x[g++] = v;
-  if (x_given_.size()) x_given_ = data_->x;
-  compiled_revision_ = model_.revision();
 }
 
 void Simulation::remember(Solved& s) const {

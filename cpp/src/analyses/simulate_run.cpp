@@ -134,10 +134,7 @@ void Simulation::run(BlockResults& res, const RunOptions& options) {
       used && used->serves_any_state() && sys_->free_rotations.empty() ? std::move(path_) : nullptr;
   finish();
   store_state();
-  if (model_.revision() == compiled_revision_ + 1) {
-    kept_tree_ = std::move(tree);
-    kept_revision_ = model_.revision();
-  }
+  if (model_.revision() == compiled_revision_ + 1) kept_tree_ = std::move(tree);
 }
 
 bool Simulation::renew() {
@@ -178,9 +175,7 @@ bool Simulation::data_holds_start() const {
 
 void Simulation::restart_data() {
   data_->reset_state(*sys_, /*keep_pivots=*/true);  // the last block's pivots replayed: no search
-  int g = 0;
-  for (const auto& [id, n] : model_.nodes)
-    for (double v : n.x) data_->x[g++] = v;
+  positions_from_model();
 }
 
 // Requests that cannot be carried out are refused before any work (formulation.md §8.1).

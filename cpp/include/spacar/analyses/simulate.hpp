@@ -337,7 +337,7 @@ class Simulation {
   // third of a first block beyond its right-hand sides (issue 37).
   bool renew();
   // Whether renew() would succeed now.
-  bool renewable() const { return kept_tree_ && model_.revision() == kept_revision_; }
+  bool renewable() const { return kept_tree_ && model_.revision() == compiled_revision_ + 1; }
 
   // Runs from many initial states over the same output times (spacar.Rollout): the rows of q0
   // and qd0 (one state each, one column per DOF; the integrated deformations start from the
@@ -459,12 +459,14 @@ class Simulation {
   // How the states are evaluated (rhs_path.hpp): chosen for a run (RunOptions::recursive), the
   // general path outside runs, except that recursive_state() keeps the tree it took.
   std::unique_ptr<RhsPath> path_ = std::make_unique<GeneralPath>();
-  // The tree path of the last run, kept for the next run of the unchanged model (renew()), and the
-  // model's revision when that run stored its state.
+  // The tree path of the last run, kept for the next run of the unchanged model (renew()): kept
+  // only if that run's store_state() was the one change since the system was compiled or
+  // reloaded, so the model is unchanged since while its revision is compiled_revision_ + 1.
   std::unique_ptr<RhsPath> kept_tree_;
-  std::uint64_t kept_revision_ = 0;
   bool renewed_ = false;  // renew() made this simulation ready for the next block, not yet run
   std::uint64_t compiled_revision_ = 0;  // the model's revision the system was compiled or reloaded at
+  // The nodes' positions of the model into the data (a new simulation's start).
+  void positions_from_model();
   // After renew(), for a block that does not continue on the kept tree: the data reset and the
   // positions read from the model, as a new simulation starts.
   void restart_data();
