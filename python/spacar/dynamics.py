@@ -138,8 +138,7 @@ def dynamics_derivatives(model: Model, q, qd, tau, *, time_limit=None):
     ∂q̈/∂(q, q̇) = −M⁻¹ ∂τ/∂(q, q̇), in C++ over the whole batch. For planar and spatial trees of
     rigid bodies on the recursive path (URDF robots, pendulums, branched linkages, floating bases
     in their DOFs of the origin and three Euler parameters; formulation.md §7) and closed loops
-    closed at points (their forward dynamics on dual numbers); other models, loops closed at a cut
-    hinge among them, raise
+    closed at points and at cut hinges (their forward dynamics on dual numbers); other models raise
     InputError saying why they are not one. ``time_limit``: wall-clock
     seconds (:class:`spacar.TimeLimitError`), the set-up included. Each call compiles and
     assembles the model: :class:`Dynamics` does that once for many calls."""

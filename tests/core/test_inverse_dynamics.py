@@ -37,6 +37,7 @@ LOOPS = {
     "spatial RSUR loop (a ball joint closes it)": trees.rsur,
     "spatial RSUR loop from a URDF, a spring on a dependent joint": lambda: sprung(trees.urdf_rsur()),
     "spatial 7R loop (closed at a point and a cut hinge)": trees.seven_bar,
+    "spatial 7R loop cut between two moving links": lambda: trees.seven_bar(last=4),
     "planar four-bar (passive rotations of the coupler and rocker)": lambda: models.four_bar(),
     "planar four-bar, a DYNE PLHINGE crank, springs, a damper, FORCE": trees.hinged_four_bar,
 }
@@ -118,7 +119,7 @@ def test_other_systems_take_the_reduced_equations():
     assert spacar.inverse_dynamics(model, q[0], qd[0], qdd[0]).shape == (n,)
 
 
-POINT_LOOPS = {
+DERIVATIVE_LOOPS = {
     "four-bar, DYNX crank": models.four_bar,
     "four-bar, DYNE PLHINGE crank, springs, damper, FORCE": trees.hinged_four_bar,
     "four-bar, reversed DYNE PLHINGE, a sprung and damped released hinge": trees.reversed_hinged_four_bar,
@@ -129,6 +130,9 @@ POINT_LOOPS = {
     "spatial RSUR, closed at a point": trees.rsur,
     "spatial RSUR from a URDF, closed by a ball joint": trees.urdf_rsur,
     "spatial RSUP (a sliding passive joint) with a pendulum, 2 DOFs, springs and loads": trees.urdf_rsup_pendulum,
+    "spatial 7R loop, closed at a point and a cut hinge": trees.seven_bar,
+    "spatial 7R loop driven in the middle, cut elsewhere": lambda: trees.seven_bar(dof=4),
+    "spatial 7R loop cut between two moving links": lambda: trees.seven_bar(last=4),
 }
 
 
@@ -142,16 +146,17 @@ def double_path_accelerations(sim, dyn, q, qd, tau):
 
 
 @pytest.mark.parametrize("offset", [0.0, 0.3])
-@pytest.mark.parametrize("name", POINT_LOOPS)
+@pytest.mark.parametrize("name", DERIVATIVE_LOOPS)
 def test_closed_loops_have_exact_derivatives(name, offset):
-    """spacar.dynamics_derivatives on planar and spatial loops closed at points (the loops' forward
+    """spacar.dynamics_derivatives on planar and spatial loops closed at points and at cut hinges
+    (their misalignments written on the dual numbers from the hinge frame; the loops' forward
     dynamics on dual numbers, closed_loop.cpp, with the tree's inverse dynamics of planar_rnea.hpp
     and spatial_rnea.hpp): its q̈ under τ gives back τ through spacar.inverse_dynamics (the
     loops' double recursion, checked above against the reduced equations) and equals the double
     path's forward dynamics; ∂q̈/∂τ is the inverse of the mass matrix that inverse_dynamics implies;
     ∂q̈/∂q, ∂q̈/∂q̇ equal central differences of the double path's q̈ to 1e-7. At a state near the
     assembled one and one 0.3 rad further (reached by continuation)."""
-    model = POINT_LOOPS[name]()
+    model = DERIVATIVE_LOOPS[name]()
     sim = _core.Simulation(model.copy().core)
     sim.assemble()
     dyn = spacar.Dynamics(model)
@@ -179,11 +184,6 @@ def test_closed_loops_have_exact_derivatives(name, offset):
     batch = dyn.dynamics_derivatives(np.array([q, q + 0.01]), np.array([qd, -qd]), np.array([tau, tau]))
     np.testing.assert_allclose(batch[1][0], dq, rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(batch[1][1], dyn.dynamics_derivatives(q + 0.01, -qd, tau)[1], rtol=1e-10, atol=1e-10)
-
-
-def test_loops_cut_at_a_hinge_have_no_derivatives_yet():
-    with pytest.raises(InputError, match="not computed on loops closed at a cut hinge"):
-        spacar.dynamics_derivatives(trees.seven_bar(), [0.1], [0.0], [0.0])
 
 
 def test_bad_arguments_are_input_errors():

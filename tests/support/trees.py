@@ -362,10 +362,11 @@ def hinged_four_bar():
     return m
 
 
-def seven_bar(dof=1):
+def seven_bar(dof=1, last=7):
     """The spatial 7R loop of spacar.compare.models.seven_r_loop at tight tolerances, hinge `dof`
-    its DOF (4: in the middle of the loop, which the tree must cut elsewhere)."""
-    m = models.seven_r_loop(eps=1e-10, epskin=1e-14, dof=dof)
+    its DOF (4: in the middle of the loop, which the tree must cut elsewhere), cut at hinge `last`
+    (7: to the ground; 4: between two moving links)."""
+    m = models.seven_r_loop(eps=1e-10, epskin=1e-14, dof=dof, last=last)
     m.timestep(5, 0.5)
     return m
 

@@ -69,6 +69,7 @@ class Hinge : public AutoDiffElement<Hinge, 8, 3> {
   }
 
   double period(int i) const override { return i == 0 ? 2.0 * M_PI : 0.0; }
+  const Eigen::Matrix3d* axes_frame() const override { return &C0_; }
 
   void constitutive(const std::vector<double>& v, double* S) const override {
     for (int i = 0; i < 9; ++i) S[i] = 0.0;

@@ -418,7 +418,7 @@ void ClosedLoopTree<Algebra>::inverse_dynamics(const double* q, const double* qd
   Eigen::Map<Eigen::VectorXd>(force, nd_).noalias() = T_.transpose() * col_;
 }
 
-// --- derivatives of loops closed at points (planar and spatial): the forward dynamics of solve()
+// --- derivatives of closed loops (planar and spatial, at points and cut hinges): the forward dynamics of solve()
 // written once on a scalar type and run on dual numbers. Exact first derivatives of θ_d(q) come from one Newton correction on duals
 // from the closed state, θ_d = θ_d* − J_d⁻¹ c(q, θ_d*) (c vanishes there: its derivative is
 // −J_d⁻¹ J_q); the rest (J, T, γ, g, τ_id, M T, Tᵀ M T) follows by the chain rule.
@@ -547,9 +547,53 @@ void ClosedLoopTree<SpatialAlgebra>::tree_inverse_dynamics(const S* q, const S* 
   static_cast<const SpatialTree&>(*tree_).inverse_dynamics_on(q, qd, qdd, force);
 }
 
+// A cut's row r, e = U · V with U = R_o1 axis and V = R_o2 across[r] (world): ė = ω_o1 · (U × V)
+// + ω_o2 · (V × U), each body's ω the sum of its path's joint rates about their world axes; at
+// θ̈ = 0, ë = Ü · V + 2 U̇ · V̇ + U · V̈ with U̇ = Ω × U, Ü = A × U + Ω × U̇ (world Ω = R ω, A = R α).
+template <>
+template <class S>
+void ClosedLoopTree<SpatialAlgebra>::add_cut_row(const std::vector<rnea::SpatialMotion<S>>& motion, const Cut& cut,
+                                                 size_t r, int row, std::vector<S>& c, std::vector<S>* J,
+                                                 std::vector<S>* gamma) const {
+  using rnea::V3;
+  const auto& bodies = tree_->bodies_;
+  const int n = nd_ + nn_;
+  auto dot = [](const V3<S>& a, const V3<S>& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  auto world = [&](int body, const Eigen::Vector3d& b) {
+    return body < 0 ? rnea::constant<S>(b) : rnea::times(motion[body].R, rnea::constant<S>(b));
+  };
+  const V3<S> U = world(cut.body[0], cut.axis), V = world(cut.body[1], cut.across[r]);
+  c[row] = dot(U, V) - cut.value[r];
+  if (J) {
+    const V3<S> w = rnea::cross(U, V);
+    for (int end = 0; end < 2; ++end)
+      for (int j = cut.body[end]; j >= 0; j = bodies[j].parent) {
+        const auto& m = bodies[j];
+        if (m.prismatic) continue;
+        const S rate = dot(rnea::times(motion[j].R, rnea::constant<S>(m.axis)), w);
+        (*J)[row * n + m.dof] = (*J)[row * n + m.dof] + (end == 0 ? m.sign : -m.sign) * rate;
+      }
+  }
+  if (!gamma) return;
+  const V3<S> zero{S(0.0), S(0.0), S(0.0)};
+  auto rates = [&](int body, const V3<S>& X, V3<S>& Xd, V3<S>& Xdd) {
+    if (body < 0) {
+      Xd = Xdd = zero;
+      return;
+    }
+    const V3<S> Om = rnea::times(motion[body].R, motion[body].w), A = rnea::times(motion[body].R, motion[body].alpha);
+    Xd = rnea::cross(Om, X);
+    Xdd = rnea::plus(rnea::cross(A, X), rnea::cross(Om, Xd));
+  };
+  V3<S> Ud, Udd, Vd, Vdd;
+  rates(cut.body[0], U, Ud, Udd);
+  rates(cut.body[1], V, Vd, Vdd);
+  (*gamma)[row] = (*gamma)[row] + dot(Udd, V) + 2.0 * dot(Ud, Vd) + dot(U, Vdd);
+}
+
 // Spatial points: the placements and motions of spatial_outward (spatial_rnea.hpp) at θ̈ = 0
 // without gravity; a point's rows Σ sign (S_j) × (x − pin_j) (a sliding joint's: its axis), its
-// acceleration R (a_v + α × b + ω × (v + ω × b)).
+// acceleration R (a_v + α × b + ω × (v + ω × b)); then the cuts' rows (add_cut_row).
 template <>
 template <class S>
 void ClosedLoopTree<SpatialAlgebra>::loop_points(const std::vector<S>& theta, const std::vector<S>* rates,
@@ -561,10 +605,9 @@ void ClosedLoopTree<SpatialAlgebra>::loop_points(const std::vector<S>& theta, co
   std::vector<rnea::SpatialMotion<S>> motion;
   rnea::spatial_outward(bodies, Eigen::Matrix<double, 6, 1>::Zero(), theta.data(), rates ? rates->data() : zero.data(),
                         zero.data(), motion);
-  const int m_rows = 3 * static_cast<int>(loops_.points.size());
-  c.assign(m_rows, S(0.0));
-  if (J) J->assign(static_cast<size_t>(m_rows) * n, S(0.0));
-  if (gamma) gamma->assign(m_rows, S(0.0));
+  c.assign(m_, S(0.0));
+  if (J) J->assign(static_cast<size_t>(m_) * n, S(0.0));
+  if (gamma) gamma->assign(m_, S(0.0));
   auto add_point = [&](int body, const Eigen::Vector3d& b, double scale, int row) {
     const V3<S> bb = rnea::constant<S>(b);
     V3<S> x = bb;
@@ -592,6 +635,8 @@ void ClosedLoopTree<SpatialAlgebra>::loop_points(const std::vector<S>& theta, co
     add_point(p.b, p.pb, -1.0, row);
     row += 3;
   }
+  for (const Cut& cut : loops_.cuts)
+    for (size_t r = 0; r < cut.rows.size(); ++r, ++row) add_cut_row(motion, cut, r, row, c, J, gamma);
 }
 
 template <class Algebra>
@@ -653,9 +698,6 @@ template <class Algebra>
 bool ClosedLoopTree<Algebra>::dynamics_derivatives(int n, const double* q, const double* qd, const double* tau,
                                                    double* qdd, double* dq, double* dqd, double* dtau) {
   if (n != nd_) return false;
-  if (!loops_.cuts.empty())
-    throw InputError("dynamics_derivatives: not computed on loops closed at a cut hinge (the recursive path computes "
-                     "them on trees and on loops closed at points; inverse_dynamics and simulate take cut loops)");
   if (m_ != nn_) {
     throw InputError("dynamics_derivatives: not computed on loops with redundant constraints (" + std::to_string(m_) +
                      " constraints on " + std::to_string(nn_) + " passive joints)");

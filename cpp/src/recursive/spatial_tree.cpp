@@ -321,10 +321,15 @@ class SpatialTree::Builder : public tree_detail::TreeBuilder<SpatialTree::Builde
         cut.body[end] = body == kGround ? kGround : placed_[body];
         cut.lambda0[end] = lambda(id);
       }
+      const Eigen::Matrix3d* frame = se.kernel->axes_frame();  // a HINGE's (sliding joints are refused above)
+      if (!frame) return refuse(element_name(se) + " closes a loop and has no hinge frame");
+      const Eigen::Matrix3d& C0 = *frame;
+      cut.axis = euler_R(cut.lambda0[0]) * C0.col(0);
       for (int k = 1; k < se.nd; ++k)
         if (sys_.def_class[se.def_offset + k] == DefClass::Fixed) {
           cut.rows.push_back(k);
           cut.value.push_back(e_[se.def_offset + k]);
+          cut.across.push_back(euler_R(cut.lambda0[1]) * (k == 1 ? C0.col(2) : Eigen::Vector3d(-C0.col(1))));
         }
       loops.cuts.push_back(std::move(cut));
     }

@@ -132,15 +132,19 @@ def spatial_chain(n: int, seed: int = 0, joints: str = "hinge", t_end: float = 0
 
 
 def seven_r_loop(seed: int = 2, crank_rate: float = 1.0, t_end: float = 1.0, n_out: int = 10, eps: float = 1e-8,
-                 epskin: float = 1e-13, dof: int = 1) -> Model:
+                 epskin: float = 1e-13, dof: int = 1, last: int = 7) -> Model:
     """A spatial 7R loop: a random (seeded) 6-link chain as :func:`spatial_chain` (rigid BEAMs
     with EMASS and rotary inertia, point masses, inertia tensors, gravity along a random
     direction) whose HINGE ``dof`` (1 … 6, the first by default) is the DOF (initial rate
     ``crank_rate``) and whose other HINGEs are released (passive), its tip node fixed to the ground and a seventh HINGE (e1 released, e2
     and e3 rigid) from the last link's LAMBDA node to the ground's about a random axis. The loop
     closes at a point and at a hinge: five constraints for five passive joints, mobility one.
-    The seed's geometry keeps the loop away from its locking positions over 1 s."""
+    The seed's geometry keeps the loop away from its locking positions over 1 s. HINGE ``i``
+    (1 … 7) is element HINGE + i, except HINGE ``last`` (if not the seventh), numbered HINGE + 8:
+    the recursive path cuts the loop at the passive hinge of the highest number (the seventh, to
+    the ground, by default; ``last`` = 4 cuts it between two moving links)."""
     rng = np.random.default_rng(seed)
+    hinge = {i: HINGE + (8 if i == last != 7 else i) for i in range(1, 8)}
     m = Model()
     p = np.array([0.1, -0.2, 0.3])
     m.xyz(1, *p)
@@ -151,21 +155,21 @@ def seven_r_loop(seed: int = 2, crank_rate: float = 1.0, t_end: float = 1.0, n_o
         m.beam(i, i, START + i, i + 1, END + i, *np.cross(d, rng.normal(size=3)))
         p = p + d
         m.xyz(i + 1, *p)
-        m.hinge(HINGE + i, END + i - 1, START + i, *rng.normal(size=3))
-        (m.dyne if i == dof else m.rlse)(HINGE + i, 1)
+        m.hinge(hinge[i], END + i - 1, START + i, *rng.normal(size=3))
+        (m.dyne if i == dof else m.rlse)(hinge[i], 1)
         m.emass(i, 1.0 + rng.random(), 1e-3, 2e-3, 3e-3)
         m.mass(i + 1, 0.2 + 0.3 * rng.random())
         Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
         J = Q @ np.diag(0.05 + 0.1 * rng.random(3)) @ Q.T
         m.mass(START + i, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2])
-    m.hinge(HINGE + n + 1, END + n, END, *rng.normal(size=3))
-    m.rlse(HINGE + n + 1, 1)
+    m.hinge(hinge[n + 1], END + n, END, *rng.normal(size=3))
+    m.rlse(hinge[n + 1], 1)
     m.fix(1)
     m.fix(n + 1)
     m.fix(END)
     g = rng.normal(size=3)
     m.gravity(*(G * g / np.linalg.norm(g)))
-    m.ed(HINGE + dof, 1, crank_rate)
+    m.ed(hinge[dof], 1, crank_rate)
     _tolerances(m, eps, epskin)
     m.timestep(n_out, t_end)
     return m

@@ -57,6 +57,9 @@ class ElementKernel {
   virtual double period(int i) const { return 0.0; }
   // Velocity-level deformation (only its rate is defined): its value is integrated, not computed.
   virtual bool velocity_level(int i) const { return false; }
+  // The element's frame C0 from its axis (HINGE, formulation.md §4.10), nullptr for the others:
+  // the recursive path writes a cut hinge's misalignments with it on dual numbers.
+  virtual const Eigen::Matrix3d* axes_frame() const { return nullptr; }
   // The rates ė at (x, v) evaluated directly (for tests): holonomic rows as the directional
   // derivative of D along v, velocity-level rows from the element's slip-rate function.
   virtual void rates(const double* x, const double* v, double* edot) const = 0;

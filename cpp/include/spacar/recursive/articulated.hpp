@@ -96,6 +96,10 @@ struct TreeLoops {
     std::array<Eigen::Vector4d, 2> lambda0;  // their Euler parameters at the recognition
     std::vector<int> rows;                   // its rigid deformations (1: e2, 2: e3)
     std::vector<double> value;               // and their values
+    // e_r = (R_o1 axis) · (R_o2 across[r]) (formulation.md §4.10): o1's hinge axis e_x and, per
+    // row, o2's e_z (e2) or −e_y (e3), in their bodies' coordinates (the ground's: world).
+    Eigen::Vector3d axis;
+    std::vector<Eigen::Vector3d> across;
   };
   std::vector<ClosurePoint> points;
   std::vector<Cut> cuts;

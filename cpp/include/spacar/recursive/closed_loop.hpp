@@ -27,6 +27,10 @@
 #include "spacar/recursive/articulated.hpp"
 
 namespace spacar {
+namespace rnea {
+template <class S>
+struct SpatialMotion;  // spatial_rnea.hpp
+}  // namespace rnea
 
 // The factorization of J_d, the constraints' Jacobian in the passive joints (m × n, m ≥ n): an LU
 // with partial pivoting where J_d is square and not near singular (smallest / largest |U_ii| above
@@ -103,14 +107,19 @@ class ClosedLoopTree : public RecursiveTree {
   bool prepare(const double* q, const double* qd);
   // q̈ at (q, q̇) under τ on a scalar type S (dual numbers: its exact derivatives), at the state
   // prepare() closed, with Jd_inverse = J_d⁻¹ there; false if Tᵀ M T is not positive definite
-  // (InputError if J_d is singular on the way). Loops closed at points only.
+  // (InputError if J_d is singular on the way).
   template <class S>
   bool loop_dynamics(const S* q, const S* qd, const S* tau, const Eigen::MatrixXd& Jd_inverse, S* qdd);
-  // The point rows c (m), J (m × θ) and the constraints' accelerations γ at θ̈ = 0 on S, at θ
-  // and θ̇ (J, γ: if given); the kinematics of add_point_rows and point_acceleration.
+  // The rows c (m: the points', then the cuts'), J (m × θ) and the constraints' accelerations γ
+  // at θ̈ = 0 on S, at θ and θ̇ (J, γ: if given); the kinematics of add_point_rows,
+  // point_acceleration and add_cut_rows.
   template <class S>
   void loop_points(const std::vector<S>& theta, const std::vector<S>* rates, std::vector<S>& c, std::vector<S>* J,
                    std::vector<S>* gamma);
+  // A spatial cut's row r into row `row` of c (J, γ: if given), on S, from the tree's motion.
+  template <class S>
+  void add_cut_row(const std::vector<rnea::SpatialMotion<S>>& motion, const typename Tree::Loops::Cut& cut, size_t r,
+                   int row, std::vector<S>& c, std::vector<S>* J, std::vector<S>* gamma) const;
   template <class S>
   void tree_inverse_dynamics(const S* q, const S* qd, const S* qdd, S* force) const;  // the tree's, on S
 
