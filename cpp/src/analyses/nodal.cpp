@@ -361,6 +361,7 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
       if (it.row() == c) diagonal_[c] = static_cast<int>(&it.value() - A.valuePtr());
   rhs_ = sol_ = res_ = Eigen::VectorXd::Zero(n_);
   rest_.assign(rest_start_.back(), 0.0);
+  for (std::vector<double>& part : parts_) part.assign(rest_start_.back(), 0.0);
   if (!symmetric_) {
     lu_.analyze(A);
     return;
@@ -390,19 +391,51 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
   ldlt_.analyze(A, order);
 }
 
-void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c) {
+void SaddlePoint::hold_part(const System& sys, const Data& data, const Eigen::VectorXd& sigma, int part,
+                            double load_factor) {
+  NodalCoefficients unit;
+  unit.stiffness = unit.geometric = unit.mass = unit.damping = 0.0;
+  unit.load_factor = load_factor;
+  for (size_t i = 0; i < sys.elements.size(); ++i) {
+    const SystemElement& se = sys.elements[i];
+    const int n = static_cast<int>(se.coords.size());
+    if (part == kGeometric || part == kMass) {
+      (part == kGeometric ? unit.geometric : unit.mass) = 1.0;
+      spacar::element_rest(sys, data, i, sigma, unit, local_);
+      unit.geometric = unit.mass = 0.0;
+    } else {
+      local_.setZero(n, n);
+      add_constitutive(sys, se, data.work[i].B, part == kStiffness ? se.S : se.D, 1.0, &layout_, local_);
+    }
+    std::copy(local_.data(), local_.data() + local_.size(), parts_[part].data() + rest_start_[i]);
+  }
+  held_[part] = true;
+  if (part == kGeometric) held_load_factor_ = load_factor;
+}
+
+void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c,
+                           bool same_state) {
   const Eigen::VectorXd& s = layout_.scale;
   const int nf = layout_.n_free;
   kkt_.set_zero();
+  // The elements' H as the sum of their parts per unit coefficient, each evaluated once per state.
+  if (!same_state) held_.fill(false);
+  const double coefficient[kParts] = {c.geometric, c.mass, c.stiffness, c.damping};
+  for (int p = 0; p < kParts; ++p)
+    if (coefficient[p] != 0.0 && (!held_[p] || (p == kGeometric && held_load_factor_ != c.load_factor)))
+      hold_part(sys, data, sigma, p, c.load_factor);
   // H, scaled to energies: H_s(a, b) = H(a, b) s_a s_b.
   auto scale_of = [&](int g) { return layout_.free_of[g] >= 0 ? s[layout_.free_of[g]] : 1.0; };
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
-    spacar::element_rest(sys, data, i, sigma, c, local_);
-    std::copy(local_.data(), local_.data() + local_.size(), rest_.data() + rest_start_[i]);
-    add_constitutive(sys, se, data.work[i].B, se.S, c.stiffness, &layout_, local_);
-    add_constitutive(sys, se, data.work[i].B, se.D, c.damping, &layout_, local_);
     const int n = static_cast<int>(se.coords.size());
+    auto part = [&](int p) { return Eigen::Map<const Eigen::MatrixXd>(parts_[p].data() + rest_start_[i], n, n); };
+    local_.setZero(n, n);
+    for (int p : {kGeometric, kMass})
+      if (coefficient[p] != 0.0) local_ += coefficient[p] * part(p);
+    std::copy(local_.data(), local_.data() + local_.size(), rest_.data() + rest_start_[i]);
+    for (int p : {kStiffness, kDamping})
+      if (coefficient[p] != 0.0) local_ += coefficient[p] * part(p);
     const double* sc = element_scale_.data() + element_scale_start_[i];
     for (int b = 0; b < n; ++b)
       for (int a = 0; a < n; ++a) local_(a, b) *= sc[a] * sc[b];
@@ -450,8 +483,9 @@ void SaddlePoint::assemble(const System& sys, Data& data, const Eigen::VectorXd&
   }
 }
 
-bool SaddlePoint::factorize(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c) {
-  assemble(sys, data, sigma, c);
+bool SaddlePoint::factorize(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c,
+                            bool same_state) {
+  assemble(sys, data, sigma, c, same_state);
   const Eigen::SparseMatrix<double>& A = kkt_.matrix();
   singular_ = false;
   negative_ = -1;
@@ -551,9 +585,9 @@ ReducedSystem::ReducedSystem(const System& sys, Data& data)
   for (size_t j = 0; j < sys.e_dyn.size(); ++j) dof_of_def_[sys.e_dyn[j]] = nxd + static_cast<int>(j);
 }
 
-bool ReducedSystem::factorize(const Eigen::VectorXd& sigma, const NodalCoefficients& c) {
+bool ReducedSystem::factorize(const Eigen::VectorXd& sigma, const NodalCoefficients& c, bool same_state) {
   c_ = c;
-  return saddle_.factorize(sys_, data_, sigma, c);
+  return saddle_.factorize(sys_, data_, sigma, c, same_state);
 }
 
 Eigen::VectorXd ReducedSystem::load(const Eigen::VectorXd& v) const {

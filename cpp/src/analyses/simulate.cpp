@@ -436,6 +436,7 @@ void Simulation::newton_refresh(double t, const Eigen::VectorXd& Y) {
   } else {
     *run_.newton_data = *data_;
   }
+  run_.newton_factorized = false;
 }
 
 void Simulation::residual(double t, const Eigen::VectorXd& Y, const Eigen::VectorXd& qdd, Eigen::VectorXd& R) {

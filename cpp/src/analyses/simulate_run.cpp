@@ -473,7 +473,10 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
     setup.newton.factorize = [this](double gh, double bh2) {
       NodalCoefficients c;
       c.mass = 1.0, c.damping = gh, c.stiffness = bh2, c.geometric = bh2;
-      run_.newton_singular = !run_.newton_system->factorize(run_.newton_data->sigma, c) || run_.newton_system->saddle().singular();
+      // A new step size at the state of the last refresh: only the coefficients change.
+      run_.newton_singular = !run_.newton_system->factorize(run_.newton_data->sigma, c, run_.newton_factorized) ||
+                             run_.newton_system->saddle().singular();
+      run_.newton_factorized = true;
     };
     setup.newton.solve = [this](const Eigen::VectorXd& r, Eigen::VectorXd& x) {
       if (run_.newton_singular) {  // the stepper reports a singular Newton matrix and halves the step

@@ -143,6 +143,8 @@ def seven_r_loop(seed: int = 2, crank_rate: float = 1.0, t_end: float = 1.0, n_o
     (1 … 7) is element HINGE + i, except HINGE ``last`` (if not the seventh), numbered HINGE + 8:
     the recursive path cuts the loop at the passive hinge of the highest number (the seventh, to
     the ground, by default; ``last`` = 4 cuts it between two moving links)."""
+    if not (1 <= dof <= 6 and 1 <= last <= 7):
+        raise ValueError(f"seven_r_loop: dof must be 1 … 6 and last 1 … 7, got {dof} and {last}")
     rng = np.random.default_rng(seed)
     hinge = {i: HINGE + (8 if i == last != 7 else i) for i in range(1, 8)}
     m = Model()

@@ -19,6 +19,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
+#include <array>
 #include <vector>
 
 #include "spacar/kinematics/data.hpp"
@@ -90,8 +91,11 @@ class SaddlePoint {
   SaddlePoint(const System& sys, const NodalLayout& layout);
 
   // Assemble H + AᵀWA and A at the current state for the stresses sigma; factorize. False if
-  // the values are not finite or (LU) the matrix is singular.
-  bool factorize(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c);
+  // the values are not finite or (LU) the matrix is singular. same_state: the state and the
+  // stresses of the last call, other coefficients only (a new step of an implicit integrator):
+  // the elements' matrices per unit coefficient kept from it are combined again, not evaluated.
+  bool factorize(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c,
+                 bool same_state = false);
   // δx (nx; zero on fixed and input coordinates) for a load r on the coordinates (nx; its
   // entries on fixed and input coordinates ignored): δx = Z (Zᵀ H Z)⁻¹ Zᵀ r; `refine`: with one
   // step of iterative refinement (the factorization chose its pivots for no accuracy).
@@ -126,7 +130,10 @@ class SaddlePoint {
   }
 
  private:
-  void assemble(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c);
+  void assemble(const System& sys, Data& data, const Eigen::VectorXd& sigma, const NodalCoefficients& c,
+                bool same_state);
+  // The elements' part `part` per unit coefficient at the current state into parts_[part].
+  void hold_part(const System& sys, const Data& data, const Eigen::VectorXd& sigma, int part, double load_factor);
   void solve_scaled(Eigen::VectorXd& rhs, bool refine);  // in place
 
   const NodalLayout& layout_;
@@ -149,6 +156,13 @@ class SaddlePoint {
   // i's n x n values (column-major) from rest_start_[i].
   std::vector<double> rest_;
   std::vector<int> rest_start_;
+  // Every element's matrices per unit coefficient at the state of the last assembly, laid out as
+  // rest_: the geometric part (stresses and loads, at held_load_factor_), the mass, the
+  // stiffness and the damping; held_[p]: part p is of that state.
+  enum Part { kGeometric, kMass, kStiffness, kDamping, kParts };
+  std::array<std::vector<double>, kParts> parts_;
+  std::array<bool, kParts> held_{};
+  double held_load_factor_ = 0.0;
 };
 
 // The reduced system of the degrees of freedom q of sys (x^d, e^d),
@@ -165,8 +179,8 @@ class ReducedSystem {
   ReducedSystem(const System& sys, Data& data);
 
   // H for the stresses sigma and the coefficients at the current state, factorized; false if
-  // its values are not finite (see SaddlePoint::factorize).
-  bool factorize(const Eigen::VectorXd& sigma, const NodalCoefficients& c);
+  // its values are not finite (see SaddlePoint::factorize, also for same_state).
+  bool factorize(const Eigen::VectorXd& sigma, const NodalCoefficients& c, bool same_state = false);
   // q = (Zᵀ H Z)⁻¹ r and dx = Z q (nx), with at most `refinements` steps of refinement (0: the
   // saddle-point solution as it is, enough for a Newton step, whose residual is exact).
   void solve(const Eigen::VectorXd& r, Eigen::VectorXd& q, Eigen::VectorXd& dx, int refinements = kRefinements);

@@ -184,6 +184,7 @@ struct RunState {
   std::unique_ptr<Data> newton_data;
   std::unique_ptr<ReducedSystem> newton_system;
   bool newton_singular = false;
+  bool newton_factorized = false;  // newton_system factorized at newton_data's state (since its refresh)
   Eigen::VectorXd tree_qdd;  // the tree's q̈ at an output time
   // Message and time of the last right-hand side that failed in Newton, kept while the
   // integration has not passed that time: at a step-size collapse it says that the kinematics
