@@ -13,7 +13,9 @@ same tolerance equals to the figure given. Pinocchio: the four-bar as three revo
 URDF, each loop closed by a 3-D point constraint (``pinocchio.constraintDynamics``, proximal
 settings at 1e-14), integrated by SciPy's DOP853 (rtol = EPS, atol = 1e-3 EPS) from spacar's
 initial state; it has no revolute closure for the 7R loop. Every model built outside the timing; time per right-hand side: spacar's
-C++ block over its right-hand sides, Pinocchio's ``constraintDynamics`` call from Python.
+C++ block over its right-hand sides, Pinocchio's ``constraintDynamics`` call from Python. And
+``spacar.dynamics_derivatives`` per state, in one call on a batch of states along the tree's run
+(random τ), on these loops and on the 7R loop cut between two of its links (``last=4``).
 
     python benchmarks/closed_loops.py [--quick] [--no-write]
 """
@@ -170,10 +172,36 @@ def run_model(name, t_end, eps_list):
     return out
 
 
+def seven_r_cut_inside(t_end, eps):
+    return models.seven_r_loop(t_end=t_end, n_out=1, eps=eps, epskin=max(1e-14, 1e-3 * eps), last=4)
+
+
+DERIVATIVE_MODELS = {"four-bar": four_bar, "RSUR (URDF)": rsur, "7R loop, cut at its hinge to the ground": seven_r,
+                     "7R loop, cut between two links": seven_r_cut_inside}
+
+
+def derivative_timings(t_end, states):
+    """Wall time per state of one spacar.dynamics_derivatives call on `states` states along the
+    tree's run at EPS 1e-8 (random τ), best of three; the Dynamics made outside the timing."""
+    out = {}
+    for name, build in DERIVATIVE_MODELS.items():
+        model = build(t_end, 1e-8)
+        model.timestep(states, t_end)
+        res = spacar.simulate(model.copy())
+        q, qd = np.array(res.q)[1:], np.array(res.qd)[1:]
+        tau = np.random.default_rng(0).uniform(-1.0, 1.0, q.shape)
+        dyn = spacar.Dynamics(model)
+        t, _ = C.best_time(lambda: dyn.dynamics_derivatives(q, qd, tau), repeat=3, min_time=0.3)
+        out[name] = {"per_state": t / len(q), "states": len(q)}
+        C.log("derivatives", name, out[name])
+    return out
+
+
 def run(a) -> dict:
     t_end, eps = (QUICK_T_END, QUICK_EPS) if a.quick else (T_END, EPS)
     return {"quick": a.quick, "t_end": t_end, "machine": C.machine(peers=True),
-            "models": {name: run_model(name, t_end, eps) for name in MODELS}}
+            "models": {name: run_model(name, t_end, eps) for name in MODELS},
+            "derivatives": derivative_timings(t_end, 100 if a.quick else 1000)}
 
 
 def section(r: dict, plots=None) -> str:
@@ -195,6 +223,11 @@ def section(r: dict, plots=None) -> str:
         pin = x.get("Pinocchio constraintDynamics + DOP853 per rhs")
         lines.append(f"| {name} | {C.fmt_time(tree)} | {C.fmt_time(general)} | {C.fmt_time(pin)} | "
                      f"{C.fmt_ratio(general, tree)} |")
+    if r.get("derivatives"):
+        lines += ["", "`spacar.dynamics_derivatives` (q̈ and its derivatives in q, q̇ and τ, exact on dual numbers), "
+                  "one call on a batch of states along the tree's run:", "", "| model | states | per state |", "|---|---|---|"]
+        for name, x in r["derivatives"].items():
+            lines.append(f"| {name} | {x['states']} | {C.fmt_time(x['per_state'])} |")
     lines += ["", "Every run (EPS → error in wall time, right-hand sides); the tree at EPS = 1e-12 equals the "
               "reference to " + ", ".join(f"{x['agreement']:.1e} ({name})" for name, x in r["models"].items()) + ":", ""]
     for name, x in r["models"].items():

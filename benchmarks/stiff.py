@@ -98,7 +98,8 @@ def run(a) -> dict:
         r["scaling"][a.scaling_case] = stiff_scaling.run_case(a.scaling_case, quick)
         r["scaling"]["config"][a.scaling_case] = cfg[a.scaling_case]
         r["scaling"].setdefault("measured_apart", {})[a.scaling_case] = dict(C.machine(peers=True),
-                                                                          date=time.strftime("%Y-%m-%d %H:%M"))
+                                                                          date=time.strftime("%Y-%m-%d %H:%M"),
+                                                                          eps=list(cfg["eps"]))
         r["quick"] = quick
         return r
     cfg = QUICK if quick else FULL

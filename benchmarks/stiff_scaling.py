@@ -377,9 +377,10 @@ def section_lines(res) -> list:
                   f"then also in place of the default in the sweep): "
                   f"{', '.join(loose)}.", ""]
     for case, info in res.get("measured_apart", {}).items():
+        eps = f", spacar's EPS {', '.join(f'{e:g}' for e in info['eps'])}" if info.get("eps") else ""
         lines += [f"The {case} case was measured apart (`python benchmarks/stiff.py --scaling-case {case}`) on "
-                  f"{info.get('date', '?')}, on {info.get('CPU', '?')}; compare its ratios, not its times, with the "
-                  "other tables.", ""]
+                  f"{info.get('date', '?')}, on {info.get('CPU', '?')}{eps}; compare its ratios, not its times, with "
+                  "the other tables.", ""]
     for case, title in (("slidercrank", "Slider-crank, rod EI × k"), ("cantilever", "Steel cantilever, n PLBEAMs"),
                         ("spatial", "Spatial steel cantilever, n BEAMs")):
         if case not in res:
