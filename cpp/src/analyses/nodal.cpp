@@ -393,16 +393,16 @@ SaddlePoint::SaddlePoint(const System& sys, const NodalLayout& layout) : layout_
 
 void SaddlePoint::hold_part(const System& sys, const Data& data, const Eigen::VectorXd& sigma, int part,
                             double load_factor) {
-  NodalCoefficients unit;
-  unit.stiffness = unit.geometric = unit.mass = unit.damping = 0.0;
+  NodalCoefficients unit;  // the part's own coefficient 1, the others 0
+  unit.stiffness = unit.damping = 0.0;
+  unit.geometric = part == kGeometric ? 1.0 : 0.0;
+  unit.mass = part == kMass ? 1.0 : 0.0;
   unit.load_factor = load_factor;
   for (size_t i = 0; i < sys.elements.size(); ++i) {
     const SystemElement& se = sys.elements[i];
     const int n = static_cast<int>(se.coords.size());
     if (part == kGeometric || part == kMass) {
-      (part == kGeometric ? unit.geometric : unit.mass) = 1.0;
       spacar::element_rest(sys, data, i, sigma, unit, local_);
-      unit.geometric = unit.mass = 0.0;
     } else {
       local_.setZero(n, n);
       add_constitutive(sys, se, data.work[i].B, part == kStiffness ? se.S : se.D, 1.0, &layout_, local_);

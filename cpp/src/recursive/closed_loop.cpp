@@ -558,19 +558,18 @@ void ClosedLoopTree<SpatialAlgebra>::add_cut_row(const std::vector<rnea::Spatial
   using rnea::V3;
   const auto& bodies = tree_->bodies_;
   const int n = nd_ + nn_;
-  auto dot = [](const V3<S>& a, const V3<S>& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
   auto world = [&](int body, const Eigen::Vector3d& b) {
     return body < 0 ? rnea::constant<S>(b) : rnea::times(motion[body].R, rnea::constant<S>(b));
   };
   const V3<S> U = world(cut.body[0], cut.axis), V = world(cut.body[1], cut.across[r]);
-  c[row] = dot(U, V) - cut.value[r];
+  c[row] = rnea::dot(U, V) - cut.value[r];
   if (J) {
     const V3<S> w = rnea::cross(U, V);
     for (int end = 0; end < 2; ++end)
       for (int j = cut.body[end]; j >= 0; j = bodies[j].parent) {
         const auto& m = bodies[j];
         if (m.prismatic) continue;
-        const S rate = dot(rnea::times(motion[j].R, rnea::constant<S>(m.axis)), w);
+        const S rate = rnea::dot(rnea::times(motion[j].R, rnea::constant<S>(m.axis)), w);
         (*J)[row * n + m.dof] = (*J)[row * n + m.dof] + (end == 0 ? m.sign : -m.sign) * rate;
       }
   }
@@ -588,7 +587,7 @@ void ClosedLoopTree<SpatialAlgebra>::add_cut_row(const std::vector<rnea::Spatial
   V3<S> Ud, Udd, Vd, Vdd;
   rates(cut.body[0], U, Ud, Udd);
   rates(cut.body[1], V, Vd, Vdd);
-  (*gamma)[row] = (*gamma)[row] + dot(Udd, V) + 2.0 * dot(Ud, Vd) + dot(U, Vdd);
+  (*gamma)[row] = (*gamma)[row] + rnea::dot(Udd, V) + 2.0 * rnea::dot(Ud, Vd) + rnea::dot(U, Vdd);
 }
 
 // Spatial points: the placements and motions of spatial_outward (spatial_rnea.hpp) at θ̈ = 0

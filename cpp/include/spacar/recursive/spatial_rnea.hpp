@@ -27,6 +27,10 @@ V3<S> cross(const V3<S>& a, const V3<S>& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 template <class S>
+S dot(const V3<S>& a, const V3<S>& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+template <class S>
 V3<S> plus(const V3<S>& a, const V3<S>& b) {
   return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
 }
