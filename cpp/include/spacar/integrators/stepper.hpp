@@ -226,6 +226,7 @@ struct StepperSetup {
   // of DOP853's current size remain in the block (Hairer's NSTIFF: his DOP853 looks for
   // stiffness only after 1000 steps). A short stiff stretch costs DOP853 little, and where the
   // stiff modes are excited (the manual's slider-crank) Radau's steps are no longer than DOP853's.
+  // (500 where AUTO goes to generalized-α: Simulation::stepper_setup.)
   double stiff_steps_ahead = 1000.0;
   // AUTO: h|λ| beyond which a DOP853 step counts as stiff (0: the edge of its stability region,
   // 6.1). An undamped structure takes 1: a step shorter than a sixth of its fastest period is
