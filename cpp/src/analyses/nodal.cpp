@@ -674,21 +674,24 @@ Eigen::VectorXd ReducedSystem::product(const Eigen::VectorXd& q, Eigen::VectorXd
   return y;
 }
 
-Eigen::VectorXd ReducedSystem::mass_product(const Eigen::VectorXd& q) {
-  const Eigen::VectorXd dx = motion(q);
-  Eigen::VectorXd f = sys_.point_mass.cwiseProduct(dx), xe;
+void ReducedSystem::solve_mass(const Eigen::VectorXd& v, Eigen::VectorXd& q, Eigen::VectorXd& dx) {
+  // The nodal load M Z v, not load(Zᵀ M Z v): the saddle point's solution depends on its load b
+  // only through Zᵀ b (the constraints' forces take the rest), which saves a transposed solve.
+  const Eigen::VectorXd dv = motion(v);
+  Eigen::VectorXd f = sys_.point_mass.cwiseProduct(dv), xe;
   for (size_t i = 0; i < sys_.elements.size(); ++i) {
     const SystemElement& se = sys_.elements[i];
     if (!se.has_mass) continue;
     const int n = static_cast<int>(se.coords.size());
     xe.resize(n);
-    for (int j = 0; j < n; ++j) xe[j] = dx[se.coords[j]];
+    for (int j = 0; j < n; ++j) xe[j] = dv[se.coords[j]];
     const Eigen::VectorXd fe = data_.work[i].M * xe;
     for (int j = 0; j < n; ++j) f[se.coords[j]] += fe[j];
   }
   for (size_t b = 0; b < sys_.bodies.size(); ++b)
-    f.segment<4>(sys_.bodies[b].coord) += data_.body_M[b] * dx.segment<4>(sys_.bodies[b].coord);
-  return reduce(f);
+    f.segment<4>(sys_.bodies[b].coord) += data_.body_M[b] * dv.segment<4>(sys_.bodies[b].coord);
+  saddle_.solve(f, dx, false);
+  q = dofs(dx);
 }
 
 void ReducedSystem::solve(const Eigen::VectorXd& r, Eigen::VectorXd& q, Eigen::VectorXd& dx, int refinements) {

@@ -432,6 +432,16 @@ bool Simulation::auto_takes_generalized_alpha() const {
   return elastic;
 }
 
+// The motion dx of the coordinates the model moves (calculable, then dynamic), each divided by
+// (10⁻³ + |x|): generalized-α's step control of the nodal positions.
+void Simulation::scale_positions(const Eigen::VectorXd& dx, Eigen::VectorXd& scaled) const {
+  const System& sys = *sys_;
+  scaled.resize(static_cast<Eigen::Index>(sys.x_calc.size() + sys.x_dyn.size()));
+  Eigen::Index k = 0;
+  for (const std::vector<int>* list : {&sys.x_calc, &sys.x_dyn})
+    for (int c : *list) scaled[k++] = dx[c] / (1e-3 + std::abs(data_->x[c]));
+}
+
 StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_switch, int n_states) {
   const int nd = sys_->n_dof(), ny = static_cast<int>(sys_->y_defs.size());
   StepperSetup setup;
@@ -460,10 +470,7 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
       v.setZero(sys.n_qhat());
       for (int j = 0; j < sys.n_dof(); ++j) v[sys.dof_cols[j]] = dq[j];
       path_->transfer(sys, *data_, v, dx);
-      scaled.resize(static_cast<Eigen::Index>(sys.x_calc.size() + sys.x_dyn.size()));
-      Eigen::Index k = 0;
-      for (const std::vector<int>* list : {&sys.x_calc, &sys.x_dyn})
-        for (int c : *list) scaled[k++] = dx[c] / (1e-3 + std::abs(data_->x[c]));
+      scale_positions(dx, scaled);
     };
   }
   if (sparse_newton()) {
@@ -486,8 +493,16 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
       Eigen::VectorXd dx;
       run_.newton_system->solve(r, x, dx, 0);
     };
-    setup.newton.weight = [this](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
-      out = run_.newton_system->mass_product(v);
+    setup.newton.solve_weighted = [this](const Eigen::VectorXd& v, Eigen::VectorXd& x, Eigen::VectorXd* scaled_dx) {
+      if (run_.newton_singular) {
+        x = Eigen::VectorXd::Constant(v.size(), std::numeric_limits<double>::quiet_NaN());
+        if (scaled_dx) scaled_dx->setConstant(std::numeric_limits<double>::quiet_NaN());
+        return;
+      }
+      Eigen::VectorXd dx;
+      run_.newton_system->solve_mass(v, x, dx);
+      // Z x from the saddle point's solution (Z at the Newton matrix's state), not another transfer.
+      if (scaled_dx) scale_positions(dx, *scaled_dx);
     };
   }
   setup.rho_inf = options.rho_inf;

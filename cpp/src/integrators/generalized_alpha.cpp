@@ -177,18 +177,20 @@ void GeneralizedAlpha::newton_solve(const Eigen::VectorXd& r, Eigen::VectorXd& x
     system_.solve(r, x);
     return;
   }
-  system_.weight(r, wv_);
-  system_.solve(wv_, x);
+  system_.solve_weighted(r, x, nullptr);
 }
 
-void GeneralizedAlpha::filter(Eigen::VectorXd& v, Eigen::VectorXd& x) {
-  if (!system_.solve) {
-    apply_weight(v);  // N⁻¹ = (W_v N)⁻¹ W_v in the residual form
-    x = lu_.solve(v);
+void GeneralizedAlpha::filter(Eigen::VectorXd& v, Eigen::VectorXd& x, Eigen::VectorXd* scaled_dx) {
+  if (system_.solve) {
+    system_.solve_weighted(v, x, scaled_dx);
     return;
   }
-  system_.weight(v, wv_);
-  system_.solve(wv_, x);
+  apply_weight(v);  // N⁻¹ = (W_v N)⁻¹ W_v in the residual form
+  x = lu_.solve(v);
+  if (scaled_dx) {
+    dq_ = x.segment(r0_ - m_, m_);
+    position_error_(dq_, *scaled_dx);
+  }
 }
 
 void GeneralizedAlpha::state_at(double h, const Eigen::VectorXd& y) {
@@ -273,7 +275,7 @@ double GeneralizedAlpha::error_norm(double h, const Eigen::VectorXd& y) {
     for (int j = 0; j < nz_; ++j)
       if (j < r || j >= r + m_) res_[j] = k * ((d_new_[j] - d_[j]) / h - (d_[j] - d_prev_[j]) / h_prev_);
   }
-  filter(res_, dd_);
+  filter(res_, dd_, position_error_ ? &dx_ : nullptr);
   double sum = 0.0;
   for (int j = 0; j < nz_; ++j) {
     const double sc = j >= r && j < r + m_ ? scale_[j - r] : scale_[m_ + j];
@@ -281,8 +283,6 @@ double GeneralizedAlpha::error_norm(double h, const Eigen::VectorXd& y) {
   }
   double err = std::sqrt(sum / nz_);  // nz_ = m positions + the others, rates left out
   if (position_error_) {  // and the positions' error in the coordinates, relative to (10⁻³ + |x|)
-    dq_ = dd_.segment(r, m_);
-    position_error_(dq_, dx_);
     const double eps = rtol_[0];
     double coords = 0.0;
     for (Eigen::Index c = 0; c < dx_.size(); ++c) coords += (dx_[c] / eps) * (dx_[c] / eps);

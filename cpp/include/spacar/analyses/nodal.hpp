@@ -186,8 +186,9 @@ class ReducedSystem {
   void solve(const Eigen::VectorXd& r, Eigen::VectorXd& q, Eigen::VectorXd& dx, int refinements = kRefinements);
   // Zᵀ H Z q from the deformations (the refinement's product); dx, if given: Z q.
   Eigen::VectorXd product(const Eigen::VectorXd& q, Eigen::VectorXd* dx = nullptr);
-  // M̄ q = Zᵀ M Z q, the reduced mass times q (element, point and body masses at the state).
-  Eigen::VectorXd mass_product(const Eigen::VectorXd& q);
+  // q = (Zᵀ H Z)⁻¹ M̄ v, M̄ = Zᵀ M Z the reduced mass (element, point and body masses at the
+  // state), and dx = Z q, without refinement.
+  void solve_mass(const Eigen::VectorXd& v, Eigen::VectorXd& q, Eigen::VectorXd& dx);
   Eigen::VectorXd reduce(const Eigen::VectorXd& b);        // Zᵀ b for a load b on the coordinates
   Eigen::VectorXd load(const Eigen::VectorXd& v) const;    // a load b with Zᵀ b = v (nx)
   Eigen::VectorXd dofs(const Eigen::VectorXd& dx) const;   // E dx: the DOFs of a motion

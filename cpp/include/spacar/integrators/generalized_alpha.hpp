@@ -53,7 +53,7 @@ class GeneralizedAlpha : public Stepper {
   // A Newton matrix of the caller's own instead of the dense one from the Jacobian (large models,
   // sparse): where the integrator would take a Jacobian, refresh(t, y) takes the state there;
   // factorize(γ′h, β′h²) factorizes S = M̄ + γ′h C̄ + β′h² K̄ at it, the residual form's W_v N;
-  // solve(r, x): x = S⁻¹ r; weight(v, out): out = M̄ v at it (W_v). Requires the residual form
+  // solve(r, x): x = S⁻¹ r; solve_weighted(v, x): x = S⁻¹ M̄ v, M̄ at it (W_v). Requires the residual form
   // (set_residual; its weight is not used then) and Z the rates alone (no other first-order
   // states).
   void set_newton_system(NewtonSystem system);
@@ -83,9 +83,10 @@ class GeneralizedAlpha : public Stepper {
   void apply_weight(Eigen::VectorXd& v);  // v's rate part times W_ (residual form)
   void factorize(double h);
   // x = (the Newton matrix)⁻¹ r for a residual of the current form; x = N⁻¹ v, the filter of the
-  // error estimate (see error_norm).
+  // error estimate (see error_norm), with scaled_dx its positions' motion of the coordinates
+  // (position_error_).
   void newton_solve(const Eigen::VectorXd& r, Eigen::VectorXd& x);
-  void filter(Eigen::VectorXd& v, Eigen::VectorXd& x);
+  void filter(Eigen::VectorXd& v, Eigen::VectorXd& x, Eigen::VectorXd* scaled_dx = nullptr);
   void shift_acceleration(double h);                  // a_use_: A for a step of size h
   void state_at(double h, const Eigen::VectorXd& y);  // y_new_, a_new_ from d_new_
   Attempt newton(const Rhs& f, double t, double h, const Eigen::VectorXd& y);

@@ -195,7 +195,9 @@ struct NewtonSystem {
   std::function<void(double t, const Eigen::VectorXd& y)> refresh;
   std::function<void(double gh, double bh2)> factorize;
   std::function<void(const Eigen::VectorXd& r, Eigen::VectorXd& x)> solve;
-  std::function<void(const Eigen::VectorXd& v, Eigen::VectorXd& out)> weight;
+  // x = S⁻¹ W_v v; with scaled_dx, also the motion of the coordinates Z x, scaled as
+  // StepperSetup::position_error's (generalized-α's error estimate: no second transfer).
+  std::function<void(const Eigen::VectorXd& v, Eigen::VectorXd& x, Eigen::VectorXd* scaled_dx)> solve_weighted;
 };
 
 // What a run offers the stepper of a segment: the shape of the state and the model's callbacks.
