@@ -202,14 +202,16 @@ Integrator::Integrator(int n, Method method) : Stepper("Integrator", n), method_
 
 std::unique_ptr<Stepper> Integrator::make(Method method, const StepperSetup& setup) {
   auto stepper = std::make_unique<Integrator>(setup.n, method);
-  stepper->set_stiffness_detection(setup.auto_switch, setup.stiff_steps_ahead, setup.stiff_bound);
+  stepper->set_stiffness_detection(setup.auto_switch, setup.stiff_steps_ahead, setup.stiff_bound, setup.stiff_count);
   return stepper;
 }
 
-void Integrator::set_stiffness_detection(bool on, double min_steps_ahead, double bound) {
+void Integrator::set_stiffness_detection(bool on, double min_steps_ahead, double bound, int count) {
   if (!(min_steps_ahead >= 0)) throw std::invalid_argument("Integrator: min_steps_ahead must be >= 0");
   if (!(bound >= 0)) throw std::invalid_argument("Integrator: the stiffness bound must be >= 0");
+  if (count < 1) throw std::invalid_argument("Integrator: the count of stiff steps must be >= 1");
   detect_stiffness_ = on;
+  stiff_count_ = count;
   min_steps_ahead_ = min_steps_ahead;
   stiff_bound_ = bound > 0.0 ? bound : scheme(method_).stiff_bound;
 }
@@ -229,12 +231,12 @@ void Integrator::estimate_stiffness(double h) {
   hlamb_ = den > 0.0 ? std::abs(h) * std::sqrt(num / den) : 0.0;
 }
 
-// Hairer's counting after an accepted step: true once kStiffSteps steps were stiff with no run of
-// kNonstiffSteps non-stiff ones between them.
+// Hairer's counting after an accepted step: true once stiff_count_ (his 15) steps were stiff with
+// no run of kNonstiffSteps non-stiff ones between them.
 bool Integrator::stiff_after_step() {
   if (hlamb_ > stiff_bound_) {
     nonstiff_steps_ = 0;
-    return ++stiff_steps_ >= kStiffSteps;
+    return ++stiff_steps_ >= stiff_count_;
   }
   if (++nonstiff_steps_ >= kNonstiffSteps) stiff_steps_ = 0;
   return false;

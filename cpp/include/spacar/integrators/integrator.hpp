@@ -26,7 +26,7 @@ class Integrator : public Stepper {
   // small perturbation of the solution: the quotient is a Rayleigh-like estimate of the
   // dominant eigenvalue of ∂f/∂y along it. A step with h|λ| above the method's bound (the edge of
   // its stability region on the negative real axis: 6.1 for DOP853, 3.25 for DOPRI5) counts as
-  // stiff: its size is set by stability, not by accuracy. After kStiffSteps such steps, not
+  // stiff: its size is set by stability, not by accuracy. After kStiffSteps such steps (or `count`), not
   // interrupted by kNonstiffSteps others in a row, the problem is stiff; integrate() stops there
   // (as with the stop condition) and wants_switch() says so, provided at least
   // `min_steps_ahead` steps of the current size remain to t_end: a change of method costs a
@@ -34,8 +34,9 @@ class Integrator : public Stepper {
   // codes make the first test only after 1000 steps, then every 1000th until a first stiff one;
   // here every step is tested, two norms beside 12 right-hand sides, so that an expensive stiff
   // problem is recognized after a few tens of steps, and the steps ahead decide whether to act.)
-  // bound: h|λ| beyond which a step counts as stiff (0: the edge of the stability region).
-  void set_stiffness_detection(bool on, double min_steps_ahead = 0.0, double bound = 0.0);
+  // bound: h|λ| beyond which a step counts as stiff (0: the edge of the stability region);
+  // count: the stiff steps it takes (kStiffSteps, Hairer's).
+  void set_stiffness_detection(bool on, double min_steps_ahead = 0.0, double bound = 0.0, int count = kStiffSteps);
   double stiffness_estimate() const;  // h|λ| of the last accepted step (0 if not detecting)
   static double stiffness_bound(Method m);  // that bound for h|λ| (DOP853 or DOPRI5)
   static constexpr int kStiffSteps = 15, kNonstiffSteps = 6;
@@ -70,6 +71,7 @@ class Integrator : public Stepper {
   bool detect_stiffness_ = false;
   double hlamb_ = 0.0, min_steps_ahead_ = 0.0, stiff_bound_ = 0.0;
   int stiff_steps_ = 0, nonstiff_steps_ = 0;   // Hairer's IASTI and NONSTI
+  int stiff_count_ = kStiffSteps;
   // Work space, allocated once so that the step loop never touches the heap.
   std::vector<Eigen::VectorXd> k_;       // stages; k_[0] = f(t, y)
   std::vector<Eigen::VectorXd> dense_;   // coefficients of the dense-output polynomial

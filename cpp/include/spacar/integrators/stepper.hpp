@@ -234,6 +234,9 @@ struct StepperSetup {
   // 6.1). An undamped structure takes 1: a step shorter than a sixth of its fastest period is
   // set by that vibration, which generalized-α need not resolve (Simulation::integrate_block).
   double stiff_bound = 0.0;
+  // AUTO: the stiff DOP853 steps that make the problem stiff (Hairer's 15; 5 towards
+  // generalized-α, whose bound of 1 sits well under the 2–5 of a structure's DOP853 steps).
+  int stiff_count = 15;
   // AUTO returns from Radau to DOP853 only where DOP853 would be stable at this many times
   // Radau's step (LSODA's RATIO, Petzold 1983: it pays for DOP853's 12 right-hand sides per step
   // against Radau's 4 to 10 and keeps the two from alternating).
