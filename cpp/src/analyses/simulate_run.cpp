@@ -432,14 +432,14 @@ bool Simulation::auto_takes_generalized_alpha() const {
   return elastic;
 }
 
-// The motion dx of the coordinates the model moves (calculable, then dynamic), each divided by
-// (10⁻³ + |x|): generalized-α's step control of the nodal positions.
-void Simulation::scale_positions(const Eigen::VectorXd& dx, Eigen::VectorXd& scaled) const {
+// The motion dx of the coordinates the model moves (calculable, then dynamic) at the positions
+// x, each divided by (10⁻³ + |x|): generalized-α's step control of the nodal positions.
+void Simulation::scale_positions(const Eigen::VectorXd& dx, const Eigen::VectorXd& x, Eigen::VectorXd& scaled) const {
   const System& sys = *sys_;
   scaled.resize(static_cast<Eigen::Index>(sys.x_calc.size() + sys.x_dyn.size()));
   Eigen::Index k = 0;
   for (const std::vector<int>* list : {&sys.x_calc, &sys.x_dyn})
-    for (int c : *list) scaled[k++] = dx[c] / (1e-3 + std::abs(data_->x[c]));
+    for (int c : *list) scaled[k++] = dx[c] / (1e-3 + std::abs(x[c]));
 }
 
 StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_switch, int n_states) {
@@ -470,7 +470,7 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
       v.setZero(sys.n_qhat());
       for (int j = 0; j < sys.n_dof(); ++j) v[sys.dof_cols[j]] = dq[j];
       path_->transfer(sys, *data_, v, dx);
-      scale_positions(dx, scaled);
+      scale_positions(dx, data_->x, scaled);
     };
   }
   if (sparse_newton()) {
@@ -496,13 +496,18 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
     setup.newton.solve_weighted = [this](const Eigen::VectorXd& v, Eigen::VectorXd& x, Eigen::VectorXd* scaled_dx) {
       if (run_.newton_singular) {
         x = Eigen::VectorXd::Constant(v.size(), std::numeric_limits<double>::quiet_NaN());
-        if (scaled_dx) scaled_dx->setConstant(std::numeric_limits<double>::quiet_NaN());
+        if (scaled_dx) scale_positions(Eigen::VectorXd::Constant(sys_->nx, std::numeric_limits<double>::quiet_NaN()),
+                                       data_->x, *scaled_dx);
         return;
       }
       Eigen::VectorXd dx;
       run_.newton_system->solve_mass(v, x, dx);
-      // Z x from the saddle point's solution (Z at the Newton matrix's state), not another transfer.
-      if (scaled_dx) scale_positions(dx, *scaled_dx);
+      // Z x from the saddle point's solution, not another transfer: Z at the Newton matrix's
+      // state (its last refresh), which is kept only while Newton contracts by 0.1 or better, so
+      // Z has changed about as little since; the coordinates' sizes |x| at the current state, as
+      // every other scale of the estimate (at the refresh's sizes, the 64-element cantilever
+      // released from y = 0 took 821 steps at EPSINT 1e-4 instead of 420).
+      if (scaled_dx) scale_positions(dx, data_->x, *scaled_dx);
     };
   }
   setup.rho_inf = options.rho_inf;
@@ -513,8 +518,9 @@ StepperSetup Simulation::stepper_setup(const RunOptions& options, bool auto_swit
     // Generalized-α's switch costs one factorization of its Newton matrix and its steps cost
     // about 2 right-hand sides against DOP853's 12: it pays ahead of far fewer steps than Radau's.
     // Not below 500: the manual's flexible slider-crank (about 200 steps of DOP853 in its 5 s)
-    // keeps DOP853 and its published numbers; a 4-element steel cantilever over 0.2 s (about 1000
-    // stability-limited steps) goes over (3-5x faster).
+    // keeps DOP853 and its published numbers; a 4-element steel cantilever over 0.2 s (650-1000
+    // stability-limited steps) goes over (at EPSINT 1e-3: 26 -> 2.1 ms; to a tip error of 1e-6 m
+    // with EPSINT alone: 26 -> 8.6 ms).
     setup.stiff_steps_ahead = 500.0;
     // Five stiff steps, not Hairer's fifteen: a structure's DOP853 steps sit at h|λ| of 2–5 from
     // the first, and at 64 elements each DOP853 step costs 12 right-hand sides of the run's

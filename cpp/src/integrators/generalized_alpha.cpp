@@ -112,6 +112,8 @@ void GeneralizedAlpha::map_tolerances() {
 
 void GeneralizedAlpha::set_newton_system(NewtonSystem system) {
   if (nz_ != m_) throw std::invalid_argument("GeneralizedAlpha: a Newton system needs the rates as the only other states");
+  if (!system.refresh || !system.factorize || !system.solve || !system.solve_weighted)
+    throw std::invalid_argument("GeneralizedAlpha: a Newton system needs refresh, factorize, solve and solve_weighted");
   system_ = std::move(system);
 }
 void GeneralizedAlpha::set_residual(Residual residual, ResidualWeight weight) {

@@ -410,7 +410,7 @@ class Simulation {
                                const std::vector<double>& times, const Stepper::Output& output);
   // What this run offers a stepper (stepper.hpp): the shape of Y and the model's callbacks.
   StepperSetup stepper_setup(const RunOptions& options, bool auto_switch, int n_states);
-  void scale_positions(const Eigen::VectorXd& dx, Eigen::VectorXd& scaled) const;
+  void scale_positions(const Eigen::VectorXd& dx, const Eigen::VectorXd& x, Eigen::VectorXd& scaled) const;
   // Whether AUTO takes this model from DOP853 to generalized-α rather than Radau: an undamped
   // structure (some degree-of-freedom deformation has a stiffness, no element has damping) at
   // EPSINT and EPSIND of at least 1e-6, where a second-order method pays (integrate_block).
