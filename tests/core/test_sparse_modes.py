@@ -201,21 +201,31 @@ def test_nodal_linearization_pickles_with_its_dense_matrices():
         back.eigenfrequencies(k=2, method="sparse")
 
 
+def beam_line(n, ea, ei, damping=0.0, point_mass=0.0):
+    """n flexible PLBEAMs of unit mass along x from 0 to 1 (every deformation a DOF; EDAMPP 0 and
+    `damping` if given), node 1 fixed; a point mass on every other node if given."""
+    m = spacar.Model()
+    for k in range(1, n + 1):
+        m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
+        m.x(2 * k + 1, k / n, 0.0)
+        m.estiff(k, ea, ei)
+        if damping:
+            m.edampp(k, 0.0, damping)
+        m.emass(k, 1.0)
+        m.dyne(k, 1, 2, 3)
+        if point_mass and k % 2 == 0:
+            m.mass(2 * k + 1, point_mass)
+    m.fix(1)
+    return m
+
+
 def test_generalized_alpha_on_a_large_model_solves_sparse():
     """From 100 DOFs generalized-α's Newton matrix goes through the sparse saddle-point system
     (Simulation::sparse_newton): a damped cantilever of 40 PLBEAMs (120 DOFs) under gravity
     agrees with Radau5 (dense Jacobian) at a tight tolerance, and 600 PLBEAMs (1800 DOFs) run
     within a 10 MB memory limit, where the dense Jacobian alone would need 26 MB."""
     def hanging(n):
-        m = spacar.Model()
-        for k in range(1, n + 1):
-            m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
-            m.x(2 * k + 1, k / n, 0.0)
-            m.estiff(k, 1e2, 1.0)
-            m.edampp(k, 0.0, 1e-3)
-            m.emass(k, 1.0)
-            m.dyne(k, 1, 2, 3)
-        m.fix(1)
+        m = beam_line(n, 1e2, 1.0, damping=1e-3)
         m.fix(2)
         m.gravity(0.0, -1.0)
         m.timestep(10, 0.2)
@@ -252,16 +262,7 @@ def test_generalized_alpha_error_control_on_the_sparse_newton_matrix_of_a_swingi
     n = 34
 
     def swinging(eps):
-        m = spacar.Model()
-        for k in range(1, n + 1):
-            m.plbeam(k, 2 * k - 1, 2 * k, 2 * k + 1, 2 * k + 2)
-            m.x(2 * k + 1, k / n, 0.0)
-            m.estiff(k, 1e3, 2.0)
-            m.emass(k, 1.0)
-            m.dyne(k, 1, 2, 3)
-            if k % 2 == 0:
-                m.mass(2 * k + 1, 0.05)
-        m.fix(1)
+        m = beam_line(n, 1e3, 2.0, point_mass=0.05)
         m.dynx(2)
         m.gravity(0.0, -9.81)
         m.timestep(5, 0.3)
