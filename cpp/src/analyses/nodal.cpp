@@ -677,19 +677,8 @@ Eigen::VectorXd ReducedSystem::product(const Eigen::VectorXd& q, Eigen::VectorXd
 void ReducedSystem::solve_mass(const Eigen::VectorXd& v, Eigen::VectorXd& q, Eigen::VectorXd& dx) {
   // The nodal load M Z v, not load(Zᵀ M Z v): the saddle point's solution depends on its load b
   // only through Zᵀ b (the constraints' forces take the rest), which saves a transposed solve.
-  const Eigen::VectorXd dv = motion(v);
-  Eigen::VectorXd f = sys_.point_mass.cwiseProduct(dv), xe;
-  for (size_t i = 0; i < sys_.elements.size(); ++i) {
-    const SystemElement& se = sys_.elements[i];
-    if (!se.has_mass) continue;
-    const int n = static_cast<int>(se.coords.size());
-    xe.resize(n);
-    for (int j = 0; j < n; ++j) xe[j] = dv[se.coords[j]];
-    const Eigen::VectorXd fe = data_.work[i].M * xe;
-    for (int j = 0; j < n; ++j) f[se.coords[j]] += fe[j];
-  }
-  for (size_t b = 0; b < sys_.bodies.size(); ++b)
-    f.segment<4>(sys_.bodies[b].coord) += data_.body_M[b] * dv.segment<4>(sys_.bodies[b].coord);
+  Eigen::VectorXd f;
+  inertia_times(sys_, data_, motion(v), f);
   saddle_.solve(f, dx, false);
   q = dofs(dx);
 }

@@ -14,9 +14,6 @@
 
 namespace spacar {
 
-namespace {
-
-// out = M acc, element by element (point masses, element masses, rigid bodies).
 void inertia_times(const System& sys, const Data& data, const Eigen::VectorXd& acc, Eigen::VectorXd& out) {
   out = sys.point_mass.cwiseProduct(acc);
   for (size_t i = 0; i < sys.elements.size(); ++i) {
@@ -30,8 +27,6 @@ void inertia_times(const System& sys, const Data& data, const Eigen::VectorXd& a
   for (size_t b = 0; b < sys.bodies.size(); ++b)
     out.segment<4>(sys.bodies[b].coord) += data.body_M[b] * acc.segment<4>(sys.bodies[b].coord);
 }
-
-}  // namespace
 
 void constitutive_stresses(const System& sys, Data& data) {
   data.sigma.setZero();

@@ -18,6 +18,9 @@ void constitutive_stresses(const System& sys, Data& data);
 void compute_inertia_and_loads(const System& sys, Data& data);
 // inertia_residual = M ẍ + h − f (after compute_inertia_and_loads).
 void inertia_force(const System& sys, Data& data);
+// out = M acc, element by element (point masses, element masses, rigid bodies; after
+// compute_inertia_and_loads).
+void inertia_times(const System& sys, const Data& data, const Eigen::VectorXd& acc, Eigen::VectorXd& out);
 // The dense global mass matrix (full path).
 void assemble_mass_matrix(const System& sys, Data& data);
 
